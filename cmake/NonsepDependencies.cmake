@@ -1,0 +1,9 @@
+# Third-party libraries, all from Debian 12 packages (scripts/setup.sh installs them).
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)          # libeigen3-dev
+find_package(Boost 1.74 REQUIRED)                     # libboost-dev: DLL, Math quadrature, Odeint (headers)
+find_package(nlohmann_json 3.11 REQUIRED)             # nlohmann-json3-dev
+find_package(CLI11 2.1 REQUIRED)                      # libcli11-dev
+find_package(Threads REQUIRED)
+if(BUILD_TESTING OR NOT DEFINED BUILD_TESTING) # tests are on unless -DBUILD_TESTING=OFF
+  find_package(doctest 2.4 REQUIRED)                  # doctest-dev
+endif()

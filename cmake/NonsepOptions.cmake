@@ -1,0 +1,30 @@
+# Build options shared by every target of the project: language level, warnings, sanitizers,
+# and the layout of the build tree (executables in build/bin, plugins in build/plugins).
+set(CMAKE_CXX_STANDARD 20)
+set(CMAKE_CXX_STANDARD_REQUIRED ON)
+set(CMAKE_CXX_EXTENSIONS OFF)
+set(CMAKE_POSITION_INDEPENDENT_CODE ON)
+set(CMAKE_CXX_VISIBILITY_PRESET hidden)
+set(CMAKE_VISIBILITY_INLINES_HIDDEN ON)
+
+if(NOT CMAKE_BUILD_TYPE AND NOT CMAKE_CONFIGURATION_TYPES)
+  set(CMAKE_BUILD_TYPE Release CACHE STRING "Build type" FORCE)
+endif()
+
+set(CMAKE_RUNTIME_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/bin")
+set(CMAKE_ARCHIVE_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/lib")
+set(CMAKE_LIBRARY_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/lib")
+# Shipped plugins land here; the host searches this folder last (see host/plugin_search_path).
+set(NONSEP_BUILD_PLUGIN_DIR "${PROJECT_BINARY_DIR}/plugins")
+
+option(NONSEP_SANITIZE "Build everything with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)
+option(NONSEP_WARNINGS_AS_ERRORS "Treat compiler warnings as errors" OFF)
+
+add_library(nonsep_warnings INTERFACE)
+target_compile_options(nonsep_warnings INTERFACE -Wall -Wextra -Wpedantic
+  $<$<BOOL:${NONSEP_WARNINGS_AS_ERRORS}>:-Werror>)
+
+if(NONSEP_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()

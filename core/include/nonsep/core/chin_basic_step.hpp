@@ -1,0 +1,156 @@
+#pragma once
+// Chin's basic algorithm, eq. (expalg) of S. A. Chin, "Explicit symplectic integrators for solving
+// non-separable Hamiltonians":
+//
+//   T(eps) = exp(eps v2 V) exp(eps t2 T) exp(eps v1 V) exp(eps t1 T) exp(eps v0 V)
+//            exp(eps t1 T) exp(eps v1 V) exp(eps t2 T) exp(eps v2 V)
+//          = exp(eps^3 [T T V] + eps^5 E5 + ...)
+//
+// with t1 = -t2, v1 = 1/t2^2, v2 = -v1/2, v0 = -2 (v1 + v2), free t2 != 0 (default -6^(1/3), which makes
+// e_TTTTV = e_VTTTV). Splitting the separable T(p) + V(q) this way advances the non-separable
+// H_TTV = T_i V_ij T_j by dt = eps^3, so eps = cbrt(dt) (the real cube root, negative for dt < 0).
+// The flows are   exp(c eps V): p <- p - c eps grad V(q)     exp(c eps T): q <- q + c eps grad T(p).
+// Order 2/3: the global error is O(dt^(2/3)) (eq. torder).
+//
+// Form VVT interchanges T and V everywhere but keeps the coefficients (paper, after eq. torder): five drifts
+// with v2, v1, v0, v1, v2 around four kicks with t2, t1, t1, t2. It solves H_VVT = V_i T_ij V_j.
+//
+// First-same-as-last: the outer flows' gradient depends only on the variable the inner flows change (grad V
+// on q in TTV, grad T on p in VVT). The last outer gradient of a step is kept with a copy of the point it was
+// evaluated at and reused by the next step when the state still holds that point bit for bit, whatever the
+// new dt. A run of steps therefore costs 4 grad T + 4 grad V evaluations per step, plus one at the start.
+#include <cmath>
+#include <cstring>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "nonsep/core/error.hpp"
+#include "nonsep/core/integrator_description.hpp"
+#include "nonsep/core/model.hpp"
+#include "nonsep/core/phase_space_batch.hpp"
+
+namespace nonsep {
+
+// The coefficients of eq. (expalg) as functions of the free parameter t2.
+struct ChinCoefficients {
+  double t1, t2, v0, v1, v2;
+
+  static double default_t2() { return -std::cbrt(6.0); }
+  // Throws InvalidArgument when t2 is zero or not finite.
+  static ChinCoefficients from_t2(double t2) {
+    if (!std::isfinite(t2) || t2 == 0.0)
+      throw InvalidArgument("t2 must be a finite non-zero number (found " + std::to_string(t2) +
+                            "); the default is -6^(1/3) = -1.8171205928321397");
+    const double v1 = 1.0 / (t2 * t2);
+    const double v2 = -v1 / 2.0;
+    return ChinCoefficients{-t2, t2, -2.0 * (v1 + v2), v1, v2};
+  }
+};
+
+// Throws InvalidArgument unless dt is finite and non-zero.
+inline void check_step_size(double dt) {
+  if (!std::isfinite(dt) || dt == 0.0)
+    throw InvalidArgument("step size dt must be finite and non-zero (found " + std::to_string(dt) + ")");
+}
+
+template <Model M>
+void check_batch_fits(const M& model, const PhaseSpaceBatch& x) {
+  if (static_cast<std::size_t>(model.dimension()) != x.dimension())
+    throw InvalidArgument("the model has dimension " + std::to_string(model.dimension()) +
+                          " but the states have dimension " + std::to_string(x.dimension()));
+}
+
+class ChinBasicStep {
+ public:
+  explicit ChinBasicStep(HamiltonianForm form = HamiltonianForm::TTV, double t2 = ChinCoefficients::default_t2())
+      : form_(form), c_(ChinCoefficients::from_t2(t2)) {}
+
+  HamiltonianForm form() const { return form_; }
+  const ChinCoefficients& coefficients() const { return c_; }
+  const EvaluationCounts& evaluations() const { return evaluations_; }
+
+  IntegratorDescription describe() const { return {"basic", Fraction(2, 3), true, true, 1, c_.t2}; }
+
+  // Advances every state of `x` by dt (finite, non-zero). Throws InvalidArgument on a bad dt or a batch whose
+  // dimension differs from the model's; propagates the model's exceptions.
+  template <Model M>
+  void step(const M& model, PhaseSpaceBatch& x, double dt) {
+    check_step_size(dt);
+    check_batch_fits(model, x);
+    const double eps = std::cbrt(dt);
+    const bool ttv = form_ == HamiltonianForm::TTV;
+    std::span<double> outer = ttv ? x.p() : x.q();
+    std::span<double> inner = ttv ? x.q() : x.p();
+    const double outer_sign = ttv ? -1.0 : 1.0;  // TTV: outer flows are kicks (p -= ...), VVT: drifts (q += ...)
+    const double inner_sign = -outer_sign;
+    const std::size_t count = x.count();
+    inner_gradient_.resize(inner.size());
+
+    prime(model, x);
+    auto outer_flow = [&](double coefficient) {
+      const double h = outer_sign * coefficient * eps;
+      for (std::size_t i = 0; i < outer.size(); ++i) outer[i] += h * outer_gradient_[i];
+    };
+    auto inner_flow = [&](double coefficient) {
+      evaluate(model, !ttv, outer, inner_gradient_, count);  // TTV: grad T(p); VVT: grad V(q)
+      const double h = inner_sign * coefficient * eps;
+      for (std::size_t i = 0; i < inner.size(); ++i) inner[i] += h * inner_gradient_[i];
+      evaluate(model, ttv, inner, outer_gradient_, count);   // TTV: grad V(q); VVT: grad T(p)
+    };
+    outer_flow(c_.v2);
+    inner_flow(c_.t2);
+    outer_flow(c_.v1);
+    inner_flow(c_.t1);
+    outer_flow(c_.v0);
+    inner_flow(c_.t1);
+    outer_flow(c_.v1);
+    inner_flow(c_.t2);
+    outer_flow(c_.v2);
+    cached_at_.assign(inner.begin(), inner.end());
+  }
+
+  // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached).
+  template <Model M>
+  void prime(const M& model, const PhaseSpaceBatch& x) {
+    const bool ttv = form_ == HamiltonianForm::TTV;
+    std::span<const double> inner = ttv ? x.q() : x.p();
+    const bool cached = cached_at_.size() == inner.size() &&
+                        std::memcmp(cached_at_.data(), inner.data(), inner.size() * sizeof(double)) == 0;
+    if (cached) return;
+    outer_gradient_.resize(inner.size());
+    evaluate(model, ttv, inner, outer_gradient_, x.count());
+    cached_at_.assign(inner.begin(), inner.end());
+  }
+
+  // The first-same-as-last gradient and the point it belongs to, for wrappers that restart from a saved state
+  // (MultiProductExpansion).
+  struct Cache {
+    std::vector<double> at, gradient;
+  };
+  Cache save_cache() const { return {cached_at_, outer_gradient_}; }
+  void restore_cache(const Cache& cache) {
+    cached_at_ = cache.at;
+    outer_gradient_ = cache.gradient;
+  }
+
+ private:
+  template <Model M>
+  void evaluate(const M& model, bool potential, std::span<const double> at, std::span<double> out,
+                std::size_t count) {
+    if (potential) {
+      model.grad_V(at, out, count);
+      evaluations_.grad_V += count;
+    } else {
+      model.grad_T(at, out, count);
+      evaluations_.grad_T += count;
+    }
+  }
+
+  HamiltonianForm form_;
+  ChinCoefficients c_;
+  EvaluationCounts evaluations_;
+  std::vector<double> outer_gradient_, inner_gradient_, cached_at_;
+};
+
+}  // namespace nonsep

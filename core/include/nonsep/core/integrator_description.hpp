@@ -1,0 +1,53 @@
+#pragma once
+// Integrators describe themselves. A SchemeDescription is the static catalogue entry of a method family
+// (what the JSON reader accepts and what `--help` prints); an IntegratorDescription describes one configured
+// instance (what a run reports in its summary).
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "nonsep/core/fraction.hpp"
+
+namespace nonsep {
+
+struct ParameterDescription {
+  enum class Kind { Number, Order };
+  std::string name;
+  Kind kind = Kind::Number;
+  // Default as it would be written in a job file ("-1.8171205928321397", "2/3"). Empty: required.
+  std::string default_text;
+  std::string description;
+};
+
+struct SchemeDescription {
+  std::string name;        // the job file's integrator.scheme: "basic", "triplet", "mpe"
+  std::string method;      // human name: "Chin basic 9-stage splitting"
+  std::string equations;   // where in the paper: "eq. (expalg)"
+  std::string summary;     // one paragraph
+  bool symplectic = true;
+  bool time_reversible = true;
+  std::vector<ParameterDescription> parameters;
+};
+
+struct IntegratorDescription {
+  std::string scheme;
+  Fraction order;
+  bool symplectic = true;
+  bool time_reversible = true;
+  std::uint64_t basic_steps_per_step = 1;
+  double t2 = 0.0;
+};
+
+// Every scheme the core provides, in a fixed order.
+std::span<const SchemeDescription> scheme_catalogue();
+// The catalogue entry named `name`, or nothing.
+std::optional<SchemeDescription> find_scheme(const std::string& name);
+
+// Orders of the paper's family are 2j/3, j = 1, 2, 3, ... (2/3, 4/3, 2, 8/3, 10/3, 4, ...).
+// Returns j for a valid order; throws InvalidArgument naming the order and listing the valid ones otherwise,
+// or if j exceeds `max_j` (the practical limit of a scheme, named in the message as `what`).
+int chin_order_index(const Fraction& order, int max_j, const std::string& what);
+
+}  // namespace nonsep

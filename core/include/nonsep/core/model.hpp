@@ -1,0 +1,61 @@
+#pragma once
+// The model interface of the core: what an integrator needs to know about T(p) and V(q).
+//
+// Batch layout (used everywhere in nonsep, including the plugin ABI): a batch holds `count` states of
+// dimension n, stored state-major and contiguous. Component i of state b is at index b*n + i, so each
+// state's n numbers are adjacent. A gradient batch has the same layout as its input. A Hessian batch holds
+// count row-major n x n matrices: entry (i, j) of state b is at index b*n*n + i*n + j.
+//
+// A type M models nonsep::Model when, for `const M m`, spans `x` (size count*n, read) and `out` (size count*n,
+// written):
+//   m.dimension()               -> std::size_t, the number of degrees of freedom n (> 0)
+//   m.grad_T(x, out, count)     writes dT/dp_i evaluated at each of the count momenta in x
+//   m.grad_V(x, out, count)     writes dV/dq_i evaluated at each of the count positions in x
+// and nonsep::ModelWithHessians when moreover (out of size count*n*n):
+//   m.hessian_T(x, out, count)  writes d2T/dp_i dp_j
+//   m.hessian_V(x, out, count)  writes d2V/dq_i dq_j
+// Hessians are needed only for the energy of the solved Hamiltonian, never for stepping.
+//
+// Evaluations may throw nonsep::ModelError (or anything else); integrators let it propagate and leave the
+// state they were stepping unspecified but valid.
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+namespace nonsep {
+
+template <class M>
+concept Model = requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
+  { m.dimension() } -> std::convertible_to<std::size_t>;
+  m.grad_T(x, out, count);
+  m.grad_V(x, out, count);
+};
+
+template <class M>
+concept ModelWithHessians =
+    Model<M> && requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
+      m.hessian_T(x, out, count);
+      m.hessian_V(x, out, count);
+    };
+
+// Gradient evaluations performed by an integrator, counted per state: one batched call on `count` states
+// counts `count` evaluations.
+struct EvaluationCounts {
+  std::uint64_t grad_T = 0;
+  std::uint64_t grad_V = 0;
+
+  EvaluationCounts& operator+=(const EvaluationCounts& other) {
+    grad_T += other.grad_T;
+    grad_V += other.grad_V;
+    return *this;
+  }
+  friend bool operator==(const EvaluationCounts&, const EvaluationCounts&) = default;
+};
+
+// Which non-separable Hamiltonian the 9-stage splitting of T(p) + V(q) solves (paper, section III):
+//   TTV: H = T_i(p) V_ij(q) T_j(p)   (kicks with grad V, drifts with grad T)
+//   VVT: H = V_i(q) T_ij(p) V_j(q)   (roles of T and V interchanged, coefficients kept)
+enum class HamiltonianForm { TTV, VVT };
+
+}  // namespace nonsep

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs what nonsep needs from Debian 12 packages (as root; quick when everything is already there),
+# then configures and builds the project in ./build with 2 parallel jobs.
+# Usage: bash scripts/setup.sh [extra cmake -D options...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  ca-certificates cmake g++ make pkg-config
+  libeigen3-dev libboost-dev nlohmann-json3-dev doctest-dev libcli11-dev
+  python3 python3-jsonschema python3-matplotlib python3-numpy
+)
+missing=()
+for package in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+cmake --build build -j2

@@ -1,0 +1,20 @@
+#pragma once
+// An independent reference: Hamilton's equations of a full Hamiltonian H(q, p) integrated by Boost.Odeint's
+// controlled Runge-Kutta-Fehlberg 7(8) at tight tolerance. Used where no closed-form solution exists.
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <vector>
+
+namespace nonsep::testing {
+
+// `rhs(x, dxdt)` writes (dH/dp, -dH/dq) for x = (q..., p...). Returns x at t_end.
+template <class Rhs>
+std::vector<double> reference_flow(Rhs rhs, std::vector<double> x, double t_end, double tolerance = 1e-14) {
+  namespace odeint = boost::numeric::odeint;
+  auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<std::vector<double>>());
+  odeint::integrate_adaptive(stepper, [&](const std::vector<double>& s, std::vector<double>& d, double) { rhs(s, d); },
+                             x, 0.0, t_end, t_end / 1000);
+  return x;
+}
+
+}  // namespace nonsep::testing

@@ -1,0 +1,102 @@
+// Measured orders of convergence on the paper's 1D test (eq. h1d) against its exact solution.
+// The reference point is exact: from (q0, 0) the orbit reaches (0, p_quarter) after the quarter period and
+// returns to (q0, 0) after four, both computed by quadrature of the conserved energy (support/paper1d_exact.hpp).
+// Each case halves dt over a range chosen inside the asymptotic regime (found by printing the local slopes
+// log2(e(dt)/e(dt/2)) from dt = T/4 down to round-off) and fits the slope of log(phase error) vs log(dt).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "nonsep/core.hpp"
+#include "support/convergence.hpp"
+#include "support/models.hpp"
+#include "support/paper1d_exact.hpp"
+#include "support/reference_flow.hpp"
+
+using namespace nonsep;
+using nonsep::testing::Paper1D;
+
+namespace {
+
+struct Study {
+  const char* scheme;
+  Fraction order;
+  double t2;
+  double q0;
+  int quarters;     // integrate to quarters * (quarter period); 1 or 4
+  int first_steps;  // steps over that time at the largest dt; each further dt halves the step
+  int halvings;
+};
+
+double measured_order(const Study& study) {
+  const auto exact = nonsep::testing::paper1d_quarter(study.q0);
+  const double t_end = exact.period * study.quarters;
+  const double q_exact = study.quarters == 4 ? study.q0 : 0.0;
+  const double p_exact = study.quarters == 4 ? 0.0 : exact.p_final;
+  std::vector<double> dts, errors;
+  for (int h = 0, steps = study.first_steps; h <= study.halvings; ++h, steps *= 2) {
+    Integrator integrator(IntegratorSpec{study.scheme, study.order, study.t2});
+    const double q[] = {study.q0}, p[] = {0.0};
+    auto x = PhaseSpaceBatch::single(q, p);
+    const double dt = t_end / steps;
+    for (int s = 0; s < steps; ++s) integrator.step(Paper1D{}, x, dt);
+    dts.push_back(dt);
+    errors.push_back(std::hypot(x.q()[0] - q_exact, x.p()[0] - p_exact));
+  }
+  const double n = nonsep::testing::fitted_exponent(dts, errors);
+  MESSAGE(std::string(study.scheme) << " " << study.order.to_string() << ": fitted exponent " << n << " for dt from "
+                       << dts.front() << " to " << dts.back() << ", errors " << errors.front() << " to "
+                       << errors.back());
+  return n;
+}
+
+const double default_t2 = ChinCoefficients::default_t2();
+
+}  // namespace
+
+TEST_CASE("exact quarter period of the paper's 1D test by quadrature") {
+  const auto exact = nonsep::testing::paper1d_quarter(2.0);
+  // The paper prints T_1/4 = 0.385841 and p = -1.569196; the quadrature of the conserved energy gives
+  // 0.38637655733612... and -sqrt(2 (sqrt(5) - 1)) = -1.5723027555148... (see README, "Exact references").
+  CHECK(exact.energy == 5.0);
+  CHECK(exact.period == doctest::Approx(0.3863765573361232).epsilon(1e-14));
+  CHECK(exact.p_final == doctest::Approx(-1.572302755514847).epsilon(1e-15));
+  // Independent check of the quadrature: Hamilton's equations of H integrated by Runge-Kutta-Fehlberg 7(8)
+  // for one quarter period end on the q = 0 axis at the exact p.
+  auto rhs = [](const std::vector<double>& s, std::vector<double>& d) {
+    const double q = s[0], p = s[1], u = 1.0 + 0.5 * p * p;
+    d[0] = 2.0 * u * p * (1.0 + q * q);
+    d[1] = -2.0 * u * u * q;
+  };
+  const auto end = nonsep::testing::reference_flow(rhs, {2.0, 0.0}, exact.period);
+  CHECK(std::abs(end[0]) < 1e-11);
+  CHECK(std::abs(end[1] - exact.p_final) < 1e-11);
+}
+
+TEST_CASE("basic step converges with order 2/3") {
+  // Local slopes are 0.660 .. 0.666 for dt = T/1024 .. T/16384.
+  CHECK(std::abs(measured_order({"basic", Fraction(2, 3), default_t2, 2.0, 1, 1024, 4}) - 2.0 / 3) < 0.1);
+}
+
+TEST_CASE("triplet composition converges with orders 4/3, 2 and 8/3") {
+  // 4/3: slopes 1.333 for dt = T/1024 .. T/8192.
+  CHECK(std::abs(measured_order({"triplet", Fraction(4, 3), default_t2, 2.0, 1, 1024, 3}) - 4.0 / 3) < 0.1);
+  // 2: an error cancellation near dt = T/256 (the error changes sign); asymptotic from T/8192 (slopes 1.89 .. 1.98).
+  CHECK(std::abs(measured_order({"triplet", Fraction(2), default_t2, 2.0, 1, 8192, 3}) - 2.0) < 0.1);
+  // 8/3: slopes 2.64 .. 2.66 for dt = T/2048 .. T/16384.
+  CHECK(std::abs(measured_order({"triplet", Fraction(8, 3), default_t2, 2.0, 1, 2048, 3}) - 8.0 / 3) < 0.1);
+}
+
+TEST_CASE("multi-product expansion converges with orders 4/3, 2, 8/3 and 4") {
+  // 4/3: slopes 1.333 for dt = T/1024 .. T/8192.
+  CHECK(std::abs(measured_order({"mpe", Fraction(4, 3), default_t2, 2.0, 1, 1024, 3}) - 4.0 / 3) < 0.1);
+  // 2: slopes 1.96 .. 1.99 for dt = T/4096 .. T/32768.
+  CHECK(std::abs(measured_order({"mpe", Fraction(2), default_t2, 2.0, 1, 4096, 3}) - 2.0) < 0.1);
+  // 8/3: slopes 2.65 .. 2.67 for dt = T/256 .. T/2048 (round-off takes over below 1e-11).
+  CHECK(std::abs(measured_order({"mpe", Fraction(8, 3), default_t2, 2.0, 1, 256, 3}) - 8.0 / 3) < 0.1);
+  // 4 (six terms): the next error term is only dt^(2/3) smaller, so the slope approaches 4 from above slowly and
+  // the weights (|c_i| up to 645) bring round-off to ~1e-11 early. With t2 = -1.2 that next term is small: over
+  // one full period from q0 = 2 the slopes are 4.11, 4.05, 4.00 for dt = 4T/512 .. 4T/2048.
+  CHECK(std::abs(measured_order({"mpe", Fraction(4), -1.2, 2.0, 4, 512, 2}) - 4.0) < 0.1);
+}

@@ -1,0 +1,106 @@
+// Bad parameters are rejected with messages that name the problem and what is allowed.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "nonsep/core.hpp"
+#include "support/models.hpp"
+
+using namespace nonsep;
+
+namespace {
+template <class F>
+std::string error_of(F f) {
+  try {
+    f();
+  } catch (const InvalidArgument& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+}  // namespace
+
+TEST_CASE("t2 = 0 and non-finite t2 are rejected") {
+  CHECK(contains(error_of([] { ChinBasicStep(HamiltonianForm::TTV, 0.0); }), "t2 must be a finite non-zero number"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(4, 3), std::nan("")}); }), "t2"));
+}
+
+TEST_CASE("non-finite or zero dt is rejected before anything moves") {
+  ChinBasicStep basic;
+  const double q[] = {1.0}, p[] = {0.0};
+  auto x = PhaseSpaceBatch::single(q, p);
+  const auto before = x;
+  for (double dt : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 0.0}) {
+    CAPTURE(dt);
+    CHECK(contains(error_of([&] { basic.step(nonsep::testing::Paper1D{}, x, dt); }), "step size dt must be finite"));
+    CHECK(x == before);
+  }
+  Integrator mpe(IntegratorSpec{"mpe", Fraction(2)});
+  CHECK(contains(error_of([&] { mpe.step(nonsep::testing::Paper1D{}, x, -std::numeric_limits<double>::infinity()); }),
+                 "dt"));
+}
+
+TEST_CASE("orders that do not exist are rejected with the list of those that do") {
+  const auto message = error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(1)}); });
+  CHECK(contains(message, "order 1 does not exist for triplet"));
+  CHECK(contains(message, "2/3, 4/3, 2, 8/3, 10/3, 4"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(5, 3)}); }), "order 5/3 does not exist for mpe"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(-2, 3)}); }), "does not exist"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"basic", Fraction(4, 3)}); }),
+                 "beyond the highest order of basic, 2/3"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(40)}); }), "beyond the highest order of mpe"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"leapfrog"}); }), "unknown integrator scheme 'leapfrog'"));
+  // Every valid order up to the limits is accepted and reported back exactly.
+  for (int j = 1; j <= 8; ++j) {
+    CHECK(Integrator(IntegratorSpec{"triplet", Fraction(2 * j, 3)}).describe().order == Fraction(2 * j, 3));
+    CHECK(Integrator(IntegratorSpec{"mpe", Fraction(2 * j, 3)}).describe().order == Fraction(2 * j, 3));
+  }
+}
+
+TEST_CASE("exact fractions parse strictly") {
+  CHECK(Fraction::parse("4/3") == Fraction(4, 3));
+  CHECK(Fraction::parse(" 8 / 3 ") == Fraction(8, 3));
+  CHECK(Fraction::parse("6/3") == Fraction(2));
+  CHECK(Fraction::parse("2").to_string() == "2");
+  CHECK(Fraction(10, 3).to_string() == "10/3");
+  for (const char* bad : {"", "4/", "/3", "1.5", "4/0", "four", "4/3/2", "4//3"}) {
+    CAPTURE(bad);
+    CHECK(contains(error_of([&] { Fraction::parse(bad); }), "is not an exact fraction"));
+  }
+  // A batch whose dimension differs from the model's is refused.
+  PhaseSpaceBatch wrong(2, 1);
+  ChinBasicStep basic;
+  CHECK(contains(error_of([&] { basic.step(nonsep::testing::Paper1D{}, wrong, 0.1); }),
+                 "the model has dimension 1 but the states have dimension 2"));
+}
+
+TEST_CASE("integrators describe themselves") {
+  const auto basic = Integrator(IntegratorSpec{"basic"}).describe();
+  CHECK(basic.order.to_string() == "2/3");
+  CHECK(basic.symplectic);
+  CHECK(basic.time_reversible);
+  CHECK(basic.basic_steps_per_step == 1);
+  const auto triplet = Integrator(IntegratorSpec{"triplet", Fraction(8, 3), -2.0}).describe();
+  CHECK(triplet.scheme == "triplet");
+  CHECK(triplet.basic_steps_per_step == 27);
+  CHECK(triplet.t2 == -2.0);
+  const auto mpe = Integrator(IntegratorSpec{"mpe", Fraction(4)}).describe();
+  CHECK_FALSE(mpe.symplectic);
+  CHECK_FALSE(mpe.time_reversible);
+  CHECK(mpe.basic_steps_per_step == 21);
+  // The catalogue lists every scheme with its parameters and defaults, for the host's reader and help text.
+  REQUIRE(scheme_catalogue().size() == 3);
+  for (const auto& scheme : scheme_catalogue()) {
+    CAPTURE(scheme.name);
+    CHECK(!scheme.summary.empty());
+    CHECK(!scheme.equations.empty());
+    REQUIRE(scheme.parameters.size() == 2);
+    CHECK(scheme.parameters[1].name == "t2");
+    CHECK(std::stod(scheme.parameters[1].default_text) == ChinCoefficients::default_t2());
+  }
+  CHECK_FALSE(find_scheme("mpe")->symplectic);
+  CHECK_FALSE(find_scheme("rk4").has_value());
+}

@@ -1,0 +1,232 @@
+// Structural properties of the integrators: time reversibility, symplecticity (one-step Jacobian), batch
+// consistency, first-same-as-last evaluation counts, energy, and the VVT form against an independent reference.
+#include <doctest/doctest.h>
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "nonsep/core.hpp"
+#include "support/convergence.hpp"
+#include "support/models.hpp"
+#include "support/reference_flow.hpp"
+
+using namespace nonsep;
+using nonsep::testing::Coupled2D;
+using nonsep::testing::Paper1D;
+
+namespace {
+
+PhaseSpaceBatch state(std::vector<double> q, std::vector<double> p) { return PhaseSpaceBatch::single(q, p); }
+
+double max_difference(const PhaseSpaceBatch& a, const PhaseSpaceBatch& b) {
+  double d = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    d = std::max({d, std::abs(a.q()[i] - b.q()[i]), std::abs(a.p()[i] - b.p()[i])});
+  return d;
+}
+
+// One-step Jacobian d(q', p')/d(q, p) by central differences, and max |J^T Omega J - Omega|.
+template <class M>
+double symplecticity_defect(const M& model, const IntegratorSpec& spec, const PhaseSpaceBatch& x0, double dt) {
+  const std::size_t n = x0.dimension(), N = 2 * n;
+  const double h = 1e-6;
+  std::vector<double> J(N * N);
+  for (std::size_t k = 0; k < N; ++k) {
+    std::array<PhaseSpaceBatch, 2> ends{x0, x0};
+    for (int side = 0; side < 2; ++side) {
+      auto& x = ends[side];
+      (k < n ? x.q()[k] : x.p()[k - n]) += side == 0 ? h : -h;
+      Integrator(spec).step(model, x, dt);
+    }
+    for (std::size_t i = 0; i < N; ++i) {
+      const double plus = i < n ? ends[0].q()[i] : ends[0].p()[i - n];
+      const double minus = i < n ? ends[1].q()[i] : ends[1].p()[i - n];
+      J[i * N + k] = (plus - minus) / (2 * h);
+    }
+  }
+  // Omega = [[0, I], [-I, 0]]; (J^T Omega J)_{ab} = sum_i J_{i a} J_{i+n, b} - J_{i+n, a} J_{i b}.
+  double defect = 0;
+  for (std::size_t a = 0; a < N; ++a)
+    for (std::size_t b = 0; b < N; ++b) {
+      double value = 0;
+      for (std::size_t i = 0; i < n; ++i) value += J[i * N + a] * J[(i + n) * N + b] - J[(i + n) * N + a] * J[i * N + b];
+      const double omega = (a < n && b == a + n) ? 1.0 : (a >= n && b + n == a) ? -1.0 : 0.0;
+      defect = std::max(defect, std::abs(value - omega));
+    }
+  return defect;
+}
+
+const std::array<HamiltonianForm, 2> forms{HamiltonianForm::TTV, HamiltonianForm::VVT};
+const double t2_default = ChinCoefficients::default_t2();
+
+}  // namespace
+
+TEST_CASE("the coefficients of eq. (expalg)") {
+  const auto c = ChinCoefficients::from_t2(-2.0);
+  CHECK(c.t1 == 2.0);
+  CHECK(c.v1 == 0.25);
+  CHECK(c.v2 == -0.125);
+  CHECK(c.v0 == -0.25);
+  // e_T = e_V = 0 (eq. tvzero): the drifts and the kicks each sum to zero.
+  CHECK(2 * c.t1 + 2 * c.t2 == 0.0);
+  CHECK(c.v0 + 2 * c.v1 + 2 * c.v2 == 0.0);
+  CHECK(ChinCoefficients::default_t2() == doctest::Approx(-1.8171205928321397));
+}
+
+TEST_CASE("a step of dt followed by one of -dt returns to the start (basic and triplet, both forms)") {
+  for (const char* scheme : {"basic", "triplet"})
+    for (const Fraction order : {Fraction(2, 3), Fraction(4, 3), Fraction(2)})
+      for (const auto form : forms) {
+        if (std::string(scheme) == "basic" && order != Fraction(2, 3)) continue;
+        CAPTURE(scheme);
+        CAPTURE(order.to_string());
+        CAPTURE(static_cast<int>(form));
+        Integrator integrator(IntegratorSpec{scheme, order, t2_default, form});
+        const auto start1 = state({1.3}, {0.4});
+        auto x1 = start1;
+        integrator.step(Paper1D{}, x1, 0.01);
+        CHECK(max_difference(x1, start1) > 1e-4);  // it did move
+        integrator.step(Paper1D{}, x1, -0.01);
+        CHECK(max_difference(x1, start1) < 1e-12);
+        const auto start2 = state({0.7, -0.3}, {0.2, 0.5});
+        auto x2 = start2;
+        integrator.step(Coupled2D{}, x2, 0.02);
+        integrator.step(Coupled2D{}, x2, -0.02);
+        CHECK(max_difference(x2, start2) < 1e-12);
+      }
+}
+
+TEST_CASE("the one-step map is symplectic for basic and triplet, and MPE is not") {
+  for (const auto form : forms) {
+    CAPTURE(static_cast<int>(form));
+    for (const Fraction order : {Fraction(2, 3), Fraction(4, 3), Fraction(2)}) {
+      CAPTURE(order.to_string());
+      const IntegratorSpec triplet{"triplet", order, t2_default, form};
+      CHECK(symplecticity_defect(Paper1D{}, triplet, state({1.2}, {0.5}), 0.05) < 1e-8);
+      CHECK(symplecticity_defect(Coupled2D{}, triplet, state({0.6, -0.4}, {0.3, 0.2}), 0.05) < 1e-8);
+    }
+    const IntegratorSpec basic{"basic", Fraction(2, 3), -2.5, form};
+    CHECK(symplecticity_defect(Coupled2D{}, basic, state({0.6, -0.4}, {0.3, 0.2}), 0.1) < 1e-8);
+    // The same measurement on MPE finds a defect far above the finite-difference noise (~1e-10) and the 1e-8 tolerance.
+    const IntegratorSpec mpe{"mpe", Fraction(4, 3), t2_default, form};
+    CHECK(symplecticity_defect(Paper1D{}, mpe, state({1.2}, {0.5}), 0.1) > 1e-6);
+    CHECK(symplecticity_defect(Coupled2D{}, mpe, state({0.6, -0.4}, {0.3, 0.2}), 0.1) > 1e-6);
+  }
+}
+
+TEST_CASE("stepping a batch equals stepping each state alone, bit for bit") {
+  for (const char* scheme : {"basic", "triplet", "mpe"}) {
+    CAPTURE(scheme);
+    const IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
+    PhaseSpaceBatch batch(2, 3);
+    const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};
+    std::copy(std::begin(qs), std::end(qs), batch.q().begin());
+    std::copy(std::begin(ps), std::end(ps), batch.p().begin());
+    Integrator together(spec);
+    for (int s = 0; s < 10; ++s) together.step(Coupled2D{}, batch, 0.01);
+    for (std::size_t b = 0; b < 3; ++b) {
+      auto x = state({qs[2 * b], qs[2 * b + 1]}, {ps[2 * b], ps[2 * b + 1]});
+      Integrator alone(spec);
+      for (int s = 0; s < 10; ++s) alone.step(Coupled2D{}, x, 0.01);
+      CHECK(x.q()[0] == batch.q(b)[0]);
+      CHECK(x.q()[1] == batch.q(b)[1]);
+      CHECK(x.p()[0] == batch.p(b)[0]);
+      CHECK(x.p()[1] == batch.p(b)[1]);
+    }
+  }
+}
+
+TEST_CASE("first-same-as-last: 4 grad T + 4 grad V per basic step, plus one at the start") {
+  for (const auto form : forms) {
+    CAPTURE(static_cast<int>(form));
+    const bool ttv = form == HamiltonianForm::TTV;
+    ChinBasicStep basic(form);
+    auto x = state({1.0}, {0.2});
+    // Steps of different sizes, including a negative one: the cached gradient depends on the point, not on dt.
+    const double dts[] = {0.01, 0.02, -0.005, 0.013, 0.01};
+    for (double dt : dts) basic.step(Paper1D{}, x, dt);
+    const std::uint64_t outer = 4 * 5 + 1, inner = 4 * 5;
+    CHECK(basic.evaluations().grad_V == (ttv ? outer : inner));
+    CHECK(basic.evaluations().grad_T == (ttv ? inner : outer));
+
+    // A state changed from outside invalidates the cached gradient: one more evaluation, never a stale one.
+    x.q()[0] += 0.1;
+    x.p()[0] += 0.1;
+    basic.step(Paper1D{}, x, 0.01);
+    CHECK(basic.evaluations().grad_V + basic.evaluations().grad_T == 2 * 4 * 6 + 2);
+  }
+  // Triplet of order 2 (9 basic steps per step) on a batch of 3 states: counts are per state.
+  TripletComposition<> triplet(ChinBasicStep(), 2);
+  PhaseSpaceBatch batch(1, 3);
+  batch.q()[0] = 0.5, batch.q()[1] = 1.0, batch.q()[2] = 1.5;
+  for (int s = 0; s < 7; ++s) triplet.step(Paper1D{}, batch, 0.01);
+  CHECK(triplet.describe().basic_steps_per_step == 9);
+  CHECK(triplet.evaluations().grad_T == 3 * 4 * 9 * 7);
+  CHECK(triplet.evaluations().grad_V == 3 * (4 * 9 * 7 + 1));
+  // MPE with m = 3 terms runs 1 + 2 + 3 basic steps per step from one shared starting gradient; the combined
+  // point is new, so each step evaluates one starting gradient.
+  MultiProductExpansion<> mpe(ChinBasicStep(), 3);
+  auto y = state({1.0}, {0.0});
+  for (int s = 0; s < 5; ++s) mpe.step(Paper1D{}, y, 0.01);
+  CHECK(mpe.describe().basic_steps_per_step == 6);
+  CHECK(mpe.evaluations().grad_T == 4 * 6 * 5);
+  CHECK(mpe.evaluations().grad_V == (4 * 6 + 1) * 5);
+}
+
+TEST_CASE("the MPE weights of eqs. (mpe43) and (mpe63)") {
+  const double n = 2.0 / 3.0, a = 1, b = std::pow(2.0, n), c = std::pow(3.0, n);
+  const auto w2 = MultiProductExpansion<>::weights_for(2);
+  CHECK(w2[0] == doctest::Approx(a / (a - b)));
+  CHECK(w2[1] == doctest::Approx(b / (b - a)));
+  const auto w3 = MultiProductExpansion<>::weights_for(3);
+  CHECK(w3[0] == doctest::Approx(a * a / ((a - b) * (a - c))));
+  CHECK(w3[1] == doctest::Approx(b * b / ((b - a) * (b - c))));
+  CHECK(w3[2] == doctest::Approx(c * c / ((c - a) * (c - b))));
+  for (int m = 1; m <= 8; ++m) {
+    double sum = 0;
+    for (double w : MultiProductExpansion<>::weights_for(m)) sum += w;
+    CHECK(sum == doctest::Approx(1.0).epsilon(1e-10));
+  }
+}
+
+TEST_CASE("energy of the solved Hamiltonian in both forms") {
+  const auto x = state({1.3}, {-0.7});
+  EnergyEvaluator ttv(HamiltonianForm::TTV), vvt(HamiltonianForm::VVT);
+  CHECK(ttv.evaluate_one(Paper1D{}, x) == doctest::Approx(Paper1D::H_TTV(1.3, -0.7)).epsilon(1e-15));
+  CHECK(vvt.evaluate_one(Paper1D{}, x) == doctest::Approx(Paper1D::H_VVT(1.3, -0.7)).epsilon(1e-15));
+  // In 2D the energy is the quadratic form grad T . Hess V grad T, checked here against a hand computation.
+  const auto y = state({0.5, -0.2}, {0.3, 0.1});
+  std::array<double, 2> g{};
+  std::array<double, 4> h{};
+  Coupled2D{}.grad_T(y.p(), g, 1);
+  Coupled2D{}.hessian_V(y.q(), h, 1);
+  const double expected = g[0] * (h[0] * g[0] + h[1] * g[1]) + g[1] * (h[2] * g[0] + h[3] * g[1]);
+  CHECK(ttv.evaluate_one(Coupled2D{}, y) == doctest::Approx(expected).epsilon(1e-15));
+}
+
+TEST_CASE("the VVT form converges to the exact flow of H_VVT = (q + q^3/3)^2 p") {
+  // Paper1D in VVT form solves H_VVT = V'(q)^2 T''(p) = (q + q^3/3)^2 p. Reference: Hamilton's equations
+  // dq/dt = (q + q^3/3)^2, dp/dt = -2 (q + q^3/3)(1 + q^2) p integrated by Runge-Kutta-Fehlberg 7(8).
+  auto rhs = [](const std::vector<double>& s, std::vector<double>& d) {
+    const double q = s[0], p = s[1], w = q + q * q * q / 3.0;
+    d[0] = w * w;
+    d[1] = -2.0 * w * (1.0 + q * q) * p;
+  };
+  const double t_end = 0.5;
+  const auto reference = nonsep::testing::reference_flow(rhs, {0.5, 0.5}, t_end);
+  for (const auto& [order, expected, first] : {std::tuple{Fraction(2, 3), 2.0 / 3, 512}, std::tuple{Fraction(4, 3), 4.0 / 3, 256}}) {
+    CAPTURE(order.to_string());
+    std::vector<double> dts, errors;
+    for (int steps = first; steps <= 8 * first; steps *= 2) {
+      Integrator integrator(IntegratorSpec{"triplet", order, t2_default, HamiltonianForm::VVT});
+      auto x = state({0.5}, {0.5});
+      for (int s = 0; s < steps; ++s) integrator.step(Paper1D{}, x, t_end / steps);
+      dts.push_back(t_end / steps);
+      errors.push_back(std::hypot(x.q()[0] - reference[0], x.p()[0] - reference[1]));
+    }
+    MESSAGE("VVT " << order.to_string() << ": error " << errors.back() << " at dt " << dts.back());
+    CHECK(errors.back() < errors.front());
+    CHECK(std::abs(nonsep::testing::fitted_exponent(dts, errors) - expected) < 0.1);
+  }
+}
