@@ -1,6 +1,6 @@
 // Measured orders of convergence on the paper's 1D test (eq. h1d) against its exact solution.
 // The reference point is exact: from (q0, 0) the orbit reaches (0, p_quarter) after the quarter period and
-// returns to (q0, 0) after four, both computed by quadrature of the conserved energy (support/paper1d_exact.hpp).
+// returns to (q0, 0) after four, both computed by quadrature of the conserved energy (nonsep/reference/paper1d_exact.hpp).
 // Each case halves dt over a range chosen inside the asymptotic regime (found by printing the local slopes
 // log2(e(dt)/e(dt/2)) from dt = T/4 down to round-off) and fits the slope of log(phase error) vs log(dt).
 #include <doctest/doctest.h>
@@ -11,8 +11,8 @@
 #include "nonsep/core.hpp"
 #include "support/convergence.hpp"
 #include "support/models.hpp"
-#include "support/paper1d_exact.hpp"
-#include "support/reference_flow.hpp"
+#include "nonsep/reference/paper1d_exact.hpp"
+#include "nonsep/reference/hamiltonian_flow.hpp"
 
 using namespace nonsep;
 using nonsep::testing::Paper1D;
@@ -30,7 +30,7 @@ struct Study {
 };
 
 double measured_order(const Study& study) {
-  const auto exact = nonsep::testing::paper1d_quarter(study.q0);
+  const auto exact = nonsep::reference::paper1d_quarter(study.q0);
   const double t_end = exact.period * study.quarters;
   const double q_exact = study.quarters == 4 ? study.q0 : 0.0;
   const double p_exact = study.quarters == 4 ? 0.0 : exact.p_final;
@@ -56,7 +56,7 @@ const double default_t2 = ChinCoefficients::default_t2();
 }  // namespace
 
 TEST_CASE("exact quarter period of the paper's 1D test by quadrature") {
-  const auto exact = nonsep::testing::paper1d_quarter(2.0);
+  const auto exact = nonsep::reference::paper1d_quarter(2.0);
   // The paper prints T_1/4 = 0.385841 and p = -1.569196; the quadrature of the conserved energy gives
   // 0.38637655733612... and -sqrt(2 (sqrt(5) - 1)) = -1.5723027555148... (see README, "Exact references").
   CHECK(exact.energy == 5.0);
@@ -69,7 +69,7 @@ TEST_CASE("exact quarter period of the paper's 1D test by quadrature") {
     d[0] = 2.0 * u * p * (1.0 + q * q);
     d[1] = -2.0 * u * u * q;
   };
-  const auto end = nonsep::testing::reference_flow(rhs, {2.0, 0.0}, exact.period);
+  const auto end = nonsep::reference::hamiltonian_flow(rhs, {2.0, 0.0}, exact.period);
   CHECK(std::abs(end[0]) < 1e-11);
   CHECK(std::abs(end[1] - exact.p_final) < 1e-11);
 }

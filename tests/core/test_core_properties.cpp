@@ -9,7 +9,7 @@
 #include "nonsep/core.hpp"
 #include "support/convergence.hpp"
 #include "support/models.hpp"
-#include "support/reference_flow.hpp"
+#include "nonsep/reference/hamiltonian_flow.hpp"
 
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
@@ -214,7 +214,7 @@ TEST_CASE("the VVT form converges to the exact flow of H_VVT = (q + q^3/3)^2 p")
     d[1] = -2.0 * w * (1.0 + q * q) * p;
   };
   const double t_end = 0.5;
-  const auto reference = nonsep::testing::reference_flow(rhs, {0.5, 0.5}, t_end);
+  const auto reference = nonsep::reference::hamiltonian_flow(rhs, {0.5, 0.5}, t_end);
   for (const auto& [order, expected, first] : {std::tuple{Fraction(2, 3), 2.0 / 3, 512}, std::tuple{Fraction(4, 3), 4.0 / 3, 256}}) {
     CAPTURE(order.to_string());
     std::vector<double> dts, errors;

@@ -6,13 +6,14 @@
 // square-root singularity at q0, which tanh-sinh quadrature handles; u - 1 is written without cancellation,
 // u - 1 = (q0 - q)(q0 + q) / (sqrt(1 + q^2) (sqrt(E) + sqrt(1 + q^2))), using the distance to the endpoint.
 #include <boost/math/quadrature/tanh_sinh.hpp>
+#include <algorithm>
 #include <cmath>
 
-namespace nonsep::testing {
+namespace nonsep::reference {
 
 struct Paper1DQuarter {
   double energy;   // H at the start, 1 + q0^2
-  double period;   // time to reach q = 0
+  double period;   // time to reach q = 0 (a quarter of the full period, by the symmetries q -> -q, p -> -p)
   double p_final;  // p there (negative)
 };
 
@@ -34,4 +35,11 @@ inline Paper1DQuarter paper1d_quarter(double q0) {
   return {energy, period, -std::sqrt(2.0 * (sqrt_e - 1.0))};
 }
 
-}  // namespace nonsep::testing
+// The exact level curve H(q, p) = 1 + q0^2 through (q0, 0): p as a function of q for |q| <= q0, upper branch
+// (the lower one is its negative).
+inline double paper1d_level_curve_p(double q0, double q) {
+  const double u = std::sqrt((1.0 + q0 * q0) / (1.0 + q * q));
+  return std::sqrt(std::max(0.0, 2.0 * (u - 1.0)));
+}
+
+}  // namespace nonsep::reference

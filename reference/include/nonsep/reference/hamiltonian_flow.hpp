@@ -5,11 +5,11 @@
 #include <boost/numeric/odeint.hpp>
 #include <vector>
 
-namespace nonsep::testing {
+namespace nonsep::reference {
 
 // `rhs(x, dxdt)` writes (dH/dp, -dH/dq) for x = (q..., p...). Returns x at t_end.
 template <class Rhs>
-std::vector<double> reference_flow(Rhs rhs, std::vector<double> x, double t_end, double tolerance = 1e-14) {
+std::vector<double> hamiltonian_flow(Rhs rhs, std::vector<double> x, double t_end, double tolerance = 1e-14) {
   namespace odeint = boost::numeric::odeint;
   auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<std::vector<double>>());
   odeint::integrate_adaptive(stepper, [&](const std::vector<double>& s, std::vector<double>& d, double) { rhs(s, d); },
@@ -17,4 +17,4 @@ std::vector<double> reference_flow(Rhs rhs, std::vector<double> x, double t_end,
   return x;
 }
 
-}  // namespace nonsep::testing
+}  // namespace nonsep::reference
