@@ -1,0 +1,22 @@
+#pragma once
+// The paper's one-dimensional model, eq. (algham): T(p) = p + p^3/6, V(q) = q^2/2 + q^4/12, so that
+//   H_TTV = T'(p)^2 V''(q) = (1 + p^2/2)^2 (1 + q^2)     (eq. h1d)    and    H_VVT = V'(q)^2 T''(p) = (q + q^3/3)^2 p.
+// Defined everywhere. Analytic gradients; Hessians by automatic differentiation.
+#include <nonsep/plugin_sdk.hpp>
+
+struct Paper1D {
+  static constexpr std::size_t dimension = 1;
+
+  template <class S>
+  S T(nonsep::sdk::Vector<S> p) const {
+    return p[0] + nonsep::sdk::cube(p[0]) / 6.0;
+  }
+  template <class S>
+  S V(nonsep::sdk::Vector<S> q) const {
+    const S q2 = q[0] * q[0];
+    return q2 / 2.0 + q2 * q2 / 12.0;
+  }
+
+  void grad_T(nonsep::sdk::Vector<double> p, std::span<double> out) const { out[0] = 1.0 + 0.5 * p[0] * p[0]; }
+  void grad_V(nonsep::sdk::Vector<double> q, std::span<double> out) const { out[0] = q[0] * (1.0 + q[0] * q[0] / 3.0); }
+};

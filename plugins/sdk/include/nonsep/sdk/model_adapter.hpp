@@ -1,0 +1,313 @@
+#pragma once
+// What a plugin model class looks like, and ModelAdapter, which turns one into a batched nonsep model
+// (nonsep/core/model.hpp) with derivatives by automatic differentiation or by the author's own code.
+//
+// A model class M (see plugins/paper1d/paper1d.hpp for a complete one) has
+//   template <class S> S T(nonsep::sdk::Vector<S> p) const;      the kinetic term T(p)
+//   template <class S> S V(nonsep::sdk::Vector<S> q) const;      the potential term V(q)
+// written once for any scalar S (double and the dual numbers of dual.hpp), and its dimension, either
+//   static constexpr std::size_t dimension = 2;                  fixed, or
+//   static constexpr std::size_t max_dimension = 16;             set by an integer parameter (declared in the
+//   static constexpr const char* dimension_parameter = "dimension";  table, with 1 <= minimum, maximum <= max_dimension)
+// Optionally:
+//   static constexpr nonsep::sdk::Parameter parameters[] = {...};   (parameters.hpp)
+//   explicit M(const nonsep::sdk::ParameterValues&);                 otherwise M is default-constructed
+//   void grad_T(nonsep::sdk::Vector<double> p, std::span<double> out) const;      analytic derivatives of one
+//   void grad_V(nonsep::sdk::Vector<double> q, std::span<double> out) const;      state (out has n entries, or
+//   void hessian_T(nonsep::sdk::Vector<double> p, std::span<double> out) const;   n*n row-major for Hessians);
+//   void hessian_V(nonsep::sdk::Vector<double> q, std::span<double> out) const;   each one replaces AD for it.
+// Model code signals a point where it cannot be evaluated by throwing EvaluationError; the plugin returns
+// NONSEP_EVALUATION_FAILED with that message. Any other exception becomes NONSEP_INTERNAL_ERROR.
+//
+// Automatic differentiation uses Dual<double, K> for gradients (one pass) and Dual<Dual<double, K>, 1> for
+// Hessians (one pass per column), with K = dimension or max_dimension. All AD storage is on the stack
+// (std::array of K duals), so there is no heap allocation while evaluating; max_dimension bounds that stack use
+// (about 16 (K+1)^2 bytes for a Hessian column pass, 4.6 KB at K = 16).
+//
+// Results are checked: a non-finite gradient, Hessian or value throws EvaluationError naming the function and
+// the point.
+#include <array>
+#include <concepts>
+#include <cstddef>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+#include "nonsep/core/error.hpp"
+#include "nonsep/sdk/dual.hpp"
+#include "nonsep/sdk/parameters.hpp"
+
+namespace nonsep::sdk {
+
+// The coordinates a model's T or V receives: the n components of one state.
+template <class S>
+using Vector = std::span<const S>;
+
+// Thrown by model code (or by the SDK for a non-finite result) where T or V cannot be evaluated.
+class EvaluationError : public nonsep::ModelError {
+ public:
+  using nonsep::ModelError::ModelError;
+};
+
+// Which derivatives an adapter uses: the author's analytic functions where they exist (preferred), or automatic
+// differentiation everywhere (automatic; to check analytic code or measure its benefit).
+enum class Derivatives { preferred, automatic };
+
+template <class M>
+concept HasFixedDimension = requires { std::integral_constant<std::size_t, M::dimension>{}; };
+
+template <class M>
+concept HasParameterDimension = requires {
+  std::integral_constant<std::size_t, M::max_dimension>{};
+  { M::dimension_parameter } -> std::convertible_to<std::string_view>;
+};
+
+template <class M>
+concept HasParameterTable = requires { std::span<const Parameter>(M::parameters); };
+
+template <class M>
+consteval std::size_t dimension_capacity() {
+  if constexpr (HasFixedDimension<M>)
+    return M::dimension;
+  else if constexpr (HasParameterDimension<M>)
+    return M::max_dimension;
+  else
+    return 0;
+}
+
+template <class M>
+concept ModelClass = (HasFixedDimension<M> != HasParameterDimension<M>) && (dimension_capacity<M>() > 0) &&
+                     requires(const M& m, Vector<double> x, Vector<Dual<double, dimension_capacity<M>()>> d,
+                              Vector<Dual<Dual<double, dimension_capacity<M>()>, 1>> dd) {
+                       { m.template T<double>(x) } -> std::convertible_to<double>;
+                       { m.template V<double>(x) } -> std::convertible_to<double>;
+                       m.template T<Dual<double, dimension_capacity<M>()>>(d);
+                       m.template V<Dual<double, dimension_capacity<M>()>>(d);
+                       m.template T<Dual<Dual<double, dimension_capacity<M>()>, 1>>(dd);
+                       m.template V<Dual<Dual<double, dimension_capacity<M>()>, 1>>(dd);
+                     };
+
+template <class M>
+concept HasAnalyticGradT = requires(const M& m, Vector<double> x, std::span<double> out) { m.grad_T(x, out); };
+template <class M>
+concept HasAnalyticGradV = requires(const M& m, Vector<double> x, std::span<double> out) { m.grad_V(x, out); };
+template <class M>
+concept HasAnalyticHessianT = requires(const M& m, Vector<double> x, std::span<double> out) { m.hessian_T(x, out); };
+template <class M>
+concept HasAnalyticHessianV = requires(const M& m, Vector<double> x, std::span<double> out) { m.hessian_V(x, out); };
+
+// The parameter table of M (empty when M declares none).
+template <class M>
+constexpr std::span<const Parameter> parameter_table() {
+  if constexpr (HasParameterTable<M>)
+    return std::span<const Parameter>(M::parameters);
+  else
+    return {};
+}
+
+// Compile-time checks of a model's declarations; each false result is a static_assert in PluginTable.
+template <class M>
+consteval bool parameter_names_are_unique() {
+  constexpr auto table = parameter_table<M>();
+  for (std::size_t i = 0; i < table.size(); ++i)
+    for (std::size_t j = i + 1; j < table.size(); ++j)
+      if (std::string_view(table[i].name) == table[j].name) return false;
+  return true;
+}
+template <class M>
+consteval bool parameter_defaults_are_in_range() {
+  for (const auto& p : parameter_table<M>()) {
+    if (p.minimum && p.default_value < *p.minimum) return false;
+    if (p.maximum && p.default_value > *p.maximum) return false;
+  }
+  return true;
+}
+template <class M>
+consteval bool dimension_parameter_is_bounded() {
+  if constexpr (HasParameterDimension<M>) {
+    for (const auto& p : parameter_table<M>())
+      if (std::string_view(p.name) == std::string_view(M::dimension_parameter))
+        return p.type == ParameterType::integer && p.minimum && *p.minimum >= 1.0 && p.maximum &&
+               *p.maximum <= static_cast<double>(M::max_dimension);
+    return false;
+  } else {
+    return true;
+  }
+}
+
+namespace detail {
+
+inline std::string format_point(const char* variable, const double* x, std::size_t n) {
+  std::string text = std::string(variable) + " = (";
+  for (std::size_t i = 0; i < n; ++i) text += (i ? ", " : "") + format_number(x[i]);
+  return text + ")";
+}
+
+inline void require_finite(const double* values, std::size_t size, const char* function, const char* variable,
+                           const double* x, std::size_t n) {
+  for (std::size_t i = 0; i < size; ++i)
+    if (!std::isfinite(values[i]))
+      throw EvaluationError(std::string(function) + " is not finite at " + format_point(variable, x, n) +
+                            " (component " + std::to_string(i) + " is " + format_number(values[i]) + ")");
+}
+
+// Writes the gradient of f at x (n <= K components) into out, by one pass of Dual<double, K>.
+template <std::size_t K, class F>
+void gradient_by_dual(const F& f, const double* x, std::size_t n, double* out) {
+  using D = Dual<double, K>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) xs[i] = D::variable(x[i], i);
+  const D y = f(Vector<D>(xs.data(), n));
+  for (std::size_t i = 0; i < n; ++i) out[i] = y.derivative[i];
+}
+
+// Writes the row-major n x n Hessian of f at x into out, column j from one pass of Dual<Dual<double, K>, 1>
+// seeded with e_j in the outer slot.
+template <std::size_t K, class F>
+void hessian_by_dual(const F& f, const double* x, std::size_t n, double* out) {
+  using Inner = Dual<double, K>;
+  using D = Dual<Inner, 1>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) xs[i].value = Inner::variable(x[i], i);
+  for (std::size_t j = 0; j < n; ++j) {
+    for (std::size_t i = 0; i < n; ++i) xs[i].derivative[0] = Inner(i == j ? 1.0 : 0.0);
+    const D y = f(Vector<D>(xs.data(), n));
+    for (std::size_t i = 0; i < n; ++i) out[i * n + j] = y.derivative[0].derivative[i];
+  }
+}
+
+}  // namespace detail
+
+// A model class behind the batched interface of nonsep/core/model.hpp (it models nonsep::ModelWithHessians),
+// plus value_T / value_V. Batch layout as in model.hpp. Spans must hold at least count*n (count*n*n for
+// Hessians, count for values) entries; shorter spans are a caller bug and throw nonsep::InvalidArgument.
+// Evaluation failures throw EvaluationError. ModelAdapter keeps no mutable state: concurrent calls are as safe
+// as M's const member functions.
+template <ModelClass M, Derivatives policy = Derivatives::preferred>
+class ModelAdapter {
+ public:
+  static constexpr std::size_t capacity = dimension_capacity<M>();
+  using Model = M;
+
+  // The model built from checked parameters (see parse_parameters), dimension from the table when it is a
+  // parameter. Throws InvalidParameter (from M's constructor, or a dimension out of 1..max_dimension).
+  explicit ModelAdapter(const ParameterValues& values) : model_(construct(values)), dimension_(dimension_of(values)) {}
+  // The model with all parameters at their defaults.
+  ModelAdapter() : ModelAdapter(parse_parameters(parameter_table<M>(), "{}")) {}
+  // Parses and checks `parameters_json` first (parse_parameters).
+  static ModelAdapter from_json(std::string_view parameters_json) {
+    return ModelAdapter(parse_parameters(parameter_table<M>(), parameters_json));
+  }
+
+  std::size_t dimension() const { return dimension_; }
+  const M& model() const { return model_; }
+
+  static constexpr bool analytic_grad_T = policy == Derivatives::preferred && HasAnalyticGradT<M>;
+  static constexpr bool analytic_grad_V = policy == Derivatives::preferred && HasAnalyticGradV<M>;
+  static constexpr bool analytic_hessian_T = policy == Derivatives::preferred && HasAnalyticHessianT<M>;
+  static constexpr bool analytic_hessian_V = policy == Derivatives::preferred && HasAnalyticHessianV<M>;
+
+  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    check_sizes(p, out, count, 1);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) {
+      out[b] = model_.template T<double>(Vector<double>(p.data() + b * n, n));
+      detail::require_finite(&out[b], 1, "T", "p", p.data() + b * n, n);
+    }
+  }
+  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    check_sizes(q, out, count, 1);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) {
+      out[b] = model_.template V<double>(Vector<double>(q.data() + b * n, n));
+      detail::require_finite(&out[b], 1, "V", "q", q.data() + b * n, n);
+    }
+  }
+
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    check_sizes(p, out, count, dimension_);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* x = p.data() + b * n;
+      double* g = out.data() + b * n;
+      if constexpr (analytic_grad_T)
+        model_.grad_T(Vector<double>(x, n), std::span<double>(g, n));
+      else
+        detail::gradient_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, g);
+      detail::require_finite(g, n, "grad T", "p", x, n);
+    }
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    check_sizes(q, out, count, dimension_);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* x = q.data() + b * n;
+      double* g = out.data() + b * n;
+      if constexpr (analytic_grad_V)
+        model_.grad_V(Vector<double>(x, n), std::span<double>(g, n));
+      else
+        detail::gradient_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, g);
+      detail::require_finite(g, n, "grad V", "q", x, n);
+    }
+  }
+  void hessian_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    check_sizes(p, out, count, dimension_ * dimension_);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* x = p.data() + b * n;
+      double* h = out.data() + b * n * n;
+      if constexpr (analytic_hessian_T)
+        model_.hessian_T(Vector<double>(x, n), std::span<double>(h, n * n));
+      else
+        detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h);
+      detail::require_finite(h, n * n, "Hessian of T", "p", x, n);
+    }
+  }
+  void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    check_sizes(q, out, count, dimension_ * dimension_);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* x = q.data() + b * n;
+      double* h = out.data() + b * n * n;
+      if constexpr (analytic_hessian_V)
+        model_.hessian_V(Vector<double>(x, n), std::span<double>(h, n * n));
+      else
+        detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h);
+      detail::require_finite(h, n * n, "Hessian of V", "q", x, n);
+    }
+  }
+
+ private:
+  static M construct(const ParameterValues& values) {
+    if constexpr (std::is_constructible_v<M, const ParameterValues&>)
+      return M(values);
+    else
+      return M();
+  }
+  static std::size_t dimension_of(const ParameterValues& values) {
+    if constexpr (HasFixedDimension<M>) {
+      return M::dimension;
+    } else {
+      const std::int64_t n = values.integer(M::dimension_parameter);
+      if (n < 1 || static_cast<std::size_t>(n) > M::max_dimension)
+        throw InvalidParameter(M::dimension_parameter,
+                               "parameter '" + std::string(M::dimension_parameter) + "' = " + std::to_string(n) +
+                                   " is outside 1.." + std::to_string(M::max_dimension));
+      return static_cast<std::size_t>(n);
+    }
+  }
+  void check_sizes(std::span<const double> in, std::span<double> out, std::size_t count,
+                   std::size_t out_per_state) const {
+    if (in.size() < count * dimension_ || out.size() < count * out_per_state)
+      throw nonsep::InvalidArgument("batch of " + std::to_string(count) + " states of dimension " +
+                                    std::to_string(dimension_) + " given spans of " + std::to_string(in.size()) +
+                                    " and " + std::to_string(out.size()) + " numbers");
+  }
+
+  M model_;
+  std::size_t dimension_;
+};
+
+}  // namespace nonsep::sdk

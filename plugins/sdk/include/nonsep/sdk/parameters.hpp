@@ -1,0 +1,176 @@
+#pragma once
+// Model parameters: the static table a model declares, and the checked values it is constructed from.
+//
+// A model lists its parameters as
+//   static constexpr nonsep::sdk::Parameter parameters[] = {
+//       {.name = "lambda", .type = nonsep::sdk::ParameterType::number, .default_value = 1.0,
+//        .minimum = -10.0, .maximum = 10.0, .description = "Henon-Heiles coupling"}};
+// and receives a ParameterValues in its constructor. The same table produces the "parameters" array of the
+// plugin metadata (plugin_abi.h), so the host can validate and document parameters without creating a model.
+//
+// Rules, identical on the host side (check_parameter_value is shared): the parameters are a JSON object; every
+// key must be in the table; an "integer" is a JSON number with an integral value, a "number" any JSON number,
+// a "boolean" true or false; minimum and maximum are inclusive. Missing keys take their defaults. Every refusal
+// throws InvalidParameter with a message that names the parameter and shows the offending value.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+namespace nonsep::sdk {
+
+enum class ParameterType { integer, number, boolean };
+
+inline const char* to_string(ParameterType type) {
+  switch (type) {
+    case ParameterType::integer: return "integer";
+    case ParameterType::number: return "number";
+    case ParameterType::boolean: return "boolean";
+  }
+  return "?";
+}
+
+// One row of a model's parameter table. For a boolean, default_value is 0 or 1 and there is no range.
+struct Parameter {
+  const char* name = "";
+  ParameterType type = ParameterType::number;
+  double default_value = 0.0;
+  std::optional<double> minimum{};  // inclusive; absent = unbounded
+  std::optional<double> maximum{};  // inclusive; absent = unbounded
+  const char* unit = "";            // "" when the parameter has no unit
+  const char* description = "";
+};
+
+// A parameter was refused. `parameter()` is its name ("" when the whole parameter text was refused).
+class InvalidParameter : public std::invalid_argument {
+ public:
+  InvalidParameter(std::string parameter, const std::string& message)
+      : std::invalid_argument(message), parameter_(std::move(parameter)) {}
+  const std::string& parameter() const { return parameter_; }
+
+ private:
+  std::string parameter_;
+};
+
+// Shortest text that reads back as the same double; integral values without a decimal point.
+inline std::string format_number(double x) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x);
+  return std::string(buffer, result.ptr);
+}
+
+// The default of a table row as JSON of the row's type.
+inline nlohmann::json default_as_json(const Parameter& p) {
+  switch (p.type) {
+    case ParameterType::integer: return static_cast<std::int64_t>(p.default_value);
+    case ParameterType::boolean: return p.default_value != 0.0;
+    case ParameterType::number: break;
+  }
+  return p.default_value;
+}
+
+// Checks one value against its declared type and range. Returns "" when it is acceptable, otherwise the complete
+// message, e.g. "parameter 'dimension' = 100 is above its maximum 16".
+inline std::string check_parameter_value(std::string_view name, std::string_view type,
+                                         std::optional<double> minimum, std::optional<double> maximum,
+                                         const nlohmann::json& value) {
+  const std::string quoted = "parameter '" + std::string(name) + "'";
+  if (type == "boolean") {
+    if (!value.is_boolean()) return quoted + " must be true or false (found " + value.dump() + ")";
+    return "";
+  }
+  if (!value.is_number()) return quoted + " must be a" + (type == "integer" ? "n integer" : " number") +
+                                 " (found " + value.dump() + ")";
+  const double x = value.get<double>();
+  if (type == "integer" && !value.is_number_integer() && !value.is_number_unsigned() &&
+      (std::trunc(x) != x || std::abs(x) > 9.0e15))
+    return quoted + " must be an integer (found " + value.dump() + ")";
+  if (minimum && x < *minimum)
+    return quoted + " = " + value.dump() + " is below its minimum " + format_number(*minimum);
+  if (maximum && x > *maximum)
+    return quoted + " = " + value.dump() + " is above its maximum " + format_number(*maximum);
+  return "";
+}
+
+// The parameters in effect for one model instance: every table entry, given or defaulted, already checked.
+class ParameterValues {
+ public:
+  ParameterValues() : values_(nlohmann::json::object()) {}
+  explicit ParameterValues(nlohmann::json checked_object) : values_(std::move(checked_object)) {}
+
+  // The value of a declared parameter. Asking for a name the table does not declare, or with the wrong type,
+  // is a bug in the model and throws std::logic_error.
+  double number(std::string_view name) const { return at(name, "number").get<double>(); }
+  std::int64_t integer(std::string_view name) const {
+    return static_cast<std::int64_t>(at(name, "integer").get<double>());
+  }
+  bool boolean(std::string_view name) const { return at(name, "boolean").get<bool>(); }
+  const nlohmann::json& json() const { return values_; }
+
+ private:
+  const nlohmann::json& at(std::string_view name, const char* type) const {
+    const auto it = values_.find(std::string(name));
+    if (it == values_.end())
+      throw std::logic_error("the model asked for parameter '" + std::string(name) + "', which it does not declare");
+    if (type == std::string_view("boolean") ? !it->is_boolean() : !it->is_number())
+      throw std::logic_error("the model asked for parameter '" + std::string(name) + "' as a " + type);
+    return *it;
+  }
+  nlohmann::json values_;
+};
+
+// Parses and checks parameters given as JSON text against a table (an empty text means "{}").
+// Throws InvalidParameter naming the parameter; see the rules at the top of this file.
+inline ParameterValues parse_parameters(std::span<const Parameter> table, std::string_view json_text) {
+  nlohmann::json given;
+  try {
+    given = json_text.empty() ? nlohmann::json::object() : nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InvalidParameter("", std::string("the parameters are not valid JSON: ") + e.what());
+  }
+  if (!given.is_object())
+    throw InvalidParameter("", "the parameters must be a JSON object such as {\"name\": value} (found " +
+                                   std::string(given.type_name()) + ")");
+  nlohmann::json checked = nlohmann::json::object();
+  for (const auto& [key, value] : given.items()) {
+    const auto row = std::find_if(table.begin(), table.end(), [&](const Parameter& p) { return key == p.name; });
+    if (row == table.end()) {
+      std::string known;
+      for (const auto& p : table) known += (known.empty() ? "" : ", ") + std::string(p.name);
+      throw InvalidParameter(key, "unknown parameter '" + key + "' (" +
+                                      (known.empty() ? "this model has no parameters" : "known parameters: " + known) +
+                                      ")");
+    }
+    const std::string problem = check_parameter_value(key, to_string(row->type), row->minimum, row->maximum, value);
+    if (!problem.empty()) throw InvalidParameter(key, problem);
+    checked[key] = value;
+  }
+  for (const auto& p : table)
+    if (!checked.contains(p.name)) checked[p.name] = default_as_json(p);
+  return ParameterValues(std::move(checked));
+}
+
+// The "parameters" array of the plugin metadata for a table.
+inline nlohmann::json parameters_metadata(std::span<const Parameter> table) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& p : table) {
+    nlohmann::json row = {{"name", p.name},
+                          {"type", to_string(p.type)},
+                          {"default", default_as_json(p)},
+                          {"description", p.description}};
+    if (p.minimum) row["minimum"] = *p.minimum;
+    if (p.maximum) row["maximum"] = *p.maximum;
+    if (*p.unit) row["unit"] = p.unit;
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+}  // namespace nonsep::sdk
