@@ -1,0 +1,381 @@
+// Loading and checking plugins (plugin_loader.hpp). Every check that can fail produces its own PluginError
+// message naming the file, what was expected and what was found; the library is unloaded only after every
+// Plugin and PluginModel from it is gone.
+#include "nonsep/host/plugin_loader.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include <boost/dll/runtime_symbol_info.hpp>
+#include <boost/dll/shared_library.hpp>
+
+#include "nonsep/plugin_abi.h"
+#include "nonsep/sdk/parameters.hpp"
+
+namespace nonsep::host {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Plugin::Loaded {
+  boost::dll::shared_library library;
+  fs::path path;
+  const nonsep_plugin_api* api = nullptr;
+  json metadata;
+};
+
+struct PluginModel::Instance {
+  Plugin plugin;  // keeps the library loaded while the instance lives
+  const nonsep_plugin_api* api = nullptr;
+  nonsep_instance* handle = nullptr;
+  std::size_t dimension = 0;
+  json parameters;
+
+  Instance() = default;
+  Instance(const Instance&) = delete;
+  Instance& operator=(const Instance&) = delete;
+  ~Instance() {
+    if (handle != nullptr) api->destroy(handle);
+  }
+};
+
+namespace {
+
+const char* status_name(nonsep_status status) {
+  switch (status) {
+    case NONSEP_OK: return "ok";
+    case NONSEP_INVALID_PARAMETERS: return "invalid parameters";
+    case NONSEP_EVALUATION_FAILED: return "evaluation failed";
+    case NONSEP_INTERNAL_ERROR: return "internal error";
+    case NONSEP_UNSUPPORTED: return "unsupported";
+  }
+  return "unknown status";
+}
+
+std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+// The metadata checks of plugin_abi.h, after the JSON has parsed. Throws PluginError naming the field.
+void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path& path) {
+  const std::string where = "the metadata of plugin " + quoted(path);
+  auto fail = [&](const std::string& problem) { throw PluginError(where + " " + problem); };
+  if (!m.is_object()) fail("must be a JSON object (found " + std::string(m.type_name()) + ")");
+  for (const char* key : {"name", "version", "description", "hamiltonian"})
+    if (!m.contains(key) || !m[key].is_string()) fail("lacks the string \"" + std::string(key) + "\"");
+  const std::string name = m["name"].get<std::string>();
+  if (name != path.stem().string())
+    fail("declares the name '" + name + "' but the file is named " + path.filename().string() +
+         "; a plugin's file must be <name>.so (expected '" + path.stem().string() + "', found '" + name + "')");
+
+  if (!m.contains("parameters") || !m["parameters"].is_array()) fail("lacks the array \"parameters\"");
+  std::set<std::string> parameter_names;
+  for (const json& p : m["parameters"]) {
+    if (!p.is_object() || !p.contains("name") || !p["name"].is_string())
+      fail("has a parameter without a string \"name\"");
+    const std::string parameter = p["name"].get<std::string>();
+    if (!parameter_names.insert(parameter).second) fail("declares parameter '" + parameter + "' twice");
+    const std::string type = p.value("type", json()).is_string() ? p["type"].get<std::string>() : "";
+    if (type != "integer" && type != "number" && type != "boolean")
+      fail("gives parameter '" + parameter + "' the type " + p.value("type", json()).dump() +
+           " (expected \"integer\", \"number\" or \"boolean\")");
+    if (!p.contains("default")) fail("gives parameter '" + parameter + "' no default");
+    for (const char* bound : {"minimum", "maximum"})
+      if (p.contains(bound) && !p[bound].is_number())
+        fail("gives parameter '" + parameter + "' a non-numeric " + bound);
+    for (const char* text : {"unit", "description"})
+      if (p.contains(text) && !p[text].is_string()) fail("gives parameter '" + parameter + "' a non-string " + text);
+    const auto bound = [&](const char* key) {
+      return p.contains(key) ? std::optional<double>(p[key].get<double>()) : std::nullopt;
+    };
+    const std::string problem =
+        sdk::check_parameter_value(parameter, type, bound("minimum"), bound("maximum"), p["default"]);
+    if (!problem.empty()) fail("has an invalid default: " + problem);
+  }
+
+  if (!m.contains("dimension") || !m["dimension"].is_object()) fail("lacks the object \"dimension\"");
+  const json& dimension = m["dimension"];
+  if (dimension.contains("fixed")) {
+    if (!dimension["fixed"].is_number_unsigned() || dimension["fixed"].get<std::uint64_t>() == 0)
+      fail("gives \"dimension\": {\"fixed\": ...} a value that is not a positive integer (found " +
+           dimension["fixed"].dump() + ")");
+  } else if (dimension.contains("parameter")) {
+    const json& parameter = dimension["parameter"];
+    const auto& parameters = m["parameters"];
+    const bool declared = parameter.is_string() && std::any_of(parameters.begin(), parameters.end(), [&](const json& p) {
+                            return p["name"] == parameter && p["type"] == "integer";
+                          });
+    if (!declared)
+      fail("sets the dimension by parameter " + parameter.dump() + ", which is not a declared integer parameter");
+  } else {
+    fail("gives \"dimension\" neither \"fixed\" nor \"parameter\"");
+  }
+
+  if (!m.contains("capabilities") || !m["capabilities"].is_object()) fail("lacks the object \"capabilities\"");
+  const std::pair<const char*, bool> present[] = {{"value_T", api.value_T != nullptr},
+                                                  {"value_V", api.value_V != nullptr},
+                                                  {"hessian_T", api.hessian_T != nullptr},
+                                                  {"hessian_V", api.hessian_V != nullptr}};
+  for (const auto& [capability, in_table] : present) {
+    const json claimed = m["capabilities"].value(capability, json(false));
+    if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
+    if (claimed.get<bool>() != in_table)
+      fail("says capability \"" + std::string(capability) + "\" is " + (claimed.get<bool>() ? "true" : "false") +
+           " but the table's " + capability + " pointer is " + (in_table ? "set" : "null"));
+  }
+}
+
+bool looks_like_path(const std::string& spec) {
+  return spec.find('/') != std::string::npos ||
+         (spec.size() > 3 && spec.compare(spec.size() - 3, 3, ".so") == 0);
+}
+
+}  // namespace
+
+std::vector<fs::path> plugin_search_path() {
+  std::vector<fs::path> directories;
+  auto add = [&](const fs::path& directory) {
+    const fs::path normal = directory.lexically_normal();
+    if (std::find(directories.begin(), directories.end(), normal) == directories.end())
+      directories.push_back(normal);
+  };
+  if (const char* variable = std::getenv("NONSEP_PLUGIN_PATH")) {
+    std::stringstream entries(variable);
+    std::string entry;
+    while (std::getline(entries, entry, ':'))
+      if (!entry.empty()) add(fs::absolute(entry));
+  }
+  std::error_code error;
+  const fs::path executable = boost::dll::program_location(error);
+  if (!error) add(executable.parent_path() / NONSEP_PLUGIN_DIR_FROM_EXECUTABLE);
+  add(NONSEP_BUILD_PLUGIN_DIR);
+  return directories;
+}
+
+const fs::path& Plugin::path() const { return loaded_->path; }
+const json& Plugin::metadata() const { return loaded_->metadata; }
+std::string Plugin::name() const { return loaded_->metadata["name"].get<std::string>(); }
+std::string Plugin::version() const { return loaded_->metadata["version"].get<std::string>(); }
+std::string Plugin::description() const { return loaded_->metadata["description"].get<std::string>(); }
+bool Plugin::has_hessians() const { return loaded_->api->hessian_T != nullptr && loaded_->api->hessian_V != nullptr; }
+bool Plugin::has_values() const { return loaded_->api->value_T != nullptr && loaded_->api->value_V != nullptr; }
+
+std::vector<PluginParameter> Plugin::parameters() const {
+  std::vector<PluginParameter> result;
+  for (const json& p : loaded_->metadata["parameters"]) {
+    PluginParameter parameter;
+    parameter.name = p["name"].get<std::string>();
+    parameter.type = p["type"].get<std::string>();
+    parameter.default_value = p["default"];
+    if (p.contains("minimum")) parameter.minimum = p["minimum"].get<double>();
+    if (p.contains("maximum")) parameter.maximum = p["maximum"].get<double>();
+    parameter.unit = p.value("unit", "");
+    parameter.description = p.value("description", "");
+    result.push_back(std::move(parameter));
+  }
+  return result;
+}
+
+PluginModel Plugin::create(const json& given) const {
+  const std::string who = "plugin '" + name() + "' (" + path().string() + ")";
+  if (!given.is_object())
+    throw PluginError(who + ": the parameters must be a JSON object such as {\"name\": value} (found " +
+                      std::string(given.type_name()) + ")");
+  const auto declared = parameters();
+  json effective = json::object();
+  for (const auto& [key, value] : given.items()) {
+    const auto row = std::find_if(declared.begin(), declared.end(), [&](const auto& p) { return p.name == key; });
+    if (row == declared.end()) {
+      std::string known;
+      for (const auto& p : declared) known += (known.empty() ? "" : ", ") + p.name;
+      throw PluginError(who + ": unknown parameter '" + key + "' (" +
+                        (known.empty() ? "this model has no parameters" : "known parameters: " + known) + ")");
+    }
+    const std::string problem = sdk::check_parameter_value(key, row->type, row->minimum, row->maximum, value);
+    if (!problem.empty()) throw PluginError(who + ": " + problem);
+    effective[key] = value;
+  }
+  for (const auto& p : declared)
+    if (!effective.contains(p.name)) effective[p.name] = p.default_value;
+
+  const nonsep_plugin_api& api = *loaded_->api;
+  auto instance = std::make_shared<PluginModel::Instance>();
+  instance->plugin = *this;
+  instance->api = &api;
+  instance->parameters = effective;
+  char message[1024] = {};
+  const std::string text = effective.dump();
+  const nonsep_status status = api.create(text.c_str(), &instance->handle, message, sizeof message);
+  message[sizeof message - 1] = '\0';
+  if (status != NONSEP_OK) {
+    if (instance->handle != nullptr) api.destroy(instance->handle);
+    instance->handle = nullptr;
+    throw PluginError(who + " could not create a model (" + status_name(status) + "): " +
+                      (message[0] ? message : "the plugin gave no message"));
+  }
+  if (instance->handle == nullptr)
+    throw PluginError(who + ": create() reported success but returned no instance");
+
+  instance->dimension = api.dimension(instance->handle);
+  const json& dimension = loaded_->metadata["dimension"];
+  const std::size_t expected = dimension.contains("fixed")
+                                   ? dimension["fixed"].get<std::size_t>()
+                                   : effective[dimension["parameter"].get<std::string>()].get<std::size_t>();
+  if (instance->dimension != expected)
+    throw PluginError(who + ": the instance has dimension " + std::to_string(instance->dimension) +
+                      " but the metadata implies " + std::to_string(expected) + " (expected " +
+                      std::to_string(expected) + ", found " + std::to_string(instance->dimension) + ")");
+  PluginModel model;
+  model.instance_ = std::move(instance);
+  return model;
+}
+
+Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directory) {
+  if (name_or_path.empty()) throw PluginError("no plugin given (an empty name)");
+  fs::path file;
+  if (looks_like_path(name_or_path)) {
+    const fs::path given(name_or_path);
+    file = (given.is_absolute() ? given : base_directory / given).lexically_normal();
+    std::error_code error;
+    if (!fs::is_regular_file(file, error))
+      throw PluginError("plugin file " + quoted(file) + " does not exist" +
+                        (given.is_absolute() ? std::string()
+                                             : " (" + quoted(given) + " relative to " + quoted(base_directory) + ")"));
+  } else {
+    std::string tried;
+    for (const fs::path& directory : plugin_search_path()) {
+      const fs::path candidate = directory / (name_or_path + ".so");
+      std::error_code error;
+      if (fs::is_regular_file(candidate, error)) {
+        file = candidate;
+        break;
+      }
+      tried += "\n  " + candidate.string() + " (no such file)";
+    }
+    if (file.empty())
+      throw PluginError("plugin '" + name_or_path + "' not found; looked in NONSEP_PLUGIN_PATH, the install's "
+                        "plugin folder and the build tree's, trying:" + tried);
+  }
+  // The checks of plugin_abi.h, in its order.
+  const fs::path& path = file;
+  auto loaded = std::make_shared<Plugin::Loaded>();
+  loaded->path = path;
+  try {
+    loaded->library.load(path, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
+  } catch (const std::exception& e) {
+    throw PluginError("cannot load " + quoted(path) + " as a shared library: " + e.what());
+  }
+  if (!loaded->library.has(NONSEP_PLUGIN_ENTRY_SYMBOL))
+    throw PluginError(quoted(path) + " is a shared library but not a nonsep plugin: it does not export the entry "
+                      "symbol '" NONSEP_PLUGIN_ENTRY_SYMBOL "' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp)");
+  const auto entry = loaded->library.get<const nonsep_plugin_api*()>(NONSEP_PLUGIN_ENTRY_SYMBOL);
+  const nonsep_plugin_api* api = entry();
+  if (api == nullptr) throw PluginError("the entry symbol of plugin " + quoted(path) + " returned a null table");
+  if (api->abi_version != NONSEP_PLUGIN_ABI_VERSION)
+    throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(api->abi_version) +
+                      " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
+                      std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found " + std::to_string(api->abi_version) +
+                      "); rebuild the plugin against this nonsep");
+  if (api->struct_size != sizeof(nonsep_plugin_api))
+    throw PluginError("plugin " + quoted(path) + " has a function table of " + std::to_string(api->struct_size) +
+                      " bytes but ABI version 1 defines " + std::to_string(sizeof(nonsep_plugin_api)) +
+                      " (expected " + std::to_string(sizeof(nonsep_plugin_api)) + ", found " +
+                      std::to_string(api->struct_size) + "); the plugin was built against a different plugin_abi.h");
+  const std::pair<const char*, bool> required[] = {
+      {"metadata_json", api->metadata_json != nullptr}, {"create", api->create != nullptr},
+      {"destroy", api->destroy != nullptr},             {"dimension", api->dimension != nullptr},
+      {"grad_T", api->grad_T != nullptr},               {"grad_V", api->grad_V != nullptr},
+      {"last_error", api->last_error != nullptr}};
+  for (const auto& [function, present] : required)
+    if (!present)
+      throw PluginError("plugin " + quoted(path) + " lacks the required function " + function +
+                        " (its table entry is null)");
+  const char* text = api->metadata_json();
+  if (text == nullptr) throw PluginError("plugin " + quoted(path) + " returned null metadata");
+  try {
+    loaded->metadata = json::parse(text);
+  } catch (const json::parse_error& e) {
+    const std::string shown = std::string(text).substr(0, 80);
+    throw PluginError("the metadata of plugin " + quoted(path) + " is not valid JSON: " + e.what() +
+                      " (metadata begins: \"" + shown + "\")");
+  }
+  check_metadata(loaded->metadata, *api, path);
+  loaded->api = api;
+  Plugin plugin;
+  plugin.loaded_ = std::move(loaded);
+  return plugin;
+}
+
+std::vector<DiscoveredPlugin> discover_plugins() {
+  std::vector<DiscoveredPlugin> found;
+  std::set<std::string> names;
+  for (const fs::path& directory : plugin_search_path()) {
+    std::error_code error;
+    if (!fs::is_directory(directory, error)) continue;
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(directory, error))
+      if (entry.path().extension() == ".so") files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    for (const fs::path& file : files) {
+      if (!names.insert(file.stem().string()).second) continue;
+      DiscoveredPlugin discovered{file, std::nullopt, ""};
+      try {
+        discovered.plugin = load_plugin(file.string(), directory);
+      } catch (const PluginError& e) {
+        discovered.error = e.what();
+      }
+      found.push_back(std::move(discovered));
+    }
+  }
+  return found;
+}
+
+std::size_t PluginModel::dimension() const { return instance_->dimension; }
+const Plugin& PluginModel::plugin() const { return instance_->plugin; }
+const json& PluginModel::parameters() const { return instance_->parameters; }
+
+
+namespace {
+
+using BatchedFunction = nonsep_status (*)(nonsep_instance*, const double*, double*, std::size_t);
+
+// Calls one batched function of the table, after checking the spans, and turns a failure into ModelError.
+void evaluate(const PluginModel& model, nonsep_instance* handle, const nonsep_plugin_api& api,
+              BatchedFunction function, const char* function_name, std::span<const double> in,
+              std::span<double> out, std::size_t count, std::size_t out_per_state) {
+  const std::size_t n = model.dimension();
+  if (in.size() < count * n || out.size() < count * out_per_state)
+    throw nonsep::InvalidArgument(std::string(function_name) + ": a batch of " + std::to_string(count) +
+                                  " states of dimension " + std::to_string(n) + " needs " +
+                                  std::to_string(count * n) + " inputs and " + std::to_string(count * out_per_state) +
+                                  " outputs (found " + std::to_string(in.size()) + " and " +
+                                  std::to_string(out.size()) + ")");
+  if (function == nullptr)
+    throw nonsep::ModelError("plugin '" + model.plugin().name() + "' does not provide " + function_name +
+                             " (its capability is false)");
+  const nonsep_status status = function(handle, in.data(), out.data(), count);
+  if (status != NONSEP_OK) {
+    const char* message = api.last_error(handle);
+    throw nonsep::ModelError("plugin '" + model.plugin().name() + "' failed in " + function_name + " (" +
+                             status_name(status) + "): " + (message != nullptr && *message ? message : "no message"));
+  }
+}
+
+}  // namespace
+
+#define NONSEP_PLUGIN_MODEL_FUNCTION(function, out_per_state)                                                     \
+  void PluginModel::function(std::span<const double> x, std::span<double> out, std::size_t count) const {         \
+    const std::size_t n = instance_->dimension;                                                                   \
+    evaluate(*this, instance_->handle, *instance_->api, instance_->api->function, #function, x, out, count,       \
+             out_per_state);                                                                                      \
+  }
+NONSEP_PLUGIN_MODEL_FUNCTION(grad_T, n)
+NONSEP_PLUGIN_MODEL_FUNCTION(grad_V, n)
+NONSEP_PLUGIN_MODEL_FUNCTION(hessian_T, n * n)
+NONSEP_PLUGIN_MODEL_FUNCTION(hessian_V, n * n)
+NONSEP_PLUGIN_MODEL_FUNCTION(value_T, (static_cast<void>(n), 1))
+NONSEP_PLUGIN_MODEL_FUNCTION(value_V, (static_cast<void>(n), 1))
+#undef NONSEP_PLUGIN_MODEL_FUNCTION
+
+}  // namespace nonsep::host
