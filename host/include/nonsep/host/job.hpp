@@ -1,0 +1,113 @@
+#pragma once
+// Job files: reading one, checking every part of it, and reporting all problems at once.
+//
+// The shape of a job file is documented key by key in docs/job-file.md and formally in schemas/job.schema.json.
+// Reading happens in three passes, each adding to one list of JobIssue:
+//   1. parse_job_text  strict JSON: syntax (with line and column), duplicate keys.
+//   2. parse_job       structure and values that need no plugin: unknown keys, types, required keys, ranges,
+//                      integrator options against nonsep::scheme_catalogue(), the time grid, initial states.
+//   3. load_job        the plugin: it must load (/model/plugin), the parameters must match its metadata
+//                      (/model/parameters/<name>), and the states must have the model's dimension (/initial/...).
+// Every issue names a JSON Pointer (RFC 6901) into the job file, what was found there and what is allowed.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/host/plugin_loader.hpp"
+
+namespace nonsep::host {
+
+// One problem in a job file. `path` is a JSON Pointer ("/integrator/order"; "" for the whole document),
+// `found` describes what is there ("\"5/3\"", "nothing", "a string"), `allowed` what would be accepted.
+struct JobIssue {
+  std::string path;
+  std::string found;
+  std::string allowed;
+};
+// "/integrator/order: found \"5/3\"; allowed: ..."
+std::string to_string(const JobIssue& issue);
+
+// Thrown by load_job with every issue of the file (never empty). what() is the full report, one issue a line.
+class InvalidJob : public std::runtime_error {
+ public:
+  InvalidJob(const std::filesystem::path& job_file, std::vector<JobIssue> issues);
+  const std::vector<JobIssue>& issues() const { return issues_; }
+
+ private:
+  std::vector<JobIssue> issues_;
+};
+
+// The time grid of a run. t_k = k * dt for k < steps, and t_steps = t_end exactly.
+// With `t_end` in the job: steps = ceil(r (1 - 1e-9)) for r = t_end / dt_requested (the slack keeps a t_end that
+// is a whole number of steps up to rounding from gaining a tiny extra step), and dt = t_end / steps, so the run
+// ends exactly at t_end with |dt| <= |dt_requested|. With `steps`: dt = dt_requested and t_end = steps * dt.
+struct TimeGrid {
+  double dt_requested = 0.0;
+  double dt = 0.0;
+  std::uint64_t steps = 0;
+  double t_end = 0.0;
+  bool from_t_end = false;
+
+  double time_at(std::uint64_t step) const { return step == steps ? t_end : static_cast<double>(step) * dt; }
+};
+
+// The initial states, state-major as in nonsep::PhaseSpaceBatch: component i of state b at b*dimension + i.
+// `shape` says how the job wrote them: "single" (one object), "list" (an array of objects) or "grid".
+struct InitialStates {
+  std::string shape;
+  std::size_t dimension = 0;
+  std::size_t count = 0;
+  std::vector<double> q, p;
+};
+
+struct Job {
+  std::filesystem::path file;       // the job file as given
+  std::filesystem::path directory;  // its folder: relative paths in the job resolve against it
+  std::string plugin;               // /model/plugin: a name or a path
+  nlohmann::json parameters = nlohmann::json::object();  // /model/parameters as written
+  IntegratorSpec integrator;        // /hamiltonian and /integrator, defaults filled in from the catalogue
+  InitialStates initial;
+  TimeGrid time;
+  std::filesystem::path output_directory;  // /output/directory resolved against `directory`
+  std::uint64_t every = 1;                 // /output/every; 0: no trajectory file
+};
+
+// Largest accepted number of initial states and of steps; larger values are reported as out of range.
+inline constexpr std::size_t max_initial_states = 1'000'000;
+inline constexpr std::uint64_t max_steps = 1'000'000'000'000;
+
+// Pass 1. Parses `text` as JSON, refusing duplicate keys (nlohmann would keep the last one silently).
+// Returns nothing and adds issues on failure.
+std::optional<nlohmann::json> parse_job_text(const std::string& text, std::vector<JobIssue>& issues);
+
+// Pass 2. Reads `document` into a Job, adding an issue for everything wrong. `job_file` locates relative paths
+// and names the default output folder. The returned Job is meaningful only if no issue was added.
+Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_file, std::vector<JobIssue>& issues);
+
+// Pass 3 (parameters). Checks `given` (the job's /model/parameters, an object) against a plugin's declared
+// parameters: known names, types (integer, number, boolean), minimum and maximum.
+void check_model_parameters(const nlohmann::json& given, const std::vector<PluginParameter>& declared,
+                            std::vector<JobIssue>& issues);
+
+// Pass 3 (dimension). Checks the initial states against the model's dimension.
+void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues);
+
+// A job ready to run: the checked job, its plugin and a model instance created with the job's parameters.
+struct LoadedJob {
+  Job job;
+  Plugin plugin;
+  PluginModel model;
+};
+
+// All three passes on the file at `job_file`. Throws InvalidJob listing every issue (an unreadable file is an
+// issue at path ""). Exceptions other than InvalidJob mean a bug or an exhausted machine.
+LoadedJob load_job(const std::filesystem::path& job_file);
+
+}  // namespace nonsep::host

@@ -1,0 +1,22 @@
+#pragma once
+// Shortest round-trip decimal text of a double (std::to_chars): reading the text back gives the same double bit
+// for bit. Used for every number nonsep writes to CSV.
+#include <charconv>
+#include <string>
+
+namespace nonsep::host {
+
+// Appends the shortest text that round-trips to `value` ("0.1", "-1.5e-07", "inf", "nan").
+inline void append_number(std::string& out, double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, result.ptr);
+}
+
+inline std::string format_number(double value) {
+  std::string text;
+  append_number(text, value);
+  return text;
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,105 @@
+#include "nonsep/host/output_files.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "nonsep/host/number_format.hpp"
+
+namespace nonsep::host {
+
+namespace {
+constexpr std::size_t buffer_capacity = 1 << 16;
+
+std::string system_reason() { return std::strerror(errno); }
+}  // namespace
+
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, std::size_t dimension)
+    : path_(path), dimension_(dimension) {
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) throw OutputError("cannot create " + path.string() + ": " + system_reason());
+  buffer_.reserve(buffer_capacity + 1024);
+  buffer_ += "trajectory,step,t";
+  for (const char* name : {"q", "p"})
+    for (std::size_t i = 0; i < dimension; ++i) {
+      buffer_ += ',';
+      buffer_ += name;
+      buffer_ += std::to_string(i);
+    }
+  buffer_ += ",H,relative_energy_error\n";
+}
+
+TrajectoryWriter::~TrajectoryWriter() {
+  try {
+    drain();
+  } catch (const OutputError&) {
+  }
+  std::fclose(file_);
+}
+
+void TrajectoryWriter::write(std::size_t trajectory, std::uint64_t step, double t, std::span<const double> q,
+                             std::span<const double> p, std::optional<double> energy,
+                             std::optional<double> relative_energy_error) {
+  buffer_ += std::to_string(trajectory);
+  buffer_ += ',';
+  buffer_ += std::to_string(step);
+  buffer_ += ',';
+  append_number(buffer_, t);
+  for (std::size_t i = 0; i < dimension_; ++i) {
+    buffer_ += ',';
+    append_number(buffer_, q[i]);
+  }
+  for (std::size_t i = 0; i < dimension_; ++i) {
+    buffer_ += ',';
+    append_number(buffer_, p[i]);
+  }
+  buffer_ += ',';
+  if (energy) append_number(buffer_, *energy);
+  buffer_ += ',';
+  if (relative_energy_error) append_number(buffer_, *relative_energy_error);
+  buffer_ += '\n';
+  if (buffer_.size() >= buffer_capacity) drain();
+}
+
+void TrajectoryWriter::drain() {
+  if (buffer_.empty()) return;
+  const std::size_t written = std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
+  if (written != buffer_.size()) {
+    buffer_.clear();
+    throw OutputError("cannot write " + path_.string() + ": " + system_reason());
+  }
+  buffer_.clear();
+}
+
+void TrajectoryWriter::flush() {
+  drain();
+  if (std::fflush(file_) != 0) throw OutputError("cannot write " + path_.string() + ": " + system_reason());
+}
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& content) {
+  std::string temporary_name = ".";
+  temporary_name += path.filename().string();
+  temporary_name += ".tmp-";
+  temporary_name += std::to_string(::getpid());
+  const std::filesystem::path temporary = path.parent_path() / temporary_name;
+  std::FILE* file = std::fopen(temporary.c_str(), "wb");
+  if (!file) throw OutputError("cannot create " + temporary.string() + ": " + system_reason());
+  const bool written = std::fwrite(content.data(), 1, content.size(), file) == content.size() &&
+                       std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+  const std::string reason = system_reason();
+  const bool closed = std::fclose(file) == 0;
+  std::error_code error;
+  if (!written || !closed) {
+    std::filesystem::remove(temporary, error);
+    throw OutputError("cannot write " + temporary.string() + ": " + reason);
+  }
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    const std::string rename_reason = error.message();
+    std::filesystem::remove(temporary, error);
+    throw OutputError("cannot rename " + temporary.string() + " to " + path.string() + ": " + rename_reason);
+  }
+}
+
+}  // namespace nonsep::host
