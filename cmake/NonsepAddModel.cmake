@@ -1,7 +1,7 @@
 # nonsep_add_model(<target> [OUTPUT_DIRECTORY <dir>] <sources>...)
 #
 # Builds a nonsep model plugin: a MODULE library named exactly <target>.so (no "lib" prefix), all symbols hidden
-# except the entry point NONSEP_EXPORT_MODEL defines, linked to nonsep::sdk. The plugin's metadata name must equal
+# except the entry point NONSEP_EXPORT_MODEL defines, linked to nonsep::sdk, unloadable (no GNU unique symbols). The plugin's metadata name must equal
 # <target>. Used in the nonsep tree (shipped plugins land in NONSEP_BUILD_PLUGIN_DIR, the folder the host
 # searches last) and by installed users after find_package(nonsep) (the plugin lands in the current binary
 # folder; point NONSEP_PLUGIN_PATH at it, or load it by path).
@@ -17,6 +17,9 @@ function(nonsep_add_model target)
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON)
   target_compile_features(${target} PRIVATE cxx_std_20)
+  # GCC marks static locals of inline functions STB_GNU_UNIQUE, which makes glibc refuse to ever unload the
+  # library; a plugin's symbols are private to it, so uniqueness buys nothing and unloading must work.
+  target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-fno-gnu-unique>)
   target_link_libraries(${target} PRIVATE nonsep::sdk)
   if(arg_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${arg_OUTPUT_DIRECTORY}")

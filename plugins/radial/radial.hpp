@@ -10,7 +10,9 @@
 // on the direction p_hat, so a state with p = 0 has no defined motion. grad_T and hessian_T therefore refuse
 // p = 0 exactly with an evaluation failure ("... undefined at p = 0 ..."); T(0) = 0 itself is fine. V is smooth
 // everywhere (written in |q|^2, never |q|), including q = 0, where grad V = 0 and Hess V = identity.
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <nonsep/plugin_sdk.hpp>
 
@@ -46,20 +48,23 @@ struct Radial {
 
   // grad T = (1/p + p/2) p_vector.
   void grad_T(nonsep::sdk::Vector<double> p, std::span<double> out) const {
-    const double p_norm = std::sqrt(squared_norm(p));
+    const double p_norm = norm(p);
     refuse_zero_momentum(p_norm, "grad T");
     const double factor = 1.0 / p_norm + 0.5 * p_norm;
     for (std::size_t i = 0; i < p.size(); ++i) out[i] = factor * p[i];
   }
-  // Hess T_ij = (1/p + p/2) delta_ij + (1/(2p) - 1/p^3) p_i p_j.
+  // Hess T_ij = (1/p + p/2) (delta_ij - p_hat_i p_hat_j) + p p_hat_i p_hat_j  (T'/p across, T'' along p_hat;
+  // this form avoids the cancellation of 1/p terms, e.g. it is exactly p in one dimension).
   void hessian_T(nonsep::sdk::Vector<double> p, std::span<double> out) const {
-    const double p_norm = std::sqrt(squared_norm(p));
+    const double p_norm = norm(p);
     refuse_zero_momentum(p_norm, "the Hessian of T");
     const std::size_t n = p.size();
-    const double diagonal = 1.0 / p_norm + 0.5 * p_norm;
-    const double outer = 0.5 / p_norm - 1.0 / (p_norm * p_norm * p_norm);
+    const double across = 1.0 / p_norm + 0.5 * p_norm;
     for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = 0; j < n; ++j) out[i * n + j] = (i == j ? diagonal : 0.0) + outer * p[i] * p[j];
+      for (std::size_t j = 0; j < n; ++j) {
+        const double along = (p[i] / p_norm) * (p[j] / p_norm);
+        out[i * n + j] = across * ((i == j ? 1.0 : 0.0) - along) + p_norm * along;
+      }
   }
   // grad V = (1 + q^2/3) q_vector.
   void grad_V(nonsep::sdk::Vector<double> q, std::span<double> out) const {
@@ -75,6 +80,15 @@ struct Radial {
   }
 
  private:
+  // |x| without underflow for tiny components (|x| = 1e-200 stays 1e-200, not 0).
+  static double norm(nonsep::sdk::Vector<double> x) {
+    double scale = 0.0;
+    for (double xi : x) scale = std::max(scale, std::abs(xi));
+    if (scale == 0.0) return 0.0;
+    double sum = 0.0;
+    for (double xi : x) sum += (xi / scale) * (xi / scale);
+    return scale * std::sqrt(sum);
+  }
   static void refuse_zero_momentum(double p_norm, const char* what) {
     if (p_norm == 0.0)
       throw nonsep::sdk::EvaluationError(std::string(what) +

@@ -198,7 +198,9 @@ Dual<S, K> exp(const Dual<S, K>& x) {
 }
 template <class S, std::size_t K>
 Dual<S, K> log(const Dual<S, K>& x) {
-  return detail::chain(x, S(log(x.value)), S(S(1.0) / x.value));
+  // Below 0 the value is NaN; so is the derivative (1/x would pretend a derivative exists there).
+  const S f_prime = value_of(x) < 0.0 ? S(std::nan("")) : S(S(1.0) / x.value);
+  return detail::chain(x, S(log(x.value)), f_prime);
 }
 // x^e for a constant exponent e.
 template <class S, std::size_t K>

@@ -34,6 +34,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 
 #include "nonsep/core/error.hpp"
 #include "nonsep/sdk/dual.hpp"
@@ -150,32 +151,44 @@ inline void require_finite(const double* values, std::size_t size, const char* f
   for (std::size_t i = 0; i < size; ++i)
     if (!std::isfinite(values[i]))
       throw EvaluationError(std::string(function) + " is not finite at " + format_point(variable, x, n) +
-                            " (component " + std::to_string(i) + " is " + format_number(values[i]) + ")");
+                            (size == 1 ? " (it is " + format_number(values[i]) + ")"
+                                       : " (component " + std::to_string(i) + " is " + format_number(values[i]) + ")"));
 }
 
-// Writes the gradient of f at x (n <= K components) into out, by one pass of Dual<double, K>.
+// Automatic derivatives of a function that is not finite at x are meaningless (log(-1) has the "derivative" -1):
+// the value computed alongside them is checked first.
+inline void require_finite_value(double value, const char* function, const char* variable, const double* x,
+                                 std::size_t n) {
+  require_finite(&value, 1, function, variable, x, n);
+}
+
+// Writes the gradient of f at x (n <= K components) into out, by one pass of Dual<double, K>. Returns f(x).
 template <std::size_t K, class F>
-void gradient_by_dual(const F& f, const double* x, std::size_t n, double* out) {
+double gradient_by_dual(const F& f, const double* x, std::size_t n, double* out) {
   using D = Dual<double, K>;
   std::array<D, K> xs;
   for (std::size_t i = 0; i < n; ++i) xs[i] = D::variable(x[i], i);
   const D y = f(Vector<D>(xs.data(), n));
   for (std::size_t i = 0; i < n; ++i) out[i] = y.derivative[i];
+  return y.value;
 }
 
 // Writes the row-major n x n Hessian of f at x into out, column j from one pass of Dual<Dual<double, K>, 1>
-// seeded with e_j in the outer slot.
+// seeded with e_j in the outer slot. Returns f(x).
 template <std::size_t K, class F>
-void hessian_by_dual(const F& f, const double* x, std::size_t n, double* out) {
+double hessian_by_dual(const F& f, const double* x, std::size_t n, double* out) {
   using Inner = Dual<double, K>;
   using D = Dual<Inner, 1>;
   std::array<D, K> xs;
   for (std::size_t i = 0; i < n; ++i) xs[i].value = Inner::variable(x[i], i);
+  double value = 0.0;
   for (std::size_t j = 0; j < n; ++j) {
     for (std::size_t i = 0; i < n; ++i) xs[i].derivative[0] = Inner(i == j ? 1.0 : 0.0);
     const D y = f(Vector<D>(xs.data(), n));
     for (std::size_t i = 0; i < n; ++i) out[i * n + j] = y.derivative[0].derivative[i];
+    value = y.value.value;
   }
+  return value;
 }
 
 }  // namespace detail
@@ -194,6 +207,10 @@ class ModelAdapter {
   // The model built from checked parameters (see parse_parameters), dimension from the table when it is a
   // parameter. Throws InvalidParameter (from M's constructor, or a dimension out of 1..max_dimension).
   explicit ModelAdapter(const ParameterValues& values) : model_(construct(values)), dimension_(dimension_of(values)) {}
+  // A model object built by the caller (fixed-dimension models only).
+  explicit ModelAdapter(M model)
+    requires HasFixedDimension<M>
+      : model_(std::move(model)), dimension_(M::dimension) {}
   // The model with all parameters at their defaults.
   ModelAdapter() : ModelAdapter(parse_parameters(parameter_table<M>(), "{}")) {}
   // Parses and checks `parameters_json` first (parse_parameters).
@@ -235,7 +252,8 @@ class ModelAdapter {
       if constexpr (analytic_grad_T)
         model_.grad_T(Vector<double>(x, n), std::span<double>(g, n));
       else
-        detail::gradient_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, g);
+        detail::require_finite_value(
+            detail::gradient_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, g), "T", "p", x, n);
       detail::require_finite(g, n, "grad T", "p", x, n);
     }
   }
@@ -248,7 +266,8 @@ class ModelAdapter {
       if constexpr (analytic_grad_V)
         model_.grad_V(Vector<double>(x, n), std::span<double>(g, n));
       else
-        detail::gradient_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, g);
+        detail::require_finite_value(
+            detail::gradient_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, g), "V", "q", x, n);
       detail::require_finite(g, n, "grad V", "q", x, n);
     }
   }
@@ -261,7 +280,8 @@ class ModelAdapter {
       if constexpr (analytic_hessian_T)
         model_.hessian_T(Vector<double>(x, n), std::span<double>(h, n * n));
       else
-        detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h);
+        detail::require_finite_value(
+            detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h), "T", "p", x, n);
       detail::require_finite(h, n * n, "Hessian of T", "p", x, n);
     }
   }
@@ -274,7 +294,8 @@ class ModelAdapter {
       if constexpr (analytic_hessian_V)
         model_.hessian_V(Vector<double>(x, n), std::span<double>(h, n * n));
       else
-        detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h);
+        detail::require_finite_value(
+            detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h), "V", "q", x, n);
       detail::require_finite(h, n * n, "Hessian of V", "q", x, n);
     }
   }

@@ -1,0 +1,186 @@
+#pragma once
+// A derivative checker for model authors (and `nonsep inspect --check`): compares a model's gradients and
+// Hessians with finite differences at sample points, the way Ceres' GradientChecker does for cost functions.
+//
+// Input: any batched model in the layout of nonsep/core/model.hpp (a plugin's PluginModel, a
+// nonsep::sdk::ModelAdapter, a hand-written model) with
+//   dimension(), grad_T, grad_V                     always,
+//   value_T(x, out, count), value_V(x, out, count)  (one value per state) when options.check_gradients,
+//   hessian_T, hessian_V                            when options.check_hessians.
+// A model whose type lacks value_T/value_V or the Hessians is checked on what it has (those checks are skipped
+// and listed in report.skipped).
+//
+// Method: 5-point central differences, f'(x) ~ [f(x-2h) - 8 f(x-h) + 8 f(x+h) - f(x+2h)] / (12 h) with
+// h = options.step * max(1, |x_i|); truncation error O(h^4), rounding error O(eps/h), about 1e-12 relative for
+// smooth models at the default step. Gradients are differenced from the values, Hessians from the gradients.
+// Every stencil of one check is one batched call, so a plugin is crossed once per function and sample point.
+//
+// Output: a DerivativeCheckReport. A comparison fails when |analytic - finite difference| >
+// options.tolerance * max(1, |finite difference|). Evaluation failures of the model propagate (ModelError).
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace nonsep {
+
+struct DerivativeCheckOptions {
+  std::size_t random_points = 16;    // sample points drawn uniformly from [-box, box]^n (same draw for p and q)
+  double box = 1.5;
+  std::uint64_t seed = 12345;
+  std::vector<std::vector<double>> points;  // further sample points, each with dimension() numbers
+  double step = 1e-3;                       // relative finite-difference step
+  double tolerance = 1e-6;                  // allowed error, relative to max(1, |finite difference|)
+  bool check_gradients = true;              // grad T, grad V against differences of T, V (needs values)
+  bool check_hessians = true;               // Hessians against differences of the gradients
+};
+
+struct DerivativeMismatch {
+  std::string function;       // "grad_T", "grad_V", "hessian_T" or "hessian_V"
+  std::vector<double> point;  // p for *_T, q for *_V
+  std::size_t component;      // index into the gradient (i) or row-major Hessian (i*n + j)
+  double computed;
+  double finite_difference;
+};
+
+struct DerivativeCheckReport {
+  std::size_t comparisons = 0;
+  double largest_error = 0.0;  // max |computed - finite difference| / max(1, |finite difference|)
+  std::vector<DerivativeMismatch> mismatches;
+  std::vector<std::string> skipped;  // checks not made, with the reason
+
+  bool passed() const { return mismatches.empty(); }
+  // Several lines: counts, the largest error, then up to `shown` mismatches and the skipped checks.
+  std::string summary(std::size_t shown = 10) const {
+    std::string text = std::to_string(comparisons) + " derivative entries compared with finite differences, " +
+                       std::to_string(mismatches.size()) + " mismatches; largest relative error " +
+                       std::to_string(largest_error) + "\n";
+    for (std::size_t k = 0; k < std::min(shown, mismatches.size()); ++k) {
+      const auto& m = mismatches[k];
+      std::string point;
+      for (double x : m.point) point += (point.empty() ? "" : ", ") + std::to_string(x);
+      text += "  " + m.function + "[" + std::to_string(m.component) + "] at (" + point +
+              "): computed " + std::to_string(m.computed) + ", finite difference " +
+              std::to_string(m.finite_difference) + "\n";
+    }
+    for (const auto& s : skipped) text += "  skipped: " + s + "\n";
+    return text;
+  }
+};
+
+namespace detail {
+
+template <class M>
+concept ModelWithValues = requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
+  m.value_T(x, out, count);
+  m.value_V(x, out, count);
+};
+template <class M>
+concept ModelWithHessianFunctions =
+    requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
+      m.hessian_T(x, out, count);
+      m.hessian_V(x, out, count);
+    };
+
+// The 4n stencil points x -/+ 2h e_i, x -/+ h e_i, in the order (i, offset -2, -1, +1, +2).
+inline std::vector<double> stencil(const std::vector<double>& x, double relative_step, std::vector<double>& steps) {
+  const std::size_t n = x.size();
+  std::vector<double> points;
+  points.reserve(4 * n * n);
+  steps.assign(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    steps[i] = relative_step * std::max(1.0, std::abs(x[i]));
+    for (double offset : {-2.0, -1.0, 1.0, 2.0}) {
+      std::vector<double> shifted = x;
+      shifted[i] += offset * steps[i];
+      points.insert(points.end(), shifted.begin(), shifted.end());
+    }
+  }
+  return points;
+}
+
+inline double five_point(const double* f, std::size_t stride, double h) {
+  return (f[0] - 8.0 * f[stride] + 8.0 * f[2 * stride] - f[3 * stride]) / (12.0 * h);
+}
+
+inline void compare(DerivativeCheckReport& report, const DerivativeCheckOptions& options, const char* function,
+                    const std::vector<double>& point, std::size_t component, double computed, double difference) {
+  const double error = std::abs(computed - difference) / std::max(1.0, std::abs(difference));
+  ++report.comparisons;
+  report.largest_error = std::max(report.largest_error, std::isfinite(error) ? error : INFINITY);
+  if (!(error <= options.tolerance))
+    report.mismatches.push_back({function, point, component, computed, difference});
+}
+
+}  // namespace detail
+
+template <class M>
+DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOptions& options = {}) {
+  const std::size_t n = model.dimension();
+  std::vector<std::vector<double>> points = options.points;
+  std::mt19937_64 engine(options.seed);
+  std::uniform_real_distribution<double> uniform(-options.box, options.box);
+  for (std::size_t k = 0; k < options.random_points; ++k) {
+    std::vector<double> x(n);
+    for (double& xi : x) xi = uniform(engine);
+    points.push_back(std::move(x));
+  }
+
+  DerivativeCheckReport report;
+  constexpr bool has_values = detail::ModelWithValues<M>;
+  constexpr bool has_hessians = detail::ModelWithHessianFunctions<M>;
+  if (options.check_gradients && !has_values) report.skipped.push_back("gradients: the model has no value_T/value_V");
+  if (options.check_hessians && !has_hessians) report.skipped.push_back("Hessians: the model has no hessian_T/hessian_V");
+
+  std::vector<double> steps, gradient(n), hessian(n * n), stencil_values, stencil_gradients;
+  for (const auto& x : points) {
+    if (x.size() != n) {
+      report.skipped.push_back("a sample point with " + std::to_string(x.size()) + " numbers for dimension " +
+                               std::to_string(n));
+      continue;
+    }
+    const std::vector<double> shifted = detail::stencil(x, options.step, steps);
+    const std::size_t count = 4 * n;
+    for (const bool kinetic : {true, false}) {
+      if constexpr (has_values) {
+        if (options.check_gradients) {
+          stencil_values.resize(count);
+          if (kinetic) {
+            model.grad_T(x, gradient, 1);
+            model.value_T(shifted, stencil_values, count);
+          } else {
+            model.grad_V(x, gradient, 1);
+            model.value_V(shifted, stencil_values, count);
+          }
+          for (std::size_t i = 0; i < n; ++i)
+            detail::compare(report, options, kinetic ? "grad_T" : "grad_V", x, i, gradient[i],
+                            detail::five_point(stencil_values.data() + 4 * i, 1, steps[i]));
+        }
+      }
+      if constexpr (has_hessians) {
+        if (options.check_hessians) {
+          stencil_gradients.resize(count * n);
+          if (kinetic) {
+            model.hessian_T(x, hessian, 1);
+            model.grad_T(shifted, stencil_gradients, count);
+          } else {
+            model.hessian_V(x, hessian, 1);
+            model.grad_V(shifted, stencil_gradients, count);
+          }
+          // Column j of the Hessian is the derivative of the gradient along e_j (stencil block j).
+          for (std::size_t j = 0; j < n; ++j)
+            for (std::size_t i = 0; i < n; ++i)
+              detail::compare(report, options, kinetic ? "hessian_T" : "hessian_V", x, i * n + j, hessian[i * n + j],
+                              detail::five_point(stencil_gradients.data() + 4 * j * n + i, n, steps[j]));
+        }
+      }
+    }
+  }
+  return report;
+}
+
+}  // namespace nonsep

@@ -1,0 +1,215 @@
+// Every way a plugin can be wrong is refused with its own message (and no crash): missing file, unknown name, not
+// a shared library, no entry symbol, ABI version, table size, metadata, create failing, and evaluation failing
+// with a status or by throwing inside the plugin.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/plugin_abi.h"
+
+using namespace nonsep::host;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path test_plugins = NONSEP_TEST_PLUGIN_DIR;
+const fs::path build_plugins = NONSEP_BUILD_PLUGIN_DIR;
+
+std::string load_error(const std::string& spec, const fs::path& base = test_plugins) {
+  try {
+    load_plugin(spec, base);
+  } catch (const PluginError& e) {
+    return e.what();
+  }
+  return "(loaded without error)";
+}
+
+template <class Error = PluginError>
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Sets NONSEP_PLUGIN_PATH for the lifetime of the object.
+struct PluginPathVariable {
+  explicit PluginPathVariable(const std::string& value) { ::setenv("NONSEP_PLUGIN_PATH", value.c_str(), 1); }
+  ~PluginPathVariable() { ::unsetenv("NONSEP_PLUGIN_PATH"); }
+};
+
+}  // namespace
+
+TEST_CASE("the valid hand-written plugin loads, so each defect below is the only reason for its failure") {
+  const Plugin plugin = load_plugin("hand_written.so", test_plugins);
+  CHECK(plugin.name() == "hand_written");
+  CHECK_FALSE(plugin.has_hessians());
+  const PluginModel model = plugin.create(nlohmann::json::object());
+  const double p[] = {0.25};
+  double out[1] = {0.0};
+  model.grad_T(p, out, 1);
+  CHECK(out[0] == 0.25);
+}
+
+TEST_CASE("missing file: the resolved path and what it was relative to") {
+  const std::string message = load_error("models/absent.so", "/jobs/run1");
+  CHECK(message == "plugin file '/jobs/run1/models/absent.so' does not exist ('models/absent.so' relative to "
+                   "'/jobs/run1')");
+  CHECK(load_error("/nowhere/absent.so") == "plugin file '/nowhere/absent.so' does not exist");
+}
+
+TEST_CASE("unknown name: every folder tried is listed, NONSEP_PLUGIN_PATH first") {
+  const PluginPathVariable variable("/nonexistent/first:/nonexistent/second");
+  const auto search_path = plugin_search_path();
+  REQUIRE(search_path.size() >= 3);
+  CHECK(search_path[0] == "/nonexistent/first");
+  CHECK(search_path[1] == "/nonexistent/second");
+  CHECK(search_path.back() == build_plugins.lexically_normal());
+  const std::string message = load_error("no_such_model", "");
+  CHECK(contains(message, "plugin 'no_such_model' not found"));
+  for (const auto& directory : search_path) CHECK(contains(message, (directory / "no_such_model.so").string()));
+}
+
+TEST_CASE("names are found in NONSEP_PLUGIN_PATH before the build tree, paths relative to the job folder") {
+  {
+    const PluginPathVariable variable(test_plugins.string());
+    CHECK(load_plugin("hand_written", "").path() == test_plugins / "hand_written.so");
+  }
+  CHECK(load_plugin("paper1d", "").path() == build_plugins / "paper1d.so");
+  CHECK(load_plugin("../paper1d.so", build_plugins / "CMakeFiles").path() == build_plugins / "paper1d.so");
+}
+
+TEST_CASE("not a shared library: the dynamic loader's own text is included") {
+  const std::string message = load_error("not_a_library.so");
+  CHECK(contains(message, "cannot load '" + (test_plugins / "not_a_library.so").string() + "' as a shared library"));
+  CHECK(contains(message, "invalid ELF header"));
+}
+
+TEST_CASE("no entry symbol") {
+  const std::string file = (test_plugins / "missing_entry_symbol.so").string();
+  CHECK(load_error("missing_entry_symbol.so") ==
+        std::string("'").append(file).append(
+            "' is a shared library but not a nonsep plugin: it does not export the entry symbol "
+            "'nonsep_plugin_entry' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp)"));
+}
+
+TEST_CASE("ABI version mismatch: expected and found") {
+  const std::string message = load_error("wrong_abi_version.so");
+  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 1 (expected 1, found 2)"));
+}
+
+TEST_CASE("wrong table size: expected and found") {
+  const std::size_t expected = sizeof(nonsep_plugin_api), found = expected - sizeof(void*);
+  const std::string message = load_error("wrong_table_size.so");
+  CHECK(contains(message, "(expected " + std::to_string(expected) + ", found " + std::to_string(found) + ")"));
+  CHECK(contains(message, "has a function table of " + std::to_string(found) + " bytes"));
+}
+
+TEST_CASE("metadata that is not valid JSON") {
+  const std::string message = load_error("invalid_metadata_json.so");
+  CHECK(contains(message, "the metadata of plugin '" + (test_plugins / "invalid_metadata_json.so").string() +
+                              "' is not valid JSON: [json.exception.parse_error"));
+  CHECK(contains(message, "(metadata begins: \"{\"name\": \"invalid_metadata_json\", \"version\": \")"));
+}
+
+TEST_CASE("metadata whose name is not the file's") {
+  CHECK(contains(load_error("metadata_names_another.so"),
+                 "declares the name 'someone_else' but the file is named metadata_names_another.so; a plugin's "
+                 "file must be <name>.so (expected 'metadata_names_another', found 'someone_else')"));
+}
+
+TEST_CASE("a required function missing from the table") {
+  CHECK(contains(load_error("missing_grad_V.so"), "lacks the required function grad_V (its table entry is null)"));
+}
+
+TEST_CASE("capabilities that disagree with the table") {
+  CHECK(contains(load_error("capability_mismatch.so"),
+                 "says capability \"hessian_T\" is true but the table's hessian_T pointer is null"));
+}
+
+TEST_CASE("create failing inside the plugin: its message names the parameter") {
+  const Plugin plugin = load_plugin("create_failing.so", test_plugins);
+  CHECK(plugin.create({{"inner_radius", 1.5}}).dimension() == 1);
+  const std::string message = error_of([&] { plugin.create({{"inner_radius", 3.0}}); });
+  CHECK(contains(message, "could not create a model (invalid parameters): parameter 'inner_radius' must be "
+                          "smaller than 'outer_radius'"));
+}
+
+TEST_CASE("parameters refused by the host before create(), each naming the parameter") {
+  const Plugin radial = load_plugin("radial", "");
+  CHECK(contains(error_of([&] { radial.create({{"dimension", 17}}); }),
+                 "parameter 'dimension' = 17 is above its maximum 16"));
+  CHECK(contains(error_of([&] { radial.create({{"dimension", 2.5}}); }),
+                 "parameter 'dimension' must be an integer (found 2.5)"));
+  CHECK(contains(error_of([&] { radial.create({{"dimenson", 3}}); }),
+                 "unknown parameter 'dimenson' (known parameters: dimension)"));
+  CHECK(contains(error_of([&] { radial.create(nlohmann::json::array()); }),
+                 "the parameters must be a JSON object"));
+  CHECK(contains(error_of([&] { load_plugin("quadratic_kinetic", "").create({{"lambda", "big"}}); }),
+                 "parameter 'lambda' must be a number (found \"big\")"));
+  CHECK(contains(error_of([&] { load_plugin("paper1d", "").create({{"lambda", 1}}); }),
+                 "unknown parameter 'lambda' (this model has no parameters)"));
+  CHECK(radial.create({{"dimension", 16}}).parameters() == nlohmann::json{{"dimension", 16}});
+  CHECK(radial.create(nlohmann::json::object()).dimension() == 2);
+}
+
+TEST_CASE("an evaluation returning an error status becomes a ModelError with the plugin's message") {
+  const PluginModel model = load_plugin("evaluation_fails.so", test_plugins).create(nlohmann::json::object());
+  const double inside[] = {0.5}, outside[] = {1.5};
+  double out[1];
+  model.grad_V(inside, out, 1);
+  CHECK(out[0] == doctest::Approx(4.0 / 3.0));
+  CHECK(error_of<nonsep::ModelError>([&] { model.grad_V(outside, out, 1); }) ==
+        "plugin 'evaluation_fails' failed in grad_V (evaluation failed): V = -log(1 - q^2) needs |q| < 1 (found q = "
+        "1.500000)");
+  CHECK(error_of<nonsep::ModelError>([&] { model.hessian_V(outside, out, 1); }) ==
+        "plugin 'evaluation_fails' failed in hessian_V (evaluation failed): V is not finite at q = (1.5) (it is nan)");
+}
+
+TEST_CASE("an exception thrown inside the plugin is caught there and becomes a ModelError") {
+  const PluginModel model = load_plugin("evaluation_throws.so", test_plugins).create(nlohmann::json::object());
+  const double p[] = {0.5};
+  double out[1];
+  CHECK(error_of<nonsep::ModelError>([&] { model.grad_T(p, out, 1); }) ==
+        "plugin 'evaluation_throws' failed in grad_T (internal error): exception in grad_T: deliberate bug: index 7 "
+        "out of range in grad_T");
+  model.grad_V(p, out, 1);  // the instance is still usable
+  CHECK(out[0] == 0.5);
+}
+
+TEST_CASE("an optional function the plugin lacks, and a batch that does not fit") {
+  const PluginModel model = load_plugin("hand_written.so", test_plugins).create(nlohmann::json::object());
+  const double x[] = {0.5, 0.25};
+  double out[4];
+  CHECK(error_of<nonsep::ModelError>([&] { model.hessian_T(x, out, 1); }) ==
+        "plugin 'hand_written' does not provide hessian_T (its capability is false)");
+  CHECK(contains(error_of<nonsep::InvalidArgument>([&] { model.grad_T(std::span(x, 1), out, 2); }),
+                 "grad_T: a batch of 2 states of dimension 1 needs 2 inputs and 2 outputs (found 1 and 4)"));
+}
+
+TEST_CASE("discovery lists good plugins and the failures with their errors, first of each name winning") {
+  const PluginPathVariable variable(test_plugins.string());
+  const auto found = discover_plugins();
+  auto entry = [&](const std::string& stem) -> const DiscoveredPlugin* {
+    for (const auto& d : found)
+      if (d.path.stem() == stem) return &d;
+    return nullptr;
+  };
+  REQUIRE(entry("paper1d") != nullptr);
+  CHECK(entry("paper1d")->plugin.has_value());
+  REQUIRE(entry("wrong_abi_version") != nullptr);
+  CHECK_FALSE(entry("wrong_abi_version")->plugin.has_value());
+  CHECK(contains(entry("wrong_abi_version")->error, "(expected 1, found 2)"));
+  REQUIRE(entry("not_a_library") != nullptr);
+  CHECK(contains(entry("not_a_library")->error, "invalid ELF header"));
+  CHECK(entry("hand_written")->path == test_plugins / "hand_written.so");
+}

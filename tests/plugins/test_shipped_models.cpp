@@ -1,0 +1,208 @@
+// The shipped models, loaded as plugins: they pass the derivative checker, their automatic and analytic
+// derivatives agree to 1e-12, the energy the core computes from them is the Hamiltonian each documents, and a
+// plugin steps exactly like the same model compiled in.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/energy.hpp"
+#include "nonsep/derivative_checker.hpp"
+#include "nonsep/host/plugin_loader.hpp"
+#include "paper1d/paper1d.hpp"
+#include "quadratic_kinetic/quadratic_kinetic.hpp"
+#include "radial/radial.hpp"
+#include "tao_product/tao_product.hpp"
+
+using nonsep::host::load_plugin;
+using nonsep::host::PluginModel;
+using nonsep::sdk::Derivatives;
+using nonsep::sdk::ModelAdapter;
+
+namespace {
+
+PluginModel shipped(const std::string& name, const nlohmann::json& parameters = nlohmann::json::object()) {
+  return load_plugin(std::string(NONSEP_BUILD_PLUGIN_DIR) + "/" + name + ".so", "").create(parameters);
+}
+
+std::vector<double> random_points(std::size_t count, std::size_t n, double box, unsigned seed) {
+  std::mt19937_64 engine(seed);
+  std::uniform_real_distribution<double> uniform(-box, box);
+  std::vector<double> x(count * n);
+  for (double& xi : x) xi = uniform(engine);
+  return x;
+}
+
+// |a - b| <= 1e-12 max(1, |b|) for every entry.
+void check_agree(const std::vector<double>& a, const std::vector<double>& b, const char* what) {
+  REQUIRE(a.size() == b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    CAPTURE(what);
+    CAPTURE(k);
+    CHECK(std::abs(a[k] - b[k]) <= 1e-12 * std::max(1.0, std::abs(b[k])));
+  }
+}
+
+// Automatic versus analytic (preferred) derivatives of model class M at 64 random points per variable.
+template <class M>
+void check_automatic_matches_analytic(const std::string& parameters = "{}") {
+  const auto automatic = ModelAdapter<M, Derivatives::automatic>::from_json(parameters);
+  const auto analytic = ModelAdapter<M, Derivatives::preferred>::from_json(parameters);
+  static_assert(ModelAdapter<M>::analytic_grad_T && ModelAdapter<M>::analytic_grad_V,
+                "every shipped model has analytic gradients");
+  const std::size_t n = automatic.dimension(), count = 64;
+  const auto x = random_points(count, n, 2.0, 7);
+  std::vector<double> a(n * count), b(n * count), ha(n * n * count), hb(n * n * count);
+  automatic.grad_T(x, a, count);
+  analytic.grad_T(x, b, count);
+  check_agree(a, b, "grad_T");
+  automatic.grad_V(x, a, count);
+  analytic.grad_V(x, b, count);
+  check_agree(a, b, "grad_V");
+  automatic.hessian_T(x, ha, count);
+  analytic.hessian_T(x, hb, count);
+  check_agree(ha, hb, "hessian_T");
+  automatic.hessian_V(x, ha, count);
+  analytic.hessian_V(x, hb, count);
+  check_agree(ha, hb, "hessian_V");
+}
+
+// H_TTV from the core's EnergyEvaluator (grad T . Hess V grad T) against the closed form, at random states.
+template <class ClosedForm>
+void check_energy(const PluginModel& model, const ClosedForm& expected) {
+  const std::size_t n = model.dimension(), count = 32;
+  nonsep::PhaseSpaceBatch x(n, count);
+  const auto q = random_points(count, n, 1.8, 11), p = random_points(count, n, 1.8, 13);
+  std::copy(q.begin(), q.end(), x.q().begin());
+  std::copy(p.begin(), p.end(), x.p().begin());
+  std::vector<double> energies(count);
+  nonsep::EnergyEvaluator(nonsep::HamiltonianForm::TTV).evaluate(model, x, energies);
+  for (std::size_t b = 0; b < count; ++b) {
+    CAPTURE(b);
+    CHECK(energies[b] == doctest::Approx(expected(x.q(b), x.p(b))).epsilon(1e-13));
+  }
+}
+
+double squared_norm(std::span<const double> x) {
+  double sum = 0.0;
+  for (double xi : x) sum += xi * xi;
+  return sum;
+}
+
+}  // namespace
+
+TEST_CASE("automatic and analytic derivatives of the shipped models agree to 1e-12") {
+  SUBCASE("paper1d") { check_automatic_matches_analytic<Paper1D>(); }
+  SUBCASE("radial, dimension 1") { check_automatic_matches_analytic<Radial>(R"({"dimension": 1})"); }
+  SUBCASE("radial, dimension 3") { check_automatic_matches_analytic<Radial>(R"({"dimension": 3})"); }
+  SUBCASE("radial, dimension 16") { check_automatic_matches_analytic<Radial>(R"({"dimension": 16})"); }
+  SUBCASE("quadratic_kinetic") { check_automatic_matches_analytic<QuadraticKinetic>(R"({"lambda": 0.7})"); }
+  SUBCASE("tao_product") { check_automatic_matches_analytic<TaoProduct>(); }
+}
+
+TEST_CASE("every shipped plugin passes the derivative checker") {
+  const std::pair<const char*, nlohmann::json> plugins[] = {{"paper1d", nlohmann::json::object()},
+                                                            {"radial", {{"dimension", 2}}},
+                                                            {"radial", {{"dimension", 5}}},
+                                                            {"quadratic_kinetic", {{"lambda", -1.5}}},
+                                                            {"tao_product", nlohmann::json::object()}};
+  for (const auto& [name, parameters] : plugins) {
+    CAPTURE(std::string(name));
+    const PluginModel model = shipped(name, parameters);
+    CHECK(model.plugin().has_values());
+    CHECK(model.plugin().has_hessians());
+    const auto report = nonsep::check_derivatives(model);
+    INFO(report.summary());
+    CHECK(report.passed());
+    CHECK(report.skipped.empty());
+    CHECK(report.comparisons > 0);
+  }
+}
+
+TEST_CASE("each shipped model documents T, V and the Hamiltonian it solves") {
+  for (const char* name : {"paper1d", "radial", "quadratic_kinetic", "tao_product"}) {
+    CAPTURE(std::string(name));
+    const auto plugin = load_plugin(name, "");
+    CHECK(plugin.name() == name);
+    const std::string hamiltonian = plugin.metadata()["hamiltonian"].get<std::string>();
+    CHECK(hamiltonian.find("T = ") != std::string::npos);
+    CHECK(hamiltonian.find("V = ") != std::string::npos);
+    CHECK(hamiltonian.find("H_TTV = ") != std::string::npos);
+    CHECK(plugin.metadata()["derivatives"]["grad_T"] == "analytic");
+  }
+}
+
+TEST_CASE("the energy of each shipped model is the Hamiltonian it documents") {
+  SUBCASE("paper1d: (1 + p^2/2)^2 (1 + q^2)") {
+    check_energy(shipped("paper1d"), [](auto q, auto p) { return std::pow(1 + p[0] * p[0] / 2, 2) * (1 + q[0] * q[0]); });
+  }
+  SUBCASE("radial: (1 + p^2/2)^2 [1 + q^2/3 + (2/3) q^2 (p_hat . q_hat)^2]") {
+    for (int dimension : {1, 2, 3, 7}) {
+      CAPTURE(dimension);
+      check_energy(shipped("radial", {{"dimension", dimension}}), [](auto q, auto p) {
+        const double p2 = squared_norm(p), q2 = squared_norm(q);
+        double dot = 0.0;
+        for (std::size_t i = 0; i < p.size(); ++i) dot += p[i] * q[i];
+        const double cosine2 = dot * dot / (p2 * q2);
+        return std::pow(1 + p2 / 2, 2) * (1 + q2 / 3 + 2.0 / 3.0 * q2 * cosine2);
+      });
+    }
+  }
+  SUBCASE("quadratic_kinetic: p_i V_ij p_j of Henon-Heiles") {
+    const double lambda = 0.8;
+    check_energy(shipped("quadratic_kinetic", {{"lambda", lambda}}), [&](auto q, auto p) {
+      return p[0] * p[0] + p[1] * p[1] + 2 * lambda * (q[1] * p[0] * p[0] + 2 * q[0] * p[0] * p[1] - q[1] * p[1] * p[1]);
+    });
+  }
+  SUBCASE("tao_product: (q^2 + 1)(p^2 + 1)/2") {
+    check_energy(shipped("tao_product"), [](auto q, auto p) { return (q[0] * q[0] + 1) * (p[0] * p[0] + 1) / 2; });
+  }
+}
+
+TEST_CASE("radial: p = 0 is refused with an explanation, q = 0 is an ordinary point") {
+  const PluginModel model = shipped("radial", {{"dimension", 3}});
+  const std::vector<double> zero(3, 0.0);
+  std::vector<double> gradient(3), hessian(9), value(1);
+  for (const auto& call : {std::function<void()>([&] { model.grad_T(zero, gradient, 1); }),
+                           std::function<void()>([&] { model.hessian_T(zero, hessian, 1); })}) {
+    std::string message;
+    try {
+      call();
+    } catch (const nonsep::ModelError& e) {
+      message = e.what();
+    }
+    CHECK(message.find("(evaluation failed)") != std::string::npos);
+    CHECK(message.find("is undefined at p = 0") != std::string::npos);
+  }
+  model.value_T(zero, value, 1);
+  CHECK(value[0] == 0.0);
+  model.grad_V(zero, gradient, 1);
+  CHECK(gradient == std::vector<double>(3, 0.0));
+  model.hessian_V(zero, hessian, 1);
+  CHECK(hessian == std::vector<double>{1, 0, 0, 0, 1, 0, 0, 0, 1});
+  // Arbitrarily close to p = 0 the gradient is defined, of length -> 1 along p.
+  const std::vector<double> tiny = {1e-300, 0.0, 0.0};
+  model.grad_T(tiny, gradient, 1);
+  CHECK(gradient[0] == doctest::Approx(1.0).epsilon(1e-15));
+  CHECK(gradient[1] == 0.0);
+  CHECK(gradient[2] == 0.0);
+}
+
+TEST_CASE("a plugin steps bit for bit like the same model compiled in") {
+  const PluginModel plugin = shipped("paper1d");
+  const ModelAdapter<Paper1D> compiled_in;
+  const double q0[] = {0.5}, p0[] = {0.0};
+  auto through_plugin = nonsep::PhaseSpaceBatch::single(q0, p0);
+  auto in_process = through_plugin;
+  nonsep::ChinBasicStep a, b;
+  for (int k = 0; k < 1000; ++k) {
+    a.step(plugin, through_plugin, 0.005);
+    b.step(compiled_in, in_process, 0.005);
+  }
+  CHECK(through_plugin == in_process);
+  CHECK(through_plugin.q()[0] != q0[0]);
+}
