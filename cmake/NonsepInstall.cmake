@@ -1,17 +1,37 @@
 # Installation: headers, libraries, the host, shipped plugins and the CMake package `nonsep`
-# (find_package(nonsep) provides nonsep::core, nonsep::sdk and nonsep_add_model()).
+# (find_package(nonsep) provides nonsep::core, nonsep::sdk, nonsep::loader and nonsep_add_model()).
+#
+# Layout under the prefix:
+#   include/nonsep/...                  core, SDK (plugin_abi.h, plugin_sdk.hpp, derivative_checker.hpp), loader
+#   lib/libnonsep_core.a, lib/libnonsep_loader.a
+#   lib/nonsep/plugins/<name>.so        shipped models (NONSEP_INSTALL_PLUGINDIR; the host finds it from bin/)
+#   lib/cmake/nonsep/                   nonsepConfig.cmake, targets, NonsepAddModel.cmake
 include(CMakePackageConfigHelpers)
 
 set(NONSEP_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/nonsep")
 
 install(DIRECTORY core/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(TARGETS nonsep_core EXPORT nonsepTargets
+set(nonsep_exported_targets nonsep_core)
+if(TARGET nonsep_sdk)
+  install(DIRECTORY plugins/sdk/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  list(APPEND nonsep_exported_targets nonsep_sdk)
+  install(TARGETS ${NONSEP_SHIPPED_MODELS} LIBRARY DESTINATION ${NONSEP_INSTALL_PLUGINDIR})
+endif()
+if(TARGET nonsep_loader)
+  install(DIRECTORY host/loader/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  list(APPEND nonsep_exported_targets nonsep_loader)
+endif()
+install(TARGETS ${nonsep_exported_targets} EXPORT nonsepTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 
 install(EXPORT nonsepTargets NAMESPACE nonsep:: DESTINATION ${NONSEP_INSTALL_CMAKEDIR})
 configure_package_config_file(cmake/nonsepConfig.cmake.in "${PROJECT_BINARY_DIR}/nonsepConfig.cmake"
-  INSTALL_DESTINATION ${NONSEP_INSTALL_CMAKEDIR})
+  INSTALL_DESTINATION ${NONSEP_INSTALL_CMAKEDIR}
+  PATH_VARS NONSEP_INSTALL_PLUGINDIR)
 write_basic_package_version_file("${PROJECT_BINARY_DIR}/nonsepConfigVersion.cmake" COMPATIBILITY SameMinorVersion)
-install(FILES "${PROJECT_BINARY_DIR}/nonsepConfig.cmake" "${PROJECT_BINARY_DIR}/nonsepConfigVersion.cmake"
+install(FILES
+  "${PROJECT_BINARY_DIR}/nonsepConfig.cmake"
+  "${PROJECT_BINARY_DIR}/nonsepConfigVersion.cmake"
+  cmake/NonsepAddModel.cmake
   DESTINATION ${NONSEP_INSTALL_CMAKEDIR})

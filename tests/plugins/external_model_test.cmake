@@ -1,0 +1,40 @@
+# Installs nonsep into a fresh prefix, builds examples/external_model against it as a user would, and loads the
+# plugin it built. Run by ctest as
+#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DCHECK_PROGRAM=... -DBUILD_TYPE=... -P external_model_test.cmake
+foreach(variable BUILD_DIR SOURCE_DIR WORK_DIR CHECK_PROGRAM)
+  if(NOT DEFINED ${variable})
+    message(FATAL_ERROR "external_model_test.cmake: ${variable} is not set")
+  endif()
+endforeach()
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE output ERROR_VARIABLE output)
+  if(NOT status EQUAL 0)
+    message(FATAL_ERROR "failed (${status}): ${ARGN}\n${output}")
+  endif()
+  set(last_output "${output}" PARENT_SCOPE)
+endfunction()
+
+file(REMOVE_RECURSE "${WORK_DIR}")
+set(prefix "${WORK_DIR}/prefix")
+run(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${prefix}")
+
+foreach(installed
+    include/nonsep/plugin_abi.h include/nonsep/plugin_sdk.hpp include/nonsep/derivative_checker.hpp
+    include/nonsep/host/plugin_loader.hpp lib/cmake/nonsep/nonsepConfig.cmake lib/cmake/nonsep/NonsepAddModel.cmake
+    lib/nonsep/plugins/paper1d.so lib/nonsep/plugins/radial.so lib/nonsep/plugins/quadratic_kinetic.so
+    lib/nonsep/plugins/tao_product.so)
+  if(NOT EXISTS "${prefix}/${installed}")
+    message(FATAL_ERROR "the install lacks ${installed}")
+  endif()
+endforeach()
+
+run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/examples/external_model" -B "${WORK_DIR}/build"
+    -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCMAKE_CXX_COMPILER=${CXX_COMPILER})
+run(${CMAKE_COMMAND} --build "${WORK_DIR}/build" -j2)
+set(plugin "${WORK_DIR}/build/relativistic_pendulum.so")
+if(NOT EXISTS "${plugin}")
+  message(FATAL_ERROR "the example did not produce ${plugin}")
+endif()
+run("${CHECK_PROGRAM}" "${plugin}")
+message(STATUS "${last_output}")
