@@ -160,6 +160,7 @@ TEST_CASE("parameters refused by the host before create(), each naming the param
                  "unknown parameter 'lambda' (this model has no parameters)"));
   CHECK(radial.create({{"dimension", 16}}).parameters() == nlohmann::json{{"dimension", 16}});
   CHECK(radial.create(nlohmann::json::object()).dimension() == 2);
+  CHECK(radial.create({}).dimension() == 2);  // {} is a JSON null for nlohmann::json: no parameters
 }
 
 TEST_CASE("an evaluation returning an error status becomes a ModelError with the plugin's message") {

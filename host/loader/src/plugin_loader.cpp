@@ -55,7 +55,7 @@ const char* status_name(nonsep_status status) {
   return "unknown status";
 }
 
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+std::string quoted(const fs::path& path) { return std::string("'").append(path.string()).append("'"); }
 
 // The metadata checks of plugin_abi.h, after the JSON has parsed. Throws PluginError naming the field.
 void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path& path) {
@@ -177,8 +177,10 @@ std::vector<PluginParameter> Plugin::parameters() const {
   return result;
 }
 
-PluginModel Plugin::create(const json& given) const {
+PluginModel Plugin::create(const json& parameters_or_null) const {
   const std::string who = "plugin '" + name() + "' (" + path().string() + ")";
+  // A JSON null (what `create({})` builds in nlohmann::json) means no parameters given.
+  const json given = parameters_or_null.is_null() ? json::object() : parameters_or_null;
   if (!given.is_object())
     throw PluginError(who + ": the parameters must be a JSON object such as {\"name\": value} (found " +
                       std::string(given.type_name()) + ")");
