@@ -188,6 +188,11 @@ class Checker {
     } else if (value.is_number_integer() && !value.is_number_unsigned()) {
       const auto x = value.get<std::int64_t>();
       if (x >= minimum && x <= maximum) return x;
+    } else if (value.is_number_float()) {
+      // JSON Schema counts 10.0 as an integer; so does nonsep, within the range.
+      const double x = value.get<double>();
+      if (std::floor(x) == x && x >= static_cast<double>(minimum) && x <= static_cast<double>(maximum))
+        return static_cast<std::int64_t>(x);
     }
     issue(path, describe(value), what);
     return std::nullopt;
@@ -277,6 +282,12 @@ std::optional<OptionValue> read_option(Checker& check, const ParameterDescriptio
       if (value.is_number_unsigned() && value.get<std::uint64_t>() > std::numeric_limits<std::int64_t>::max())
         throw InvalidArgument("too large");
       result.order = Fraction(value.get<std::int64_t>());
+      return result;
+    }
+    // JSON Schema counts 2.0 as an integer; so does nonsep.
+    if (value.is_number_float() && std::floor(value.get<double>()) == value.get<double>() &&
+        std::abs(value.get<double>()) < 1e15) {
+      result.order = Fraction(static_cast<std::int64_t>(value.get<double>()));
       return result;
     }
   } catch (const InvalidArgument&) {

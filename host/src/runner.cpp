@@ -209,7 +209,7 @@ class Run {
       if (auto error = relative_error(energy_at(slot), record.energy_initial))
         record.max_abs_relative_error = std::max(record.max_abs_relative_error, std::abs(*error));
     }
-    if (step % job_.every == 0 || step == job_.time.steps) write_samples(step);
+    if (writer_ && (step % job_.every == 0 || step == job_.time.steps)) write_samples(step);
   }
 
   // Energies of the active states (NaN where unknown); returns the model's message per slot for those it failed on.

@@ -1,0 +1,139 @@
+#pragma once
+// Helpers for the host's tests: temporary folders, writing job files, and running the built `nonsep` executable
+// (NONSEP_EXECUTABLE, a compile definition) with its stdout and stderr captured.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+extern char** environ;
+
+namespace nonsep::host_testing {
+
+// A fresh folder under the system's temporary folder, removed with its contents on destruction.
+class TemporaryFolder {
+ public:
+  TemporaryFolder() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "nonsep-host-test-XXXXXX").string();
+    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TemporaryFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path.string());
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+inline nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(read_text(path)); }
+
+inline void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+}
+
+inline std::filesystem::path write_job(const std::filesystem::path& path, const nlohmann::json& job) {
+  write_text(path, job.dump(2));
+  return path;
+}
+
+// The quickstart job of examples/jobs/quickstart.json, as a JSON value to modify.
+inline nlohmann::json quickstart_job() {
+  return read_json(std::filesystem::path(NONSEP_SOURCE_DIR) / "examples/jobs/quickstart.json");
+}
+
+// Makes the test plugins (tests/host/plugins) findable by name.
+inline void use_test_plugins() { ::setenv("NONSEP_PLUGIN_PATH", NONSEP_TEST_PLUGIN_DIR, 1); }
+
+struct Process {
+  pid_t pid = -1;
+  std::filesystem::path out, err;
+};
+
+// Starts `nonsep args...` with stdout and stderr going to files in `folder`.
+inline Process start_nonsep(const std::vector<std::string>& args, const std::filesystem::path& folder) {
+  use_test_plugins();
+  static int serial = 0;
+  Process process;
+  process.out = folder / ("stdout-" + std::to_string(++serial) + ".txt");
+  process.err = folder / ("stderr-" + std::to_string(serial) + ".txt");
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, process.out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 2, process.err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::vector<std::string> argv_storage{NONSEP_EXECUTABLE};
+  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& arg : argv_storage) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  const int error = posix_spawn(&process.pid, NONSEP_EXECUTABLE, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) throw std::runtime_error("cannot start " + std::string(NONSEP_EXECUTABLE));
+  return process;
+}
+
+struct Result {
+  int status = -1;  // the exit status, or 128 + signal number when killed by a signal
+  std::string out, err;
+};
+
+inline Result finish(const Process& process) {
+  int wait_status = 0;
+  if (::waitpid(process.pid, &wait_status, 0) != process.pid) throw std::runtime_error("waitpid failed");
+  Result result;
+  result.status = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 128 + WTERMSIG(wait_status);
+  result.out = read_text(process.out);
+  result.err = read_text(process.err);
+  return result;
+}
+
+// Runs `nonsep args...` to completion.
+inline Result run_nonsep(const std::vector<std::string>& args, const std::filesystem::path& folder) {
+  return finish(start_nonsep(args, folder));
+}
+
+// The rows of a CSV file, split at commas (no quoting in nonsep's files); row 0 is the header.
+inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream text(read_text(path));
+  std::string line;
+  while (std::getline(text, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream fields(line);
+    while (std::getline(fields, cell, ',')) cells.push_back(cell);
+    if (!line.empty() && line.back() == ',') cells.push_back("");
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+}  // namespace nonsep::host_testing

@@ -1,0 +1,138 @@
+// A test plugin written directly against the C ABI (plugin_abi.h), without the SDK, so that it can do what SDK
+// plugins refuse to: return non-finite gradients. It exercises the host's handling of trajectories that diverge
+// and of a plugin that fails mid-run.
+//
+//   T(p) = |p|^2 / 2          grad T = p,      Hess T = I
+//   V(q) = sum_i q_i^4 / 4    grad V = q^3,    Hess V = diag(3 q_i^2)      H_TTV = 3 sum_i q_i^2 p_i^2
+//
+// grad V overflows to inf for |q| > ~5.6e102 (no finiteness check), so a state that starts there turns
+// non-finite in its first step. Parameter fail_above: grad V reports NONSEP_EVALUATION_FAILED at any finite |q_i|
+// above it. Built three times: "blowup" (all functions), "blowup_gradients_only" (no values, no Hessians: no energy) and
+// "blowup_wrong_hessian" (Hess V = diag(2 q_i^2), wrong on purpose, for the derivative check).
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <new>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "nonsep/plugin_abi.h"
+
+#ifndef BLOWUP_NAME
+#error "BLOWUP_NAME must be defined"
+#endif
+#if !defined(BLOWUP_WITH_HESSIANS) || !defined(BLOWUP_WRONG_HESSIAN)
+#error "BLOWUP_WITH_HESSIANS and BLOWUP_WRONG_HESSIAN must be defined (0 or 1)"
+#endif
+
+struct nonsep_instance {
+  std::size_t dimension = 1;
+  double fail_above = 1e300;
+  std::string last_error;
+};
+
+namespace {
+
+const char* metadata() {
+  static const std::string text = nlohmann::json{
+      {"name", BLOWUP_NAME},
+      {"version", "0.0.1"},
+      {"description", "host test model: V = q^4/4 whose gradient overflows, and a switch to make it fail"},
+      {"hamiltonian", "T = |p|^2/2, V = sum q_i^4/4; H_TTV = 3 sum q_i^2 p_i^2"},
+      {"dimension", {{"parameter", "dimension"}}},
+      {"parameters",
+       {{{"name", "dimension"}, {"type", "integer"}, {"default", 1}, {"minimum", 1}, {"maximum", 8},
+         {"description", "number of degrees of freedom"}},
+        {{"name", "fail_above"}, {"type", "number"}, {"default", 1e300}, {"minimum", 0}, {"unit", "length"},
+         {"description", "grad V fails for any |q_i| above this"}}}},
+      {"capabilities",
+       {{"value_T", BLOWUP_WITH_HESSIANS == 1}, {"value_V", BLOWUP_WITH_HESSIANS == 1},
+        {"hessian_T", BLOWUP_WITH_HESSIANS == 1}, {"hessian_V", BLOWUP_WITH_HESSIANS == 1}}}}.dump();
+  return text.c_str();
+}
+
+nonsep_status create(const char* parameters_json, nonsep_instance** out, char* message, std::size_t size) {
+  *out = nullptr;
+  try {
+    const auto parameters = nlohmann::json::parse(parameters_json);
+    auto instance = new nonsep_instance;
+    instance->dimension = parameters.value("dimension", std::size_t{1});
+    instance->fail_above = parameters.value("fail_above", 1e300);
+    *out = instance;
+    return NONSEP_OK;
+  } catch (const std::exception& error) {
+    std::snprintf(message, size, "%s", error.what());
+    return NONSEP_INVALID_PARAMETERS;
+  }
+}
+
+void destroy(nonsep_instance* instance) { delete instance; }
+std::size_t dimension(const nonsep_instance* instance) { return instance->dimension; }
+
+nonsep_status grad_T(nonsep_instance* instance, const double* p, double* out, std::size_t count) {
+  for (std::size_t i = 0; i < count * instance->dimension; ++i) out[i] = p[i];
+  return NONSEP_OK;
+}
+nonsep_status grad_V(nonsep_instance* instance, const double* q, double* out, std::size_t count) {
+  for (std::size_t i = 0; i < count * instance->dimension; ++i) {
+    if (std::isfinite(q[i]) && std::abs(q[i]) > instance->fail_above) {
+      instance->last_error = "q = " + std::to_string(q[i]) + " is beyond fail_above";
+      return NONSEP_EVALUATION_FAILED;
+    }
+    out[i] = q[i] * q[i] * q[i];
+  }
+  return NONSEP_OK;
+}
+nonsep_status value_T(nonsep_instance* instance, const double* p, double* out, std::size_t count) {
+  const std::size_t n = instance->dimension;
+  for (std::size_t b = 0; b < count; ++b) {
+    out[b] = 0.0;
+    for (std::size_t i = 0; i < n; ++i) out[b] += 0.5 * p[b * n + i] * p[b * n + i];
+  }
+  return NONSEP_OK;
+}
+nonsep_status value_V(nonsep_instance* instance, const double* q, double* out, std::size_t count) {
+  const std::size_t n = instance->dimension;
+  for (std::size_t b = 0; b < count; ++b) {
+    out[b] = 0.0;
+    for (std::size_t i = 0; i < n; ++i) out[b] += 0.25 * std::pow(q[b * n + i], 4);
+  }
+  return NONSEP_OK;
+}
+nonsep_status hessian_T(nonsep_instance* instance, const double*, double* out, std::size_t count) {
+  const std::size_t n = instance->dimension;
+  for (std::size_t b = 0; b < count; ++b)
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j) out[b * n * n + i * n + j] = i == j ? 1.0 : 0.0;
+  return NONSEP_OK;
+}
+nonsep_status hessian_V(nonsep_instance* instance, const double* q, double* out, std::size_t count) {
+  const std::size_t n = instance->dimension;
+  for (std::size_t b = 0; b < count; ++b)
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j) out[b * n * n + i * n + j] =
+            i == j ? (BLOWUP_WRONG_HESSIAN ? 2.0 : 3.0) * q[b * n + i] * q[b * n + i] : 0.0;
+  return NONSEP_OK;
+}
+const char* last_error(const nonsep_instance* instance) { return instance->last_error.c_str(); }
+
+const nonsep_plugin_api api = {
+    NONSEP_PLUGIN_ABI_VERSION,
+    sizeof(nonsep_plugin_api),
+    metadata,
+    create,
+    destroy,
+    dimension,
+    grad_T,
+    grad_V,
+    BLOWUP_WITH_HESSIANS ? value_T : nullptr,
+    BLOWUP_WITH_HESSIANS ? value_V : nullptr,
+    BLOWUP_WITH_HESSIANS ? hessian_T : nullptr,
+    BLOWUP_WITH_HESSIANS ? hessian_V : nullptr,
+    last_error,
+};
+
+}  // namespace
+
+extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* nonsep_plugin_entry() { return &api; }

@@ -1,0 +1,303 @@
+// The job reader in-process: values, defaults from the scheme catalogue, the time grid, initial-state shapes, and
+// that every problem is reported with its JSON path, all at once.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "host_test_support.hpp"
+#include "nonsep/core/integrator_description.hpp"
+#include "nonsep/host/job.hpp"
+
+using nlohmann::json;
+using namespace nonsep;
+using namespace nonsep::host;
+
+namespace {
+
+struct Parsed {
+  Job job;
+  std::vector<JobIssue> issues;
+};
+
+Parsed parse(const json& document, const std::string& file = "/jobs/test.json") {
+  Parsed parsed;
+  parsed.job = parse_job(document, file, parsed.issues);
+  return parsed;
+}
+
+Parsed parse_text(const std::string& text) {
+  Parsed parsed;
+  if (auto document = parse_job_text(text, parsed.issues)) parsed.job = parse_job(*document, "/jobs/test.json", parsed.issues);
+  return parsed;
+}
+
+std::vector<std::string> paths(const std::vector<JobIssue>& issues) {
+  std::vector<std::string> result;
+  for (const auto& issue : issues) result.push_back(issue.path);
+  return result;
+}
+
+bool names(const std::vector<JobIssue>& issues, const std::string& path) {
+  return std::any_of(issues.begin(), issues.end(), [&](const JobIssue& issue) { return issue.path == path; });
+}
+
+json with_time(json time) {
+  json job = host_testing::quickstart_job();
+  job["time"] = std::move(time);
+  return job;
+}
+
+}  // namespace
+
+TEST_CASE("the quickstart job reads into the values it spells out") {
+  const auto parsed = parse(host_testing::quickstart_job());
+  REQUIRE(parsed.issues.empty());
+  const Job& job = parsed.job;
+  CHECK(job.plugin == "paper1d");
+  CHECK(job.parameters == json::object());
+  CHECK(job.integrator.scheme == "triplet");
+  CHECK(job.integrator.order == Fraction(4, 3));
+  CHECK(job.integrator.t2 == -2.0);
+  CHECK(job.integrator.form == HamiltonianForm::TTV);
+  CHECK(job.initial.shape == "single");
+  CHECK(job.initial.count == 1);
+  CHECK(job.initial.q == std::vector<double>{2.0});
+  CHECK(job.initial.p == std::vector<double>{0.0});
+  CHECK(job.output_directory == std::filesystem::path("/jobs/quickstart.out"));
+  CHECK(job.every == 1);
+}
+
+TEST_CASE("integrator options left out take the catalogue's defaults") {
+  for (const auto& scheme : scheme_catalogue()) {
+    CAPTURE(scheme.name);
+    json document = host_testing::quickstart_job();
+    document["integrator"] = {{"scheme", scheme.name}};
+    const auto parsed = parse(document);
+    REQUIRE(parsed.issues.empty());
+    for (const auto& parameter : scheme.parameters) {
+      REQUIRE_FALSE(parameter.default_text.empty());
+      if (parameter.name == "order") CHECK(parsed.job.integrator.order == Fraction::parse(parameter.default_text));
+      if (parameter.name == "t2") CHECK(parsed.job.integrator.t2 == std::stod(parameter.default_text));
+    }
+  }
+  CHECK(parse(host_testing::quickstart_job()).job.integrator.t2 != ChinCoefficients::default_t2());
+}
+
+TEST_CASE("orders are exact fractions or integers and must exist for the scheme") {
+  json document = host_testing::quickstart_job();
+  document["integrator"] = {{"scheme", "triplet"}, {"order", 2}};
+  CHECK(parse(document).job.integrator.order == Fraction(2));
+  document["integrator"]["order"] = " 8 / 3 ";
+  CHECK(parse(document).job.integrator.order == Fraction(8, 3));
+  document["integrator"]["order"] = 2.0;
+  CHECK(parse(document).job.integrator.order == Fraction(2));
+  for (const json& bad : {json("5/3"), json(1.5), json("4/3x"), json(0), json("-4/3"), json(true)}) {
+    CAPTURE(bad.dump());
+    document["integrator"]["order"] = bad;
+    CHECK(paths(parse(document).issues) == std::vector<std::string>{"/integrator/order"});
+  }
+  document["integrator"] = {{"scheme", "basic"}, {"order", "4/3"}};
+  const auto issues = parse(document).issues;
+  REQUIRE(issues.size() == 1);
+  CHECK(issues[0].path == "/integrator/order");
+  CHECK(issues[0].allowed.find("2/3") != std::string::npos);
+}
+
+TEST_CASE("t_end is reached exactly: steps = ceil(t_end/dt) with a relative slack of 1e-9, dt = t_end/steps") {
+  struct Case {
+    double dt, t_end;
+    std::uint64_t steps;
+  };
+  for (const Case c : {Case{0.005, 0.3863765573361232, 78}, Case{0.1, 0.3, 3}, Case{0.1, 0.7, 7}, Case{0.1, 1.0, 10},
+                       Case{0.1, 1.01, 11}, Case{0.1, 1.0000000001, 10}, Case{1.0, 0.25, 1}, Case{-0.01, -0.05, 5}}) {
+    CAPTURE(c.dt);
+    CAPTURE(c.t_end);
+    const auto parsed = parse(with_time({{"dt", c.dt}, {"t_end", c.t_end}}));
+    REQUIRE(parsed.issues.empty());
+    const TimeGrid& time = parsed.job.time;
+    CHECK(time.steps == c.steps);
+    CHECK(time.dt == c.t_end / static_cast<double>(c.steps));
+    CHECK(time.dt_requested == c.dt);
+    CHECK(time.t_end == c.t_end);
+    CHECK(time.time_at(time.steps) == c.t_end);
+    CHECK(std::abs(time.dt) <= std::abs(c.dt) * (1.0 + 1e-9));
+  }
+}
+
+TEST_CASE("steps instead of t_end: exactly that many steps of dt") {
+  const auto parsed = parse(with_time({{"dt", 0.25}, {"steps", 12}}));
+  REQUIRE(parsed.issues.empty());
+  CHECK(parsed.job.time.steps == 12);
+  CHECK(parsed.job.time.dt == 0.25);
+  CHECK(parsed.job.time.t_end == 3.0);
+  CHECK(parsed.job.time.time_at(5) == 1.25);
+  CHECK_FALSE(parsed.job.time.from_t_end);
+}
+
+TEST_CASE("time: the problems of dt, t_end and steps") {
+  CHECK(paths(parse(with_time({{"dt", 0.01}, {"t_end", -1.0}})).issues) == std::vector<std::string>{"/time/t_end"});
+  CHECK(paths(parse(with_time({{"dt", 0.0}, {"steps", 3}})).issues) == std::vector<std::string>{"/time/dt"});
+  CHECK(paths(parse(with_time({{"dt", 0.1}})).issues) == std::vector<std::string>{"/time/t_end"});
+  CHECK(paths(parse(with_time({{"dt", 0.1}, {"steps", 2}, {"t_end", 0.2}})).issues) ==
+        std::vector<std::string>{"/time/steps"});
+  CHECK(paths(parse(with_time({{"dt", 0.1}, {"steps", 0}})).issues) == std::vector<std::string>{"/time/steps"});
+  CHECK(paths(parse(with_time({{"dt", 1e300}, {"steps", 1000000000}})).issues) ==
+        std::vector<std::string>{"/time/steps"});
+  CHECK(paths(parse(with_time({{"dt", 1e-12}, {"t_end", 1e6}})).issues) == std::vector<std::string>{"/time/t_end"});
+  CHECK(paths(parse(with_time({{"dt", 0.1}, {"steps", 4}, {"stop", 1}})).issues) ==
+        std::vector<std::string>{"/time/stop"});
+}
+
+TEST_CASE("initial states: one, a list, or a grid in row-major order (last axis fastest)") {
+  json document = host_testing::quickstart_job();
+  document["initial"] = json::array({{{"q", {1.0}}, {"p", {0.5}}}, {{"q", {2.0}}, {"p", {-0.5}}}});
+  auto parsed = parse(document);
+  REQUIRE(parsed.issues.empty());
+  CHECK(parsed.job.initial.shape == "list");
+  CHECK(parsed.job.initial.q == std::vector<double>{1.0, 2.0});
+  CHECK(parsed.job.initial.p == std::vector<double>{0.5, -0.5});
+
+  document["initial"] = {{"grid", {{"q", {{{"from", 0.0}, {"to", 1.0}, {"count", 3}}, 7.0}},
+                                   {"p", {{{"values", {5.0, 6.0}}}, -1.0}}}}};
+  parsed = parse(document);
+  REQUIRE(parsed.issues.empty());
+  const InitialStates& states = parsed.job.initial;
+  CHECK(states.shape == "grid");
+  CHECK(states.dimension == 2);
+  REQUIRE(states.count == 6);
+  // q0 in {0, 0.5, 1} (slowest), q1 = 7, p0 in {5, 6}, p1 = -1.
+  CHECK(states.q == std::vector<double>{0.0, 7.0, 0.0, 7.0, 0.5, 7.0, 0.5, 7.0, 1.0, 7.0, 1.0, 7.0});
+  CHECK(states.p == std::vector<double>{5.0, -1.0, 6.0, -1.0, 5.0, -1.0, 6.0, -1.0, 5.0, -1.0, 6.0, -1.0});
+
+  document["initial"] = {{"grid", {{"q", {{{"from", 0.0}, {"to", 1.0}, {"count", 1000}}}},
+                                   {"p", {{{"from", 0.0}, {"to", 1.0}, {"count", 1001}}}}}}};
+  CHECK(paths(parse(document).issues) == std::vector<std::string>{"/initial/grid"});
+}
+
+TEST_CASE("every problem of a job is reported at once, each with its JSON path") {
+  json document = host_testing::quickstart_job();
+  document["colour"] = "blue";
+  document["model"]["plugin"] = "";
+  document["hamiltonian"] = "TVT";
+  document["integrator"]["order"] = "4/3x";
+  document["integrator"]["t2"] = 0.0;
+  document["initial"] = json::array({{{"q", {1.0}}, {"p", {0.0}}}, {{"q", {"x"}}, {"p", {0.0}}}, {{"q", {1.0}}}});
+  document["time"]["dt"] = -0.0;
+  document["output"]["every"] = -3;
+  const auto parsed = parse(document);
+  for (const char* path : {"/colour", "/model/plugin", "/hamiltonian", "/integrator/order", "/integrator/t2",
+                           "/initial/1/q/0", "/initial/2/p", "/time/dt", "/output/every"}) {
+    CAPTURE(path);
+    CHECK(names(parsed.issues, path));
+  }
+  CHECK(parsed.issues.size() == 9);
+  for (const auto& issue : parsed.issues) {
+    CHECK_FALSE(issue.found.empty());
+    CHECK_FALSE(issue.allowed.empty());
+  }
+}
+
+TEST_CASE("an unknown scheme still gets its options checked") {
+  json document = host_testing::quickstart_job();
+  document["integrator"] = {{"scheme", "rk4"}, {"order", "x"}, {"step", 2}};
+  CHECK(paths(parse(document).issues) ==
+        std::vector<std::string>{"/integrator/scheme", "/integrator/step", "/integrator/order"});
+}
+
+TEST_CASE("strict JSON: syntax errors give line and column, duplicate keys are refused with their path") {
+  auto parsed = parse_text("{\n  \"model\": {\"plugin\": \"paper1d\"},\n  \"time\": { \"dt\": 0.1 \"steps\": 1 }\n}");
+  REQUIRE(parsed.issues.size() == 1);
+  CHECK(parsed.issues[0].path.empty());
+  CHECK(parsed.issues[0].found.find("line 3") != std::string::npos);
+
+  parsed = parse_text(R"({"initial": [{"q": [1], "p": [0]}, {"q": [1], "q": [2], "p": [0]}]})");
+  CHECK(paths(parsed.issues) == std::vector<std::string>{"/initial/1/q"});
+
+  parsed = parse_text(R"({"model": {"parameters": {"a/b": 1, "a/b": 2}}})");
+  CHECK(paths(parsed.issues) == std::vector<std::string>{"/model/parameters/a~1b"});
+}
+
+TEST_CASE("model parameters are checked against the plugin's metadata") {
+  std::vector<PluginParameter> declared(3);
+  declared[0].name = "dimension";
+  declared[0].type = "integer";
+  declared[0].minimum = 1;
+  declared[0].maximum = 16;
+  declared[1].name = "mass";
+  declared[1].type = "number";
+  declared[1].minimum = 0;
+  declared[1].unit = "kg";
+  declared[2].name = "damped";
+  declared[2].type = "boolean";
+
+  std::vector<JobIssue> issues;
+  check_model_parameters({{"dimension", 3}, {"mass", 2.5}, {"damped", true}}, declared, issues);
+  CHECK(issues.empty());
+
+  check_model_parameters({{"dimension", 2.5}, {"mass", -1}, {"damped", 1}, {"colour", 1}, {"a/b", 1}}, declared,
+                         issues);
+  CHECK(paths(issues) == std::vector<std::string>{"/model/parameters/a~1b", "/model/parameters/colour",
+                                                  "/model/parameters/damped", "/model/parameters/dimension",
+                                                  "/model/parameters/mass"});
+  CHECK(issues[4].allowed.find(">= 0") != std::string::npos);
+  CHECK(issues[4].allowed.find("kg") != std::string::npos);
+
+  issues.clear();
+  check_model_parameters({{"dimension", 17}}, declared, issues);
+  CHECK(paths(issues) == std::vector<std::string>{"/model/parameters/dimension"});
+  CHECK(issues[0].allowed.find("<= 16") != std::string::npos);
+}
+
+TEST_CASE("initial states must have the model's dimension") {
+  InitialStates states;
+  states.shape = "list";
+  states.dimension = 2;
+  states.count = 3;
+  std::vector<JobIssue> issues;
+  check_dimension(states, 2, issues);
+  CHECK(issues.empty());
+  check_dimension(states, 1, issues);
+  CHECK(paths(issues) == std::vector<std::string>{"/initial/0/q"});
+  states.shape = "grid";
+  check_dimension(states, 3, issues);
+  CHECK(issues.back().path == "/initial/grid/q");
+}
+
+TEST_CASE("the output folder is relative to the job file, by default <job>.out beside it") {
+  json document = host_testing::quickstart_job();
+  document.erase("output");
+  auto parsed = parse(document, "/data/runs/orbit.json");
+  CHECK(parsed.job.output_directory == std::filesystem::path("/data/runs/orbit.out"));
+  CHECK(parsed.job.every == 1);
+  document["output"] = {{"directory", "results/a"}, {"every", 0}};
+  parsed = parse(document, "/data/runs/orbit.json");
+  CHECK(parsed.job.output_directory == std::filesystem::path("/data/runs/results/a"));
+  CHECK(parsed.job.every == 0);
+  document["output"] = {{"directory", "/abs/out"}};
+  CHECK(parse(document, "/data/runs/orbit.json").job.output_directory == std::filesystem::path("/abs/out"));
+}
+
+TEST_CASE("load_job reports a missing file and a plugin that cannot be loaded as issues") {
+  host_testing::TemporaryFolder folder;
+  try {
+    load_job(folder / "absent.json");
+    FAIL("no exception");
+  } catch (const InvalidJob& error) {
+    REQUIRE(error.issues().size() == 1);
+    CHECK(error.issues()[0].path.empty());
+  }
+  json document = host_testing::quickstart_job();
+  document["model"]["plugin"] = "./nowhere/model.so";
+  document["time"]["dt"] = 0;
+  const auto file = host_testing::write_job(folder / "job.json", document);
+  try {
+    load_job(file);
+    FAIL("no exception");
+  } catch (const InvalidJob& error) {
+    CHECK(paths(error.issues()) == std::vector<std::string>{"/time/dt", "/model/plugin"});
+    CHECK(std::string(error.what()).find("2 problems") != std::string::npos);
+  }
+}
