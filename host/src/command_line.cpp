@@ -180,7 +180,7 @@ int command_inspect(const std::string& name, bool as_json, bool check) {
     const DerivativeCheck result = check_derivatives(model, *plugin);
     (as_json ? std::cerr : std::cout) << "derivative check of " << plugin->name() << " (default parameters, dimension "
                                       << model.dimension() << "):\n"
-                                      << format_derivative_check(result);
+                                      << result.text;
     return to_int(result.passed ? ExitStatus::success : ExitStatus::run_failed);
   } catch (const PluginError& error) {
     std::cerr << "nonsep: " << error.what() << "\n";

@@ -1,8 +1,6 @@
 #pragma once
 // What `nonsep inspect` and `nonsep models` print, and the derivative check of `nonsep inspect --check`.
-#include <cstddef>
 #include <string>
-#include <vector>
 
 #include "nonsep/host/plugin_loader.hpp"
 
@@ -16,25 +14,16 @@ std::string describe_plugin(const Plugin& plugin);
 // failed to load. No trailing newline.
 std::string describe_discovered(const DiscoveredPlugin& discovered);
 
-// The finite-difference check of a plugin instance's derivatives at a few fixed pseudo-random points in [-1, 1]^n:
-// grad T and grad V against central differences of value_T / value_V (when the plugin has values), the Hessians
-// against central differences of the gradients and for symmetry (when it has Hessians), and batch consistency
-// (one call on all points gives the same numbers, bit for bit, as one call per point; the runner relies on it).
-// A derivative passes when |analytic - numeric| <= tolerance * max(1, |analytic|).
-struct DerivativeCheckLine {
-  std::string what;          // "grad_T vs value_T", "hessian_V symmetry", "grad_V batch consistency", ...
-  double worst_error = 0.0;  // the largest scaled error over all points and components
-  bool passed = true;
-  std::string note;          // why it was skipped or where it failed
-};
+// `nonsep inspect --check`: the SDK's derivative checker (nonsep/derivative_checker.hpp: 5-point finite
+// differences at seeded random points in [-1.5, 1.5]^n, tolerance 1e-6 relative) on a plugin instance, checking
+// grad T and grad V against value_T / value_V when the plugin has values and the Hessians against the gradients
+// when it has Hessians; plus batch consistency: one call on all points gives the same numbers, bit for bit, as one
+// call per point (the runner relies on it to retire states from an ensemble without changing the others).
+// Throws nonsep::ModelError when the plugin fails to evaluate at a sample point.
 struct DerivativeCheck {
   bool passed = true;
-  std::vector<DerivativeCheckLine> lines;
+  std::string text;  // several lines, each ending in '\n'; the last says "passed" or "FAILED"
 };
-
-// Throws nonsep::ModelError when the plugin fails to evaluate at a check point.
-DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin, std::size_t points = 5,
-                                  double tolerance = 1e-6);
-std::string format_derivative_check(const DerivativeCheck& check);
+DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin);
 
 }  // namespace nonsep::host
