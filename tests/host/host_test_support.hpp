@@ -105,9 +105,22 @@ struct Result {
   std::string out, err;
 };
 
-inline Result finish(const Process& process) {
+// Waits for `process` to end; after `timeout` it is killed (SIGKILL) and std::runtime_error thrown, so that a test
+// of a process that fails to stop fails instead of hanging.
+inline Result finish(const Process& process, std::chrono::seconds timeout = std::chrono::seconds(120)) {
   int wait_status = 0;
-  if (::waitpid(process.pid, &wait_status, 0) != process.pid) throw std::runtime_error("waitpid failed");
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    const pid_t done = ::waitpid(process.pid, &wait_status, WNOHANG);
+    if (done == process.pid) break;
+    if (done < 0) throw std::runtime_error("waitpid failed");
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(process.pid, SIGKILL);
+      ::waitpid(process.pid, &wait_status, 0);
+      throw std::runtime_error("nonsep did not finish within " + std::to_string(timeout.count()) + " s; killed");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
   Result result;
   result.status = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 128 + WTERMSIG(wait_status);
   result.out = read_text(process.out);

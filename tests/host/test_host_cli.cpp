@@ -340,7 +340,7 @@ TEST_CASE("SIGINT: the run finishes its step, writes its outputs with status int
   for (int i = 0; i < 400 && !(std::filesystem::exists(csv) && read_text(csv).size() > 2000); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(25));
   REQUIRE(::kill(process.pid, SIGINT) == 0);
-  const auto result = finish(process);
+  const auto result = finish(process, std::chrono::seconds(30));
   INFO("stderr: " << result.err);
   CHECK(result.status == 130);
   const json summary = read_json(folder / "out" / "summary.json");
