@@ -7,3 +7,11 @@ find_package(Threads REQUIRED)
 if(BUILD_TESTING OR NOT DEFINED BUILD_TESTING) # tests are on unless -DBUILD_TESTING=OFF
   find_package(doctest 2.4 REQUIRED)                  # doctest-dev
 endif()
+
+# Python is used by tests and the figure scripts with modules from Debian packages (python3-jsonschema,
+# python3-matplotlib), which live in the system interpreter. Prefer it over another python3 earlier on PATH
+# (pyenv, a virtualenv) unless the user chose one with -DPython3_EXECUTABLE.
+if(NOT DEFINED Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
+  set(Python3_EXECUTABLE /usr/bin/python3 CACHE FILEPATH "Python interpreter with the Debian python3-* modules")
+endif()
+find_package(Python3 COMPONENTS Interpreter)
