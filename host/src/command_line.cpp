@@ -19,6 +19,7 @@
 #include "nonsep/host/plugin_report.hpp"
 #include "nonsep/host/progress_bar.hpp"
 #include "nonsep/host/runner.hpp"
+#include "nonsep/host/study.hpp"
 
 #ifndef NONSEP_VERSION
 #error "NONSEP_VERSION must be defined by the build"
@@ -90,6 +91,32 @@ std::string time_text(const TimeGrid& time) {
                                                           : "");
 }
 
+// The end of a study: one line per integrator with its fitted exponent, or what went wrong.
+int report_study(const RunOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
+  const auto& summary = outcome.summary;
+  const auto& runs = summary["study"]["runs"];
+  std::string line = summary["status"].get<std::string>() + ": study of " + std::to_string(summary["fits"].size()) +
+                     " integrators, " + std::to_string(runs["completed"].get<std::size_t>()) + " runs completed";
+  for (const char* other : {"diverged", "failed", "interrupted"})
+    if (runs[other].get<std::size_t>() > 0) line += ", " + std::to_string(runs[other].get<std::size_t>()) + " " + other;
+  line += "; results in " + directory.string();
+  std::ostream& out = outcome.exit_status == ExitStatus::success ? std::cout : std::cerr;
+  if (outcome.exit_status != ExitStatus::success || !quiet) {
+    out << (outcome.exit_status == ExitStatus::success ? "" : "nonsep: ") << line << "\n";
+    for (const auto& fit : summary["fits"])
+      out << "  " << fit["integrator"].get<std::string>() << ": energy error exponent "
+          << (fit["exponent"].is_null() ? std::string("(no fit)") : format_number(fit["exponent"].get<double>()))
+          << " (nominal " << fit["order"].get<std::string>() << ")\n";
+  }
+  if (summary.contains("error")) std::cerr << "nonsep: " << summary["error"].get<std::string>() << "\n";
+  if (summary.contains("failures"))
+    for (const auto& failure : summary["failures"])
+      std::cerr << "nonsep: " << failure["integrator"].get<std::string>() << " with " << failure["steps"]
+                << " steps " << failure["status"].get<std::string>() << ": " << failure["error"].get<std::string>()
+                << "\n";
+  return to_int(outcome.exit_status);
+}
+
 int command_run(const std::string& job_file, const std::string& output, bool quiet) {
   std::optional<LoadedJob> loaded;
   try {
@@ -106,12 +133,13 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
   {
     InterruptGuard guard;
     try {
-      outcome = run_job(*loaded, options);
+      outcome = loaded->job.study ? run_study(*loaded, options) : run_job(*loaded, options);
     } catch (const OutputError& error) {
       std::cerr << "nonsep: " << error.what() << "\n";
       return to_int(ExitStatus::invalid_input);
     }
   }
+  if (loaded->job.study) return report_study(outcome, options.output_directory, quiet);
   const auto& summary = outcome.summary;
   const auto& counts = summary["counts"];
   const std::string status = summary["status"].get<std::string>();
@@ -145,6 +173,21 @@ int command_validate(const std::string& job_file) {
     const LoadedJob loaded = load_job(job_file);
     const Job& job = loaded.job;
     const auto& spec = job.integrator;
+    if (job.study) {
+      std::cout << "valid: " << job_file << "\n"
+                << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
+                << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
+                << "  study:       " << job.study->integrators.size() << " integrators to t_end = "
+                << format_number(job.time.t_end) << (job.study->reference_q.empty() ? "" : ", with a reference")
+                << "\n";
+      for (const auto& integrator : job.study->integrators)
+        std::cout << "    " << integrator.label << ": " << integrator.spec.scheme << ", order "
+                  << integrator.spec.order.to_string() << ", t2 = " << format_number(integrator.spec.t2) << ", "
+                  << integrator.steps.size() << " step counts " << integrator.steps.front() << ".."
+                  << integrator.steps.back() << " (" << integrator.steps_from << ")\n";
+      std::cout << "  output:      " << job.output_directory.string() << "\n";
+      return to_int(ExitStatus::success);
+    }
     std::cout << "valid: " << job_file << "\n"
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"

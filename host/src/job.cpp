@@ -296,29 +296,29 @@ std::optional<OptionValue> read_option(Checker& check, const ParameterDescriptio
   return std::nullopt;
 }
 
-IntegratorSpec read_integrator(Checker& check, const json& document) {
-  IntegratorSpec spec;
+HamiltonianForm read_form(Checker& check, const json& document) {
   if (const json* form = check.member(document, "", "hamiltonian", false, "")) {
-    if (*form == "TTV")
-      spec.form = HamiltonianForm::TTV;
-    else if (*form == "VVT")
-      spec.form = HamiltonianForm::VVT;
-    else
-      check.issue("/hamiltonian", describe(*form),
-                  "\"TTV\" (H = T_i V_ij T_j, the default) or \"VVT\" (H = V_i T_ij V_j)");
+    if (*form == "TTV") return HamiltonianForm::TTV;
+    if (*form == "VVT") return HamiltonianForm::VVT;
+    check.issue("/hamiltonian", describe(*form),
+                "\"TTV\" (H = T_i V_ij T_j, the default) or \"VVT\" (H = V_i T_ij V_j)");
   }
-  const json* integrator =
-      check.member(document, "", "integrator", true, "an object with \"scheme\" (" + scheme_names() + ") and options");
-  if (!integrator || !check.object(*integrator, "/integrator", "an object with \"scheme\" and the scheme's options"))
-    return spec;
+  return HamiltonianForm::TTV;
+}
 
+// An integrator object {"scheme": ..., options...} at `path` (already known to be an object). `extra_keys` are
+// further keys the caller reads itself (a study's "label", "steps", "dt").
+IntegratorSpec read_integrator_object(Checker& check, const json& integrator, const std::string& path,
+                                      HamiltonianForm form, const std::vector<std::string>& extra_keys = {}) {
+  IntegratorSpec spec;
+  spec.form = form;
   std::optional<SchemeDescription> scheme;
-  if (const json* name = check.member(*integrator, "/integrator", "scheme", true, "one of " + scheme_names())) {
+  if (const json* name = check.member(integrator, path, "scheme", true, "one of " + scheme_names())) {
     if (name->is_string()) scheme = find_scheme(name->get<std::string>());
     if (scheme)
       spec.scheme = scheme->name;
     else
-      check.issue("/integrator/scheme", describe(*name), "one of " + scheme_names());
+      check.issue(child(path, "scheme"), describe(*name), "one of " + scheme_names());
   }
   // With an unknown scheme, check the options every scheme shares so that their problems are reported too.
   std::vector<ParameterDescription> parameters;
@@ -333,17 +333,18 @@ IntegratorSpec read_integrator(Checker& check, const json& document) {
   }
   std::vector<std::string> keys{"scheme"};
   for (const auto& parameter : parameters) keys.push_back(parameter.name);
-  check.known_keys(*integrator, "/integrator", keys);
+  keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
+  check.known_keys(integrator, path, keys);
 
   for (const auto& parameter : parameters) {
-    const std::string path = child("/integrator", parameter.name);
-    const json* given = check.member(*integrator, "/integrator", parameter.name, parameter.default_text.empty(),
+    const std::string option_path = child(path, parameter.name);
+    const json* given = check.member(integrator, path, parameter.name, parameter.default_text.empty(),
                                      parameter.description);
     if (!given) {
       if (!parameter.default_text.empty()) set_option(spec, parameter, default_option(parameter));
       continue;
     }
-    const auto value = read_option(check, parameter, *given, path);
+    const auto value = read_option(check, parameter, *given, option_path);
     if (!value || !scheme) continue;
     // The core decides what is valid: build the scheme with this one option set and the others at their defaults.
     IntegratorSpec probe{scheme->name, {}, {}, spec.form};
@@ -354,10 +355,21 @@ IntegratorSpec read_integrator(Checker& check, const json& document) {
       const Integrator probe_integrator(probe);
       set_option(spec, parameter, *value);
     } catch (const InvalidArgument& error) {
-      check.issue(path, describe(*given), error.what());
+      check.issue(option_path, describe(*given), error.what());
     }
   }
   return spec;
+}
+
+IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form) {
+  const json* integrator =
+      check.member(document, "", "integrator", true, "an object with \"scheme\" (" + scheme_names() + ") and options");
+  if (!integrator || !check.object(*integrator, "/integrator", "an object with \"scheme\" and the scheme's options")) {
+    IntegratorSpec spec;
+    spec.form = form;
+    return spec;
+  }
+  return read_integrator_object(check, *integrator, "/integrator", form);
 }
 
 TimeGrid read_time(Checker& check, const json& document) {
@@ -449,6 +461,175 @@ void read_state(Checker& check, const json& value, const std::string& path, Init
   states.q.insert(states.q.end(), q->begin(), q->end());
   states.p.insert(states.p.end(), p->begin(), p->end());
   ++states.count;
+}
+
+// A study's time: {"t_end": T} only (the step sizes come from the study).
+TimeGrid read_study_time(Checker& check, const json& document) {
+  TimeGrid grid;
+  const std::string what = "an object {\"t_end\": T}: a study runs every integrator to T with its own step counts";
+  const json* time = check.member(document, "", "time", true, what);
+  if (!time || !check.object(*time, "/time", what)) return grid;
+  check.known_keys(*time, "/time", {"t_end"});
+  if (const json* value = check.member(*time, "/time", "t_end", true, "the end time, a finite non-zero number"))
+    if (const auto t_end = check.finite_number(*value, "/time/t_end", "the end time, a finite non-zero number")) {
+      if (*t_end == 0.0)
+        check.issue("/time/t_end", describe(*value), "a finite non-zero number (negative integrates backwards)");
+      else
+        grid.t_end = *t_end;
+    }
+  return grid;
+}
+
+// A list of step counts (`key` "steps") or step sizes (`key` "dt") at `path`, as distinct increasing step counts
+// over `t_end` (0 when the end time is invalid: the sizes are then only checked).
+std::optional<std::vector<std::uint64_t>> read_step_list(Checker& check, const json& value, const std::string& path,
+                                                         const std::string& key, double t_end) {
+  const bool counts = key == "steps";
+  const std::string what = counts ? "a non-empty array of step counts, integers from 1 to " + std::to_string(max_steps)
+                                  : "a non-empty array of step sizes, finite non-zero numbers of the sign of t_end";
+  if (!value.is_array() || value.empty()) {
+    check.issue(path, describe(value), what);
+    return std::nullopt;
+  }
+  std::vector<std::uint64_t> result;
+  bool ok = true;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string item = child(path, i);
+    if (counts) {
+      const auto n = check.integer(value[i], item, 1, static_cast<std::int64_t>(max_steps),
+                                   "a step count, an integer from 1 to " + std::to_string(max_steps));
+      if (n)
+        result.push_back(static_cast<std::uint64_t>(*n));
+      else
+        ok = false;
+      continue;
+    }
+    const auto dt = check.finite_number(value[i], item, "a step size, a finite non-zero number");
+    if (!dt) {
+      ok = false;
+      continue;
+    }
+    if (*dt == 0.0 || (t_end != 0.0 && !(t_end / *dt > 0.0))) {
+      check.issue(item, describe(value[i]), "a non-zero step size of the same sign as /time/t_end");
+      ok = false;
+      continue;
+    }
+    if (t_end == 0.0) continue;
+    const double rounded = std::max(1.0, std::ceil(t_end / *dt * (1.0 - 1e-9)));
+    if (!(rounded <= static_cast<double>(max_steps))) {
+      check.issue(item, describe(value[i]) + ", which needs " + format_number(rounded) + " steps to /time/t_end",
+                  "at most " + std::to_string(max_steps) + " steps");
+      ok = false;
+      continue;
+    }
+    result.push_back(static_cast<std::uint64_t>(rounded));
+  }
+  if (!ok) return std::nullopt;
+  std::sort(result.begin(), result.end());
+  if (std::adjacent_find(result.begin(), result.end()) != result.end()) {
+    check.issue(path, describe(value) + ", which gives the same step count twice",
+                "distinct step " + std::string(counts ? "counts" : "sizes (each gives ceil(t_end / dt) steps)"));
+    return std::nullopt;
+  }
+  return result;
+}
+
+// /study/steps or /study/dt (exactly one) inside `object` at `path`; `required` when the object must give one.
+std::optional<std::vector<std::uint64_t>> read_steps_or_dt(Checker& check, const json& object, const std::string& path,
+                                                           double t_end, bool required, std::string& from,
+                                                           const std::string& from_prefix) {
+  const bool has_steps = object.contains("steps"), has_dt = object.contains("dt");
+  if (has_steps && has_dt) {
+    check.issue(child(path, "dt"), describe(object["dt"]) + " together with " + child(path, "steps"),
+                "either \"steps\" (step counts over t_end) or \"dt\" (step sizes), not both");
+    return std::nullopt;
+  }
+  if (!has_steps && !has_dt) {
+    if (required)
+      check.issue(child(path, "steps"), "nothing (neither \"steps\" nor \"dt\" is given)",
+                  "\"steps\": [step counts over /time/t_end] or \"dt\": [step sizes]");
+    return std::nullopt;
+  }
+  const std::string key = has_steps ? "steps" : "dt";
+  from = from_prefix + key;
+  return read_step_list(check, object[key], child(path, key), key, t_end);
+}
+
+std::string default_label(const IntegratorSpec& spec) {
+  return spec.scheme == "basic" ? spec.scheme : spec.scheme + " " + spec.order.to_string();
+}
+
+Study read_study(Checker& check, const json& study_value, HamiltonianForm form, double t_end) {
+  Study study;
+  const std::string path = "/study";
+  const std::string what =
+      "an object {\"integrators\": [...], \"steps\": [...] or \"dt\": [...], \"reference\": {\"q\", \"p\"}}";
+  if (!check.object(study_value, path, what)) return study;
+  check.known_keys(study_value, path, {"integrators", "steps", "dt", "reference"});
+  std::string study_from;
+  const std::size_t before = check.issue_count();
+  const auto study_steps = read_steps_or_dt(check, study_value, path, t_end, false, study_from, "study.");
+  const bool study_steps_invalid = check.issue_count() != before;
+
+  const json* list = check.member(study_value, path, "integrators", true,
+                                  "a non-empty array of integrators, each as /integrator of a run");
+  if (list && (!list->is_array() || list->empty())) {
+    check.issue(child(path, "integrators"), describe(*list),
+                "a non-empty array of integrators, each {\"scheme\": ..., options, \"label\", \"steps\" or \"dt\"}");
+    list = nullptr;
+  }
+  for (std::size_t i = 0; list && i < list->size(); ++i) {
+    const std::string item = child(child(path, "integrators"), i);
+    const json& entry = (*list)[i];
+    if (!check.object(entry, item, "an integrator {\"scheme\": ..., options, \"label\", \"steps\" or \"dt\"}")) continue;
+    StudyIntegrator integrator;
+    integrator.spec = read_integrator_object(check, entry, item, form, {"label", "steps", "dt"});
+    integrator.label = default_label(integrator.spec);
+    if (const json* label = check.member(entry, item, "label", false, ""))
+      if (auto text = check.string(*label, child(item, "label"), "a non-empty string naming the integrator"))
+        integrator.label = *text;
+    std::string from;
+    if (entry.contains("steps") || entry.contains("dt")) {
+      if (auto steps = read_steps_or_dt(check, entry, item, t_end, true, from, "integrator.")) {
+        integrator.steps = std::move(*steps);
+        integrator.steps_from = from;
+      }
+    } else if (study_steps) {
+      integrator.steps = *study_steps;
+      integrator.steps_from = study_from;
+    } else if (!study_steps_invalid) {
+      check.issue(child(item, "steps"), "nothing: neither this integrator nor /study gives steps or dt",
+                  "\"steps\" or \"dt\" here, or in /study for every integrator");
+    }
+    for (const auto& other : study.integrators)
+      if (other.label == integrator.label)
+        check.issue(child(item, "label"), "\"" + integrator.label + "\", the label of an earlier integrator",
+                    "a distinct label per integrator (add \"label\" to tell them apart)");
+    study.integrators.push_back(std::move(integrator));
+  }
+
+  if (const json* reference = check.member(study_value, path, "reference", false, "")) {
+    const std::string reference_path = child(path, "reference");
+    if (check.object(*reference, reference_path, "the exact state at t_end {\"q\": [...], \"p\": [...]}")) {
+      InitialStates state;
+      read_state(check, *reference, reference_path, state, reference_path);
+      study.reference_q = std::move(state.q);
+      study.reference_p = std::move(state.p);
+    }
+  }
+  return study;
+}
+
+Analysis read_analysis(Checker& check, const json& value) {
+  Analysis analysis;
+  const std::string what = "an object {\"closest_return_after\": t}";
+  if (!check.object(value, "/analysis", what)) return analysis;
+  check.known_keys(value, "/analysis", {"closest_return_after"});
+  if (const json* after = check.member(value, "/analysis", "closest_return_after", false, ""))
+    analysis.closest_return_after = check.finite_number(
+        *after, "/analysis/closest_return_after",
+        "a finite time: from then on the smallest phase-space distance to the initial state is tracked");
+  return analysis;
 }
 
 // One axis of a grid: a number, {"from", "to", "count"} or {"values": [...]}.
@@ -592,7 +773,8 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
   if (!check.object(document, "", "a JSON object with the keys model, integrator, initial, time (docs/job-file.md)"))
     return job;
   check.known_keys(document, "",
-                   {"$schema", "description", "model", "hamiltonian", "integrator", "initial", "time", "output"});
+                   {"$schema", "description", "model", "hamiltonian", "integrator", "initial", "time", "output",
+                    "analysis", "study"});
   if (const json* value = check.member(document, "", "$schema", false, ""))
     check.string(*value, "/$schema", "a string (the JSON Schema the file follows; ignored by nonsep)");
   if (const json* value = check.member(document, "", "description", false, ""))
@@ -611,9 +793,30 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
         job.parameters = *parameters;
   }
 
-  job.integrator = read_integrator(check, document);
+  const HamiltonianForm form = read_form(check, document);
   job.initial = read_initial(check, document);
-  job.time = read_time(check, document);
+  if (const json* study = check.member(document, "", "study", false, "")) {
+    if (document.contains("integrator"))
+      check.issue("/integrator", "an integrator together with /study",
+                  "no /integrator in a study: each entry of /study/integrators is one");
+    if (document.contains("analysis"))
+      check.issue("/analysis", "an analysis together with /study", "/analysis in single runs only");
+    job.integrator.form = form;
+    job.time = read_study_time(check, document);
+    job.study = read_study(check, *study, form, job.time.t_end);
+    if (job.initial.count > 1)
+      check.issue("/initial", std::to_string(job.initial.count) + " states",
+                  "one state: a study runs every integrator from the same initial state");
+    if (!job.study->reference_q.empty() && job.initial.dimension != 0 &&
+        job.study->reference_q.size() != job.initial.dimension)
+      check.issue("/study/reference/q", std::to_string(job.study->reference_q.size()) + " components",
+                  std::to_string(job.initial.dimension) + ", as many as the initial state has");
+  } else {
+    job.integrator = read_integrator(check, document, form);
+    job.time = read_time(check, document);
+    if (const json* analysis = check.member(document, "", "analysis", false, ""))
+      job.analysis = read_analysis(check, *analysis);
+  }
 
   std::filesystem::path output = job_file.stem().string() + ".out";
   if (const json* section = check.member(document, "", "output", false, "");

@@ -34,6 +34,10 @@ struct TrajectoryRecord {
   double diverged_t = 0.0;
   std::string diverged_variable;
   std::string error;
+  // /analysis/closest_return_after: the smallest |(q, p) - (q0, p0)| from then on, where and when.
+  std::optional<double> closest_distance;
+  std::uint64_t closest_step = 0;
+  double closest_t = 0.0;
 };
 
 std::optional<double> relative_error(std::optional<double> energy, std::optional<double> initial) {
@@ -209,7 +213,31 @@ class Run {
       if (auto error = relative_error(energy_at(slot), record.energy_initial))
         record.max_abs_relative_error = std::max(record.max_abs_relative_error, std::abs(*error));
     }
+    if (job_.analysis.closest_return_after) track_closest_return(step);
     if (writer_ && (step % job_.every == 0 || step == job_.time.steps)) write_samples(step);
+  }
+
+  // Updates each active trajectory's closest return to its initial state, for |t| >= |closest_return_after|.
+  void track_closest_return(std::uint64_t step) {
+    const double t = job_.time.time_at(step);
+    if (std::abs(t) < std::abs(*job_.analysis.closest_return_after)) return;
+    const std::size_t n = job_.initial.dimension;
+    for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+      TrajectoryRecord& record = records_[slots_[slot]];
+      const std::size_t first = slots_[slot] * n;
+      double sum = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double dq = batch_.q(slot)[i] - job_.initial.q[first + i];
+        const double dp = batch_.p(slot)[i] - job_.initial.p[first + i];
+        sum += dq * dq + dp * dp;
+      }
+      const double distance = std::sqrt(sum);
+      if (!record.closest_distance || distance < *record.closest_distance) {
+        record.closest_distance = distance;
+        record.closest_step = step;
+        record.closest_t = t;
+      }
+    }
   }
 
   // Energies of the active states (NaN where unknown); returns the model's message per slot for those it failed on.
@@ -389,6 +417,11 @@ class Run {
       if (record.status == "diverged")
         entry["diverged"] = {{"step", record.diverged_step}, {"t", record.diverged_t}, {"variable", record.diverged_variable}};
       if (!record.error.empty()) entry["error"] = record.error;
+      if (job_.analysis.closest_return_after)
+        entry["closest_return"] = record.closest_distance ? json{{"distance", *record.closest_distance},
+                                                                 {"t", record.closest_t},
+                                                                 {"step", record.closest_step}}
+                                                          : json(nullptr);
       trajectories.push_back(std::move(entry));
     }
     summary["trajectories"] = std::move(trajectories);

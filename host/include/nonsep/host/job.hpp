@@ -67,6 +67,28 @@ struct InitialStates {
   std::vector<double> q, p;
 };
 
+// A convergence study (/study): the job's model and initial state are run to time.t_end by each integrator at
+// each of its step counts, and the errors at t_end are compared (study.hpp). Step counts are per integrator: the
+// study's list (/study/steps, or /study/dt turned into counts as TimeGrid does) unless the integrator gives its own.
+struct StudyIntegrator {
+  std::string label;           // /study/integrators/<i>/label, default "<scheme> <order>" ("triplet 4/3"; "basic")
+  IntegratorSpec spec;         // as /integrator of a single run, sharing /hamiltonian
+  std::vector<std::uint64_t> steps;  // distinct, in increasing order; dt = t_end / steps
+  std::string steps_from;      // where the counts came from: "study.steps", "study.dt", "integrator.steps", ...
+};
+struct Study {
+  std::vector<StudyIntegrator> integrators;
+  // /study/reference: the exact state at t_end, for the phase-space error; empty when not given.
+  std::vector<double> reference_q, reference_p;
+};
+
+// Per-trajectory analysis of a single run (/analysis).
+struct Analysis {
+  // /analysis/closest_return_after: from this time on, the smallest Euclidean phase-space distance
+  // |(q, p) - (q0, p0)| to the trajectory's initial state is tracked at every step (summary: closest_return).
+  std::optional<double> closest_return_after;
+};
+
 struct Job {
   std::filesystem::path file;       // the job file as given
   std::filesystem::path directory;  // its folder: relative paths in the job resolve against it
@@ -77,6 +99,10 @@ struct Job {
   TimeGrid time;
   std::filesystem::path output_directory;  // /output/directory resolved against `directory`
   std::uint64_t every = 1;                 // /output/every; 0: no trajectory file
+  Analysis analysis;                       // /analysis (single runs only)
+  // /study: present for a convergence study, which has no /integrator, no /time/dt and exactly one initial state;
+  // `integrator` and `time.dt` are then unused and time.t_end is the study's end time.
+  std::optional<Study> study;
 };
 
 // Largest accepted number of initial states and of steps; larger values are reported as out of range.
