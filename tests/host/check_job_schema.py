@@ -18,7 +18,7 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--nonsep", required=True)
     parser.add_argument("--schema", required=True)
-    parser.add_argument("--examples", required=True, help="folder of example job files")
+    parser.add_argument("--examples", required=True, action="append", help="a folder of example job files (repeatable)")
     parser.add_argument("--jobs", required=True, help="tests/host/jobs")
     args = parser.parse_args()
     failures = []
@@ -28,7 +28,7 @@ def main():
     jsonschema.Draft202012Validator.check_schema(schema)
     validator = jsonschema.Draft202012Validator(schema)
 
-    examples = sorted(glob.glob(os.path.join(args.examples, "*.json")))
+    examples = sorted(path for folder in args.examples for path in glob.glob(os.path.join(folder, "*.json")))
     if len(examples) < 3:
         failures.append(f"expected at least 3 example jobs in {args.examples}, found {len(examples)}")
     for example in examples:
@@ -59,19 +59,23 @@ def main():
             current = catalogue.setdefault(m.group(1), {})
         elif (m := re.match(r"^      (\w+) \((?:default (\S+)|required)\): ", line)) and current is not None:
             current[m.group(1)] = m.group(2)
-    schema_schemes = schema["properties"]["integrator"]["properties"]["scheme"]["enum"]
-    if sorted(schema_schemes) != sorted(catalogue):
-        failures.append(f"schema schemes {schema_schemes} differ from the catalogue's {sorted(catalogue)}")
-    for branch in schema["properties"]["integrator"]["allOf"]:
-        name = branch["if"]["properties"]["scheme"]["const"]
-        options = {key: value for key, value in branch["then"]["properties"].items() if key != "scheme"}
-        expected = catalogue.get(name, {})
-        if sorted(options) != sorted(expected):
-            failures.append(f"schema options of {name} {sorted(options)} differ from the catalogue's {sorted(expected)}")
-        for option, default_text in expected.items():
-            default = options.get(option, {}).get("default")
-            if default is None or (default != default_text and not (isinstance(default, float) and default == float(default_text))):
-                failures.append(f"schema default of {name}.{option} is {default!r}, the catalogue's is {default_text}")
+    # A run's /integrator and a study's integrators (which add label, steps and dt) both follow the catalogue.
+    for where, integrator, own_keys in (("/integrator", schema["properties"]["integrator"], {"scheme"}),
+                                        ("study integrators", schema["$defs"]["study_integrator"],
+                                         {"scheme", "label", "steps", "dt"})):
+        schema_schemes = integrator["properties"]["scheme"]["enum"]
+        if sorted(schema_schemes) != sorted(catalogue):
+            failures.append(f"{where}: schema schemes {schema_schemes} differ from the catalogue's {sorted(catalogue)}")
+        for branch in integrator["allOf"]:
+            name = branch["if"]["properties"]["scheme"]["const"]
+            options = {key: value for key, value in branch["then"]["properties"].items() if key not in own_keys}
+            expected = catalogue.get(name, {})
+            if sorted(options) != sorted(expected):
+                failures.append(f"{where}: schema options of {name} {sorted(options)} differ from the catalogue's {sorted(expected)}")
+            for option, default_text in expected.items():
+                default = options.get(option, {}).get("default")
+                if default is None or (default != default_text and not (isinstance(default, float) and default == float(default_text))):
+                    failures.append(f"{where}: schema default of {name}.{option} is {default!r}, the catalogue's is {default_text}")
 
     for failure in failures:
         print(f"FAIL {failure}", file=sys.stderr)
