@@ -230,7 +230,8 @@ class StudyExecution {
     entry["symplectic"] = description.symplectic;
     entry["steps_from"] = integrator.steps_from;
     const auto energy_fit = fit_power_law(dts, energy_errors);
-    entry["n_points"] = energy_fit ? energy_fit->points : 0;
+    entry["n_points"] = std::count_if(energy_errors.begin(), energy_errors.end(),
+                                      [](double e) { return std::isfinite(e) && e != 0.0; });
     entry["exponent"] = energy_fit ? json(energy_fit->exponent) : json(nullptr);
     // The sign of the energy error at the smallest dt fitted (the largest step count).
     double sign = 1.0;

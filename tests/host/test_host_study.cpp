@@ -1,0 +1,168 @@
+// Convergence studies (/study) and the closest-return analysis (/analysis): the power-law fit on its own, and the
+// built executable on small paper1d jobs, compared with the core run directly.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "host_test_support.hpp"
+#include "nonsep/core.hpp"
+#include "nonsep/host/study.hpp"
+#include "nonsep/sdk/model_adapter.hpp"
+#include "paper1d/paper1d.hpp"
+
+using json = nlohmann::json;
+using namespace nonsep::host_testing;
+
+namespace {
+
+constexpr double quarter_period = 0.3863765573361232;
+constexpr double p_at_quarter = -1.5723027555148466;
+
+using PluginPaper1D = nonsep::sdk::ModelAdapter<::Paper1D>;
+
+json study_job(json integrators, json steps) {
+  return {{"model", {{"plugin", "paper1d"}}},
+          {"initial", {{"q", {2.0}}, {"p", {0.0}}}},
+          {"time", {{"t_end", quarter_period}}},
+          {"study", {{"steps", std::move(steps)}, {"reference", {{"q", {0.0}}, {"p", {p_at_quarter}}}},
+                     {"integrators", std::move(integrators)}}}};
+}
+
+struct Finished {
+  int status;
+  json summary;
+  std::vector<std::vector<std::string>> rows;
+};
+
+Finished run_study_job(const TemporaryFolder& folder, const std::string& name, const json& job) {
+  const auto file = write_job(folder / (name + ".json"), job);
+  const auto result = run_nonsep({"run", "--quiet", "--output", (folder / name).string(), file.string()}, folder.path());
+  INFO("stderr: " << result.err);
+  REQUIRE(std::filesystem::exists(folder / name / "summary.json"));
+  return {result.status, read_json(folder / name / "summary.json"), read_csv(folder / name / "convergence.csv")};
+}
+
+}  // namespace
+
+TEST_CASE("fit_power_law recovers c dt^n, skips zero and non-finite errors, and needs two distinct dt") {
+  const std::vector<double> dt{0.1, 0.05, 0.025, 0.0125, 0.001};
+  std::vector<double> error;
+  for (double h : dt) error.push_back(-2.0 * std::pow(h, 2.0 / 3.0));
+  error.back() = std::numeric_limits<double>::quiet_NaN();
+  const auto fit = nonsep::host::fit_power_law(dt, error);
+  REQUIRE(fit);
+  CHECK(fit->exponent == doctest::Approx(2.0 / 3.0).epsilon(1e-12));
+  CHECK(fit->constant == doctest::Approx(2.0).epsilon(1e-12));
+  CHECK(fit->points == 4);
+  const std::vector<double> one_error{1e-3, 0.0, std::numeric_limits<double>::infinity()};
+  CHECK_FALSE(nonsep::host::fit_power_law(std::vector<double>{0.1, 0.2, 0.3}, one_error));
+  CHECK_FALSE(nonsep::host::fit_power_law(std::vector<double>{0.1, 0.1}, std::vector<double>{1e-3, 2e-3}));
+}
+
+TEST_CASE("a study's rows are the core's runs bit for bit, and its fit is the slope through them") {
+  TemporaryFolder folder;
+  const json integrators = {{{"scheme", "basic"}, {"t2", -2.0}},
+                            {{"scheme", "mpe"}, {"order", "2"}, {"t2", -2.0}, {"steps", {256, 512, 1024}}}};
+  const auto run = run_study_job(folder, "study", study_job(integrators, {128, 256}));
+  REQUIRE(run.status == 0);
+  REQUIRE(run.rows.size() == 1 + 2 + 3);
+  CHECK(run.rows[0] == std::vector<std::string>{"integrator", "scheme", "order", "t2", "symplectic", "dt", "steps",
+                                                "basic_steps", "grad_T", "grad_V", "relative_energy_error",
+                                                "phase_error", "status"});
+  const PluginPaper1D model;
+  nonsep::EnergyEvaluator energy(nonsep::HamiltonianForm::TTV);
+  const double q0[] = {2.0}, p0[] = {0.0};
+  const double h0 = energy.evaluate_one(model, nonsep::PhaseSpaceBatch::single(q0, p0));
+  for (std::size_t r = 1; r < run.rows.size(); ++r) {
+    const auto& row = run.rows[r];
+    INFO("row " << r);
+    const bool basic = row[0] == "basic";
+    CHECK(row[0] == (basic ? "basic" : "mpe 2"));
+    const std::uint64_t steps = std::stoull(row[6]);
+    const double dt = quarter_period / static_cast<double>(steps);
+    CHECK(std::stod(row[5]) == dt);
+    nonsep::Integrator integrator({basic ? "basic" : "mpe", basic ? nonsep::Fraction(2, 3) : nonsep::Fraction(2), -2.0});
+    auto x = nonsep::PhaseSpaceBatch::single(q0, p0);
+    for (std::uint64_t k = 0; k < steps; ++k) integrator.step(model, x, dt);
+    CHECK(std::stoull(row[7]) == steps * (basic ? 1 : 6));
+    CHECK(std::stoull(row[8]) == integrator.evaluations().grad_T);
+    CHECK(std::stoull(row[9]) == integrator.evaluations().grad_V);
+    CHECK(std::stod(row[10]) == (energy.evaluate_one(model, x) - h0) / h0);
+    const double dq = x.q(0)[0], dp = x.p(0)[0] - p_at_quarter;
+    CHECK(std::stod(row[11]) == std::sqrt(dq * dq + dp * dp));
+    CHECK(row[12] == "completed");
+  }
+  const auto& fits = run.summary["fits"];
+  REQUIRE(fits.size() == 2);
+  // Two points: the fit is the line through them.
+  const double e1 = std::stod(run.rows[1][10]), e2 = std::stod(run.rows[2][10]);
+  CHECK(fits[0]["exponent"].get<double>() == doctest::Approx(std::log(e1 / e2) / std::log(2.0)).epsilon(1e-12));
+  CHECK(fits[0]["constant"].get<double>() < 0.0);  // the basic step loses energy here
+  CHECK(fits[0]["n_points"] == 2);
+  CHECK(fits[0]["steps_from"] == "study.steps");
+  CHECK(fits[1]["steps_from"] == "integrator.steps");
+  CHECK(fits[1]["steps_min"] == 256);
+  CHECK(fits[1]["steps_max"] == 1024);
+  CHECK(std::abs(fits[1]["exponent"].get<double>() - 2.0) < 0.3);
+  CHECK(std::abs(fits[1]["phase_exponent"].get<double>() - 2.0) < 0.3);
+}
+
+TEST_CASE("a study run the plugin fails on is a failed row, left out of the fit, and the exit status is 1") {
+  TemporaryFolder folder;
+  const json integrators = {{{"scheme", "triplet"}, {"order", "8/3"}, {"t2", -2.0}}};
+  const auto run = run_study_job(folder, "failing", study_job(integrators, {16, 1024}));
+  CHECK(run.status == 1);
+  CHECK(run.summary["status"] == "failed");
+  REQUIRE(run.rows.size() == 3);
+  CHECK(run.rows[1][12] == "failed");
+  CHECK(run.rows[1][10].empty());
+  CHECK(run.rows[2][12] == "completed");
+  CHECK(run.summary["fits"][0]["n_points"] == 1);
+  CHECK(run.summary["fits"][0]["exponent"].is_null());
+  REQUIRE(run.summary["failures"].size() == 1);
+  CHECK(run.summary["failures"][0]["steps"] == 16);
+}
+
+TEST_CASE("closest_return is the minimum distance to the start over every step from closest_return_after on") {
+  TemporaryFolder folder;
+  const json job = {{"model", {{"plugin", "paper1d"}}},
+                    {"integrator", {{"scheme", "basic"}, {"t2", -2.0}}},
+                    {"initial", {{{"q", {2.0}}, {"p", {0.0}}}, {{"q", {0.5}}, {"p", {0.0}}}}},
+                    {"time", {{"dt", 0.005}, {"t_end", 3.0}}},
+                    {"analysis", {{"closest_return_after", 1.2}}},
+                    {"output", {{"every", 1}}}};
+  const auto file = write_job(folder / "orbit.json", job);
+  const auto result = run_nonsep({"run", "--quiet", "--output", (folder / "orbit").string(), file.string()}, folder.path());
+  REQUIRE(result.status == 0);
+  const json summary = read_json(folder / "orbit" / "summary.json");
+  const auto rows = read_csv(folder / "orbit" / "trajectory.csv");
+  for (std::size_t trajectory = 0; trajectory < 2; ++trajectory) {
+    double q0 = 0.0, best = std::numeric_limits<double>::infinity(), best_t = -1.0;
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+      if (std::stoul(rows[r][0]) != trajectory) continue;
+      const double t = std::stod(rows[r][2]), q = std::stod(rows[r][3]), p = std::stod(rows[r][4]);
+      if (std::stoul(rows[r][1]) == 0) q0 = q;
+      if (t < 1.2) continue;
+      const double d = std::hypot(q - q0, p);
+      if (d < best) {
+        best = d;
+        best_t = t;
+      }
+    }
+    const auto& closest = summary["trajectories"][trajectory]["closest_return"];
+    INFO("trajectory " << trajectory);
+    CHECK(closest["distance"].get<double>() == best);
+    CHECK(closest["t"].get<double>() == best_t);
+    CHECK(best < 5e-3);  // the orbit closes after one period
+  }
+  // Without /analysis there is no closest_return.
+  json plain = job;
+  plain.erase("analysis");
+  const auto plain_file = write_job(folder / "plain.json", plain);
+  REQUIRE(run_nonsep({"run", "--quiet", "--output", (folder / "plain").string(), plain_file.string()}, folder.path())
+              .status == 0);
+  CHECK_FALSE(read_json(folder / "plain" / "summary.json")["trajectories"][0].contains("closest_return"));
+}
