@@ -262,7 +262,9 @@ int run_command_line(int argc, char** argv) {
     std::string job_file, output, plugin_name;
     bool quiet = false, as_json = false, check = false;
 
-    auto* run = app.add_subcommand("run", "Run a job: trajectory.csv (streamed) and summary.json in the output folder");
+    auto* run = app.add_subcommand("run",
+                                   "Run a job: trajectory.csv (streamed) and summary.json in the output folder; a "
+                                   "study (/study): convergence.csv, and summary.json with the fitted exponents");
     run->add_option("JOB.json", job_file, "the job file")->required();
     run->add_option("--output,-o", output,
                     "output folder, relative to the current directory (overrides the job's output.directory)");
