@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -205,4 +206,40 @@ TEST_CASE("a plugin steps bit for bit like the same model compiled in") {
   }
   CHECK(through_plugin == in_process);
   CHECK(through_plugin.q()[0] != q0[0]);
+}
+
+namespace {
+// V = log(q): not finite for q <= 0 (no shipped model has such a domain).
+struct LogPotential {
+  static constexpr std::size_t dimension = 1;
+  template <class S>
+  S T(nonsep::sdk::Vector<S> p) const {
+    return p[0] * p[0] / 2.0;
+  }
+  template <class S>
+  S V(nonsep::sdk::Vector<S> q) const {
+    using std::log;
+    return log(q[0]);
+  }
+};
+}  // namespace
+
+TEST_CASE("a shipped model returns overflowing and NaN results as numbers, not as evaluation failures") {
+  // The host, not the plugin, decides what a non-finite number means: the trajectory is reported as diverged
+  // (where, when and which variable), not as failed.
+  const PluginModel model = shipped("paper1d", nlohmann::json::object());
+  const double huge[] = {1e120}, larger[] = {1e200}, not_a_number[] = {std::nan("")};
+  double out[1] = {0.0};
+  model.grad_V(huge, out, 1);  // q + q^3 / 3 overflows
+  CHECK(out[0] == std::numeric_limits<double>::infinity());
+  model.grad_T(larger, out, 1);  // 1 + p^2 / 2 overflows
+  CHECK(out[0] == std::numeric_limits<double>::infinity());
+  model.hessian_V(not_a_number, out, 1);
+  CHECK(std::isnan(out[0]));
+  // Automatic differentiation where the function itself is not finite gives NaN derivatives, not a finite
+  // "derivative" that would let the state go on.
+  const ModelAdapter<LogPotential> log_model;
+  const double negative[] = {-1.0};
+  log_model.grad_V(negative, out, 1);
+  CHECK(std::isnan(out[0]));
 }

@@ -1,6 +1,6 @@
 // An SDK plugin with a domain: V = -log(1 - q^2) exists only for |q| < 1. The analytic grad V refuses the rest
-// with EvaluationError; the automatic Hessian of V meets log of a negative number, which the SDK's finiteness
-// check reports.
+// with EvaluationError (a failure); the automatic Hessian of V meets log of a negative number, which the SDK returns
+// as NaN (a number: the host would report the trajectory as diverged).
 #include <cmath>
 #include <string>
 

@@ -6,9 +6,10 @@
 //
 // which defines the entry symbol of plugin_abi.h and a constant function table for it. The table's functions
 // parse and range-check parameters (parameters.hpp), batch over states, compute derivatives (analytic where the
-// class has them, automatic differentiation otherwise), check results for finiteness, and turn every C++
-// exception into a status code with a message (EvaluationError -> NONSEP_EVALUATION_FAILED, InvalidParameter ->
-// NONSEP_INVALID_PARAMETERS, anything else -> NONSEP_INTERNAL_ERROR). Nothing throws across the boundary.
+// class has them, automatic differentiation otherwise), pass non-finite results through as numbers (the host
+// reports the trajectory as diverged), and turn every C++ exception into a status code with a message
+// (EvaluationError -> NONSEP_EVALUATION_FAILED, InvalidParameter -> NONSEP_INVALID_PARAMETERS, anything else ->
+// NONSEP_INTERNAL_ERROR). Nothing throws across the boundary.
 //
 // The plugin's file must be named <name>.so (nonsep_add_model() in CMake does that): the host refuses a file whose
 // metadata name differs from its file name. Every SDK plugin provides all optional functions (values and

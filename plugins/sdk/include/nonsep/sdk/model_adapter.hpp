@@ -24,10 +24,16 @@
 // (std::array of K duals), so there is no heap allocation while evaluating; max_dimension bounds that stack use
 // (about 16 (K+1)^2 bytes for a Hessian column pass, 4.6 KB at K = 16).
 //
-// Results are checked: a non-finite gradient, Hessian or value throws EvaluationError naming the function and
-// the point.
+// Non-finite results are numbers, not failures: a gradient, Hessian or value that overflows or is NaN is returned
+// as computed, and the host sees the state become non-finite and reports the trajectory as diverged (where, when
+// and which variable). Only where automatic differentiation has no meaning (the function itself is not finite at
+// x, as in log(-1), whose dual "derivative" -1 is finite) are the derivatives set to NaN, so that such a point
+// diverges too instead of silently continuing with a wrong number. Failures are what model code throws
+// (EvaluationError and other exceptions).
 #include <array>
+#include <cmath>
 #include <concepts>
+#include <limits>
 #include <cstddef>
 #include <span>
 #include <stdexcept>
@@ -46,7 +52,8 @@ namespace nonsep::sdk {
 template <class S>
 using Vector = std::span<const S>;
 
-// Thrown by model code (or by the SDK for a non-finite result) where T or V cannot be evaluated.
+// Thrown by model code where T or V cannot be evaluated (outside its domain, say). A non-finite number is not
+// an error: return it, and the host reports the trajectory as diverged.
 class EvaluationError : public nonsep::ModelError {
  public:
   using nonsep::ModelError::ModelError;
@@ -140,26 +147,11 @@ consteval bool dimension_parameter_is_bounded() {
 
 namespace detail {
 
-inline std::string format_point(const char* variable, const double* x, std::size_t n) {
-  std::string text = std::string(variable) + " = (";
-  for (std::size_t i = 0; i < n; ++i) text += (i ? ", " : "") + format_number(x[i]);
-  return text + ")";
-}
-
-inline void require_finite(const double* values, std::size_t size, const char* function, const char* variable,
-                           const double* x, std::size_t n) {
-  for (std::size_t i = 0; i < size; ++i)
-    if (!std::isfinite(values[i]))
-      throw EvaluationError(std::string(function) + " is not finite at " + format_point(variable, x, n) +
-                            (size == 1 ? " (it is " + format_number(values[i]) + ")"
-                                       : " (component " + std::to_string(i) + " is " + format_number(values[i]) + ")"));
-}
-
 // Automatic derivatives of a function that is not finite at x are meaningless (log(-1) has the "derivative" -1):
-// the value computed alongside them is checked first.
-inline void require_finite_value(double value, const char* function, const char* variable, const double* x,
-                                 std::size_t n) {
-  require_finite(&value, 1, function, variable, x, n);
+// when the value computed alongside them is not finite, the `size` derivatives in `out` become NaN.
+inline void poison_if_not_finite(double value, double* out, std::size_t size) {
+  if (std::isfinite(value)) return;
+  for (std::size_t i = 0; i < size; ++i) out[i] = std::numeric_limits<double>::quiet_NaN();
 }
 
 // Writes the gradient of f at x (n <= K components) into out, by one pass of Dual<double, K>. Returns f(x).
@@ -231,7 +223,6 @@ class ModelAdapter {
     const std::size_t n = dimension_;
     for (std::size_t b = 0; b < count; ++b) {
       out[b] = model_.template T<double>(Vector<double>(p.data() + b * n, n));
-      detail::require_finite(&out[b], 1, "T", "p", p.data() + b * n, n);
     }
   }
   void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
@@ -239,7 +230,6 @@ class ModelAdapter {
     const std::size_t n = dimension_;
     for (std::size_t b = 0; b < count; ++b) {
       out[b] = model_.template V<double>(Vector<double>(q.data() + b * n, n));
-      detail::require_finite(&out[b], 1, "V", "q", q.data() + b * n, n);
     }
   }
 
@@ -252,9 +242,8 @@ class ModelAdapter {
       if constexpr (analytic_grad_T)
         model_.grad_T(Vector<double>(x, n), std::span<double>(g, n));
       else
-        detail::require_finite_value(
-            detail::gradient_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, g), "T", "p", x, n);
-      detail::require_finite(g, n, "grad T", "p", x, n);
+        detail::poison_if_not_finite(
+            detail::gradient_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, g), g, n);
     }
   }
   void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
@@ -266,9 +255,8 @@ class ModelAdapter {
       if constexpr (analytic_grad_V)
         model_.grad_V(Vector<double>(x, n), std::span<double>(g, n));
       else
-        detail::require_finite_value(
-            detail::gradient_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, g), "V", "q", x, n);
-      detail::require_finite(g, n, "grad V", "q", x, n);
+        detail::poison_if_not_finite(
+            detail::gradient_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, g), g, n);
     }
   }
   void hessian_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
@@ -280,9 +268,8 @@ class ModelAdapter {
       if constexpr (analytic_hessian_T)
         model_.hessian_T(Vector<double>(x, n), std::span<double>(h, n * n));
       else
-        detail::require_finite_value(
-            detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h), "T", "p", x, n);
-      detail::require_finite(h, n * n, "Hessian of T", "p", x, n);
+        detail::poison_if_not_finite(
+            detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h), h, n * n);
     }
   }
   void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
@@ -294,9 +281,8 @@ class ModelAdapter {
       if constexpr (analytic_hessian_V)
         model_.hessian_V(Vector<double>(x, n), std::span<double>(h, n * n));
       else
-        detail::require_finite_value(
-            detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h), "V", "q", x, n);
-      detail::require_finite(h, n * n, "Hessian of V", "q", x, n);
+        detail::poison_if_not_finite(
+            detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h), h, n * n);
     }
   }
 
