@@ -189,10 +189,13 @@ class Checker {
       const auto x = value.get<std::int64_t>();
       if (x >= minimum && x <= maximum) return x;
     } else if (value.is_number_float()) {
-      // JSON Schema counts 10.0 as an integer; so does nonsep, within the range.
+      // JSON Schema counts 10.0 as an integer; so does nonsep, within the range. The bounds are checked on the
+      // double first: converting one outside the range of std::int64_t is undefined.
       const double x = value.get<double>();
-      if (std::floor(x) == x && x >= static_cast<double>(minimum) && x <= static_cast<double>(maximum))
-        return static_cast<std::int64_t>(x);
+      if (std::floor(x) == x && x >= -0x1p63 && x < 0x1p63) {
+        const auto integral = static_cast<std::int64_t>(x);
+        if (integral >= minimum && integral <= maximum) return integral;
+      }
     }
     issue(path, describe(value), what);
     return std::nullopt;
@@ -674,6 +677,7 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
   if (!check.object(grid, path, "an object {\"q\": [axis, ...], \"p\": [axis, ...]}, one axis per component")) return;
   check.known_keys(grid, path, {"q", "p"});
   std::vector<std::vector<double>> axes;
+  std::size_t count = 1;  // states: the product of the axes' sizes
   std::size_t sizes[2] = {0, 0};
   bool ok = true;
   for (int which = 0; which < 2; ++which) {
@@ -691,10 +695,18 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
     sizes[which] = list->size();
     for (std::size_t i = 0; i < list->size(); ++i) {
       auto axis = read_axis(check, (*list)[i], child(child(path, name), i));
-      if (axis)
-        axes.push_back(std::move(*axis));
-      else
+      if (!axis) {
         ok = false;
+        continue;
+      }
+      // Stops at the first axis that makes the grid too large, before reading (and allocating) the others.
+      if (count > max_initial_states / axis->size()) {
+        check.issue(path, "a grid of more than " + std::to_string(max_initial_states) + " states",
+                    "at most " + std::to_string(max_initial_states) + " states");
+        return;
+      }
+      count *= axis->size();
+      axes.push_back(std::move(*axis));
     }
   }
   if (sizes[0] && sizes[1] && sizes[0] != sizes[1]) {
@@ -703,28 +715,28 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
     ok = false;
   }
   if (!ok) return;
-  std::size_t count = 1;
-  for (const auto& axis : axes) {
-    if (count > max_initial_states / axis.size()) {
-      check.issue(path, "a grid of more than " + std::to_string(max_initial_states) + " states",
-                  "at most " + std::to_string(max_initial_states) + " states");
-      return;
-    }
-    count *= axis.size();
-  }
   // Row-major over the axes in the order q0, q1, ..., p0, p1, ...: the last axis varies fastest.
   const std::size_t n = sizes[0];
+  if (count > max_initial_values / n) {
+    check.issue(path, "a grid of " + std::to_string(count) + " states of dimension " + std::to_string(n),
+                "at most " + std::to_string(max_initial_values) + " numbers in q (states times dimension)");
+    return;
+  }
   states.dimension = n;
   states.count = count;
   states.q.resize(count * n);
   states.p.resize(count * n);
-  for (std::size_t b = 0; b < count; ++b) {
-    std::size_t rest = b;
-    for (std::size_t a = axes.size(); a-- > 0;) {
-      const double value = axes[a][rest % axes[a].size()];
-      rest /= axes[a].size();
-      (a < n ? states.q[b * n + a] : states.p[b * n + (a - n)]) = value;
-    }
+  // Axis a repeats each of its values `stride` times (the product of the later axes' sizes), the whole pattern
+  // count / (size * stride) times; no division per value.
+  std::size_t stride = count;
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    const std::vector<double>& axis = axes[a];
+    stride /= axis.size();
+    double* column = a < n ? states.q.data() + a : states.p.data() + (a - n);
+    std::size_t b = 0;
+    while (b < count)
+      for (const double value : axis)
+        for (std::size_t r = 0; r < stride; ++r, ++b) column[b * n] = value;
   }
 }
 
@@ -774,7 +786,7 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
     return job;
   check.known_keys(document, "",
                    {"$schema", "description", "model", "hamiltonian", "integrator", "initial", "time", "output",
-                    "analysis", "study"});
+                    "analysis", "study", "checkpoint"});
   if (const json* value = check.member(document, "", "$schema", false, ""))
     check.string(*value, "/$schema", "a string (the JSON Schema the file follows; ignored by nonsep)");
   if (const json* value = check.member(document, "", "description", false, ""))
@@ -801,6 +813,9 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
                   "no /integrator in a study: each entry of /study/integrators is one");
     if (document.contains("analysis"))
       check.issue("/analysis", "an analysis together with /study", "/analysis in single runs only");
+    if (document.contains("checkpoint"))
+      check.issue("/checkpoint", "a checkpoint policy together with /study",
+                  "/checkpoint in single runs only (a study is not resumed)");
     job.integrator.form = form;
     job.time = read_study_time(check, document);
     job.study = read_study(check, *study, form, job.time.t_end);
@@ -832,6 +847,26 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
         job.every = static_cast<std::uint64_t>(*stride);
   }
   job.output_directory = output.is_absolute() ? output : job.directory / output;
+
+  const std::string checkpoint_what = "an object {\"every_steps\": n, \"every_seconds\": s}";
+  if (const json* section = check.member(document, "", "checkpoint", false, "");
+      section && check.object(*section, "/checkpoint", checkpoint_what)) {
+    check.known_keys(*section, "/checkpoint", {"every_steps", "every_seconds"});
+    if (const json* value = check.member(*section, "/checkpoint", "every_steps", false, ""))
+      if (auto steps = check.integer(*value, "/checkpoint/every_steps", 0, static_cast<std::int64_t>(max_steps),
+                                     "an integer from 0 to " + std::to_string(max_steps) +
+                                         ": save a checkpoint every n steps (0: not by steps)"))
+        job.checkpoint.every_steps = static_cast<std::uint64_t>(*steps);
+    if (const json* value = check.member(*section, "/checkpoint", "every_seconds", false, "")) {
+      const std::string what = "a finite number >= 0: save a checkpoint every s seconds of wall time (0: not by time)";
+      if (auto seconds = check.finite_number(*value, "/checkpoint/every_seconds", what)) {
+        if (*seconds < 0.0)
+          check.issue("/checkpoint/every_seconds", describe(*value), what);
+        else
+          job.checkpoint.every_seconds = *seconds;
+      }
+    }
+  }
   return job;
 }
 
@@ -843,7 +878,7 @@ void check_model_parameters(const json& given, const std::vector<PluginParameter
   for (const auto& [name, value] : given.items()) {
     const std::string path = child("/model/parameters", name);
     const auto it = std::find_if(declared.begin(), declared.end(),
-                                 [&](const PluginParameter& parameter) { return parameter.name == name; });
+                                 [&key = name](const PluginParameter& parameter) { return parameter.name == key; });
     if (it == declared.end()) {
       check.issue(path, "the unknown parameter \"" + name + "\"",
                   names.empty() ? "none: this plugin has no parameters" : "the plugin's parameters " + names);

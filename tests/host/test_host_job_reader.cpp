@@ -175,6 +175,44 @@ TEST_CASE("initial states: one, a list, or a grid in row-major order (last axis 
   document["initial"] = {{"grid", {{"q", {{{"from", 0.0}, {"to", 1.0}, {"count", 1000}}}},
                                    {"p", {{{"from", 0.0}, {"to", 1.0}, {"count", 1001}}}}}}};
   CHECK(paths(parse(document).issues) == std::vector<std::string>{"/initial/grid"});
+
+  // Found by fuzzing: axes are refused as soon as their product is too large, before the rest are allocated
+  // (here 200 axes of a million values each would need 1.6 GB), and a grid of allowed size but large dimension
+  // must not ask for more than max_initial_values numbers.
+  json huge_axes = json::array();
+  for (int i = 0; i < 200; ++i) huge_axes.push_back({{"from", 0.0}, {"to", 1.0}, {"count", 1000000}});
+  document["initial"] = {{"grid", {{"q", huge_axes}, {"p", huge_axes}}}};
+  CHECK(paths(parse(document).issues) == std::vector<std::string>{"/initial/grid"});
+  json wide_q = json::array({{{"from", 0.0}, {"to", 1.0}, {"count", 1000000}}}), wide_p = json::array({0.0});
+  for (int i = 0; i < 150; ++i) {
+    wide_q.push_back(0.0);
+    wide_p.push_back(0.0);
+  }
+  document["initial"] = {{"grid", {{"q", wide_q}, {"p", wide_p}}}};
+  const auto wide = parse(document);
+  REQUIRE(paths(wide.issues) == std::vector<std::string>{"/initial/grid"});
+  CHECK(wide.issues[0].found == "a grid of 1000000 states of dimension 151");
+}
+
+TEST_CASE("checkpoint: every_steps and every_seconds, with defaults, and each problem with its path") {
+  json document = host_testing::quickstart_job();
+  auto parsed = parse(document);
+  CHECK(parsed.job.checkpoint.every_steps == 0);
+  CHECK(parsed.job.checkpoint.every_seconds == 60.0);
+  document["checkpoint"] = {{"every_steps", 500}, {"every_seconds", 0}};
+  parsed = parse(document);
+  CHECK(parsed.issues.empty());
+  CHECK(parsed.job.checkpoint.every_steps == 500);
+  CHECK(parsed.job.checkpoint.every_seconds == 0.0);
+  document["checkpoint"] = {{"every_steps", 2.5}, {"every_seconds", -1}, {"every_minute", 1}};
+  CHECK(paths(parse(document).issues) ==
+        std::vector<std::string>{"/checkpoint/every_minute", "/checkpoint/every_steps", "/checkpoint/every_seconds"});
+  // 2^63 as a double is integral but beyond std::int64_t: refused, not converted (undefined behaviour).
+  document["checkpoint"] = {{"every_steps", 9.223372036854775807e18}};
+  CHECK(paths(parse(document).issues) == std::vector<std::string>{"/checkpoint/every_steps"});
+  document.erase("checkpoint");
+  document["output"]["every"] = 9.223372036854775807e18;
+  CHECK(paths(parse(document).issues) == std::vector<std::string>{"/output/every"});
 }
 
 TEST_CASE("every problem of a job is reported at once, each with its JSON path") {

@@ -89,6 +89,14 @@ struct Analysis {
   std::optional<double> closest_return_after;
 };
 
+// When a run saves checkpoint.json (host/include/nonsep/host/checkpoint.hpp) so that `nonsep run --resume` can
+// continue it: after every `every_steps` steps and/or once `every_seconds` of wall time have passed since the
+// last one (0 turns either off), and always when the run is interrupted.
+struct CheckpointPolicy {
+  std::uint64_t every_steps = 0;
+  double every_seconds = 60.0;
+};
+
 struct Job {
   std::filesystem::path file;       // the job file as given
   std::filesystem::path directory;  // its folder: relative paths in the job resolve against it
@@ -103,11 +111,16 @@ struct Job {
   // /study: present for a convergence study, which has no /integrator, no /time/dt and exactly one initial state;
   // `integrator` and `time.dt` are then unused and time.t_end is the study's end time.
   std::optional<Study> study;
+  CheckpointPolicy checkpoint;             // /checkpoint
 };
 
 // Largest accepted number of initial states and of steps; larger values are reported as out of range.
 inline constexpr std::size_t max_initial_states = 1'000'000;
 inline constexpr std::uint64_t max_steps = 1'000'000'000'000;
+// Largest accepted number of initial values, states times dimension (2^24: 128 MiB for q and as much for p; a
+// million states of dimension 16 fit), so that a grid written in a few lines cannot ask for more memory and time
+// than a machine has.
+inline constexpr std::size_t max_initial_values = 16'777'216;
 
 // Pass 1. Parses `text` as JSON, refusing duplicate keys (nlohmann would keep the last one silently).
 // Returns nothing and adds issues on failure.
