@@ -28,3 +28,13 @@ if(NONSEP_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
+
+# libFuzzer instrumentation for tests/fuzz (clang only). The harness links -fsanitize=fuzzer; everything else is
+# instrumented without libFuzzer's main.
+option(NONSEP_FUZZ "Build the libFuzzer harnesses of tests/fuzz (requires clang)" OFF)
+if(NONSEP_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "NONSEP_FUZZ needs clang (CXX=clang++), not ${CMAKE_CXX_COMPILER_ID}")
+  endif()
+  add_compile_options(-fsanitize=fuzzer-no-link)
+endif()

@@ -187,7 +187,8 @@ PluginModel Plugin::create(const json& parameters_or_null) const {
   const auto declared = parameters();
   json effective = json::object();
   for (const auto& [key, value] : given.items()) {
-    const auto row = std::find_if(declared.begin(), declared.end(), [&](const auto& p) { return p.name == key; });
+    const auto row =
+        std::find_if(declared.begin(), declared.end(), [&name = key](const auto& p) { return p.name == name; });
     if (row == declared.end()) {
       std::string known;
       for (const auto& p : declared) known += (known.empty() ? "" : ", ") + p.name;

@@ -140,7 +140,8 @@ inline ParameterValues parse_parameters(std::span<const Parameter> table, std::s
                                    std::string(given.type_name()) + ")");
   nlohmann::json checked = nlohmann::json::object();
   for (const auto& [key, value] : given.items()) {
-    const auto row = std::find_if(table.begin(), table.end(), [&](const Parameter& p) { return key == p.name; });
+    const auto row =
+        std::find_if(table.begin(), table.end(), [&name = key](const Parameter& p) { return name == p.name; });
     if (row == table.end()) {
       std::string known;
       for (const auto& p : table) known += (known.empty() ? "" : ", ") + std::string(p.name);
