@@ -1,5 +1,6 @@
 #include "nonsep/host/command_line.hpp"
 
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "nonsep/core/integrator_description.hpp"
+#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/number_format.hpp"
@@ -30,12 +32,18 @@ namespace nonsep::host {
 namespace {
 
 std::atomic<bool> stop_requested{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "the SIGINT flag must be lock-free to be set in a handler");
+std::atomic<int> stop_signal{0};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free,
+              "the stop flags must be lock-free to be set in a signal handler");
 
-extern "C" void request_stop(int) { stop_requested.store(true); }
+extern "C" void request_stop(int signal) {
+  stop_signal.store(signal);
+  stop_requested.store(true);
+}
 
-// Catches the first SIGINT (the run finishes its step and writes its outputs); SA_RESETHAND restores the default
-// action, so a second Ctrl-C ends the process at once.
+// Catches the first SIGINT or SIGTERM (the run finishes its step, flushes trajectory.csv and writes its checkpoint
+// and summary); SA_RESETHAND restores the default action, so a second signal of the same kind ends the process at
+// once. No SA_RESTART: a plugin sleeping or waiting in a system call sees EINTR and returns sooner.
 class InterruptGuard {
  public:
   InterruptGuard() {
@@ -43,14 +51,18 @@ class InterruptGuard {
     action.sa_handler = request_stop;
     sigemptyset(&action.sa_mask);
     action.sa_flags = SA_RESETHAND;
-    sigaction(SIGINT, &action, &previous_);
+    sigaction(SIGINT, &action, &previous_interrupt_);
+    sigaction(SIGTERM, &action, &previous_terminate_);
   }
-  ~InterruptGuard() { sigaction(SIGINT, &previous_, nullptr); }
+  ~InterruptGuard() {
+    sigaction(SIGINT, &previous_interrupt_, nullptr);
+    sigaction(SIGTERM, &previous_terminate_, nullptr);
+  }
   InterruptGuard(const InterruptGuard&) = delete;
   InterruptGuard& operator=(const InterruptGuard&) = delete;
 
  private:
-  struct sigaction previous_ = {};
+  struct sigaction previous_interrupt_ = {}, previous_terminate_ = {};
 };
 
 std::string exit_status_text() {
@@ -60,7 +72,9 @@ std::string exit_status_text() {
          "       says which and where); an output could not be written; `inspect --check` found wrong derivatives\n"
          "  2    invalid input, nothing was run: usage, job file, parameters, a plugin that cannot be loaded,\n"
          "       an output folder that cannot be created\n"
-         "  130  interrupted (SIGINT): the current step was finished, outputs written with status \"interrupted\"\n";
+         "  130  interrupted (SIGINT): the current step was finished, outputs written with status \"interrupted\",\n"
+         "       and a checkpoint: `nonsep run JOB --resume` continues the run\n"
+         "  143  terminated (SIGTERM): the same as 130\n";
 }
 
 // Generated from nonsep::scheme_catalogue(), like the job reader's checks.
@@ -117,18 +131,25 @@ int report_study(const RunOutcome& outcome, const std::filesystem::path& directo
   return to_int(outcome.exit_status);
 }
 
-int command_run(const std::string& job_file, const std::string& output, bool quiet) {
+int command_run(const std::string& job_file, const std::string& output, bool quiet, bool resume) {
   std::optional<LoadedJob> loaded;
   try {
     loaded.emplace(load_job(job_file));
   } catch (const InvalidJob& error) {
     return report_invalid_job(error);
   }
+  if (resume && loaded->job.study) {
+    std::cerr << "nonsep: cannot resume: " << job_file << " is a convergence study (/study), which is not resumed; "
+              << "run it again without --resume\n";
+    return to_int(ExitStatus::invalid_input);
+  }
   RunOptions options;
   options.output_directory = output.empty() ? loaded->job.output_directory : std::filesystem::path(output);
   options.show_progress = !quiet && stderr_is_terminal();
   options.stop_requested = &stop_requested;
+  options.resume = resume;
   stop_requested.store(false);
+  stop_signal.store(0);
   RunOutcome outcome;
   {
     InterruptGuard guard;
@@ -137,8 +158,13 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
     } catch (const OutputError& error) {
       std::cerr << "nonsep: " << error.what() << "\n";
       return to_int(ExitStatus::invalid_input);
+    } catch (const CheckpointError& error) {
+      std::cerr << "nonsep: cannot resume: " << error.what() << "\n";
+      return to_int(ExitStatus::invalid_input);
     }
   }
+  if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() == SIGTERM)
+    outcome.exit_status = ExitStatus::terminated;
   if (loaded->job.study) return report_study(outcome, options.output_directory, quiet);
   const auto& summary = outcome.summary;
   const auto& counts = summary["counts"];
@@ -155,6 +181,10 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
   } else {
     std::cerr << "nonsep: " << line << "\n";
     if (summary.contains("error")) std::cerr << "nonsep: " << summary["error"].get<std::string>() << "\n";
+    if (status == "interrupted")
+      std::cerr << "nonsep: stopped by " << (stop_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT") << " after step "
+                << summary["time"]["steps_completed"] << "; `nonsep run " << job_file
+                << (output.empty() ? "" : " --output " + output) << " --resume` continues from there\n";
     for (const auto& trajectory : summary["trajectories"]) {
       if (trajectory["status"] == "diverged")
         std::cerr << "nonsep: trajectory " << trajectory["index"] << " diverged at step "
@@ -260,7 +290,7 @@ int run_command_line(int argc, char** argv) {
                "tree's plugin folders.");
 
     std::string job_file, output, plugin_name;
-    bool quiet = false, as_json = false, check = false;
+    bool quiet = false, as_json = false, check = false, resume = false;
 
     auto* run = app.add_subcommand("run",
                                    "Run a job: trajectory.csv (streamed) and summary.json in the output folder; a "
@@ -269,6 +299,9 @@ int run_command_line(int argc, char** argv) {
     run->add_option("--output,-o", output,
                     "output folder, relative to the current directory (overrides the job's output.directory)");
     run->add_flag("--quiet,-q", quiet, "no progress bar and no completion line");
+    run->add_flag("--resume", resume,
+                  "continue an interrupted run from checkpoint.json in its output folder; the outputs end as those of "
+                  "an uninterrupted run");
     run->footer(schemes_text() + "\n" + exit_status_text());
 
     auto* validate = app.add_subcommand(
@@ -294,7 +327,7 @@ int run_command_line(int argc, char** argv) {
       const int code = app.exit(error);
       return code == 0 ? to_int(ExitStatus::success) : to_int(ExitStatus::invalid_input);
     }
-    if (run->parsed()) return command_run(job_file, output, quiet);
+    if (run->parsed()) return command_run(job_file, output, quiet, resume);
     if (validate->parsed()) return command_validate(job_file);
     if (inspect->parsed()) return command_inspect(plugin_name, as_json, check);
     if (models->parsed()) return command_models();

@@ -30,6 +30,21 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, std::size_
   buffer_ += ",H,relative_energy_error\n";
 }
 
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, std::size_t dimension, std::uint64_t size)
+    : path_(path), dimension_(dimension), flushed_size_(size) {
+  std::error_code error;
+  const auto existing = std::filesystem::file_size(path, error);
+  if (error) throw OutputError("cannot resume " + path.string() + ": " + error.message());
+  if (existing < size)
+    throw OutputError("cannot resume " + path.string() + ": it has " + std::to_string(existing) +
+                      " bytes, fewer than the " + std::to_string(size) + " the checkpoint recorded");
+  std::filesystem::resize_file(path, size, error);
+  if (error) throw OutputError("cannot resume " + path.string() + ": " + error.message());
+  file_ = std::fopen(path.c_str(), "ab");
+  if (!file_) throw OutputError("cannot open " + path.string() + ": " + system_reason());
+  buffer_.reserve(buffer_capacity + 1024);
+}
+
 TrajectoryWriter::~TrajectoryWriter() {
   try {
     drain();
@@ -69,6 +84,7 @@ void TrajectoryWriter::drain() {
     buffer_.clear();
     throw OutputError("cannot write " + path_.string() + ": " + system_reason());
   }
+  flushed_size_ += buffer_.size();
   buffer_.clear();
 }
 

@@ -10,6 +10,7 @@
 #include "nonsep/core/energy.hpp"
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/output_files.hpp"
 #include "nonsep/host/progress_bar.hpp"
 
@@ -20,25 +21,6 @@ using json = nlohmann::ordered_json;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// What the summary needs to know about one trajectory; O(dimension) memory, whatever the number of steps.
-struct TrajectoryRecord {
-  std::string status = "running";
-  std::uint64_t final_step = 0;
-  double final_t = 0.0;
-  std::vector<double> final_q, final_p;
-  std::optional<double> energy_initial, energy_final;
-  double max_abs_relative_error = 0.0;
-  std::optional<std::uint64_t> last_written_step;
-  std::uint64_t diverged_step = 0;
-  double diverged_t = 0.0;
-  std::string diverged_variable;
-  std::string error;
-  // /analysis/closest_return_after: the smallest |(q, p) - (q0, p0)| from then on, where and when.
-  std::optional<double> closest_distance;
-  std::uint64_t closest_step = 0;
-  double closest_t = 0.0;
-};
 
 std::optional<double> relative_error(std::optional<double> energy, std::optional<double> initial) {
   if (!energy || !initial || *initial == 0.0) return std::nullopt;
@@ -112,12 +94,17 @@ class Run {
         records_(job_.initial.count),
         batch_(job_.initial.dimension, job_.initial.count),
         slots_(job_.initial.count) {
+    fingerprint_ = job_fingerprint(loaded);
     std::error_code error;
     std::filesystem::create_directories(options.output_directory, error);
     if (error)
       throw OutputError("cannot create the output folder " + options.output_directory.string() + ": " +
                         error.message());
     const auto trajectory_path = options.output_directory / "trajectory.csv";
+    if (options.resume) {
+      resume(load_checkpoint(checkpoint_path(), loaded), trajectory_path);
+      return;
+    }
     if (job_.every > 0)
       writer_.emplace(trajectory_path, job_.initial.dimension);
     else
@@ -132,11 +119,16 @@ class Run {
     const auto start = Clock::now();
     ProgressBar progress(options_.show_progress, job_.time.steps);
     auto next_flush = start + std::chrono::seconds(1);
+    const auto checkpoint_interval = std::chrono::duration<double>(job_.checkpoint.every_seconds);
+    auto next_checkpoint = start + std::chrono::duration_cast<Clock::duration>(checkpoint_interval);
     try {
-      const auto energy_errors = evaluate_energies();
-      for (std::size_t slot = 0; slot < slots_.size(); ++slot) records_[slots_[slot]].energy_initial = energy_at(slot);
-      retire_energy_failures(energy_errors, 0);
-      write_samples(0);
+      if (!resumed_) {
+        const auto energy_errors = evaluate_energies();
+        for (std::size_t slot = 0; slot < slots_.size(); ++slot)
+          records_[slots_[slot]].energy_initial = energy_at(slot);
+        retire_energy_failures(energy_errors, 0);
+        write_samples(0);
+      }
       while (completed_ < job_.time.steps && !slots_.empty()) {
         if (options_.stop_requested && options_.stop_requested->load()) {
           interrupted_ = true;
@@ -144,16 +136,27 @@ class Run {
         }
         advance(completed_ + 1);
         const auto now = Clock::now();
-        if (writer_ && now >= next_flush) {
+        if ((job_.checkpoint.every_steps > 0 && completed_ % job_.checkpoint.every_steps == 0) ||
+            (job_.checkpoint.every_seconds > 0.0 && now >= next_checkpoint)) {
+          save_state();
+          next_checkpoint = now + std::chrono::duration_cast<Clock::duration>(checkpoint_interval);
+          next_flush = now + std::chrono::seconds(1);
+        } else if (writer_ && now >= next_flush) {
           writer_->flush();
           next_flush = now + std::chrono::seconds(1);
         }
         progress.update(completed_, job_.time.time_at(completed_), slots_.size());
       }
+      // An interrupted run keeps where it stopped, before its last rows (finish_active) are written.
+      if (interrupted_) save_state();
     } catch (const std::exception& error) {
       run_error_ = error.what();
     }
     progress.finish();
+    if (!interrupted_ && run_error_.empty()) {
+      std::error_code ignored;
+      std::filesystem::remove(checkpoint_path(), ignored);
+    }
     finish_active();
     if (writer_) {
       try {
@@ -175,6 +178,45 @@ class Run {
   }
 
  private:
+  std::filesystem::path checkpoint_path() const { return options_.output_directory / checkpoint_file_name; }
+
+  // Flushes trajectory.csv and saves checkpoint.json for the state after step completed_.
+  void save_state() {
+    if (writer_) writer_->flush();
+    RunState state;
+    state.step = completed_;
+    state.trajectory_bytes = writer_ ? writer_->flushed_size() : 0;
+    state.slots = slots_;
+    state.q.assign(batch_.q().begin(), batch_.q().end());
+    state.p.assign(batch_.p().begin(), batch_.p().end());
+    state.energies = energies_;
+    state.records = records_;
+    state.evaluations = evaluations();
+    save_checkpoint(checkpoint_path(), state, fingerprint_);
+  }
+
+  // Continues from `state` (load_checkpoint): the batch, the records, and trajectory.csv cut back to the
+  // checkpoint's size.
+  void resume(RunState state, const std::filesystem::path& trajectory_path) {
+    const std::size_t n = job_.initial.dimension;
+    batch_ = PhaseSpaceBatch(n, state.slots.size());
+    std::copy(state.q.begin(), state.q.end(), batch_.q().begin());
+    std::copy(state.p.begin(), state.p.end(), batch_.p().begin());
+    slots_ = std::move(state.slots);
+    energies_ = std::move(state.energies);
+    records_ = std::move(state.records);
+    completed_ = state.step;
+    evaluations_before_ = state.evaluations;
+    resumed_ = true;
+    if (job_.every > 0) writer_.emplace(trajectory_path, n, state.trajectory_bytes);
+  }
+
+  EvaluationCounts evaluations() const {
+    EvaluationCounts counts = evaluations_before_;
+    counts += integrator_.evaluations();
+    return counts;
+  }
+
   // One step of every active state, from `step - 1` to `step`.
   void advance(std::uint64_t step) {
     const PhaseSpaceBatch before = batch_;
@@ -429,7 +471,7 @@ class Run {
                          {"diverged", count_status("diverged")},
                          {"failed", count_status("failed")},
                          {"interrupted", count_status("interrupted")}};
-    const auto evaluations = integrator_.evaluations();
+    const auto evaluations = this->evaluations();
     summary["evaluations"] = {{"grad_T", evaluations.grad_T}, {"grad_V", evaluations.grad_V}};
     summary["wall_seconds"] = wall_seconds;
     return summary;
@@ -449,6 +491,9 @@ class Run {
   std::optional<TrajectoryWriter> writer_;
   std::uint64_t completed_ = 0;
   bool interrupted_ = false;
+  bool resumed_ = false;
+  EvaluationCounts evaluations_before_;  // counted before the checkpoint a resumed run started from
+  std::string fingerprint_;             // job_fingerprint, for checkpoints
   std::string run_error_;
 };
 

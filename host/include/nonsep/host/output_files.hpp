@@ -27,6 +27,9 @@ class TrajectoryWriter {
  public:
   // Creates or truncates `path` and writes the header. Throws OutputError.
   TrajectoryWriter(const std::filesystem::path& path, std::size_t dimension);
+  // Resumes the file at `path`: cuts it back to its first `size` bytes (what a checkpoint recorded) and appends.
+  // Throws OutputError when the file is missing or shorter than `size`.
+  TrajectoryWriter(const std::filesystem::path& path, std::size_t dimension, std::uint64_t size);
   TrajectoryWriter(const TrajectoryWriter&) = delete;
   TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
   // Flushes; a failure here is lost, so callers flush() explicitly at the end of a run.
@@ -38,6 +41,8 @@ class TrajectoryWriter {
   // Writes the buffer to the file and flushes the stream. Throws OutputError.
   void flush();
   const std::filesystem::path& path() const { return path_; }
+  // Bytes handed to the file so far, header included; after flush() they are all in it.
+  std::uint64_t flushed_size() const { return flushed_size_; }
 
  private:
   void drain();
@@ -45,6 +50,7 @@ class TrajectoryWriter {
   std::filesystem::path path_;
   std::FILE* file_ = nullptr;
   std::size_t dimension_;
+  std::uint64_t flushed_size_ = 0;
   std::string buffer_;
 };
 

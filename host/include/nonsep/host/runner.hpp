@@ -1,7 +1,7 @@
 #pragma once
-// Running a loaded job: every initial state is stepped together as one nonsep::PhaseSpaceBatch (one plugin call
-// per stage for the whole ensemble), samples stream to trajectory.csv, and summary.json is written at the end,
-// whatever the end was.
+// Running a loaded job, or resuming one: every initial state is stepped together as one nonsep::PhaseSpaceBatch
+// (one plugin call per stage for the whole ensemble), samples stream to trajectory.csv, and summary.json is written
+// at the end, whatever the end was.
 //
 // Per trajectory, after every step:
 //   - a state with a non-finite q or p is retired with status "diverged" (step, t and the first non-finite
@@ -30,6 +30,8 @@ struct RunOptions {
   bool show_progress = false;              // draw a ProgressBar on stderr (the caller checks for a terminal)
   // Checked after every step; when true the run stops with status "interrupted" (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;
+  // Continue from output_directory/checkpoint.json (checkpoint.hpp) instead of starting at step 0.
+  bool resume = false;
 };
 
 struct RunOutcome {
@@ -38,7 +40,14 @@ struct RunOutcome {
 };
 
 // Runs `job`. Throws OutputError, before anything is
-// computed, when the output folder or trajectory.csv cannot be created. Every failure after that is reported in
+// computed, when the output folder or trajectory.csv cannot be created, and CheckpointError when asked to resume
+// from a checkpoint that is missing, damaged or another job's.
+//
+// Checkpoints (job.checkpoint, checkpoint.hpp) are saved between steps, after flushing trajectory.csv, and when
+// the run is interrupted (before the interrupted states' last rows, which a resumed run drops again); a run that
+// ends otherwise removes checkpoint.json. A resumed run ends with the same final states, energies and
+// trajectory.csv, bit for bit, as an uninterrupted one; its evaluation counts may exceed those by one gradient
+// (the reused last gradient of the basic step is not in the checkpoint). Every failure after that is reported in
 // the outcome (and in summary.json) rather than thrown; if even summary.json cannot be written the outcome says
 // so in summary["error"] and exit_status is run_failed.
 RunOutcome run_job(const LoadedJob& job, const RunOptions& options);
