@@ -102,6 +102,7 @@ inline Process start_nonsep(const std::vector<std::string>& args, const std::fil
 
 struct Result {
   int status = -1;  // the exit status, or 128 + signal number when killed by a signal
+  bool killed = false;  // ended by a signal rather than by exiting (status 143 alone does not tell)
   std::string out, err;
 };
 
@@ -123,6 +124,7 @@ inline Result finish(const Process& process, std::chrono::seconds timeout = std:
   }
   Result result;
   result.status = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 128 + WTERMSIG(wait_status);
+  result.killed = WIFSIGNALED(wait_status);
   result.out = read_text(process.out);
   result.err = read_text(process.err);
   return result;

@@ -7,13 +7,20 @@
 //
 // grad V overflows to inf for |q| > ~5.6e102 (no finiteness check), so a state that starts there turns
 // non-finite in its first step. Parameter fail_above: grad V reports NONSEP_EVALUATION_FAILED at any finite |q_i|
-// above it. Built three times: "blowup" (all functions), "blowup_gradients_only" (no values, no Hessians: no energy) and
-// "blowup_wrong_hessian" (Hess V = diag(2 q_i^2), wrong on purpose, for the derivative check).
+// above it. Parameters nan_after and inf_after: grad V returns NaN (or +inf) in every component from its
+// (n+1)-th call on (0: never). Parameter sleep_ms: every call of grad V sleeps that long first (a very slow model,
+// to test that the host stays interruptible). Built three times: "blowup" (all functions), "blowup_gradients_only"
+// (no values, no Hessians: no energy) and "blowup_wrong_hessian" (Hess V = diag(2 q_i^2), wrong on purpose, for the
+// derivative check).
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <new>
 #include <string>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -29,6 +36,8 @@
 struct nonsep_instance {
   std::size_t dimension = 1;
   double fail_above = 1e300;
+  std::uint64_t nan_after = 0, inf_after = 0, sleep_ms = 0;
+  std::uint64_t grad_V_calls = 0;
   std::string last_error;
 };
 
@@ -45,7 +54,13 @@ const char* metadata() {
        {{{"name", "dimension"}, {"type", "integer"}, {"default", 1}, {"minimum", 1}, {"maximum", 8},
          {"description", "number of degrees of freedom"}},
         {{"name", "fail_above"}, {"type", "number"}, {"default", 1e300}, {"minimum", 0}, {"unit", "length"},
-         {"description", "grad V fails for any |q_i| above this"}}}},
+         {"description", "grad V fails for any |q_i| above this"}},
+        {{"name", "nan_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
+         {"description", "grad V returns NaN from its (n+1)-th call on; 0: never"}},
+        {{"name", "inf_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
+         {"description", "grad V returns +inf from its (n+1)-th call on; 0: never"}},
+        {{"name", "sleep_ms"}, {"type", "integer"}, {"default", 0}, {"minimum", 0}, {"maximum", 10000},
+         {"description", "each call of grad V sleeps this many milliseconds first"}}}},
       {"capabilities",
        {{"value_T", BLOWUP_WITH_HESSIANS == 1}, {"value_V", BLOWUP_WITH_HESSIANS == 1},
         {"hessian_T", BLOWUP_WITH_HESSIANS == 1}, {"hessian_V", BLOWUP_WITH_HESSIANS == 1}}}}.dump();
@@ -59,6 +74,9 @@ nonsep_status create(const char* parameters_json, nonsep_instance** out, char* m
     auto instance = new nonsep_instance;
     instance->dimension = parameters.value("dimension", std::size_t{1});
     instance->fail_above = parameters.value("fail_above", 1e300);
+    instance->nan_after = parameters.value("nan_after", std::uint64_t{0});
+    instance->inf_after = parameters.value("inf_after", std::uint64_t{0});
+    instance->sleep_ms = parameters.value("sleep_ms", std::uint64_t{0});
     *out = instance;
     return NONSEP_OK;
   } catch (const std::exception& error) {
@@ -75,6 +93,15 @@ nonsep_status grad_T(nonsep_instance* instance, const double* p, double* out, st
   return NONSEP_OK;
 }
 nonsep_status grad_V(nonsep_instance* instance, const double* q, double* out, std::size_t count) {
+  if (instance->sleep_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(instance->sleep_ms));
+  const std::uint64_t call = ++instance->grad_V_calls;
+  const bool nan = instance->nan_after > 0 && call > instance->nan_after;
+  const bool inf = instance->inf_after > 0 && call > instance->inf_after;
+  if (nan || inf) {
+    for (std::size_t i = 0; i < count * instance->dimension; ++i)
+      out[i] = nan ? std::numeric_limits<double>::quiet_NaN() : std::numeric_limits<double>::infinity();
+    return NONSEP_OK;
+  }
   for (std::size_t i = 0; i < count * instance->dimension; ++i) {
     if (std::isfinite(q[i]) && std::abs(q[i]) > instance->fail_above) {
       instance->last_error = "q = " + std::to_string(q[i]) + " is beyond fail_above";
