@@ -4,6 +4,7 @@ find_package(Boost 1.74 REQUIRED)                     # libboost-dev: DLL, Math 
 find_package(nlohmann_json 3.11 REQUIRED)             # nlohmann-json3-dev
 find_package(CLI11 2.1 REQUIRED)                      # libcli11-dev
 find_package(Threads REQUIRED)
+find_package(OpenMP 4.5 REQUIRED COMPONENTS CXX)      # libgomp (comes with g++): the host's ensemble threads
 if(BUILD_TESTING OR NOT DEFINED BUILD_TESTING) # tests are on unless -DBUILD_TESTING=OFF
   find_package(doctest 2.4 REQUIRED)                  # doctest-dev
 endif()

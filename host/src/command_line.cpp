@@ -131,7 +131,8 @@ int report_study(const RunOutcome& outcome, const std::filesystem::path& directo
   return to_int(outcome.exit_status);
 }
 
-int command_run(const std::string& job_file, const std::string& output, bool quiet, bool resume) {
+int command_run(const std::string& job_file, const std::string& output, bool quiet, bool resume,
+                unsigned threads) {
   std::optional<LoadedJob> loaded;
   try {
     loaded.emplace(load_job(job_file));
@@ -148,6 +149,7 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
   options.show_progress = !quiet && stderr_is_terminal();
   options.stop_requested = &stop_requested;
   options.resume = resume;
+  options.threads = threads;
   stop_requested.store(false);
   stop_signal.store(0);
   RunOutcome outcome;
@@ -291,6 +293,7 @@ int run_command_line(int argc, char** argv) {
 
     std::string job_file, output, plugin_name;
     bool quiet = false, as_json = false, check = false, resume = false;
+    unsigned threads = 0;
 
     auto* run = app.add_subcommand("run",
                                    "Run a job: trajectory.csv (streamed) and summary.json in the output folder; a "
@@ -302,6 +305,9 @@ int run_command_line(int argc, char** argv) {
     run->add_flag("--resume", resume,
                   "continue an interrupted run from checkpoint.json in its output folder; the outputs end as those of "
                   "an uninterrupted run");
+    run->add_option("--threads,-j", threads,
+                    "worker threads for the ensemble (default: all cores); results are bit-identical for any number")
+        ->check(CLI::PositiveNumber);
     run->footer(schemes_text() + "\n" + exit_status_text());
 
     auto* validate = app.add_subcommand(
@@ -327,7 +333,7 @@ int run_command_line(int argc, char** argv) {
       const int code = app.exit(error);
       return code == 0 ? to_int(ExitStatus::success) : to_int(ExitStatus::invalid_input);
     }
-    if (run->parsed()) return command_run(job_file, output, quiet, resume);
+    if (run->parsed()) return command_run(job_file, output, quiet, resume, threads);
     if (validate->parsed()) return command_validate(job_file);
     if (inspect->parsed()) return command_inspect(plugin_name, as_json, check);
     if (models->parsed()) return command_models();

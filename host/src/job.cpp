@@ -836,7 +836,7 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
   std::filesystem::path output = job_file.stem().string() + ".out";
   if (const json* section = check.member(document, "", "output", false, "");
       section && check.object(*section, "/output", "an object {\"directory\": ..., \"every\": ...}")) {
-    check.known_keys(*section, "/output", {"directory", "every"});
+    check.known_keys(*section, "/output", {"directory", "every", "energy_every"});
     if (const json* directory = check.member(*section, "/output", "directory", false, ""))
       if (auto text = check.string(*directory, "/output/directory",
                                    "a folder name or path, relative to the job file's folder"))
@@ -845,6 +845,12 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
       if (auto stride = check.integer(*every, "/output/every", 0, std::numeric_limits<std::int64_t>::max(),
                                       "an integer >= 0: write every n-th step to trajectory.csv (0: no trajectory)"))
         job.every = static_cast<std::uint64_t>(*stride);
+    if (const json* energy_every = check.member(*section, "/output", "energy_every", false, ""))
+      if (auto stride = check.integer(*energy_every, "/output/energy_every", 0,
+                                      std::numeric_limits<std::int64_t>::max(),
+                                      "an integer >= 0: also evaluate H every n-th step (0: only at the written "
+                                      "samples, the start and the end)"))
+        job.energy_every = static_cast<std::uint64_t>(*stride);
   }
   job.output_directory = output.is_absolute() ? output : job.directory / output;
 

@@ -4,9 +4,11 @@
 // plugin failure, missing Hessians and SIGINT.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "host_test_support.hpp"
@@ -462,4 +464,97 @@ TEST_CASE("inspect shows the metadata, --json the raw metadata, --check the deri
   result = run_nonsep({"inspect", "no_such_plugin"}, folder.path());
   CHECK(result.status == 2);
   CHECK(result.err.find("no_such_plugin") != std::string::npos);
+}
+
+namespace {
+
+// The largest |relative_energy_error| over the rows of a trajectory.csv (the numbers round-trip exactly).
+double largest_csv_energy_error(const std::filesystem::path& csv) {
+  double largest = 0.0;
+  for (const auto& row : read_csv(csv))
+    if (row[0] != "trajectory" && !row.back().empty()) largest = std::max(largest, std::abs(std::stod(row.back())));
+  return largest;
+}
+
+// summary.json without what legitimately differs between two runs of one job: the time taken and the folder.
+json comparable(json summary) {
+  summary.erase("wall_seconds");
+  summary["output"].erase("directory");
+  return summary;
+}
+
+}  // namespace
+
+TEST_CASE("energy: H at step 0, the samples, every energy_every-th step and the end; max_abs over exactly those") {
+  TemporaryFolder folder;
+  json job = quickstart_job();
+  job["time"] = {{"dt", 0.005}, {"steps", 120}};  // past the quarter period: the error is largest mid-run
+  job["output"] = {{"every", 1}};
+  const json all = run_job(folder, "every1", job);
+  const json& all_energy = all["trajectories"][0]["energy"];
+  CHECK(number(all_energy["relative_error_max_abs"]) == largest_csv_energy_error(folder / "every1" / "trajectory.csv"));
+  CHECK(all["energy"]["relative_error_max_abs"].get<std::string>().find("where H was evaluated") != std::string::npos);
+
+  job["output"] = {{"every", 0}, {"energy_every", 1}};
+  const json strided = run_job(folder, "energy_every1", job);
+  CHECK(strided["output"]["energy_every"] == 1);
+  CHECK(strided["trajectories"][0]["energy"] == all_energy);
+  CHECK(strided["trajectories"][0]["final"] == all["trajectories"][0]["final"]);
+
+  job["output"] = {{"every", 0}};
+  const json ends = run_job(folder, "ends_only", job);
+  const json& ends_energy = ends["trajectories"][0]["energy"];
+  CHECK(ends_energy["final"] == all_energy["final"]);
+  CHECK(number(ends_energy["relative_error_max_abs"]) == std::abs(number(ends_energy["relative_error_final"])));
+  CHECK(number(ends_energy["relative_error_max_abs"]) < number(all_energy["relative_error_max_abs"]));
+
+  job["output"] = {{"every", 10}};
+  const json sampled = run_job(folder, "every10", job);
+  CHECK(number(sampled["trajectories"][0]["energy"]["relative_error_max_abs"]) ==
+        largest_csv_energy_error(folder / "every10" / "trajectory.csv"));
+  CHECK(sampled["trajectories"][0]["final"] == all["trajectories"][0]["final"]);
+}
+
+TEST_CASE("threads: 1, 2 and 3 threads write byte-identical trajectory.csv and summary.json (but wall_seconds)") {
+  TemporaryFolder folder;
+  use_test_plugins();
+  // 600 trajectories: three blocks of run_block_size = 256. A diverging state in the first block and, in the
+  // second job, a failing state in the last block make blocks replay their chunk step by step.
+  json diverging = json::array(), failing = json::array(), completing = json::array();
+  for (int i = 0; i < 600; ++i) {
+    const double q = 0.5 + 0.001 * i;
+    diverging.push_back(i == 100 ? state(1e103, 1.0) : state(q, 0.25));
+    failing.push_back(i == 550 ? state(5.0, 0.0) : state(q, 0.25));
+    completing.push_back(state(q, 0.25));
+  }
+  for (const auto& [name, job, expected] : {std::tuple{"diverging", blowup_job(diverging), 1},
+                                            std::tuple{"failing", blowup_job(failing, {{"fail_above", 3.0}}), 1},
+                                            std::tuple{"paper1d", paper1d_job(completing, {{"dt", 0.002}, {"steps", 30}}), 0}}) {
+    const std::string job_name = name;
+    CAPTURE(job_name);
+    const auto file = write_job(folder / (std::string(name) + ".json"), job);
+    std::vector<std::string> csv;
+    std::vector<json> summaries;
+    for (const char* threads : {"1", "2", "3"}) {
+      const auto out = folder / (std::string(name) + "-" + threads);
+      const auto result =
+          run_nonsep({"run", "--quiet", "--threads", threads, "--output", out.string(), file.string()}, folder.path());
+      CHECK(result.status == expected);
+      csv.push_back(read_text(out / "trajectory.csv"));
+      summaries.push_back(comparable(read_json(out / "summary.json")));
+    }
+    CHECK(summaries[0]["trajectories"].size() == 600);
+    CHECK(csv[0].size() > 10000);
+    CHECK(csv[1] == csv[0]);
+    CHECK(csv[2] == csv[0]);
+    CHECK(summaries[1] == summaries[0]);
+    CHECK(summaries[2] == summaries[0]);
+  }
+}
+
+TEST_CASE("--threads must be a positive number") {
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", quickstart_job());
+  CHECK(run_nonsep({"run", "--threads", "0", file.string()}, folder.path()).status == 2);
+  CHECK(run_nonsep({"run", "--threads", "two", file.string()}, folder.path()).status == 2);
 }

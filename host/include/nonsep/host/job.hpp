@@ -107,6 +107,7 @@ struct Job {
   TimeGrid time;
   std::filesystem::path output_directory;  // /output/directory resolved against `directory`
   std::uint64_t every = 1;                 // /output/every; 0: no trajectory file
+  std::uint64_t energy_every = 0;          // /output/energy_every; 0: H only at samples, start and end
   Analysis analysis;                       // /analysis (single runs only)
   // /study: present for a convergence study, which has no /integrator, no /time/dt and exactly one initial state;
   // `integrator` and `time.dt` are then unused and time.t_end is the study's end time.

@@ -1,21 +1,36 @@
 #pragma once
-// Running a loaded job, or resuming one: every initial state is stepped together as one nonsep::PhaseSpaceBatch
-// (one plugin call per stage for the whole ensemble), samples stream to trajectory.csv, and summary.json is written
-// at the end, whatever the end was.
+// Running a loaded job, or resuming one (checkpoints below): samples stream to trajectory.csv, and summary.json
+// is written at the end, whatever the end was.
 //
-// Per trajectory, after every step:
+// Blocks and threads. The trajectories are split into fixed blocks of `run_block_size` consecutive trajectories,
+// whatever the number of threads; each block is one nonsep::PhaseSpaceBatch with its own Integrator (one plugin
+// call per stage for the whole block). Blocks run on `RunOptions::threads` OpenMP threads, each thread with its
+// own plugin instance (the ABI's contract: one instance per thread). The plugin evaluates every state on its own
+// and the blocks do not depend on the thread count, so trajectory.csv and summary.json (except wall_seconds) are
+// byte-identical for any number of threads. Rows of one sample are written in trajectory order.
+//
+// Stepping goes in chunks: from one event (a written sample, an energy evaluation, the end; at most
+// `run_chunk_state_steps` state-steps) to the next, each block advances without per-step bookkeeping. When a
+// block's chunk ends with a non-finite number or the plugin fails in it, the block goes back to its state at the
+// chunk's start (integrator included) and redoes the chunk step by step with the checks below, so the numbers,
+// evaluation counts and statuses are the same as if every step had been checked.
+//
+// Per trajectory, at every step:
 //   - a state with a non-finite q or p is retired with status "diverged" (step, t and the first non-finite
 //     variable, e.g. "p[0]"); its "final" is its last finite state, which is also the last row written for it;
-//   - when the plugin fails on the batch (nonsep::ModelError), the step is redone state by state from the
+//   - when the plugin fails on the block (nonsep::ModelError), the step is redone state by state from the
 //     previous step's copy, and only the states the plugin fails on are retired, with status "failed" and the
 //     plugin's message.
-// Removing a state from the batch does not change the others: the plugin evaluates each state on its own, so the
-// remaining states' numbers are the same bit for bit as in a run without the retired one.
+// Removing a state from a block does not change the others' numbers.
 //
-// Energy: H (nonsep::EnergyEvaluator, needs the plugin's Hessians) is evaluated at every step; the summary's
-// relative_error_max_abs is the largest |H - H0| / |H0| over every step, not only the sampled ones. Without
-// Hessians the H columns are empty, the energies null, and summary.energy.reason says why.
+// Energy: H (nonsep::EnergyEvaluator, needs the plugin's Hessians) is evaluated at step 0, at every written sample
+// (output.every), every output.energy_every-th step when that is > 0, at the last step, and for the final state of
+// a trajectory that stops early. relative_error_max_abs is the largest |H - H0| / |H0| over those steps only. A
+// state whose H cannot be evaluated at one of those steps is retired as "failed". Without Hessians the H columns
+// are empty, the energies null, and summary.energy.reason says why.
 #include <atomic>
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -28,11 +43,15 @@ namespace nonsep::host {
 struct RunOptions {
   std::filesystem::path output_directory;  // where trajectory.csv and summary.json go; created if missing
   bool show_progress = false;              // draw a ProgressBar on stderr (the caller checks for a terminal)
-  // Checked after every step; when true the run stops with status "interrupted" (set from a SIGINT handler).
+  // Checked between chunks (a few milliseconds apart); when true the run stops with status "interrupted" (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;
   // Continue from output_directory/checkpoint.json (checkpoint.hpp) instead of starting at step 0.
   bool resume = false;
+  unsigned threads = 0;  // worker threads; 0: all cores (omp_get_max_threads)
 };
+
+inline constexpr std::size_t run_block_size = 256;              // trajectories per block
+inline constexpr std::uint64_t run_chunk_state_steps = 1 << 16;  // largest chunk: state-steps of all active states
 
 struct RunOutcome {
   ExitStatus exit_status = ExitStatus::success;  // success, run_failed or interrupted
@@ -43,7 +62,7 @@ struct RunOutcome {
 // computed, when the output folder or trajectory.csv cannot be created, and CheckpointError when asked to resume
 // from a checkpoint that is missing, damaged or another job's.
 //
-// Checkpoints (job.checkpoint, checkpoint.hpp) are saved between steps, after flushing trajectory.csv, and when
+// Checkpoints (job.checkpoint, checkpoint.hpp) are saved between chunks (checkpoint.every_steps ends a chunk), after flushing trajectory.csv, and when
 // the run is interrupted (before the interrupted states' last rows, which a resumed run drops again); a run that
 // ends otherwise removes checkpoint.json. A resumed run ends with the same final states, energies and
 // trajectory.csv, bit for bit, as an uninterrupted one; its evaluation counts may exceed those by one gradient
