@@ -8,6 +8,9 @@
 //   3. threads:              run_job on a large ensemble, 1 thread over 2 threads (speed-up).
 //   4. AD over analytic:     run_job on 1024 trajectories, paper1d_autodiff.so (T and V only, gradients by the
 //                            SDK's dual numbers) over paper1d.so (hand-written gradients), 1 thread.
+//   6b. output:              run_job on one trajectory writing trajectory.csv every 10^4 steps (with H at each
+//                            row) over the same run with every = 0.
+//   6c. energy:              the same with H at every step (output.energy_every = 1) over H at start and end.
 // Host runs keep the evaluations of H it always does (start and end) and write summary.json; the step counts make
 // those a negligible part of the time. Every host run's final state is checked bit for bit against the
 // compiled-in loop, so a faster but wrong path cannot pass.
@@ -60,14 +63,15 @@ double initial_q(std::size_t b, std::size_t count) {
 
 // A paper1d job of `count` trajectories and `steps` basic steps, written to `folder`/`name`.json and loaded.
 nonsep::host::LoadedJob make_job(const std::filesystem::path& folder, const std::string& name,
-                                 const std::string& plugin, std::size_t count, std::uint64_t steps) {
+                                 const std::string& plugin, std::size_t count, std::uint64_t steps,
+                                 std::uint64_t every = 0, std::uint64_t energy_every = 0) {
   json initial = json::array();
   for (std::size_t b = 0; b < count; ++b) initial.push_back({{"q", {initial_q(b, count)}}, {"p", {0.0}}});
   const json job = {{"model", {{"plugin", plugin}}},
                     {"integrator", {{"scheme", "basic"}}},
                     {"initial", initial},
                     {"time", {{"dt", dt}, {"steps", steps}}},
-                    {"output", {{"directory", name + ".out"}, {"every", 0}}}};
+                    {"output", {{"directory", name + ".out"}, {"every", every}, {"energy_every", energy_every}}}};
   const auto file = folder / (name + ".json");
   std::ofstream(file) << job.dump();
   return nonsep::host::load_job(file);
@@ -87,14 +91,19 @@ double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vect
   return elapsed.count();
 }
 
-// Seconds for the compiled-in loop: ChinBasicStep on one batch of `count` states.
-double time_compiled(std::size_t count, std::uint64_t steps, std::vector<double>& final_q) {
+// Seconds for the compiled-in loop: ChinBasicStep on one batch of `job`'s states. dt and t2 are taken from the
+// loaded job, not from constants: the compiler would fold cbrt(dt) with correctly rounded arithmetic, which can
+// differ in the last bit from the run-time cbrt the host uses.
+double time_compiled(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
   const CompiledPaper1D model;
-  nonsep::PhaseSpaceBatch x(1, count);
-  for (std::size_t b = 0; b < count; ++b) x.q()[b] = initial_q(b, count);
-  nonsep::ChinBasicStep stepper;
+  nonsep::PhaseSpaceBatch x(1, job.job.initial.count);
+  std::copy(job.job.initial.q.begin(), job.job.initial.q.end(), x.q().begin());
+  std::copy(job.job.initial.p.begin(), job.job.initial.p.end(), x.p().begin());
+  nonsep::ChinBasicStep stepper(job.job.integrator.form, job.job.integrator.t2);
+  const double step_size = job.job.time.dt;
+  const std::uint64_t steps = job.job.time.steps;
   const auto start = Clock::now();
-  for (std::uint64_t k = 0; k < steps; ++k) stepper.step(model, x, dt);
+  for (std::uint64_t k = 0; k < steps; ++k) stepper.step(model, x, step_size);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
   final_q.assign(x.q().begin(), x.q().end());
   return elapsed.count();
@@ -150,7 +159,9 @@ int main(int argc, char** argv) {
   bool agree = true;
   auto check = [&](const char* what, const std::vector<double>& host, const std::vector<double>& compiled) {
     if (host != compiled) {
-      std::fprintf(stderr, "%s: the host's final states differ from the compiled-in loop's\n", what);
+      std::fprintf(stderr, "%s: the host's final states differ from the compiled-in loop's (%zu, %zu states; "
+                   "first q %.17g, %.17g)\n", what, host.size(), compiled.size(), host.empty() ? 0.0 : host[0],
+                   compiled.empty() ? 0.0 : compiled[0]);
       agree = false;
     }
   };
@@ -160,7 +171,7 @@ int main(int argc, char** argv) {
     const auto steps = scaled(4e6);
     const auto job = make_job(folder, "single", analytic, 1, steps);
     const auto [host, compiled] = interleaved(
-        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_compiled(1, steps, compiled_q); });
+        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_compiled(job, compiled_q); });
     check("figure 1", host_q, compiled_q);
     const double per = 1e9 / static_cast<double>(steps);
     figures.push_back({"1. one trajectory: host / compiled in", "ns per basic step", "<= 1.15", host / compiled,
@@ -172,7 +183,7 @@ int main(int argc, char** argv) {
     const auto job = make_job(folder, "ensemble", analytic, count, steps);
     const auto [host, compiled] =
         interleaved(repetitions, [&] { return time_host(job, 1, host_q); },
-                    [&] { return time_compiled(count, steps, compiled_q); });
+                    [&] { return time_compiled(job, compiled_q); });
     check("figure 2", host_q, compiled_q);
     const double per = 1e9 / static_cast<double>(steps * count);
     figures.push_back({"2. 1024 trajectories: host (1 thread) / compiled-in batch", "ns per basic step per trajectory",
@@ -211,6 +222,32 @@ int main(int argc, char** argv) {
     const double per = 1e9 / static_cast<double>(steps * count);
     figures.push_back({"4. 1024 trajectories: AD plugin / analytic plugin", "ns per basic step per trajectory",
                        "<= 2", ad / exact, ad * per, exact * per});
+  }
+  {  // 6b. output every 10^4 steps over no output, one trajectory
+    const auto steps = scaled(4e6);
+    const auto job_output = make_job(folder, "output", analytic, 1, steps, 10000);
+    const auto job_silent = make_job(folder, "silent", analytic, 1, steps, 0);
+    std::vector<double> silent_q;
+    const auto [output, silent] = interleaved(
+        repetitions, [&] { return time_host(job_output, 1, host_q); },
+        [&] { return time_host(job_silent, 1, silent_q); });
+    check("figure 6b", host_q, silent_q);
+    const double per = 1e9 / static_cast<double>(steps);
+    figures.push_back({"6b. one trajectory: output every 10^4 steps / no output", "ns per basic step", "~ 1",
+                       output / silent, output * per, silent * per});
+  }
+  {  // 6c. H at every step (energy_every = 1, the old default) over H at start and end only
+    const auto steps = scaled(4e6);
+    const auto job_energy = make_job(folder, "energy", analytic, 1, steps, 0, 1);
+    const auto job_silent = make_job(folder, "silent", analytic, 1, steps, 0, 0);
+    std::vector<double> silent_q;
+    const auto [energy, silent] = interleaved(
+        repetitions, [&] { return time_host(job_energy, 1, host_q); },
+        [&] { return time_host(job_silent, 1, silent_q); });
+    check("figure 6c", host_q, silent_q);
+    const double per = 1e9 / static_cast<double>(steps);
+    figures.push_back({"6c. one trajectory: H at every step / H at start and end", "ns per basic step",
+                       "(informative)", energy / silent, energy * per, silent * per});
   }
   std::filesystem::remove_all(folder);
 
