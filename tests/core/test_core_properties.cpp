@@ -230,3 +230,74 @@ TEST_CASE("the VVT form converges to the exact flow of H_VVT = (q + q^3/3)^2 p")
     CHECK(std::abs(nonsep::testing::fitted_exponent(dts, errors) - expected) < 0.1);
   }
 }
+
+TEST_CASE("a basic step with one dt per state gives each state what a step of its dt alone gives, bit for bit") {
+  for (const auto form : forms) {
+    CAPTURE(static_cast<int>(form));
+    const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};
+    const std::vector<double> dts{0.01, -0.003, 0.02 / 3.0};
+    PhaseSpaceBatch batch(2, 3);
+    std::copy(std::begin(qs), std::end(qs), batch.q().begin());
+    std::copy(std::begin(ps), std::end(ps), batch.p().begin());
+    ChinBasicStep together(form, -2.0);
+    for (int s = 0; s < 4; ++s) together.step(Coupled2D{}, batch, dts);
+    std::uint64_t evaluations = 0;
+    for (std::size_t b = 0; b < 3; ++b) {
+      auto x = state({qs[2 * b], qs[2 * b + 1]}, {ps[2 * b], ps[2 * b + 1]});
+      ChinBasicStep alone(form, -2.0);
+      for (int s = 0; s < 4; ++s) alone.step(Coupled2D{}, x, dts[b]);
+      CHECK(x == PhaseSpaceBatch::single(batch.q(b), batch.p(b)));
+      evaluations += alone.evaluations().grad_T + alone.evaluations().grad_V;
+    }
+    CHECK(together.evaluations().grad_T + together.evaluations().grad_V == evaluations);
+    CHECK_THROWS_AS(together.step(Coupled2D{}, batch, std::vector<double>{0.01, 0.01}), InvalidArgument);
+    CHECK_THROWS_AS(together.step(Coupled2D{}, batch, std::vector<double>{0.01, 0.0, 0.01}), InvalidArgument);
+  }
+}
+
+namespace {
+// Coupled2D, counting the calls into it (each call is one crossing of a plugin boundary in the host).
+struct CountingCoupled2D : Coupled2D {
+  mutable std::uint64_t calls = 0;
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    ++calls;
+    Coupled2D::grad_T(p, out, count);
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    ++calls;
+    Coupled2D::grad_V(q, out, count);
+  }
+};
+}  // namespace
+
+TEST_CASE("MPE: the terms batched give the term-by-term numbers and evaluation counts bit for bit, in 8m calls") {
+  for (const auto form : forms)
+    for (int m = 1; m <= 6; ++m) {
+      CAPTURE(static_cast<int>(form));
+      CAPTURE(m);
+      PhaseSpaceBatch batched(2, 3);
+      const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};
+      std::copy(std::begin(qs), std::end(qs), batched.q().begin());
+      std::copy(std::begin(ps), std::end(ps), batched.p().begin());
+      PhaseSpaceBatch sequential = batched;
+      MultiProductExpansion<> together(ChinBasicStep(form), m), one_by_one(ChinBasicStep(form), m);
+      const CountingCoupled2D model_together, model_one_by_one;
+      for (double dt : {0.01, 0.01, -0.004, 0.02}) {
+        together.step(model_together, batched, dt);
+        one_by_one.step_term_by_term(model_one_by_one, sequential, dt);
+        CHECK(batched == sequential);
+      }
+      CHECK(together.evaluations().grad_T == one_by_one.evaluations().grad_T);
+      CHECK(together.evaluations().grad_V == one_by_one.evaluations().grad_V);
+      // Per step: 8 calls per round (m rounds) plus one for the new starting point; term by term 8 per basic
+      // step, m(m+1)/2 of them.
+      const auto steps = 4u, rounds = static_cast<unsigned>(m), basic = static_cast<unsigned>(m * (m + 1) / 2);
+      if (m == 1) {  // the basic step itself: first-same-as-last across steps
+        CHECK(model_together.calls == 8 * steps + 1);
+        CHECK(model_one_by_one.calls == 8 * steps + 1);
+      } else {
+        CHECK(model_together.calls == steps * (8 * rounds + 1));
+        CHECK(model_one_by_one.calls == steps * (8 * basic + 1));
+      }
+    }
+}

@@ -78,36 +78,25 @@ class ChinBasicStep {
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
     check_step_size(dt);
     check_batch_fits(model, x);
-    const double eps = std::cbrt(dt);
-    const bool ttv = form_ == HamiltonianForm::TTV;
-    std::span<double> outer = ttv ? x.p() : x.q();
-    std::span<double> inner = ttv ? x.q() : x.p();
-    const double outer_sign = ttv ? -1.0 : 1.0;  // TTV: outer flows are kicks (p -= ...), VVT: drifts (q += ...)
-    const double inner_sign = -outer_sign;
-    const std::size_t count = x.count();
-    inner_gradient_.resize(inner.size());
+    eps_.assign(1, std::cbrt(dt));
+    advance(model, x);
+  }
 
-    prime(model, x);
-    auto outer_flow = [&](double coefficient) {
-      const double h = outer_sign * coefficient * eps;
-      for (std::size_t i = 0; i < outer.size(); ++i) outer[i] += h * outer_gradient_[i];
-    };
-    auto inner_flow = [&](double coefficient) {
-      evaluate(model, !ttv, outer, inner_gradient_, count);  // TTV: grad T(p); VVT: grad V(q)
-      const double h = inner_sign * coefficient * eps;
-      for (std::size_t i = 0; i < inner.size(); ++i) inner[i] += h * inner_gradient_[i];
-      evaluate(model, ttv, inner, outer_gradient_, count);   // TTV: grad V(q); VVT: grad T(p)
-    };
-    outer_flow(c_.v2);
-    inner_flow(c_.t2);
-    outer_flow(c_.v1);
-    inner_flow(c_.t1);
-    outer_flow(c_.v0);
-    inner_flow(c_.t1);
-    outer_flow(c_.v1);
-    inner_flow(c_.t2);
-    outer_flow(c_.v2);
-    cached_at_.assign(inner.begin(), inner.end());
+  // Advances state b of `x` by dt[b] (one entry per state, each finite and non-zero): states of different step
+  // sizes share each stage's model evaluation. State b gets bit for bit what step(model, x_b, dt[b]) gives it.
+  // Throws InvalidArgument on a bad dt or dt.size() != x.count().
+  template <Model M>
+  void step(const M& model, PhaseSpaceBatch& x, std::span<const double> dt) {
+    check_batch_fits(model, x);
+    if (dt.size() != x.count())
+      throw InvalidArgument("a batch of " + std::to_string(x.count()) + " states needs as many step sizes (found " +
+                            std::to_string(dt.size()) + ")");
+    eps_.resize(dt.size());
+    for (std::size_t b = 0; b < dt.size(); ++b) {
+      check_step_size(dt[b]);
+      eps_[b] = std::cbrt(dt[b]);
+    }
+    advance(model, x);
   }
 
   // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached).
@@ -135,6 +124,48 @@ class ChinBasicStep {
   }
 
  private:
+  // One basic step of every state; eps_ holds eps = cbrt(dt), one for all states or one per state.
+  template <Model M>
+  void advance(const M& model, PhaseSpaceBatch& x) {
+    const bool ttv = form_ == HamiltonianForm::TTV;
+    std::span<double> outer = ttv ? x.p() : x.q();
+    std::span<double> inner = ttv ? x.q() : x.p();
+    const double outer_sign = ttv ? -1.0 : 1.0;  // TTV: outer flows are kicks (p -= ...), VVT: drifts (q += ...)
+    const double inner_sign = -outer_sign;
+    const std::size_t count = x.count(), n = x.dimension();
+    inner_gradient_.resize(inner.size());
+
+    prime(model, x);
+    // y += sign * coefficient * eps * gradient, state by state when the states have their own eps.
+    auto flow = [&](std::span<double> y, std::span<const double> gradient, double sign, double coefficient) {
+      if (eps_.size() == 1) {
+        const double h = sign * coefficient * eps_[0];
+        for (std::size_t i = 0; i < y.size(); ++i) y[i] += h * gradient[i];
+        return;
+      }
+      for (std::size_t b = 0; b < count; ++b) {
+        const double h = sign * coefficient * eps_[b];
+        for (std::size_t i = b * n; i < (b + 1) * n; ++i) y[i] += h * gradient[i];
+      }
+    };
+    auto outer_flow = [&](double coefficient) { flow(outer, outer_gradient_, outer_sign, coefficient); };
+    auto inner_flow = [&](double coefficient) {
+      evaluate(model, !ttv, outer, inner_gradient_, count);  // TTV: grad T(p); VVT: grad V(q)
+      flow(inner, inner_gradient_, inner_sign, coefficient);
+      evaluate(model, ttv, inner, outer_gradient_, count);   // TTV: grad V(q); VVT: grad T(p)
+    };
+    outer_flow(c_.v2);
+    inner_flow(c_.t2);
+    outer_flow(c_.v1);
+    inner_flow(c_.t1);
+    outer_flow(c_.v0);
+    inner_flow(c_.t1);
+    outer_flow(c_.v1);
+    inner_flow(c_.t2);
+    outer_flow(c_.v2);
+    cached_at_.assign(inner.begin(), inner.end());
+  }
+
   template <Model M>
   void evaluate(const M& model, bool potential, std::span<const double> at, std::span<double> out,
                 std::size_t count) {
@@ -151,6 +182,7 @@ class ChinBasicStep {
   ChinCoefficients c_;
   EvaluationCounts evaluations_;
   std::vector<double> outer_gradient_, inner_gradient_, cached_at_;
+  std::vector<double> eps_;  // cbrt(dt): one entry, or one per state
 };
 
 }  // namespace nonsep
