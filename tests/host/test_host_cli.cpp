@@ -34,10 +34,14 @@ struct CoreRun {
 // into this test: the same arithmetic as the plugin the host loads, so results must agree bit for bit.
 using PluginPaper1D = nonsep::sdk::ModelAdapter<::Paper1D>;
 
-// The core on its own: `steps` steps of dt from (q0, p0) on `model`.
+// The core on its own: `steps` steps of dt from (q0, p0) on `model`. dt goes through a volatile so that the
+// compiler cannot fold cbrt(dt) for a literal dt: folding rounds correctly, which can differ in the last bit from
+// the run-time cbrt the host uses.
 template <class M = PluginPaper1D>
-CoreRun core_run(const nonsep::IntegratorSpec& spec, double q0, double p0, double dt, std::uint64_t steps,
+CoreRun core_run(const nonsep::IntegratorSpec& spec, double q0, double p0, double literal_dt, std::uint64_t steps,
                  const M& model = M{}) {
+  volatile double opaque_dt = literal_dt;
+  const double dt = opaque_dt;
   nonsep::Integrator integrator(spec);
   const double q[] = {q0}, p[] = {p0};
   CoreRun run{nonsep::PhaseSpaceBatch::single(q, p), {}};
@@ -144,9 +148,10 @@ TEST_CASE("every scheme and both Hamiltonian forms agree with the core bit for b
                        Case{"mpe", "4/3", "VVT"}, Case{"triplet", "4/3", "VVT"}}) {
     // H_VVT = (q + q^3/3)^2 p is unbounded below; (0.5, 0.25) stays tame over these 25 steps.
     const double q0 = std::string(c.form) == "VVT" ? 0.5 : 1.5;
-    CAPTURE(c.scheme);
-    CAPTURE(c.order);
-    CAPTURE(c.form);
+    const std::string scheme = c.scheme, order = c.order, form = c.form;
+    CAPTURE(scheme);
+    CAPTURE(order);
+    CAPTURE(form);
     json job = paper1d_job(state(q0, 0.25), {{"dt", 0.01}, {"steps", 25}},
                            {{"scheme", c.scheme}, {"order", c.order}});
     job["hamiltonian"] = c.form;
