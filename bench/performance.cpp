@@ -190,8 +190,8 @@ int main(int argc, char** argv) {
                        "<= 1.2", host / compiled, host * per, compiled * per});
   }
   {  // 3. two threads over one, large ensemble
-    const std::size_t count = 16384;
-    const auto steps = scaled(400);
+    const std::size_t count = 8192;
+    const auto steps = scaled(2000);
     const auto job = make_job(folder, "threads", analytic, count, steps);
     std::vector<double> two_q;
     const auto [one, two] = interleaved(
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
       agree = false;
     }
     const double per = 1e9 / static_cast<double>(steps * count);
-    figures.push_back({"3. 16384 trajectories: 1 thread / 2 threads (speed-up)", "ns per basic step per trajectory",
+    figures.push_back({"3. 8192 trajectories: 1 thread / 2 threads (speed-up)", "ns per basic step per trajectory",
                        ">= 1.8", one / two, two * per, one * per});
   }
   {  // 4. AD over analytic gradients, through the host
