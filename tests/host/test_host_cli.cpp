@@ -563,3 +563,23 @@ TEST_CASE("--threads must be a positive number") {
   CHECK(run_nonsep({"run", "--threads", "0", file.string()}, folder.path()).status == 2);
   CHECK(run_nonsep({"run", "--threads", "two", file.string()}, folder.path()).status == 2);
 }
+
+TEST_CASE("closest_return is the same whether the run steps in chunks (every = 0) or sample by sample, and on a replay") {
+  TemporaryFolder folder;
+  use_test_plugins();
+  // Blowup with a diverging middle state: the block replays its first chunk step by step.
+  json job = blowup_job(json::array({state(1.0, 0.5), state(1e103, 1.0), state(-0.5, 0.25)}));
+  job["analysis"] = {{"closest_return_after", 0.01}};
+  job["time"] = {{"dt", 0.001}, {"steps", 400}};
+  job["output"] = {{"every", 1}};
+  const json sampled = run_job(folder, "sampled", job, 1);
+  job["output"] = {{"every", 0}};
+  const json chunked = run_job(folder, "chunked", job, 1);
+  for (std::size_t i : {0u, 2u}) {
+    CAPTURE(i);
+    REQUIRE(sampled["trajectories"][i]["closest_return"].is_object());
+    CHECK(chunked["trajectories"][i]["closest_return"] == sampled["trajectories"][i]["closest_return"]);
+    CHECK(chunked["trajectories"][i]["final"] == sampled["trajectories"][i]["final"]);
+  }
+  CHECK(chunked["trajectories"][1]["closest_return"] == sampled["trajectories"][1]["closest_return"]);
+}
