@@ -43,7 +43,7 @@ namespace nonsep::host {
 struct RunOptions {
   std::filesystem::path output_directory;  // where trajectory.csv and summary.json go; created if missing
   bool show_progress = false;              // draw a ProgressBar on stderr (the caller checks for a terminal)
-  // Checked between chunks (a few milliseconds apart); when true the run stops with status "interrupted" (set from a SIGINT handler).
+  // Checked between chunks (at most 2^20 state-steps, a fraction of a second, apart); when true the run stops with status "interrupted" (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;
   // Continue from output_directory/checkpoint.json (checkpoint.hpp) instead of starting at step 0.
   bool resume = false;
@@ -51,7 +51,7 @@ struct RunOptions {
 };
 
 inline constexpr std::size_t run_block_size = 256;              // trajectories per block
-inline constexpr std::uint64_t run_chunk_state_steps = 1 << 16;  // largest chunk: state-steps of all active states
+inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chunk: state-steps of all active states
 
 struct RunOutcome {
   ExitStatus exit_status = ExitStatus::success;  // success, run_failed or interrupted
