@@ -171,7 +171,7 @@ class Run {
   }
 
   void create_workers() {
-    const unsigned requested = options.threads > 0 ? options.threads : static_cast<unsigned>(omp_get_max_threads());
+    const unsigned requested = options_.threads > 0 ? options_.threads : static_cast<unsigned>(omp_get_max_threads());
     const std::size_t blocks = (job_.initial.count + run_block_size - 1) / run_block_size;
     const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(requested, blocks));
     workers_.push_back(Worker{model_, EnergyEvaluator(job_.integrator.form)});
