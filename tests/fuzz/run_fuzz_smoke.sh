@@ -7,7 +7,7 @@ set -euo pipefail
 source_dir=$1
 build_dir=$2
 seconds=${3:-30}
-CC=clang CXX=clang++ cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+CC=clang CXX=clang++ cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DNONSEP_FUZZ=ON -DNONSEP_SANITIZE=ON -DNONSEP_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$build_dir" -j2 --target fuzz_job_reader
 scratch=$(mktemp -d)
