@@ -283,7 +283,8 @@ int run_command_line(int argc, char** argv) {
   try {
     CLI::App app{"nonsep " NONSEP_VERSION
                  ": explicit symplectic integrators for non-separable Hamiltonians H = T_i(p) V_ij(q) T_j(p)\n"
-                 "(S. A. Chin). Models are plugins; runs are described by JSON job files (docs/job-file.md).",
+                 "(S. A. Chin). Models are plugins; runs are described by JSON job files (README.md, section\n"
+                 "Running nonsep).",
                  "nonsep"};
     app.set_version_flag("--version", "nonsep " NONSEP_VERSION);
     app.require_subcommand(1);

@@ -89,7 +89,7 @@ class StrictDocumentBuilder : public nlohmann::json_sax<json> {
     std::string message = error.what();
     if (const auto bracket = message.find("] "); message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos)
       message = message.substr(bracket + 2);
-    issues_.push_back({"", "text that is not JSON (" + message + ")", "a JSON object as described in docs/job-file.md"});
+    issues_.push_back({"", "text that is not JSON (" + message + ")", "a JSON object as described in README.md"});
     return false;
   }
 
@@ -782,7 +782,8 @@ Job parse_job(const json& document, const std::filesystem::path& job_file, std::
   Job job;
   job.file = job_file;
   job.directory = job_file.parent_path().empty() ? std::filesystem::path(".") : job_file.parent_path();
-  if (!check.object(document, "", "a JSON object with the keys model, integrator, initial, time (docs/job-file.md)"))
+  if (!check.object(document, "",
+                    "a JSON object with the keys model, integrator, initial, time (README.md, section Running nonsep)"))
     return job;
   check.known_keys(document, "",
                    {"$schema", "description", "model", "hamiltonian", "integrator", "initial", "time", "output",
