@@ -12,6 +12,7 @@
 #include "nonsep/core.hpp"
 #include "support/convergence.hpp"
 #include "support/models.hpp"
+#include "support/nan_aware.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
 
 using namespace nonsep;
@@ -25,7 +26,7 @@ PhaseSpaceBatch state(std::vector<double> q, std::vector<double> p) { return Pha
 double max_difference(const PhaseSpaceBatch& a, const PhaseSpaceBatch& b) {
   double d = 0;
   for (std::size_t i = 0; i < a.size(); ++i)
-    d = std::max({d, std::abs(a.q()[i] - b.q()[i]), std::abs(a.p()[i] - b.p()[i])});
+    d = testing::max_or_nan(d, testing::max_or_nan(std::abs(a.q()[i] - b.q()[i]), std::abs(a.p()[i] - b.p()[i])));
   return d;
 }
 

@@ -17,6 +17,7 @@
 #include "nonsep/sdk/model_adapter.hpp"
 #include "paper1d/paper1d.hpp"
 #include "support/models.hpp"
+#include "support/nan_aware.hpp"
 #include "nonsep/core.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 
@@ -479,7 +480,8 @@ namespace {
 double largest_csv_energy_error(const std::filesystem::path& csv) {
   double largest = 0.0;
   for (const auto& row : read_csv(csv))
-    if (row[0] != "trajectory" && !row.back().empty()) largest = std::max(largest, std::abs(std::stod(row.back())));
+    if (row[0] != "trajectory" && !row.back().empty())
+      largest = nonsep::testing::max_or_nan(largest, std::abs(std::stod(row.back())));
   return largest;
 }
 
