@@ -308,7 +308,7 @@ int run_command_line(int argc, char** argv) {
                   "an uninterrupted run");
     run->add_option("--threads,-j", threads,
                     "worker threads for the ensemble (default: all cores); results are bit-identical for any number")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::Range(1u, 4096u));
     run->footer(schemes_text() + "\n" + exit_status_text());
 
     auto* validate = app.add_subcommand(
@@ -328,6 +328,13 @@ int run_command_line(int argc, char** argv) {
     auto* models = app.add_subcommand("models", "List the plugins on the search path, one line each");
     models->footer(exit_status_text());
 
+    // CLI11 would call an unknown command a missing subcommand without naming it.
+    const auto named = [&](const CLI::App* command) { return command->check_name(argv[1]); };
+    if (argc > 1 && argv[1][0] != '-' && app.get_subcommands(named).empty()) {
+      std::cerr << "nonsep: unknown command '" << argv[1]
+                << "'; the commands are run, validate, inspect and models (see nonsep --help)\n";
+      return to_int(ExitStatus::invalid_input);
+    }
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {

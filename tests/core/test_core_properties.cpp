@@ -108,6 +108,7 @@ TEST_CASE("the one-step map is symplectic for basic and triplet, and MPE is not"
       CHECK(symplecticity_defect(Coupled2D{}, triplet, state({0.6, -0.4}, {0.3, 0.2}), 0.02) < 1e-8);
     }
     const IntegratorSpec basic{"basic", Fraction(2, 3), -2.5, form};
+    CHECK(symplecticity_defect(Paper1D{}, basic, state({1.2}, {0.5}), 0.1) < 1e-8);
     CHECK(symplecticity_defect(Coupled2D{}, basic, state({0.6, -0.4}, {0.3, 0.2}), 0.1) < 1e-8);
     // The same measurement on MPE finds a defect far above the finite-difference noise (~1e-10) and the 1e-8 tolerance.
     const IntegratorSpec mpe{"mpe", Fraction(4, 3), t2_default, form};

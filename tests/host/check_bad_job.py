@@ -4,6 +4,7 @@ stderr; with --schema, schemas/job.schema.json must reject the file too (files t
 JSON syntax errors or a plugin's parameters, are run without --schema)."""
 import argparse
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -27,8 +28,14 @@ def main():
         for path in args.path:
             # Issues are printed as "  <path>: found ...", the whole document as "(document)".
             shown = path if path else "(document)"
-            if f"  {shown}: found" not in result.stderr:
+            # An issue runs from its "  <path>: found" line to the next issue (a plugin's search list spans lines).
+            starts = [m.start() for m in re.finditer(r"^  \S*: found", result.stderr, re.MULTILINE)] + [None]
+            issues = [result.stderr[a:b] for a, b in zip(starts, starts[1:])]
+            named = [issue for issue in issues if issue.startswith(f"  {shown}: found")]
+            if not named:
                 failures.append(f"`nonsep {command[0]}` did not name {shown!r}")
+            elif not all("; allowed: " in line for line in named):
+                failures.append(f"`nonsep {command[0]}` did not say what is allowed at {shown!r}")
         if not args.path:
             failures.append("no expected path given")
         if failures:

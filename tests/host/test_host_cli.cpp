@@ -431,6 +431,9 @@ TEST_CASE("usage: --version, --help with the schemes, options and exit statuses,
                                               {"inspect", "paper1d", "--nope"}}) {
     CHECK(run_nonsep(args, folder.path()).status == 2);
   }
+  const auto unknown = run_nonsep({"frobnicate", "job.json"}, folder.path());
+  CHECK(unknown.err.find("unknown command 'frobnicate'; the commands are run, validate, inspect and models") !=
+        std::string::npos);
 }
 
 TEST_CASE("models lists every plugin on the search path, one line each") {
@@ -561,10 +564,12 @@ TEST_CASE("threads: 1, 2 and 3 threads write byte-identical trajectory.csv and s
   }
 }
 
-TEST_CASE("--threads must be a positive number") {
+TEST_CASE("--threads must be a whole number from 1 to 4096") {
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", quickstart_job());
-  CHECK(run_nonsep({"run", "--threads", "0", file.string()}, folder.path()).status == 2);
+  const auto zero = run_nonsep({"run", "--threads", "0", file.string()}, folder.path());
+  CHECK(zero.status == 2);
+  CHECK(zero.err.find("--threads: Value 0 not in range 1 to 4096") != std::string::npos);
   CHECK(run_nonsep({"run", "--threads", "two", file.string()}, folder.path()).status == 2);
 }
 
@@ -672,4 +677,21 @@ TEST_CASE("README: the worked example shows the quickstart's job, command line, 
     CAPTURE(shown_row);
     CHECK(csv.find(shown_row + "\n") != std::string::npos);
   }
+}
+
+TEST_CASE("README: the example of errors in a job file is what `nonsep validate` prints") {
+  const auto blocks = readme_code_blocks("### Errors in job files");
+  REQUIRE(!blocks.empty());
+  REQUIRE(blocks[0].first == "console");
+  const std::string& shown = blocks[0].second;
+  const std::string prompt = "$ nonsep validate ";
+  REQUIRE(shown.rfind(prompt, 0) == 0);
+  const auto command_end = shown.find('\n');
+  const std::string job = shown.substr(prompt.size(), command_end - prompt.size());
+  const std::string absolute = (std::filesystem::path(NONSEP_SOURCE_DIR) / job).string();
+  TemporaryFolder folder;
+  auto result = run_nonsep({"validate", absolute}, folder.path());
+  CHECK(result.status == 2);
+  result.err.replace(result.err.find(absolute), absolute.size(), job);  // as run from the repository's root
+  CHECK(result.err == shown.substr(command_end + 1));
 }
