@@ -20,7 +20,7 @@ set(prefix "${WORK_DIR}/prefix")
 run(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${prefix}")
 
 foreach(installed
-    include/nonsep/plugin_abi.h include/nonsep/plugin_sdk.hpp include/nonsep/derivative_checker.hpp
+    bin/nonsep include/nonsep/plugin_abi.h include/nonsep/plugin_sdk.hpp include/nonsep/derivative_checker.hpp
     include/nonsep/host/plugin_loader.hpp lib/cmake/nonsep/nonsepConfig.cmake lib/cmake/nonsep/NonsepAddModel.cmake
     lib/nonsep/plugins/paper1d.so lib/nonsep/plugins/radial.so lib/nonsep/plugins/quadratic_kinetic.so
     lib/nonsep/plugins/tao_product.so)
@@ -38,3 +38,28 @@ if(NOT EXISTS "${plugin}")
 endif()
 run("${CHECK_PROGRAM}" "${plugin}")
 message(STATUS "${last_output}")
+
+# The installed host: it finds the shipped models in the install's plugin folder (NONSEP_PLUGIN_PATH empty), and
+# loads, checks and runs the model built outside the tree, named by path.
+set(ENV{NONSEP_PLUGIN_PATH} "")
+run("${prefix}/bin/nonsep" models)
+foreach(model paper1d radial quadratic_kinetic tao_product)
+  if(NOT last_output MATCHES "${model}  [^\n]*${prefix}/lib/nonsep/plugins/${model}\\.so")
+    message(FATAL_ERROR "`nonsep models` of the install does not list ${model} from its plugin folder:\n${last_output}")
+  endif()
+endforeach()
+run("${prefix}/bin/nonsep" inspect "${plugin}" --check)
+if(NOT last_output MATCHES "relativistic_pendulum")
+  message(FATAL_ERROR "`nonsep inspect --check` did not describe the plugin:\n${last_output}")
+endif()
+file(WRITE "${WORK_DIR}/pendulum.json" "{\"model\": {\"plugin\": \"build/relativistic_pendulum.so\"},
+  \"integrator\": {\"scheme\": \"triplet\", \"order\": \"4/3\"}, \"initial\": {\"q\": [0.3], \"p\": [0.5]},
+  \"time\": {\"dt\": 0.01, \"steps\": 1000}, \"output\": {\"every\": 100}}")
+run("${prefix}/bin/nonsep" run --quiet "${WORK_DIR}/pendulum.json")
+file(READ "${WORK_DIR}/pendulum.out/summary.json" summary)
+string(JSON status GET "${summary}" status)
+string(JSON error GET "${summary}" trajectories 0 energy relative_error_max_abs)
+if(NOT status STREQUAL "completed" OR error GREATER 0.01)  # triplet 4/3 at dt = 0.01: about 1.1e-3
+  message(FATAL_ERROR "the installed host's run of the external model: status ${status}, energy error ${error}")
+endif()
+message(STATUS "installed nonsep: models listed, external plugin checked and run (energy error ${error})")
