@@ -2,15 +2,15 @@
 # CI: valgrind memcheck of loading, using and unloading every shipped plugin through the `nonsep` executable:
 # `nonsep inspect NAME --check` (load, metadata, create, every function at sample points, destroy, unload) and a
 # short ensemble run with energies (every function again, through the runner, writing both outputs). Fails on any
-# memcheck error and on definite or indirect leaks. valgrind.supp lists the suppressed reports, each explained.
+# memcheck error and on definite, indirect or possible leaks. valgrind.supp lists the suppressed reports, each explained.
 # Usage: run_valgrind_plugins.sh NONSEP_EXECUTABLE SOURCE_DIR
 set -euo pipefail
 nonsep=$1
 source_dir=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-memcheck=(valgrind --quiet --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect
-  --show-leak-kinds=definite,indirect --suppressions="$source_dir/tests/ci/valgrind.supp")
+memcheck=(valgrind --quiet --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible
+  --show-leak-kinds=definite,indirect,possible --suppressions="$source_dir/tests/ci/valgrind.supp")
 
 # name, parameters, one state's q and p (each run has two copies of it: a batch of two)
 plugins=(
