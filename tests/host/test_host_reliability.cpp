@@ -164,6 +164,29 @@ TEST_CASE("an exception inside the plugin: the trajectory fails with the excepti
   CHECK(rows[0][1] == "0");
 }
 
+TEST_CASE("an exception inside the plugin partway: every row before it complete, the failure at the step after") {
+  TemporaryFolder folder;
+  // H_TTV = p^2 from (0.5, 0.5): q = 0.5 + t (to the method's error), past 1.1 at t = 0.6. grad V throws where
+  // |q| > 1.1; the stages of a step reach well beyond its ends (the drifts of eq. expalg are of size
+  // cbrt(dt) = 0.2 here, forwards and backwards), so the first throw comes at some step before t = 0.6.
+  const Ran ran = run(folder, job_with(broken_plugin("evaluation_throws"), state(0.5, 0.5),
+                                       {{"throw_above_p", 10.0}, {"throw_above_q", 1.1}}, {{"dt", 0.01}, {"steps", 200}}),
+                      1);
+  const json& trajectory = ran.summary["trajectories"][0];
+  CHECK(trajectory["status"] == "failed");
+  const auto last_step = trajectory["final"]["step"].get<std::uint64_t>();
+  CHECK(last_step >= 10);
+  CHECK(last_step < 60);
+  CHECK(trajectory["final"]["q"][0].get<double>() == doctest::Approx(0.5 + 0.01 * last_step).epsilon(1e-3));
+  const auto error = trajectory["error"].get<std::string>();
+  CHECK(contains(error, "the model failed at step " + std::to_string(last_step + 1) + ": "));
+  CHECK(contains(error, "exception in grad_V: deliberate bug: q beyond the table in grad_V"));
+  // Every step before the failure is in trajectory.csv, complete.
+  const auto rows = check_complete_csv(folder / "out/trajectory.csv", 1);
+  REQUIRE(rows.size() == last_step + 1);
+  for (std::size_t k = 0; k < rows.size(); ++k) CHECK(rows[k][1] == std::to_string(k));
+}
+
 TEST_CASE("NaN or Inf from the plugin after N calls: the trajectory diverges where it happens, exit 1") {
   for (const char* parameter : {"nan_after", "inf_after"}) {
     CAPTURE(std::string(parameter));
