@@ -11,7 +11,7 @@ std::string known_schemes() {
 }  // namespace
 
 Integrator::Integrator(const IntegratorSpec& spec)
-    : form_(spec.form), stepper_(ChinBasicStep(spec.form, spec.t2)) {
+    : spec_(spec), form_(spec.form), stepper_(ChinBasicStep(spec.form, spec.t2)) {
   ChinBasicStep base(spec.form, spec.t2);
   if (spec.scheme == "basic") {
     chin_order_index(spec.order, 1, "basic");

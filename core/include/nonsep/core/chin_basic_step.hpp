@@ -69,6 +69,8 @@ class ChinBasicStep {
   HamiltonianForm form() const { return form_; }
   const ChinCoefficients& coefficients() const { return c_; }
   const EvaluationCounts& evaluations() const { return evaluations_; }
+  // Counts evaluations made elsewhere on this stepper's behalf (the fused plugin path, plugin_abi.h integrate).
+  void add_evaluations(const EvaluationCounts& counts) { evaluations_ += counts; }
 
   IntegratorDescription describe() const { return {"basic", Fraction(2, 3), true, true, 1, c_.t2}; }
 
@@ -113,7 +115,7 @@ class ChinBasicStep {
   }
 
   // The first-same-as-last gradient and the point it belongs to, for wrappers that restart from a saved state
-  // (MultiProductExpansion).
+  // (MultiProductExpansion) and for handing the cache to another copy of the stepper (Integrator::export_cache).
   struct Cache {
     std::vector<double> at, gradient;
   };

@@ -56,6 +56,7 @@ class MultiProductExpansion {
   Fraction order() const { return Fraction(2 * terms(), 3); }
   const Base& base() const { return base_; }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
+  void add_evaluations(const EvaluationCounts& counts) { base_.add_evaluations(counts); }
   IntegratorDescription describe() const {
     IntegratorDescription d = base_.describe();
     d.scheme = "mpe";

@@ -40,6 +40,7 @@ class TripletComposition {
 
   const Base& base() const { return base_; }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
+  void add_evaluations(const EvaluationCounts& counts) { base_.add_evaluations(counts); }
   IntegratorDescription describe() const {
     IntegratorDescription d = base_.describe();
     d.scheme = "triplet";
