@@ -1,7 +1,9 @@
 # nonsep_add_model(<target> [OUTPUT_DIRECTORY <dir>] <sources>...)
 #
 # Builds a nonsep model plugin: a MODULE library named exactly <target>.so (no "lib" prefix), all symbols hidden
-# except the entry point NONSEP_EXPORT_MODEL defines, linked to nonsep::sdk, unloadable (no GNU unique symbols). The plugin's metadata name must equal
+# except the entry point NONSEP_EXPORT_MODEL defines, linked to nonsep::sdk (and through it nonsep::core, the static
+# PIC library whose Integrator the SDK's integrate() runs inside the plugin; its symbols stay private to the
+# plugin), unloadable (no GNU unique symbols). The plugin's metadata name must equal
 # <target>. Used in the nonsep tree (shipped plugins land in NONSEP_BUILD_PLUGIN_DIR, the folder the host
 # searches last) and by installed users after find_package(nonsep) (the plugin lands in the current binary
 # folder; point NONSEP_PLUGIN_PATH at it, or load it by path).
@@ -21,6 +23,8 @@ function(nonsep_add_model target)
   # library; a plugin's symbols are private to it, so uniqueness buys nothing and unloading must work.
   target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-fno-gnu-unique>)
   target_link_libraries(${target} PRIVATE nonsep::sdk)
+  # The static libraries linked in (nonsep::core) export nothing from the plugin: the host has its own copy.
+  target_link_options(${target} PRIVATE "LINKER:--exclude-libs,ALL")
   if(arg_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${arg_OUTPUT_DIRECTORY}")
   elseif(DEFINED NONSEP_BUILD_PLUGIN_DIR)

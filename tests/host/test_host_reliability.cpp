@@ -96,7 +96,7 @@ TEST_CASE(
     "a plugin that cannot be loaded: validate and run exit 2 naming /model/plugin and the defect, nothing is run") {
   const std::pair<const char*, const char*> cases[] = {
       {"missing_entry_symbol", "does not export the entry symbol 'nonsep_plugin_entry'"},
-      {"wrong_abi_version", "uses plugin ABI version 2 but this host uses version 1"},
+      {"wrong_abi_version", "uses plugin ABI version 1 but this host uses version 2"},
       {"wrong_table_size", "has a function table of"},
       {"invalid_metadata_json", "is not valid JSON"},
       {"metadata_names_another", "declares the name 'someone_else'"},

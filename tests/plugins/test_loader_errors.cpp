@@ -105,7 +105,7 @@ TEST_CASE("no entry symbol") {
 
 TEST_CASE("ABI version mismatch: expected and found") {
   const std::string message = load_error("wrong_abi_version.so");
-  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 1 (expected 1, found 2)"));
+  CHECK(contains(message, "uses plugin ABI version 1 but this host uses version 2 (expected 2, found 1)"));
 }
 
 TEST_CASE("wrong table size: expected and found") {
@@ -212,7 +212,7 @@ TEST_CASE("discovery lists good plugins and the failures with their errors, firs
   CHECK(entry("paper1d")->plugin.has_value());
   REQUIRE(entry("wrong_abi_version") != nullptr);
   CHECK_FALSE(entry("wrong_abi_version")->plugin.has_value());
-  CHECK(contains(entry("wrong_abi_version")->error, "(expected 1, found 2)"));
+  CHECK(contains(entry("wrong_abi_version")->error, "(expected 2, found 1)"));
   REQUIRE(entry("not_a_library") != nullptr);
   CHECK(contains(entry("not_a_library")->error, "invalid ELF header"));
   CHECK(entry("hand_written")->path == test_plugins / "hand_written.so");

@@ -33,6 +33,7 @@ struct PluginModel::Instance {
   nonsep_instance* handle = nullptr;
   std::size_t dimension = 0;
   json parameters;
+  std::vector<double> fsal_gradient;  // integrate(): the first-same-as-last gradient crossing the ABI
 
   Instance() = default;
   Instance(const Instance&) = delete;
@@ -116,7 +117,8 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
   const std::pair<const char*, bool> present[] = {{"value_T", api.value_T != nullptr},
                                                   {"value_V", api.value_V != nullptr},
                                                   {"hessian_T", api.hessian_T != nullptr},
-                                                  {"hessian_V", api.hessian_V != nullptr}};
+                                                  {"hessian_V", api.hessian_V != nullptr},
+                                                  {"integrate", api.integrate != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
@@ -159,6 +161,7 @@ std::string Plugin::name() const { return loaded_->metadata["name"].get<std::str
 std::string Plugin::version() const { return loaded_->metadata["version"].get<std::string>(); }
 std::string Plugin::description() const { return loaded_->metadata["description"].get<std::string>(); }
 bool Plugin::has_hessians() const { return loaded_->api->hessian_T != nullptr && loaded_->api->hessian_V != nullptr; }
+bool Plugin::has_integrate() const { return loaded_->api->integrate != nullptr; }
 bool Plugin::has_values() const { return loaded_->api->value_T != nullptr && loaded_->api->value_V != nullptr; }
 
 std::vector<PluginParameter> Plugin::parameters() const {
@@ -282,7 +285,7 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                       "); rebuild the plugin against this nonsep");
   if (api->struct_size != sizeof(nonsep_plugin_api))
     throw PluginError("plugin " + quoted(path) + " has a function table of " + std::to_string(api->struct_size) +
-                      " bytes but ABI version 1 defines " + std::to_string(sizeof(nonsep_plugin_api)) +
+                      " bytes but ABI version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " defines " + std::to_string(sizeof(nonsep_plugin_api)) +
                       " (expected " + std::to_string(sizeof(nonsep_plugin_api)) + ", found " +
                       std::to_string(api->struct_size) + "); the plugin was built against a different plugin_abi.h");
   const std::pair<const char*, bool> required[] = {
@@ -380,5 +383,40 @@ NONSEP_PLUGIN_MODEL_FUNCTION(hessian_V, n * n)
 NONSEP_PLUGIN_MODEL_FUNCTION(value_T, (static_cast<void>(n), 1))
 NONSEP_PLUGIN_MODEL_FUNCTION(value_V, (static_cast<void>(n), 1))
 #undef NONSEP_PLUGIN_MODEL_FUNCTION
+
+bool PluginModel::can_integrate() const { return instance_->api->integrate != nullptr; }
+
+void PluginModel::integrate(Integrator& integrator, PhaseSpaceBatch& x, double dt, std::uint64_t steps) const {
+  const nonsep_plugin_api& api = *instance_->api;
+  if (api.integrate == nullptr)
+    throw nonsep::ModelError("plugin '" + plugin().name() + "' does not provide integrate (its capability is false)");
+  if (x.dimension() != instance_->dimension)
+    throw nonsep::InvalidArgument("integrate: the plugin's model has dimension " +
+                                  std::to_string(instance_->dimension) + " but the states have dimension " +
+                                  std::to_string(x.dimension()));
+  const IntegratorSpec& spec = integrator.spec();
+  nonsep_integrator wanted{};
+  wanted.scheme = spec.scheme == "basic"     ? std::uint32_t{NONSEP_SCHEME_BASIC}
+                  : spec.scheme == "triplet" ? std::uint32_t{NONSEP_SCHEME_TRIPLET}
+                  : spec.scheme == "mpe"     ? std::uint32_t{NONSEP_SCHEME_MPE}
+                                             : 0xffffffffu;  // cannot happen: Integrator checked the name
+  wanted.form = spec.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT;
+  wanted.order_numerator = spec.order.numerator();
+  wanted.order_denominator = spec.order.denominator();
+  wanted.t2 = spec.t2;
+  std::vector<double>& gradient = instance_->fsal_gradient;
+  gradient.resize(x.q().size());
+  int valid = integrator.export_cache(x, gradient) ? 1 : 0;
+  EvaluationCounts counts;
+  const nonsep_status status = api.integrate(instance_->handle, &wanted, x.q().data(), x.p().data(), gradient.data(),
+                                             &valid, x.count(), dt, steps, &counts.grad_T, &counts.grad_V);
+  if (status != NONSEP_OK) {
+    const char* message = api.last_error(instance_->handle);
+    throw nonsep::ModelError("plugin '" + plugin().name() + "' failed in integrate (" + status_name(status) +
+                             "): " + (message != nullptr && *message ? message : "no message"));
+  }
+  integrator.import_cache(x, gradient, valid != 0);
+  integrator.add_evaluations(counts);
+}
 
 }  // namespace nonsep::host

@@ -158,6 +158,7 @@ const nonsep_plugin_api api = {
     BLOWUP_WITH_HESSIANS ? hessian_T : nullptr,
     BLOWUP_WITH_HESSIANS ? hessian_V : nullptr,
     last_error,
+    nullptr,  // integrate: absent, so the host steps it through grad_T and grad_V
 };
 
 }  // namespace

@@ -2,8 +2,8 @@
 // that is wrong in exactly one way. Each defect has a test in test_loader_errors.cpp that asserts its message.
 //   0  none: a valid plugin "hand_written" (T = p^2/2, V = q^2/2), so the defects below are the only difference
 //   1  the entry symbol has another name
-//   2  abi_version is 2
-//   3  struct_size is one pointer short (a table built against a shorter header)
+//   2  abi_version is 1 (a plugin built for the previous ABI, without integrate)
+//   3  struct_size is one pointer short (a table built against a shorter header: version 1's size)
 //   4  the metadata is not valid JSON
 //   5  the metadata names another plugin than the file
 //   6  the required grad_V is null
@@ -59,7 +59,7 @@ const char* last_error(const nonsep_instance* instance) { return instance->last_
 
 const nonsep_plugin_api table = {
 #if NONSEP_TEST_DEFECT == 2
-    2u,
+    1u,
 #else
     NONSEP_PLUGIN_ABI_VERSION,
 #endif
@@ -83,6 +83,7 @@ const nonsep_plugin_api table = {
     nullptr,
     nullptr,
     &last_error,
+    nullptr,  // integrate: optional, absent (the host steps through grad_T and grad_V)
 };
 
 }  // namespace

@@ -1,11 +1,11 @@
-/* nonsep plugin ABI, version 1.
+/* nonsep plugin ABI, version 2 (version 1 had no integrate()).
  *
  * A plugin is a shared library that exports one C symbol, NONSEP_PLUGIN_ENTRY_SYMBOL ("nonsep_plugin_entry"),
  * of type nonsep_plugin_entry_fn. It returns a pointer to a constant, statically allocated function table
  * (nonsep_plugin_api) that stays valid while the library is loaded. Nothing else is looked up by name.
  *
  * Checks the host makes, in this order, before using anything else in the table:
- *   1. abi_version == NONSEP_PLUGIN_ABI_VERSION   (refused with "expected 1, found N")
+ *   1. abi_version == NONSEP_PLUGIN_ABI_VERSION   (refused with "expected 2, found N")
  *   2. struct_size == sizeof(nonsep_plugin_api)  (refused with expected and found sizes)
  *   3. metadata_json() returns valid JSON of the shape below.
  *
@@ -29,7 +29,8 @@
  *     "dimension": { "fixed": 1 }                  or  { "parameter": "dimension" },
  *     "parameters": [ { "name": "dimension", "type": "integer" | "number" | "boolean",
  *                       "default": 2, "minimum": 1, "maximum": 64, "unit": "", "description": "..." } ],
- *     "capabilities": { "value_T": true, "value_V": true, "hessian_T": true, "hessian_V": true }
+ *     "capabilities": { "value_T": true, "value_V": true, "hessian_T": true, "hessian_V": true,
+ *                       "integrate": true }
  *   }
  * "minimum", "maximum" and "unit" may be absent. Each capability is true exactly when the table's pointer is
  * non-null.
@@ -44,7 +45,7 @@
 extern "C" {
 #endif
 
-#define NONSEP_PLUGIN_ABI_VERSION 1u
+#define NONSEP_PLUGIN_ABI_VERSION 2u
 #define NONSEP_PLUGIN_ENTRY_SYMBOL "nonsep_plugin_entry"
 
 typedef enum nonsep_status {
@@ -56,6 +57,27 @@ typedef enum nonsep_status {
 } nonsep_status;
 
 typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin */
+
+/* The integrator integrate() runs: the same choices as a job's "integrator" object (nonsep/core/integrator.hpp).
+ * A plain struct, so the hot path parses nothing. */
+typedef enum nonsep_scheme {
+  NONSEP_SCHEME_BASIC = 0,   /* Chin's basic step, order 2/3 */
+  NONSEP_SCHEME_TRIPLET = 1, /* triplet composition of the basic step */
+  NONSEP_SCHEME_MPE = 2      /* multi-product expansion of the basic step */
+} nonsep_scheme;
+
+typedef enum nonsep_form {
+  NONSEP_FORM_TTV = 0, /* H = T_i V_ij T_j */
+  NONSEP_FORM_VVT = 1  /* H = V_i T_ij V_j */
+} nonsep_form;
+
+typedef struct nonsep_integrator {
+  uint32_t scheme;           /* a nonsep_scheme */
+  uint32_t form;             /* a nonsep_form */
+  int64_t order_numerator;   /* the order as a fraction: 2/3, 4/3, 2/1, ... */
+  int64_t order_denominator; /* > 0 */
+  double t2;                 /* the basic step's free coefficient (finite, non-zero; default -6^(1/3)) */
+} nonsep_integrator;
 
 typedef struct nonsep_plugin_api {
   uint32_t abi_version; /* NONSEP_PLUGIN_ABI_VERSION */
@@ -84,6 +106,34 @@ typedef struct nonsep_plugin_api {
 
   /* Message for the last failed call on this instance (never NULL; "" when there was none). */
   const char* (*last_error)(const nonsep_instance* instance);
+
+  /* Optional (NULL when absent; capability "integrate"): the fused stepping loop. Advances the count states
+   * (q, p in the batch layout above, updated in place) by `steps` steps of size dt with `integrator`, run inside
+   * the plugin on the model compiled into it (the SDK instantiates the core's Integrator on its ModelAdapter), so
+   * no function pointer is crossed per gradient. It must give, bit for bit, the states and evaluation counts that
+   * the core's Integrator stepping through this table's grad_T and grad_V gives: the host runs a chunk of steps
+   * through it, and falls back to its own stepping (through grad_T, grad_V) to redo a chunk step by step.
+   *
+   * First-same-as-last cache: the basic step's last outer gradient (grad V at q in TTV, grad T at p in VVT) is
+   * reused as the next step's first. fsal_gradient holds count*n doubles (batch layout). On entry, *fsal_valid
+   * != 0 says that fsal_gradient holds that gradient at the states' current q (TTV) or p (VVT); 0 that it must
+   * be evaluated. On return with NONSEP_OK, *fsal_valid and fsal_gradient describe the final states the same way
+   * (0 when the integrator's last gradient is not at the final point, as after an MPE step). So a run split into
+   * calls, or mixing calls with the host's own steps, makes exactly the evaluations of one uninterrupted run.
+   *
+   * Counts: on NONSEP_OK, adds the gradient evaluations made, per state (one batched gradient of count states
+   * counts count), to *grad_T_count and *grad_V_count.
+   *
+   * steps == 0 changes nothing. A bad integrator (unknown scheme or form, an order the scheme does not have, a
+   * bad t2 or dt) is NONSEP_INTERNAL_ERROR with a message. Non-finite numbers are not failures: the states are
+   * advanced as computed and the host checks them. After a status other than NONSEP_OK, q, p, fsal_gradient,
+   * *fsal_valid and the counts are unspecified (the host goes back to its own copy).
+   *
+   * Thread safety: as for the other functions of an instance (one thread at a time per instance); the instance
+   * may keep the integrator and a workspace between calls. */
+  nonsep_status (*integrate)(nonsep_instance* instance, const nonsep_integrator* integrator, double* q, double* p,
+                             double* fsal_gradient, int* fsal_valid, size_t count, double dt, uint64_t steps,
+                             uint64_t* grad_T_count, uint64_t* grad_V_count);
 } nonsep_plugin_api;
 
 typedef const nonsep_plugin_api* (*nonsep_plugin_entry_fn)(void);

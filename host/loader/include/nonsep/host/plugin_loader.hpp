@@ -14,6 +14,7 @@
 // Errors. Everything that fails before a run starts throws PluginError with a complete message (which plugin,
 // which file, what was expected and found). Evaluation failures during a run throw nonsep::ModelError with the
 // plugin's own message.
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -25,6 +26,8 @@
 #include <nlohmann/json.hpp>
 
 #include "nonsep/core/error.hpp"
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/phase_space_batch.hpp"
 
 struct nonsep_plugin_api;
 struct nonsep_instance;
@@ -57,6 +60,7 @@ class Plugin {
   std::vector<PluginParameter> parameters() const;
   bool has_hessians() const;  // both hessian_T and hessian_V
   bool has_values() const;    // both value_T and value_V
+  bool has_integrate() const; // the fused stepping loop integrate() (ABI version 2, optional)
 
   // Creates an instance. `parameters` must be a JSON object; unknown names, wrong types and values out of range
   // are refused with a PluginError naming the parameter (checked by the host against the metadata first, then by
@@ -95,6 +99,14 @@ class PluginModel {
   void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const;
   void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const;
   void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const;
+
+  // The fused path (plugin_abi.h integrate): whether the plugin has it, and `steps` steps of dt on x with
+  // `integrator`'s scheme run inside the plugin. integrator's first-same-as-last cache goes in and comes back
+  // and the plugin's evaluations are added to its counts, so stepping on with `integrator` gives what stepping
+  // with it all along would have. Throws nonsep::ModelError when the plugin lacks integrate or fails (x and the
+  // integrator's cache are then unspecified: the caller goes back to a copy).
+  bool can_integrate() const;
+  void integrate(Integrator& integrator, PhaseSpaceBatch& x, double dt, std::uint64_t steps) const;
 
   const Plugin& plugin() const;
   // The parameters in effect: the metadata's defaults overlaid with those given to create().
