@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <exception>
 #include <cmath>
 #include <numeric>
@@ -86,6 +87,12 @@ std::vector<std::string> isolate_failures(PhaseSpaceBatch& x, const PhaseSpaceBa
   return errors;
 }
 
+// NONSEP_FUSED=0 in the environment switches the fused path off (RunOptions::fused).
+bool fused_switched_off_by_environment() {
+  const char* value = std::getenv("NONSEP_FUSED");
+  return value != nullptr && std::string(value) == "0";
+}
+
 bool all_finite(const PhaseSpaceBatch& x) {
   bool finite = true;
   for (double v : x.q()) finite &= std::isfinite(v);
@@ -137,6 +144,7 @@ class Run {
         model_(loaded.model),
         options_(options),
         prototype_(job_.integrator),
+        fused_(options.fused && !fused_switched_off_by_environment()),
         energy_available_(loaded.plugin.has_hessians()),
         records_(job_.initial.count) {
     fingerprint_ = job_fingerprint(loaded);
@@ -373,9 +381,13 @@ class Run {
     const double dt = job_.time.dt;
     bool clean = true;
     try {
-      for (std::uint64_t step = from; step < to; ++step) {
-        block.integrator.step(worker.model, block.batch, dt);
-        if (closest) track_closest_return(block, step + 1);
+      if (fused_ && !closest && worker.model.can_integrate()) {
+        worker.model.integrate(block.integrator, block.batch, dt, to - from);
+      } else {
+        for (std::uint64_t step = from; step < to; ++step) {
+          block.integrator.step(worker.model, block.batch, dt);
+          if (closest) track_closest_return(block, step + 1);
+        }
       }
     } catch (const ModelError&) {
       clean = false;
@@ -741,6 +753,7 @@ class Run {
   const PluginModel& model_;
   const RunOptions& options_;
   Integrator prototype_;  // describes the scheme; the blocks step with their own copies
+  bool fused_;             // unchecked chunks through the plugin's integrate() when it has one (RunOptions::fused)
   bool energy_available_;
   std::vector<TrajectoryRecord> records_;
   std::vector<Block> blocks_;

@@ -15,6 +15,12 @@
 // chunk's start (integrator included) and redoes the chunk step by step with the checks below, so the numbers,
 // evaluation counts and statuses are the same as if every step had been checked.
 //
+// Fused path: when the plugin provides integrate() (every SDK plugin does) and no per-step analysis is asked for
+// (analysis.closest_return_after), a block's unchecked chunk is one call into the plugin, which runs the core's
+// Integrator on its compiled-in model; the first-same-as-last gradient and the evaluation counts go in and come
+// back into the block's Integrator, so replays, checkpoints and counts are those of the host path. A replay is
+// always stepped by the host (RunOptions::fused).
+//
 // Per trajectory, at every step:
 //   - a state with a non-finite q or p is retired with status "diverged" (step, t and the first non-finite
 //     variable, e.g. "p[0]"); its "final" is its last finite state, which is also the last row written for it;
@@ -48,6 +54,11 @@ struct RunOptions {
   // Continue from output_directory/checkpoint.json (checkpoint.hpp) instead of starting at step 0.
   bool resume = false;
   unsigned threads = 0;  // worker threads; 0: all cores (omp_get_max_threads)
+  // Run unchecked chunks through the plugin's own stepping loop (plugin_abi.h integrate, the fused path) when it
+  // has one. Results are the same bit for bit either way (states, evaluation counts, files); false, or the
+  // environment variable NONSEP_FUSED=0, steps through grad_T and grad_V as ABI version 1 plugins are (tests and
+  // the benchmark compare the two).
+  bool fused = true;
 };
 
 inline constexpr std::size_t run_block_size = 256;              // trajectories per block
