@@ -3,8 +3,10 @@
 //
 //   1. one trajectory:       ns per basic step of `nonsep run` (nonsep::host::run_job on paper1d.so, output every
 //                            = 0) over the same ChinBasicStep on the same model class compiled in (ModelAdapter).
+//                            The host runs chunks through the plugin's integrate() (the fused path, the default);
+//   1u.                      the same with the fused path off (RunOptions::fused = false: a plugin call per stage).
 //   2. ensemble of 1024:     ns per basic step per trajectory, run_job with 1 thread over the compiled-in batched
-//                            loop (ChinBasicStep on one PhaseSpaceBatch of 1024 states).
+//                            loop (ChinBasicStep on one PhaseSpaceBatch of 1024 states); 2u with the fused path off.
 //   3. threads:              run_job on a large ensemble, 1 thread over 2 threads (speed-up).
 //   4. AD over analytic:     run_job on 1024 trajectories, paper1d_autodiff.so (T and V only, gradients by the
 //                            SDK's dual numbers) over paper1d.so (hand-written gradients), 1 thread.
@@ -78,10 +80,13 @@ nonsep::host::LoadedJob make_job(const std::filesystem::path& folder, const std:
 }
 
 // Seconds for the host to run `job` on `threads` threads; `final_q` receives every trajectory's final q.
-double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
+// `fused` = false switches the fused path (the plugin's integrate()) off.
+double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q,
+                 bool fused = true) {
   nonsep::host::RunOptions options;
   options.output_directory = job.job.output_directory;
   options.threads = threads;
+  options.fused = fused;
   const auto start = Clock::now();
   const auto outcome = nonsep::host::run_job(job, options);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
@@ -176,6 +181,12 @@ int main(int argc, char** argv) {
     const double per = 1e9 / static_cast<double>(steps);
     figures.push_back({"1. one trajectory: host / compiled in", "ns per basic step", "<= 1.15", host / compiled,
                        host * per, compiled * per});
+    const auto [unfused, compiled_again] = interleaved(
+        repetitions, [&] { return time_host(job, 1, host_q, false); },
+        [&] { return time_compiled(job, compiled_q); });
+    check("figure 1u", host_q, compiled_q);
+    figures.push_back({"1u. one trajectory: host, fused path off / compiled in", "ns per basic step", "(report)",
+                       unfused / compiled_again, unfused * per, compiled_again * per});
   }
   {  // 2. ensemble of 1024, one thread
     const std::size_t count = 1024;
@@ -188,6 +199,13 @@ int main(int argc, char** argv) {
     const double per = 1e9 / static_cast<double>(steps * count);
     figures.push_back({"2. 1024 trajectories: host (1 thread) / compiled-in batch", "ns per basic step per trajectory",
                        "<= 1.2", host / compiled, host * per, compiled * per});
+    const auto [unfused, compiled_again] =
+        interleaved(repetitions, [&] { return time_host(job, 1, host_q, false); },
+                    [&] { return time_compiled(job, compiled_q); });
+    check("figure 2u", host_q, compiled_q);
+    figures.push_back({"2u. 1024 trajectories: host (1 thread), fused path off / compiled-in batch",
+                       "ns per basic step per trajectory", "(report)", unfused / compiled_again, unfused * per,
+                       compiled_again * per});
   }
   {  // 3. two threads over one, large ensemble
     const std::size_t count = 8192;
