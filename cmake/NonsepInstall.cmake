@@ -3,7 +3,7 @@
 #
 # Layout under the prefix:
 #   include/nonsep/...                  core, SDK (plugin_abi.h, plugin_sdk.hpp, derivative_checker.hpp), loader
-#   lib/libnonsep_core.a, lib/libnonsep_loader.a
+#   lib/libnonsep_core.a, lib/libnonsep_loader.a  (position-independent: plugins link nonsep_core)
 #   lib/nonsep/plugins/<name>.so        shipped models (NONSEP_INSTALL_PLUGINDIR; the host finds it from bin/)
 #   lib/cmake/nonsep/                   nonsepConfig.cmake, targets, NonsepAddModel.cmake
 include(CMakePackageConfigHelpers)

@@ -13,7 +13,7 @@
 //
 // The plugin's file must be named <name>.so (nonsep_add_model() in CMake does that): the host refuses a file whose
 // metadata name differs from its file name. Every SDK plugin provides all optional functions (values and
-// Hessians of T and V); its metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T and
+// Hessians of T and V, and integrate); its metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T and
 // hessian_V, whether it is "analytic" or "automatic".
 //
 // The table's optional integrate() (the fused path of plugin_abi.h) runs the core's nonsep::Integrator on
