@@ -290,7 +290,8 @@ int run_command_line(int argc, char** argv) {
     app.require_subcommand(1);
     app.footer(schemes_text() + "\n" + exit_status_text() +
                "\nPlugins are searched in $NONSEP_PLUGIN_PATH (':'-separated), then the installed and the build "
-               "tree's plugin folders.");
+               "tree's plugin folders. NONSEP_FUSED=0 makes runs step through the plugin's gradients instead of its "
+               "integrate() (the same results, slower; for comparisons).");
 
     std::string job_file, output, plugin_name;
     bool quiet = false, as_json = false, check = false, resume = false;
