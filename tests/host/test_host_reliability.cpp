@@ -95,7 +95,8 @@ void wait_for_file(const std::filesystem::path& path, std::size_t bytes = 0) {
 TEST_CASE(
     "a plugin that cannot be loaded: validate and run exit 2 naming /model/plugin and the defect, nothing is run") {
   const std::pair<const char*, const char*> cases[] = {
-      {"missing_entry_symbol", "does not export the entry symbol 'nonsep_plugin_entry'"},
+      {"missing_entry_symbol", "does not export the symbol 'nonsep_plugin'"},
+      {"version_1_entry", "uses plugin ABI version 1 (it exports 'nonsep_plugin_entry')"},
       {"wrong_abi_version", "uses plugin ABI version 1 but this host uses version 2"},
       {"wrong_table_size", "has a function table of"},
       {"invalid_metadata_json", "is not valid JSON"},

@@ -95,12 +95,19 @@ TEST_CASE("not a shared library: the dynamic loader's own text is included") {
   CHECK(contains(message, "invalid ELF header"));
 }
 
-TEST_CASE("no entry symbol") {
+TEST_CASE("no plugin symbol") {
   const std::string file = (test_plugins / "missing_entry_symbol.so").string();
   CHECK(load_error("missing_entry_symbol.so") ==
         std::string("'").append(file).append(
-            "' is a shared library but not a nonsep plugin: it does not export the entry symbol "
-            "'nonsep_plugin_entry' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp)"));
+            "' is a shared library but not a nonsep plugin: it does not export the symbol 'nonsep_plugin' (define "
+            "it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp, or NONSEP_DEFINE_PLUGIN, see plugin_abi.h)"));
+}
+
+TEST_CASE("a plugin of ABI version 1 (its entry function, no plugin symbol): expected and found") {
+  const std::string file = (test_plugins / "version_1_entry.so").string();
+  CHECK(load_error("version_1_entry.so") ==
+        "plugin '" + file + "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
+        "version 2 (expected 2, found 1); rebuild the plugin against this nonsep");
 }
 
 TEST_CASE("ABI version mismatch: expected and found") {

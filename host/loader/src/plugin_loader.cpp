@@ -10,7 +10,9 @@
 #include <system_error>
 
 #include <boost/dll/runtime_symbol_info.hpp>
+#include <boost/dll/import.hpp>
 #include <boost/dll/shared_library.hpp>
+#include <boost/shared_ptr.hpp>
 
 #include "nonsep/plugin_abi.h"
 #include "nonsep/sdk/parameters.hpp"
@@ -21,9 +23,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 struct Plugin::Loaded {
-  boost::dll::shared_library library;
+  boost::shared_ptr<const nonsep_plugin_api> table;  // from import_alias: owns the loaded library
   fs::path path;
-  const nonsep_plugin_api* api = nullptr;
+  const nonsep_plugin_api* api = nullptr;            // table.get()
   json metadata;
 };
 
@@ -267,17 +269,26 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
   const fs::path& path = file;
   auto loaded = std::make_shared<Plugin::Loaded>();
   loaded->path = path;
+  boost::dll::shared_library library;
   try {
-    loaded->library.load(path, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
+    library.load(path, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
   } catch (const std::exception& e) {
     throw PluginError("cannot load " + quoted(path) + " as a shared library: " + e.what());
   }
-  if (!loaded->library.has(NONSEP_PLUGIN_ENTRY_SYMBOL))
-    throw PluginError(quoted(path) + " is a shared library but not a nonsep plugin: it does not export the entry "
-                      "symbol '" NONSEP_PLUGIN_ENTRY_SYMBOL "' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp)");
-  const auto entry = loaded->library.get<const nonsep_plugin_api*()>(NONSEP_PLUGIN_ENTRY_SYMBOL);
-  const nonsep_plugin_api* api = entry();
-  if (api == nullptr) throw PluginError("the entry symbol of plugin " + quoted(path) + " returned a null table");
+  if (!library.has(NONSEP_PLUGIN_SYMBOL)) {
+    if (library.has(NONSEP_PLUGIN_V1_ENTRY_SYMBOL))
+      throw PluginError("plugin " + quoted(path) + " uses plugin ABI version 1 (it exports '"
+                        NONSEP_PLUGIN_V1_ENTRY_SYMBOL "') but this host uses version " +
+                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
+                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found 1); rebuild the plugin against this nonsep");
+    throw PluginError(quoted(path) + " is a shared library but not a nonsep plugin: it does not export the symbol '"
+                      NONSEP_PLUGIN_SYMBOL "' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp, or "
+                      "NONSEP_DEFINE_PLUGIN, see plugin_abi.h)");
+  }
+  // The symbol is a pointer to the table; import_alias returns the table as a shared_ptr that owns the library.
+  loaded->table = boost::dll::import_alias<const nonsep_plugin_api>(std::move(library), NONSEP_PLUGIN_SYMBOL);
+  const nonsep_plugin_api* api = loaded->table.get();
+  if (api == nullptr) throw PluginError("the symbol '" NONSEP_PLUGIN_SYMBOL "' of plugin " + quoted(path) + " is a null table");
   if (api->abi_version != NONSEP_PLUGIN_ABI_VERSION)
     throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(api->abi_version) +
                       " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +

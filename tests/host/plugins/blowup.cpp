@@ -163,4 +163,4 @@ const nonsep_plugin_api api = {
 
 }  // namespace
 
-extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* nonsep_plugin_entry() { return &api; }
+NONSEP_DEFINE_PLUGIN(api);

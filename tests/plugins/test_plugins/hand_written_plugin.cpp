@@ -1,13 +1,14 @@
 // A plugin written by hand against plugin_abi.h (no SDK), compiled once per NONSEP_TEST_DEFECT to get a library
 // that is wrong in exactly one way. Each defect has a test in test_loader_errors.cpp that asserts its message.
 //   0  none: a valid plugin "hand_written" (T = p^2/2, V = q^2/2), so the defects below are the only difference
-//   1  the entry symbol has another name
+//   1  the exported symbol has another name
 //   2  abi_version is 1 (a plugin built for the previous ABI, without integrate)
 //   3  struct_size is one pointer short (a table built against a shorter header: version 1's size)
 //   4  the metadata is not valid JSON
 //   5  the metadata names another plugin than the file
 //   6  the required grad_V is null
 //   7  the metadata claims hessian_T but the pointer is null
+//   8  exports ABI version 1's entry function nonsep_plugin_entry instead of the symbol nonsep_plugin
 #include <cstddef>
 #include <cstring>
 
@@ -89,11 +90,9 @@ const nonsep_plugin_api table = {
 }  // namespace
 
 #if NONSEP_TEST_DEFECT == 1
-extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* nonsep_plugin_entry_v0(void) {
-  return &table;
-}
+extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* const nonsep_plugin_v0 = &table;
+#elif NONSEP_TEST_DEFECT == 8
+extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* nonsep_plugin_entry(void) { return &table; }
 #else
-extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* nonsep_plugin_entry(void) {
-  return &table;
-}
+NONSEP_DEFINE_PLUGIN(table);
 #endif

@@ -1,8 +1,11 @@
-/* nonsep plugin ABI, version 2 (version 1 had no integrate()).
+/* nonsep plugin ABI, version 2 (version 1 had no integrate(), and exported a function, nonsep_plugin_entry,
+ * returning the table instead of the pointer below).
  *
- * A plugin is a shared library that exports one C symbol, NONSEP_PLUGIN_ENTRY_SYMBOL ("nonsep_plugin_entry"),
- * of type nonsep_plugin_entry_fn. It returns a pointer to a constant, statically allocated function table
- * (nonsep_plugin_api) that stays valid while the library is loaded. Nothing else is looked up by name.
+ * A plugin is a shared library that exports one C symbol, NONSEP_PLUGIN_SYMBOL ("nonsep_plugin"): a constant
+ * pointer to a constant, statically allocated function table (nonsep_plugin_api) that stays valid while the
+ * library is loaded. NONSEP_DEFINE_PLUGIN(table) defines it, in C or C++. The host reads it with Boost.DLL's
+ * import_alias, which keeps the library loaded for as long as the host holds the table. Nothing else is looked
+ * up by name.
  *
  * Checks the host makes, in this order, before using anything else in the table:
  *   1. abi_version == NONSEP_PLUGIN_ABI_VERSION   (refused with "expected 2, found N")
@@ -46,7 +49,9 @@ extern "C" {
 #endif
 
 #define NONSEP_PLUGIN_ABI_VERSION 2u
-#define NONSEP_PLUGIN_ENTRY_SYMBOL "nonsep_plugin_entry"
+#define NONSEP_PLUGIN_SYMBOL "nonsep_plugin"
+/* The symbol of ABI version 1 (a function returning the table); the host names it when refusing such a plugin. */
+#define NONSEP_PLUGIN_V1_ENTRY_SYMBOL "nonsep_plugin_entry"
 
 typedef enum nonsep_status {
   NONSEP_OK = 0,
@@ -136,10 +141,19 @@ typedef struct nonsep_plugin_api {
                              uint64_t* grad_T_count, uint64_t* grad_V_count);
 } nonsep_plugin_api;
 
-typedef const nonsep_plugin_api* (*nonsep_plugin_entry_fn)(void);
-
 #ifdef __cplusplus
 }
+#define NONSEP_PLUGIN_EXTERN_C extern "C"
+#else
+#define NONSEP_PLUGIN_EXTERN_C
 #endif
+
+/* Defines the exported symbol NONSEP_PLUGIN_SYMBOL, pointing at `table` (a nonsep_plugin_api with static storage),
+ * with default visibility whatever -fvisibility says. Use it once per plugin, at file scope:
+ *   static const nonsep_plugin_api table = { NONSEP_PLUGIN_ABI_VERSION, sizeof(nonsep_plugin_api), ... };
+ *   NONSEP_DEFINE_PLUGIN(table); */
+#define NONSEP_DEFINE_PLUGIN(table)                                                                   \
+  NONSEP_PLUGIN_EXTERN_C __attribute__((visibility("default"))) const nonsep_plugin_api* const nonsep_plugin = \
+      &(table)
 
 #endif /* NONSEP_PLUGIN_ABI_H */

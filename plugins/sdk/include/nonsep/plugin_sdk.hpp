@@ -4,7 +4,7 @@
 //
 //   NONSEP_EXPORT_MODEL(Paper1D, "paper1d", "1.0.0", "one-line description", "T, V and the H it solves");
 //
-// which defines the entry symbol of plugin_abi.h and a constant function table for it. The table's functions
+// which defines the symbol of plugin_abi.h (NONSEP_DEFINE_PLUGIN) and the constant function table it points at. The table's functions
 // parse and range-check parameters (parameters.hpp), batch over states, compute derivatives (analytic where the
 // class has them, automatic differentiation otherwise), pass non-finite results through as numbers (the host
 // reports the trajectory as diverged), and turn every C++ exception into a status code with a message
@@ -303,7 +303,4 @@ class PluginTable {
     static constexpr ::nonsep::sdk::ModelIdentity value{name, version, description, hamiltonian};        \
   };                                                                                                     \
   }                                                                                                      \
-  extern "C" NONSEP_PLUGIN_EXPORT const nonsep_plugin_api* nonsep_plugin_entry(void) {                  \
-    return &::nonsep::sdk::PluginTable<Model, policy, nonsep_exported_model_identity>::api;              \
-  }                                                                                                      \
-  static_assert(true, "NONSEP_EXPORT_MODEL ends with a semicolon")
+  NONSEP_DEFINE_PLUGIN((::nonsep::sdk::PluginTable<Model, policy, nonsep_exported_model_identity>::api))

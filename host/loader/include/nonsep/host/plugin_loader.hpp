@@ -73,8 +73,8 @@ class Plugin {
   std::shared_ptr<const Loaded> loaded_;
 };
 
-// Throws PluginError: file not found (listing every place tried), not a shared library, no entry symbol,
-// ABI version mismatch, wrong table size, invalid metadata.
+// Throws PluginError: file not found (listing every place tried), not a shared library, no plugin symbol,
+// ABI version mismatch (also a version-1 plugin, recognised by its entry function), wrong table size, invalid metadata.
 Plugin load_plugin(const std::string& name_or_path, const std::filesystem::path& base_directory);
 
 std::vector<std::filesystem::path> plugin_search_path();
