@@ -1,6 +1,7 @@
 #include "nonsep/core/fraction.hpp"
 
 #include <charconv>
+#include <limits>
 #include <numeric>
 
 #include "nonsep/core/error.hpp"
@@ -9,6 +10,9 @@ namespace nonsep {
 
 Fraction::Fraction(std::int64_t numerator, std::int64_t denominator) {
   if (denominator == 0) throw InvalidArgument("a fraction cannot have denominator 0");
+  constexpr std::int64_t lowest = std::numeric_limits<std::int64_t>::min();
+  if (numerator == lowest || denominator == lowest)  // its negation and its absolute value overflow
+    throw InvalidArgument("a fraction's numerator and denominator must lie within +-(2^63 - 1)");
   if (denominator < 0) {
     numerator = -numerator;
     denominator = -denominator;

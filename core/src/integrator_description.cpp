@@ -67,13 +67,16 @@ std::optional<SchemeDescription> find_scheme(const std::string& name) {
 }
 
 int chin_order_index(const Fraction& order, int max_j, const std::string& what) {
-  // order = a/b = 2j/3  <=>  j = 3a / (2b) is a positive integer.
+  // order = a/b = 2j/3 in lowest terms: a = 2j, b = 3 when 3 does not divide j; a = 2j/3, b = 1 when it does. So
+  // a is positive and even, b is 1 or 3, and j = 3a/2 or a/2. Divisions only: a may be as large as int64 allows.
   const std::int64_t a = order.numerator();
   const std::int64_t b = order.denominator();
-  if (a <= 0 || (3 * a) % (2 * b) != 0)
+  if (a <= 0 || a % 2 != 0 || (b != 1 && b != 3))
     throw InvalidArgument("order " + order.to_string() + " does not exist for " + what + "; the orders are " +
                           orders_list());
-  const std::int64_t j = 3 * a / (2 * b);
+  const std::int64_t half = a / 2;
+  const bool beyond = b == 1 ? half > max_j / 3 : half > max_j;
+  const std::int64_t j = beyond ? std::int64_t{max_j} + 1 : (b == 1 ? 3 * half : half);
   if (j > max_j)
     throw InvalidArgument("order " + order.to_string() + " is beyond the highest order of " + what + ", " +
                           Fraction(2 * max_j, 3).to_string());

@@ -53,6 +53,15 @@ TEST_CASE("orders that do not exist are rejected with the list of those that do"
                  "beyond the highest order of basic, 2/3"));
   CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(40)}); }), "beyond the highest order of mpe"));
   CHECK(contains(error_of([] { Integrator(IntegratorSpec{"leapfrog"}); }), "unknown integrator scheme 'leapfrog'"));
+  // Orders near the int64 limit (found by fuzzing: 3a overflowed) are refused, not computed with.
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(6148914691236517204)}); }),
+                 "beyond the highest order of mpe"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(9223372036854775806, 3)}); }),
+                 "beyond the highest order of triplet"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(9223372036854775807)}); }),
+                 "does not exist for triplet"));
+  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(-9223372036854775807, 3)}); }),
+                 "does not exist for triplet"));
   // Every valid order up to the limits is accepted and reported back exactly.
   for (int j = 1; j <= 8; ++j) {
     CHECK(Integrator(IntegratorSpec{"triplet", Fraction(2 * j, 3)}).describe().order == Fraction(2 * j, 3));
@@ -70,6 +79,10 @@ TEST_CASE("exact fractions parse strictly") {
     CAPTURE(bad);
     CHECK(contains(error_of([&] { Fraction::parse(bad); }), "is not an exact fraction"));
   }
+  // The lowest int64 has no negation: refused rather than overflowed.
+  CHECK(contains(error_of([] { Fraction::parse("-9223372036854775808/-1"); }), "within +-(2^63 - 1)"));
+  CHECK(contains(error_of([] { Fraction(1, std::numeric_limits<std::int64_t>::min()); }), "within +-(2^63 - 1)"));
+  CHECK(Fraction::parse("-9223372036854775807/9223372036854775807") == Fraction(-1));
   // A batch whose dimension differs from the model's is refused.
   PhaseSpaceBatch wrong(2, 1);
   ChinBasicStep basic;
