@@ -187,7 +187,12 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
       std::cerr << "nonsep: stopped by " << (stop_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT") << " after step "
                 << summary["time"]["steps_completed"] << "; `nonsep run " << job_file
                 << (output.empty() ? "" : " --output " + output) << " --resume` continues from there\n";
+    // One line per stopped trajectory, up to a screenful: an ensemble may have thousands (all are in the summary).
+    constexpr std::size_t shown_at_most = 20;
+    std::size_t stopped = 0;
     for (const auto& trajectory : summary["trajectories"]) {
+      if (trajectory["status"] != "diverged" && trajectory["status"] != "failed") continue;
+      if (++stopped > shown_at_most) continue;
       if (trajectory["status"] == "diverged")
         std::cerr << "nonsep: trajectory " << trajectory["index"] << " diverged at step "
                   << trajectory["diverged"]["step"] << ", t = " << trajectory["diverged"]["t"] << " ("
@@ -196,6 +201,9 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
         std::cerr << "nonsep: trajectory " << trajectory["index"] << " failed: "
                   << trajectory["error"].get<std::string>() << "\n";
     }
+    if (stopped > shown_at_most)
+      std::cerr << "nonsep: ... and " << stopped - shown_at_most << " more trajectories that diverged or failed; "
+                << (options.output_directory / "summary.json").string() << " lists them all\n";
   }
   return to_int(outcome.exit_status);
 }

@@ -695,3 +695,20 @@ TEST_CASE("README: the example of errors in a job file is what `nonsep validate`
   result.err.replace(result.err.find(absolute), absolute.size(), job);  // as run from the repository's root
   CHECK(result.err == shown.substr(command_end + 1));
 }
+
+TEST_CASE("many trajectories stop: stderr names the first 20 and says how many more summary.json lists") {
+  TemporaryFolder folder;
+  json initial = json::array();
+  for (int k = 0; k < 25; ++k) initial.push_back(state(1e103, 0.0));  // grad V = q^3 overflows in the first step
+  initial.push_back(state(0.5, 0.5));
+  const auto file = write_job(folder / "many.json", blowup_job(initial));
+  const auto result = run_nonsep({"run", "--quiet", file.string()}, folder.path());
+  CHECK(result.status == 1);
+  std::size_t lines = 0;
+  for (std::size_t at = 0; (at = result.err.find("nonsep: trajectory ", at)) != std::string::npos; ++at) ++lines;
+  CHECK(lines == 20);
+  CHECK(result.err.find("nonsep: trajectory 19 diverged at step 1") != std::string::npos);
+  CHECK(result.err.find("nonsep: trajectory 20 ") == std::string::npos);
+  CHECK(result.err.find("... and 5 more trajectories that diverged or failed; ") != std::string::npos);
+  CHECK(read_json(folder / "many.out/summary.json")["counts"]["diverged"] == 25);
+}
