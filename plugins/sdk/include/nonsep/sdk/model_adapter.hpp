@@ -149,9 +149,10 @@ namespace detail {
 
 // Automatic derivatives of a function that is not finite at x are meaningless (log(-1) has the "derivative" -1):
 // when the value computed alongside them is not finite, the `size` derivatives in `out` become NaN.
+// Written as a select, not a branch, so that the batch loops around it still vectorize.
 inline void poison_if_not_finite(double value, double* out, std::size_t size) {
-  if (std::isfinite(value)) return;
-  for (std::size_t i = 0; i < size; ++i) out[i] = std::numeric_limits<double>::quiet_NaN();
+  const bool finite = std::isfinite(value);
+  for (std::size_t i = 0; i < size; ++i) out[i] = finite ? out[i] : std::numeric_limits<double>::quiet_NaN();
 }
 
 // Writes the gradient of f at x (n <= K components) into out, by one pass of Dual<double, K>. Returns f(x).
@@ -233,9 +234,18 @@ class ModelAdapter {
     }
   }
 
+  // The dimension of the states, a compile-time constant for a model of fixed dimension, so that the loops over a
+  // batch unroll and vectorize.
+  std::size_t batch_dimension() const {
+    if constexpr (HasFixedDimension<M>)
+      return M::dimension;
+    else
+      return dimension_;
+  }
+
   void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
     check_sizes(p, out, count, dimension_);
-    const std::size_t n = dimension_;
+    const std::size_t n = batch_dimension();
     for (std::size_t b = 0; b < count; ++b) {
       const double* x = p.data() + b * n;
       double* g = out.data() + b * n;
@@ -248,7 +258,7 @@ class ModelAdapter {
   }
   void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
     check_sizes(q, out, count, dimension_);
-    const std::size_t n = dimension_;
+    const std::size_t n = batch_dimension();
     for (std::size_t b = 0; b < count; ++b) {
       const double* x = q.data() + b * n;
       double* g = out.data() + b * n;
