@@ -17,6 +17,16 @@ import tempfile
 import time
 
 
+def read_available(master, wait):
+    """What the pseudo-terminal has to read within `wait` seconds (b"" if nothing, or once the child has closed it)."""
+    try:
+        if select.select([master], [], [], wait)[0]:
+            return os.read(master, 65536)
+    except OSError:  # EIO: every writer has gone
+        pass
+    return b""
+
+
 def run(nonsep, job, quiet, terminal, wait_for_bar):
     master, slave = pty.openpty()
     args = [nonsep, "run", job] + (["--quiet"] if quiet else [])
@@ -25,40 +35,22 @@ def run(nonsep, job, quiet, terminal, wait_for_bar):
     os.close(slave)
     seen = b""
     deadline = time.monotonic() + (30 if wait_for_bar else 2)
-    while time.monotonic() < deadline:
-        if terminal:
-            ready, _, _ = select.select([master], [], [], 0.05)
-            if ready:
-                try:
-                    seen += os.read(master, 65536)
-                except OSError:
-                    break
-        else:
+    while time.monotonic() < deadline and process.poll() is None:
+        seen += read_available(master, 0.05) if terminal else b""
+        if not terminal:
             time.sleep(0.05)
         if wait_for_bar and b"\r[" in seen and b"active" in seen.split(b"\r[")[-1]:
             break
     process.send_signal(signal.SIGINT)
     if terminal:
-        end = time.monotonic() + 30
-        while process.poll() is None and time.monotonic() < end:
-            ready, _, _ = select.select([master], [], [], 0.05)
-            if ready:
-                try:
-                    seen += os.read(master, 65536)
-                except OSError:
-                    break
+        deadline = time.monotonic() + 30
+        while process.poll() is None and time.monotonic() < deadline:
+            seen += read_available(master, 0.05)
         status = process.wait(timeout=30)
-        try:
-            while select.select([master], [], [], 0.1)[0]:
-                chunk = os.read(master, 65536)
-                if not chunk:
-                    break
-                seen += chunk
-        except OSError:
-            pass
+        while chunk := read_available(master, 0.1):
+            seen += chunk
     else:
-        _, err = process.communicate(timeout=30)
-        seen = err
+        _, seen = process.communicate(timeout=30)
         status = process.returncode
     os.close(master)
     return status, seen.decode(errors="replace")
