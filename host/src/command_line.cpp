@@ -171,7 +171,7 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
   const auto& summary = outcome.summary;
   const auto& counts = summary["counts"];
   const std::string status = summary["status"].get<std::string>();
-  const std::size_t trajectories = summary["trajectories"].size();
+  const std::size_t trajectories = outcome.trajectories.size();
   std::string line = status + ": " + std::to_string(trajectories) + (trajectories == 1 ? " trajectory (" : " trajectories (") +
                      std::to_string(counts["completed"].get<std::size_t>()) + " completed";
   for (const char* other : {"diverged", "failed", "interrupted"})
@@ -190,16 +190,16 @@ int command_run(const std::string& job_file, const std::string& output, bool qui
     // One line per stopped trajectory, up to a screenful: an ensemble may have thousands (all are in the summary).
     constexpr std::size_t shown_at_most = 20;
     std::size_t stopped = 0;
-    for (const auto& trajectory : summary["trajectories"]) {
-      if (trajectory["status"] != "diverged" && trajectory["status"] != "failed") continue;
+    for (std::size_t index = 0; index < outcome.trajectories.size(); ++index) {
+      const TrajectoryRecord& trajectory = outcome.trajectories[index];
+      if (trajectory.status != "diverged" && trajectory.status != "failed") continue;
       if (++stopped > shown_at_most) continue;
-      if (trajectory["status"] == "diverged")
-        std::cerr << "nonsep: trajectory " << trajectory["index"] << " diverged at step "
-                  << trajectory["diverged"]["step"] << ", t = " << trajectory["diverged"]["t"] << " ("
-                  << trajectory["diverged"]["variable"].get<std::string>() << " is not finite)\n";
-      else if (trajectory["status"] == "failed" && trajectory.contains("error"))
-        std::cerr << "nonsep: trajectory " << trajectory["index"] << " failed: "
-                  << trajectory["error"].get<std::string>() << "\n";
+      if (trajectory.status == "diverged")
+        std::cerr << "nonsep: trajectory " << index << " diverged at step " << trajectory.diverged_step
+                  << ", t = " << format_number(trajectory.diverged_t) << " (" << trajectory.diverged_variable
+                  << " is not finite)\n";
+      else if (!trajectory.error.empty())
+        std::cerr << "nonsep: trajectory " << index << " failed: " << trajectory.error << "\n";
     }
     if (stopped > shown_at_most)
       std::cerr << "nonsep: ... and " << stopped - shown_at_most << " more trajectories that diverged or failed; "

@@ -93,29 +93,55 @@ void TrajectoryWriter::flush() {
   if (std::fflush(file_) != 0) throw OutputError("cannot write " + path_.string() + ": " + system_reason());
 }
 
-void write_file_atomically(const std::filesystem::path& path, const std::string& content) {
+namespace {
+std::filesystem::path temporary_path_for(const std::filesystem::path& path) {
   std::string temporary_name = ".";
   temporary_name += path.filename().string();
   temporary_name += ".tmp-";
   temporary_name += std::to_string(::getpid());
-  const std::filesystem::path temporary = path.parent_path() / temporary_name;
-  std::FILE* file = std::fopen(temporary.c_str(), "wb");
-  if (!file) throw OutputError("cannot create " + temporary.string() + ": " + system_reason());
-  const bool written = std::fwrite(content.data(), 1, content.size(), file) == content.size() &&
-                       std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+  return path.parent_path() / temporary_name;
+}
+}  // namespace
+
+AtomicFile::AtomicFile(const std::filesystem::path& path) : path_(path), temporary_(temporary_path_for(path)) {
+  file_ = std::fopen(temporary_.c_str(), "wb");
+  if (!file_) throw OutputError("cannot create " + temporary_.string() + ": " + system_reason());
+}
+
+AtomicFile::~AtomicFile() {
+  if (!file_) return;
+  std::fclose(file_);
+  std::error_code ignored;
+  std::filesystem::remove(temporary_, ignored);
+}
+
+void AtomicFile::write(std::string_view text) {
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size())
+    throw OutputError("cannot write " + temporary_.string() + ": " + system_reason());
+}
+
+void AtomicFile::commit() {
+  const bool written = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
   const std::string reason = system_reason();
-  const bool closed = std::fclose(file) == 0;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
   std::error_code error;
   if (!written || !closed) {
-    std::filesystem::remove(temporary, error);
-    throw OutputError("cannot write " + temporary.string() + ": " + reason);
+    std::filesystem::remove(temporary_, error);
+    throw OutputError("cannot write " + temporary_.string() + ": " + reason);
   }
-  std::filesystem::rename(temporary, path, error);
+  std::filesystem::rename(temporary_, path_, error);
   if (error) {
     const std::string rename_reason = error.message();
-    std::filesystem::remove(temporary, error);
-    throw OutputError("cannot rename " + temporary.string() + " to " + path.string() + ": " + rename_reason);
+    std::filesystem::remove(temporary_, error);
+    throw OutputError("cannot rename " + temporary_.string() + " to " + path_.string() + ": " + rename_reason);
   }
+}
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& content) {
+  AtomicFile file(path);
+  file.write(content);
+  file.commit();
 }
 
 }  // namespace nonsep::host

@@ -19,6 +19,7 @@
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/output_files.hpp"
 #include "nonsep/host/progress_bar.hpp"
+#include "nonsep/host/summary_json.hpp"
 
 namespace nonsep::host {
 
@@ -31,10 +32,6 @@ using Clock = std::chrono::steady_clock;
 std::optional<double> relative_error(std::optional<double> energy, std::optional<double> initial) {
   if (!energy || !initial || *initial == 0.0) return std::nullopt;
   return (*energy - *initial) / *initial;
-}
-
-json optional_number(std::optional<double> value) {
-  return value && std::isfinite(*value) ? json(*value) : json(nullptr);
 }
 
 // The first non-finite variable of state `slot` ("q[0]", "p[2]"), or "".
@@ -239,11 +236,16 @@ class Run {
     outcome.summary = summary(std::chrono::duration<double>(Clock::now() - start).count());
     outcome.exit_status = exit_status();
     try {
-      write_file_atomically(options_.output_directory / "summary.json", outcome.summary.dump(2) + "\n");
+      write_summary_json(options_.output_directory / "summary.json", outcome.summary,
+                         {records_, job_.initial.q, job_.initial.p, job_.initial.dimension,
+                          job_.analysis.closest_return_after.has_value()},
+                         static_cast<unsigned>(workers_.size()));
     } catch (const OutputError& error) {
       outcome.summary["error"] = (run_error_.empty() ? "" : run_error_ + "; ") + error.what();
       if (outcome.exit_status == ExitStatus::success) outcome.exit_status = ExitStatus::run_failed;
     }
+    outcome.summary.erase("trajectories");
+    outcome.trajectories = std::move(records_);
     return outcome;
   }
 
@@ -702,35 +704,7 @@ class Run {
                          {"trajectory", writer_ ? json("trajectory.csv") : json(nullptr)},
                          {"every", job_.every},
                          {"energy_every", job_.energy_every}};
-    json trajectories = json::array();
-    const std::size_t n = job_.initial.dimension;
-    for (std::size_t index = 0; index < records_.size(); ++index) {
-      const TrajectoryRecord& record = records_[index];
-      json entry;
-      entry["index"] = index;
-      entry["status"] = record.status;
-      const auto q0 = job_.initial.q.begin() + static_cast<std::ptrdiff_t>(index * n);
-      const auto p0 = job_.initial.p.begin() + static_cast<std::ptrdiff_t>(index * n);
-      entry["initial"] = {{"q", std::vector<double>(q0, q0 + static_cast<std::ptrdiff_t>(n))},
-                          {"p", std::vector<double>(p0, p0 + static_cast<std::ptrdiff_t>(n))}};
-      entry["final"] = {{"t", record.final_t}, {"step", record.final_step}, {"q", record.final_q}, {"p", record.final_p}};
-      const bool relative_known = record.energy_initial && *record.energy_initial != 0.0;
-      entry["energy"] = {
-          {"initial", optional_number(record.energy_initial)},
-          {"final", optional_number(record.energy_final)},
-          {"relative_error_final", optional_number(relative_error(record.energy_final, record.energy_initial))},
-          {"relative_error_max_abs", relative_known ? json(record.max_abs_relative_error) : json(nullptr)}};
-      if (record.status == "diverged")
-        entry["diverged"] = {{"step", record.diverged_step}, {"t", record.diverged_t}, {"variable", record.diverged_variable}};
-      if (!record.error.empty()) entry["error"] = record.error;
-      if (job_.analysis.closest_return_after)
-        entry["closest_return"] = record.closest_distance ? json{{"distance", *record.closest_distance},
-                                                                 {"t", record.closest_t},
-                                                                 {"step", record.closest_step}}
-                                                          : json(nullptr);
-      trajectories.push_back(std::move(entry));
-    }
-    summary["trajectories"] = std::move(trajectories);
+    summary["trajectories"] = nullptr;  // the entries: summary_json_text, from records_
     summary["counts"] = {{"completed", count_status("completed")},
                          {"diverged", count_status("diverged")},
                          {"failed", count_status("failed")},

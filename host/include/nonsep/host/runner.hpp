@@ -38,9 +38,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/job.hpp"
 
@@ -66,7 +68,13 @@ inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chun
 
 struct RunOutcome {
   ExitStatus exit_status = ExitStatus::success;  // success, run_failed or interrupted
-  nlohmann::ordered_json summary;                // what summary.json holds, keys in the documented order
+  // What summary.json holds, keys in the documented order, except "trajectories": its entries are written from
+  // `trajectories` (summary_json.hpp) and not built as json values, which would cost more than the stepping on a
+  // short ensemble.
+  nlohmann::ordered_json summary;
+  // summary.json's /trajectories as records, one per trajectory in job order (the initial states are the job's).
+  // Empty for a study (run_study), whose summary has no trajectories.
+  std::vector<TrajectoryRecord> trajectories;
 };
 
 // Runs `job`. Throws OutputError, before anything is
