@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <optional>
 #include <functional>
 #include <stdexcept>
@@ -227,21 +228,28 @@ void emit_entries(const TrajectoryEntries& entries, unsigned threads, const std:
   constexpr std::size_t run = 256;  // entries per thread and round
   const std::size_t parts = std::clamp<std::size_t>((count + run - 1) / run, 1, std::max(threads, 1u));
   std::vector<std::string> texts(parts);
+  std::vector<std::exception_ptr> errors(parts);  // an exception may not leave an OpenMP region
   for (std::string& text : texts) text.reserve(run * entry_size_estimate(n));
   sink("[\n");
   for (std::size_t round = 0; round < count; round += parts * run) {
 #pragma omp parallel for num_threads(static_cast<int>(parts)) schedule(static, 1) if (parts > 1)
     for (std::size_t part = 0; part < parts; ++part) {
-      std::string& text = texts[part];
-      text.clear();
-      const std::size_t begin = std::min(count, round + part * run), end = std::min(count, begin + run);
-      for (std::size_t index = begin; index < end; ++index) {
-        if (index > 0) text += ",\n";
-        text += "    ";
-        append_entry(text, index, entries.records[index], entries.initial_q.subspan(index * n, n),
-                     entries.initial_p.subspan(index * n, n), entries.closest_return);
+      try {
+        std::string& text = texts[part];
+        text.clear();
+        const std::size_t begin = std::min(count, round + part * run), end = std::min(count, begin + run);
+        for (std::size_t index = begin; index < end; ++index) {
+          if (index > 0) text += ",\n";
+          text += "    ";
+          append_entry(text, index, entries.records[index], entries.initial_q.subspan(index * n, n),
+                       entries.initial_p.subspan(index * n, n), entries.closest_return);
+        }
+      } catch (...) {
+        errors[part] = std::current_exception();
       }
     }
+    for (const auto& error : errors)
+      if (error) std::rethrow_exception(error);
     for (const std::string& text : texts) sink(text);
   }
   sink("\n  ]");
