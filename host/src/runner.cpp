@@ -29,11 +29,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::optional<double> relative_error(std::optional<double> energy, std::optional<double> initial) {
-  if (!energy || !initial || *initial == 0.0) return std::nullopt;
-  return (*energy - *initial) / *initial;
-}
-
 // The first non-finite variable of state `slot` ("q[0]", "p[2]"), or "".
 std::string first_non_finite(const PhaseSpaceBatch& x, std::size_t slot) {
   const auto q = x.q(slot), p = x.p(slot);
@@ -507,7 +502,7 @@ class Run {
         if (step == 0) record.energy_initial = std::isfinite(block.energies[slot])
                                                    ? std::optional<double>(block.energies[slot])
                                                    : std::nullopt;
-        if (auto error = relative_error(energy_in(block, slot), record.energy_initial))
+        if (auto error = relative_energy_error(energy_in(block, slot), record.energy_initial))
           record.max_abs_relative_error = std::max(record.max_abs_relative_error, std::abs(*error));
         continue;
       }
@@ -591,7 +586,7 @@ class Run {
     TrajectoryRecord& record = records_[trajectory];
     if (!writer_ || record.last_written_step == step) return;
     writer_->write(trajectory, step, job_.time.time_at(step), q, p, energy,
-                   relative_error(energy, record.energy_initial));
+                   relative_energy_error(energy, record.energy_initial));
     record.last_written_step = step;
   }
 

@@ -1,16 +1,16 @@
 #include "nonsep/host/summary_json.hpp"
 
-#include "nonsep/host/output_files.hpp"
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <exception>
-#include <optional>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
+
+#include "nonsep/host/output_files.hpp"
 
 namespace nonsep::host {
 
@@ -37,7 +37,8 @@ void append_optional(std::string& out, std::optional<double> value) {
 
 // Plain printable ASCII goes straight in (statuses, variable names); anything else through nlohmann's escaping.
 void append_string(std::string& out, const std::string& text) {
-  const bool plain = std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f && c != '"' && c != '\\'; });
+  const bool plain = std::all_of(text.begin(), text.end(),
+                                 [](char c) { return c >= 0x20 && c < 0x7f && c != '"' && c != '\\'; });
   if (!plain) {
     out += dump(json(text));
     return;
@@ -113,14 +114,11 @@ void append_entry(std::string& out, std::size_t index, const TrajectoryRecord& r
   }
   {
     const bool relative_known = record.energy_initial && *record.energy_initial != 0.0;
-    const std::optional<double> relative_final =
-        relative_known && record.energy_final
-            ? std::optional<double>((*record.energy_final - *record.energy_initial) / *record.energy_initial)
-            : std::nullopt;
     ObjectWriter energy(entry.key("energy"), depth + 2);
     append_optional(energy.key("initial"), record.energy_initial);
     append_optional(energy.key("final"), record.energy_final);
-    append_optional(energy.key("relative_error_final"), relative_final);
+    append_optional(energy.key("relative_error_final"),
+                    relative_energy_error(record.energy_final, record.energy_initial));
     append_optional(energy.key("relative_error_max_abs"),
                     relative_known ? std::optional<double>(record.max_abs_relative_error) : std::nullopt);
     energy.close();
@@ -218,7 +216,8 @@ namespace {
 // to `threads` threads formats a run of consecutive entries into its own buffer, and the buffers go to the sink
 // in order, so the text is the same for any number of threads and the memory is a few buffers, whatever the
 // number of trajectories.
-void emit_entries(const TrajectoryEntries& entries, unsigned threads, const std::function<void(std::string_view)>& sink) {
+void emit_entries(const TrajectoryEntries& entries, unsigned threads,
+                  const std::function<void(std::string_view)>& sink) {
   const std::size_t count = entries.records.size();
   if (count == 0) {
     sink("[]");

@@ -166,7 +166,8 @@ ordered_json reference_entry(std::size_t index, const TrajectoryRecord& record, 
                      {"relative_error_final", or_null(relative_final)},
                      {"relative_error_max_abs", relative_known ? or_null(record.max_abs_relative_error) : nullptr}};
   if (record.status == "diverged")
-    entry["diverged"] = {{"step", record.diverged_step}, {"t", record.diverged_t}, {"variable", record.diverged_variable}};
+    entry["diverged"] = {
+        {"step", record.diverged_step}, {"t", record.diverged_t}, {"variable", record.diverged_variable}};
   if (!record.error.empty()) entry["error"] = record.error;
   if (closest_return)
     entry["closest_return"] = record.closest_distance ? ordered_json{{"distance", *record.closest_distance},
@@ -220,7 +221,9 @@ TEST_CASE("summary.json: the trajectory entries written as text are nlohmann's d
       CAPTURE(dimension);
       CAPTURE(closest_return);
       ordered_json header = {{"status", "failed"},
-                             {"model", {{"parameters", {{"trajectories", "null"}, {"label", "\n  \"trajectories\": null"}}}}},
+                             {"model",
+                              {{"parameters",
+                                {{"trajectories", "null"}, {"label", "\n  \"trajectories\": null"}}}}},
                              {"trajectories", nullptr},
                              {"counts", {{"completed", 3}, {"diverged", 1}}},
                              {"wall_seconds", 0.125}};
@@ -247,7 +250,8 @@ TEST_CASE("summary.json: the trajectory entries written as text are nlohmann's d
   }
   // No trajectories: an empty array, as nlohmann writes it.
   const ordered_json header = {{"status", "completed"}, {"trajectories", nullptr}};
-  CHECK(summary_json_text(header, TrajectoryEntries{}) == "{\n  \"status\": \"completed\",\n  \"trajectories\": []\n}\n");
+  CHECK(summary_json_text(header, TrajectoryEntries{}) ==
+        "{\n  \"status\": \"completed\",\n  \"trajectories\": []\n}\n");
   CHECK_THROWS_AS(summary_json_text(ordered_json{{"status", "completed"}}, TrajectoryEntries{}), std::logic_error);
 }
 

@@ -52,6 +52,13 @@ struct TrajectoryRecord {
   double closest_t = 0.0;
 };
 
+// (H - H0) / H0, unknown when either is unknown or H0 = 0: trajectory.csv's relative_energy_error and the
+// summary's relative_error_final.
+inline std::optional<double> relative_energy_error(std::optional<double> energy, std::optional<double> initial) {
+  if (!energy || !initial || *initial == 0.0) return std::nullopt;
+  return (*energy - *initial) / *initial;
+}
+
 // The state of a run between two steps.
 struct RunState {
   std::uint64_t step = 0;                 // steps completed
