@@ -699,7 +699,7 @@ class Run {
                          {"trajectory", writer_ ? json("trajectory.csv") : json(nullptr)},
                          {"every", job_.every},
                          {"energy_every", job_.energy_every}};
-    summary["trajectories"] = nullptr;  // the entries: summary_json_text, from records_
+    summary["trajectories"] = nullptr;  // the entries: write_summary_json, from records_
     summary["counts"] = {{"completed", count_status("completed")},
                          {"diverged", count_status("diverged")},
                          {"failed", count_status("failed")},

@@ -271,10 +271,6 @@ void emit_summary(const json& header, const TrajectoryEntries& entries, unsigned
 
 }  // namespace
 
-void append_trajectory_entries(std::string& out, const TrajectoryEntries& entries, unsigned threads) {
-  emit_entries(entries, threads, [&](std::string_view text) { out += text; });
-}
-
 std::string summary_json_text(const json& header, const TrajectoryEntries& entries, unsigned threads) {
   std::string text;
   emit_summary(header, entries, threads, [&](std::string_view piece) { text += piece; });

@@ -30,16 +30,14 @@ struct TrajectoryEntries {
   bool closest_return = false;  // the job asks for /analysis/closest_return_after: every entry has "closest_return"
 };
 
-// Appends /trajectories (from its "[" to its "]") as it stands in summary.json, where the array is a top-level
-// value: entries indented by 4 spaces, their keys by 6. Entry keys, in order: index, status, initial {q, p},
-// final {t, step, q, p}, energy {initial, final, relative_error_final, relative_error_max_abs}, diverged {step, t,
-// variable} (status "diverged" only), error (when there is one), closest_return {distance, t, step} or null (when
-// asked for). A large ensemble's entries are formatted on up to `threads` threads, 256 consecutive entries each
-// at a time (the text is the same for any number).
-void append_trajectory_entries(std::string& out, const TrajectoryEntries& entries, unsigned threads = 1);
-
 // The text of summary.json: `header` (which holds "trajectories": null where the entries go) with the entries in
 // that place, ending in a newline. Throws std::logic_error when the header has no such member.
+// /trajectories is laid out as nlohmann dumps a top-level array: entries indented by 4 spaces, their keys by 6.
+// Entry keys, in order: index, status, initial {q, p}, final {t, step, q, p}, energy {initial, final,
+// relative_error_final, relative_error_max_abs}, diverged {step, t, variable} (status "diverged" only), error (when
+// there is one), closest_return {distance, t, step} or null (when asked for). A large ensemble's entries are
+// formatted on up to `threads` threads, 256 consecutive entries each at a time (the text is the same for any
+// number).
 std::string summary_json_text(const nlohmann::ordered_json& header, const TrajectoryEntries& entries,
                               unsigned threads = 1);
 
