@@ -1,12 +1,22 @@
 # nonsep_add_model(<target> [OUTPUT_DIRECTORY <dir>] <sources>...)
 #
-# Builds a nonsep model plugin: a MODULE library named exactly <target>.so (no "lib" prefix), all symbols hidden
-# except the entry point NONSEP_EXPORT_MODEL defines, linked to nonsep::sdk (and through it nonsep::core, the static
-# PIC library whose Integrator the SDK's integrate() runs inside the plugin; its symbols stay private to the
-# plugin), unloadable (no GNU unique symbols). The plugin's metadata name must equal
-# <target>. Used in the nonsep tree (shipped plugins land in NONSEP_BUILD_PLUGIN_DIR, the folder the host
-# searches last) and by installed users after find_package(nonsep) (the plugin lands in the current binary
-# folder; point NONSEP_PLUGIN_PATH at it, or load it by path).
+# Builds a nonsep model plugin: a MODULE library named exactly <target>.so (no "lib" prefix) whose metadata name
+# must equal <target>. Only the symbol `nonsep_plugin` that NONSEP_EXPORT_MODEL (plugin_sdk.hpp) or
+# NONSEP_DEFINE_PLUGIN (plugin_abi.h) defines is exported; everything else is hidden. It uses nonsep::sdk, which is
+# header-only: no nonsep library is linked into a plugin (the host steps; a plugin only evaluates, plugin_abi.h).
+#
+# Unloading: GCC marks static locals of inline functions (the SDK's metadata string) STB_GNU_UNIQUE, which makes
+# glibc refuse to ever unload the library; -fno-gnu-unique keeps a plugin unloadable (tests/plugins/
+# test_plugin_lifetime.cpp). A plugin's symbols are private to it, so uniqueness buys nothing.
+#
+# Optimised by default: when the project sets no CMAKE_BUILD_TYPE (and the generator has a single configuration),
+# the plugin is built with -O3 -DNDEBUG, the flags of a Release build and of the shipped plugins, and a STATUS
+# message says so. Without this, CMake's empty build type compiles with no optimisation at all, and a model runs
+# several times slower than the shipped ones for no visible reason.
+#
+# Used in the nonsep tree (shipped plugins land in NONSEP_BUILD_PLUGIN_DIR, the folder the host searches last) and
+# by installed users after find_package(nonsep) (the plugin lands in the current binary folder; point
+# NONSEP_PLUGIN_PATH at it, or load it by path).
 function(nonsep_add_model target)
   cmake_parse_arguments(PARSE_ARGV 1 arg "" "OUTPUT_DIRECTORY" "")
   if(NOT arg_UNPARSED_ARGUMENTS)
@@ -19,12 +29,15 @@ function(nonsep_add_model target)
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON)
   target_compile_features(${target} PRIVATE cxx_std_20)
-  # GCC marks static locals of inline functions STB_GNU_UNIQUE, which makes glibc refuse to ever unload the
-  # library; a plugin's symbols are private to it, so uniqueness buys nothing and unloading must work.
   target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-fno-gnu-unique>)
   target_link_libraries(${target} PRIVATE nonsep::sdk)
-  # The static libraries linked in (nonsep::core) export nothing from the plugin: the host has its own copy.
-  target_link_options(${target} PRIVATE "LINKER:--exclude-libs,ALL")
+  get_property(multi_config GLOBAL PROPERTY GENERATOR_IS_MULTI_CONFIG)
+  if(NOT multi_config AND NOT CMAKE_BUILD_TYPE)
+    target_compile_options(${target} PRIVATE -O3)
+    target_compile_definitions(${target} PRIVATE NDEBUG)
+    message(STATUS "nonsep_add_model(${target}): no CMAKE_BUILD_TYPE set, so the plugin is built optimised "
+                   "(-O3 -DNDEBUG, as Release and the shipped plugins); set CMAKE_BUILD_TYPE to choose otherwise")
+  endif()
   if(arg_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${arg_OUTPUT_DIRECTORY}")
   elseif(DEFINED NONSEP_BUILD_PLUGIN_DIR)

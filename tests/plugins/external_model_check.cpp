@@ -30,9 +30,13 @@ int main(int argc, char** argv) {
     const auto parameters = plugin.parameters();
     expect(parameters.size() == 1 && parameters[0].name == "g" && parameters[0].unit == "1/time^2",
            "parameter g with its unit");
+    expect(plugin.has_values() && plugin.has_hessians() && plugin.has_third_derivatives(),
+           "values, Hessians and third derivatives (ABI version 3, filled in by the SDK)");
+    expect(plugin.thread_safe(), "thread_safe, as the SDK declares");
     const auto model = plugin.create({{"g", 2.0}});
     const auto report = nonsep::check_derivatives(model);
-    expect(report.passed() && report.comparisons > 0, "derivative check: " + report.summary());
+    expect(report.passed() && report.comparisons > 0 && report.skipped.empty(),
+           "derivative check: " + report.summary());
 
     // H_TTV = g cos(q) p^2 / (1 + p^2) is conserved to O(dt^(2/3)) over a stretch of the orbit.
     const double q0[] = {0.3}, p0[] = {1.0};

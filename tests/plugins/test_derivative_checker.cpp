@@ -9,7 +9,7 @@ namespace {
 
 // A correct model except for one deliberately wrong derivative, chosen by `wrong`.
 struct Anharmonic2D {
-  enum class Wrong { nothing, grad_V, hessian_T };
+  enum class Wrong { nothing, grad_V, hessian_T, d3V };
   static constexpr std::size_t dimension = 2;
   Wrong wrong = Wrong::nothing;
 
@@ -30,6 +30,12 @@ struct Anharmonic2D {
     out[1] = out[2] = wrong == Wrong::hessian_T ? 0.0 : 1.0;
     out[3] = p[1];
   }
+  // V_001 = 2, every other third derivative of V is 0: d3V = (4 u0 u1, 2 u0^2); d3T comes from automatic
+  // differentiation.
+  void d3V(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> u, std::span<double> out) const {
+    out[0] = 4.0 * u[0] * u[1];
+    out[1] = 2.0 * u[0] * u[0] + (wrong == Wrong::d3V ? 1e-3 : 0.0);
+  }
 };
 
 using Adapter = nonsep::sdk::ModelAdapter<Anharmonic2D>;
@@ -42,7 +48,7 @@ TEST_CASE("correct analytic and automatic derivatives pass") {
   const auto report = nonsep::check_derivatives(with(Anharmonic2D::Wrong::nothing));
   INFO(report.summary());
   CHECK(report.passed());
-  CHECK(report.comparisons == 16 * (2 + 2 + 4 + 4));
+  CHECK(report.comparisons == 16 * (2 + 2 + 4 + 4 + 2 + 2));
   CHECK(report.largest_error < 1e-9);
   CHECK(report.skipped.empty());
 }
@@ -72,14 +78,30 @@ TEST_CASE("a wrong off-diagonal Hessian entry is caught in both places") {
   }
 }
 
+TEST_CASE("a wrong directional third derivative is caught and located") {
+  const auto report = nonsep::check_derivatives(with(Anharmonic2D::Wrong::d3V));
+  REQUIRE_FALSE(report.passed());
+  CHECK(report.mismatches.size() == 16);
+  for (const auto& mismatch : report.mismatches) {
+    CHECK(mismatch.function == "d3V");
+    CHECK(mismatch.component == 1);
+    CHECK(mismatch.computed - mismatch.finite_difference == doctest::Approx(1e-3).epsilon(1e-3));
+  }
+}
+
 TEST_CASE("a model without values has its Hessians checked and the gradient check reported as skipped") {
+  // Coupled2D with its value_T and value_V hidden.
+  struct WithoutValues : private nonsep::testing::Coupled2D {
+    using Coupled2D::dimension, Coupled2D::grad_T, Coupled2D::grad_V, Coupled2D::hessian_T, Coupled2D::hessian_V,
+        Coupled2D::d3T, Coupled2D::d3V;
+  };
   nonsep::DerivativeCheckOptions options;
   options.points = {{0.3, -0.2}};
   options.random_points = 2;
-  const auto report = nonsep::check_derivatives(nonsep::testing::Coupled2D{}, options);
+  const auto report = nonsep::check_derivatives(WithoutValues{}, options);
   INFO(report.summary());
   CHECK(report.passed());
-  CHECK(report.comparisons == 3 * (4 + 4));
+  CHECK(report.comparisons == 3 * (4 + 4 + 2 + 2));
   REQUIRE(report.skipped.size() == 1);
   CHECK(report.skipped[0] == "gradients: the model has no value_T/value_V");
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "nonsep/sdk/dual.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
@@ -48,6 +49,17 @@ TEST_CASE("each function of dual.hpp has the derivative a finite difference give
       {"tanh", [](const D& x) { return tanh(x); }, [](double x) { return std::tanh(x); }, 0.8},
       {"asinh", [](const D& x) { return asinh(x); }, [](double x) { return std::asinh(x); }, -1.1},
       {"abs", [](const D& x) { return abs(x); }, [](double x) { return std::abs(x); }, -1.1},
+      {"acosh", [](const D& x) { return acosh(x); }, [](double x) { return std::acosh(x); }, 1.6},
+      {"atanh", [](const D& x) { return atanh(x); }, [](double x) { return std::atanh(x); }, -0.45},
+      {"expm1", [](const D& x) { return expm1(x); }, [](double x) { return std::expm1(x); }, -0.3},
+      {"log1p", [](const D& x) { return log1p(x); }, [](double x) { return std::log1p(x); }, 0.35},
+      {"erf", [](const D& x) { return erf(x); }, [](double x) { return std::erf(x); }, 0.8},
+      {"pow(2.5, x)", [](const D& x) { return pow(2.5, x); }, [](double x) { return std::pow(2.5, x); }, -0.7},
+      {"pow(x, x)", [](const D& x) { return pow(x, x); }, [](double x) { return std::pow(x, x); }, 1.4},
+      {"min(x, 0.5)", [](const D& x) { return min(x, 0.5); }, [](double x) { return std::min(x, 0.5); }, 0.3},
+      {"max(x, 0.5)", [](const D& x) { return max(x, 0.5); }, [](double x) { return std::max(x, 0.5); }, 0.3},
+      {"atan2(x, 0.4)", [](const D& x) { return atan2(x, 0.4); }, [](double x) { return std::atan2(x, 0.4); }, -1.2},
+      {"hypot(0.4, x)", [](const D& x) { return hypot(0.4, x); }, [](double x) { return std::hypot(0.4, x); }, -1.2},
       {"x / (1 - x)", [](const D& x) { return x / (1.0 - x); }, [](double x) { return x / (1.0 - x); }, 0.25},
       {"2 / x - x * 3 + 1", [](const D& x) { return 2.0 / x - x * 3.0 + 1.0; },
        [](double x) { return 2.0 / x - x * 3.0 + 1.0; }, 0.6},
@@ -109,4 +121,112 @@ TEST_CASE("comparisons look at values only") {
   CHECK(b > 1.5);
   CHECK(1.0 == a);
   CHECK(nonsep::sdk::value_of(Dual<Dual<double, 2>, 1>(3.5)) == 3.5);
+}
+
+namespace {
+
+// A function of two variables, written once for any scalar (double and every nesting of duals).
+struct BinaryCase {
+  const char* name;
+  std::function<double(nonsep::sdk::Vector<double>)> on_double;
+  std::function<nonsep::sdk::GradientDual<2>(nonsep::sdk::Vector<nonsep::sdk::GradientDual<2>>)> gradient;
+  std::function<nonsep::sdk::HessianDual<2>(nonsep::sdk::Vector<nonsep::sdk::HessianDual<2>>)> hessian;
+  std::function<nonsep::sdk::ThirdDerivativeDual<2>(nonsep::sdk::Vector<nonsep::sdk::ThirdDerivativeDual<2>>)> third;
+  std::array<double, 2> at;
+};
+
+// The using-directive gives the double versions (nonsep::sdk's using-declarations of std's); ADL the dual ones.
+#define NONSEP_TEST_BINARY(name, expression, x, y)                                              \
+  BinaryCase {                                                                                  \
+    name, [](auto v) { using namespace nonsep::sdk; return expression; },                       \
+        [](auto v) { using namespace nonsep::sdk; return expression; },                         \
+        [](auto v) { using namespace nonsep::sdk; return expression; },                         \
+        [](auto v) { using namespace nonsep::sdk; return expression; }, { x, y }                \
+  }
+
+// Central difference of g (a vector of `size` numbers at a 2-point) along e_k, component i.
+template <class G>
+double difference(const G& g, std::array<double, 2> at, std::size_t k, std::size_t i, std::size_t size) {
+  const double h = 1e-5;
+  std::vector<double> plus(size), minus(size);
+  auto shifted = at;
+  shifted[k] += h;
+  g(shifted.data(), plus.data());
+  shifted[k] = at[k] - h;
+  g(shifted.data(), minus.data());
+  return (plus[i] - minus[i]) / (2.0 * h);
+}
+
+}  // namespace
+
+TEST_CASE("two-argument functions and pow with a variable exponent: gradients, Hessians and third derivatives "
+          "of every nesting agree with finite differences") {
+  using nonsep::sdk::detail::directional_third_by_dual;
+  using nonsep::sdk::detail::gradient_by_dual;
+  using nonsep::sdk::detail::hessian_by_dual;
+  const BinaryCase cases[] = {
+      NONSEP_TEST_BINARY("atan2", atan2(v[0], v[1]), 0.7, -1.3),
+      NONSEP_TEST_BINARY("hypot", hypot(v[0], v[1]), 0.7, -1.3),
+      NONSEP_TEST_BINARY("pow(x, y)", pow(v[0], v[1]), 1.7, -0.6),
+      NONSEP_TEST_BINARY("pow(x, y) x y", pow(v[0] * v[1] + 2.0, v[1] * 0.5), 0.4, 1.3),
+      NONSEP_TEST_BINARY("min", min(v[0], v[1]) * v[1], 0.7, -1.3),
+      NONSEP_TEST_BINARY("max", max(v[0] * v[0], v[1]) * v[0], 0.7, -1.3),
+      NONSEP_TEST_BINARY("erf expm1 log1p", erf(v[0]) * expm1(v[1]) + log1p(v[0] * v[1]), 0.3, 0.8),
+      NONSEP_TEST_BINARY("acosh atanh", acosh(1.5 + v[0] * v[0]) * atanh(v[1] / 2.0), -0.4, 0.9),
+  };
+  const double u[] = {0.8, -0.35};
+  for (const auto& c : cases) {
+    CAPTURE(std::string(c.name));
+    double gradient[2], hessian[4], third[2];
+    const double value = gradient_by_dual<2>(c.gradient, c.at.data(), 2, gradient);
+    CHECK(value == doctest::Approx(c.on_double(c.at)).epsilon(1e-15));
+    CHECK(hessian_by_dual<2>(c.hessian, c.at.data(), 2, hessian) == doctest::Approx(value).epsilon(1e-15));
+    CHECK(directional_third_by_dual<2>(c.third, c.at.data(), u, 2, third) == doctest::Approx(value).epsilon(1e-15));
+    const auto values = [&](const double* x, double* out) { out[0] = c.on_double(nonsep::sdk::Vector<double>(x, 2)); };
+    const auto gradients = [&](const double* x, double* out) { gradient_by_dual<2>(c.gradient, x, 2, out); };
+    const auto quadratic_form = [&](const double* x, double* out) {
+      double h[4];
+      hessian_by_dual<2>(c.hessian, x, 2, h);
+      out[0] = u[0] * u[0] * h[0] + u[0] * u[1] * (h[1] + h[2]) + u[1] * u[1] * h[3];
+    };
+    for (std::size_t k = 0; k < 2; ++k) {
+      CHECK(gradient[k] == doctest::Approx(difference(values, c.at, k, 0, 1)).epsilon(1e-8));
+      for (std::size_t i = 0; i < 2; ++i)
+        CHECK(hessian[i * 2 + k] == doctest::Approx(difference(gradients, c.at, k, i, 2)).epsilon(1e-8));
+      CHECK(third[k] == doctest::Approx(difference(quadratic_form, c.at, k, 0, 1)).epsilon(1e-7));
+    }
+  }
+}
+
+TEST_CASE("pow(x, y) at x = 0 and x < 0 has derivative 0 in y, so pow(x, S(3)) works for negative x") {
+  using D = Dual<double, 2>;
+  const D x = D::variable(-2.0, 0), y = D(3.0);
+  const D r = pow(x, y);
+  CHECK(r.value == -8.0);
+  CHECK(r.derivative[0] == 12.0);
+  CHECK(r.derivative[1] == 0.0);
+  const D zero = pow(D::variable(0.0, 0), D::variable(2.0, 1));
+  CHECK(zero.value == 0.0);
+  CHECK(zero.derivative[0] == 0.0);
+  CHECK(zero.derivative[1] == 0.0);
+}
+
+TEST_CASE("directional third derivatives of a function of three variables are exact") {
+  // f = x^2 y z + exp(y) z^3: T_ijk written out; out_k = sum_ij f_ijk u_i u_j.
+  auto f = [](auto v) { return v[0] * v[0] * v[1] * v[2] + exp(v[1]) * v[2] * v[2] * v[2]; };
+  const double x = 0.7, y = -0.4, z = 1.1, at[] = {x, y, z}, u[] = {0.5, -1.2, 0.9};
+  double third[3];
+  nonsep::sdk::detail::directional_third_by_dual<5>(f, at, u, 3, third);
+  // Nonzero third derivatives: f_xxy = 2z, f_xxz = 2y, f_xyz = 2x, f_yyy = e^y z^3, f_yyz = 3 e^y z^2,
+  // f_yzz = 6 e^y z, f_zzz = 6 e^y.
+  const double e = std::exp(y);
+  const double f_xxy = 2 * z, f_xxz = 2 * y, f_xyz = 2 * x, f_yyy = e * z * z * z, f_yyz = 3 * e * z * z,
+               f_yzz = 6 * e * z, f_zzz = 6 * e;
+  const double ux = u[0], uy = u[1], uz = u[2];
+  const double expected[] = {2 * f_xxy * ux * uy + 2 * f_xxz * ux * uz + 2 * f_xyz * uy * uz,
+                             f_xxy * ux * ux + 2 * f_xyz * ux * uz + f_yyy * uy * uy + 2 * f_yyz * uy * uz +
+                                 f_yzz * uz * uz,
+                             f_xxz * ux * ux + 2 * f_xyz * ux * uy + f_yyz * uy * uy + 2 * f_yzz * uy * uz +
+                                 f_zzz * uz * uz};
+  for (int k = 0; k < 3; ++k) CHECK(third[k] == doctest::Approx(expected[k]).epsilon(1e-14));
 }

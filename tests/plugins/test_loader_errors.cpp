@@ -107,12 +107,14 @@ TEST_CASE("a plugin of ABI version 1 (its entry function, no plugin symbol): exp
   const std::string file = (test_plugins / "version_1_entry.so").string();
   CHECK(load_error("version_1_entry.so") ==
         "plugin '" + file + "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
-        "version 2 (expected 2, found 1); rebuild the plugin against this nonsep");
+        "version 3 (expected 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) and "
+        "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
 }
 
-TEST_CASE("ABI version mismatch: expected and found") {
+TEST_CASE("a plugin of ABI version 2 (the one with integrate): expected and found, and how to rebuild") {
   const std::string message = load_error("wrong_abi_version.so");
-  CHECK(contains(message, "uses plugin ABI version 1 but this host uses version 2 (expected 2, found 1)"));
+  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 3 (expected 3, found 2)"));
+  CHECK(contains(message, "rebuild the plugin against the installed SDK"));
 }
 
 TEST_CASE("wrong table size: expected and found") {
@@ -142,6 +144,24 @@ TEST_CASE("a required function missing from the table") {
 TEST_CASE("capabilities that disagree with the table") {
   CHECK(contains(load_error("capability_mismatch.so"),
                  "says capability \"hessian_T\" is true but the table's hessian_T pointer is null"));
+  CHECK(contains(load_error("claims_absent_d3T.so"),
+                 "says capability \"d3T\" is true but the table's d3T pointer is null"));
+  CHECK(contains(load_error("unclaimed_d3V.so"),
+                 "says capability \"d3V\" is false but the table's d3V pointer is set"));
+}
+
+TEST_CASE("metadata without \"thread_safe\" (required since ABI version 3)") {
+  CHECK(contains(load_error("metadata_without_thread_safe.so"),
+                 "the metadata of plugin '" + (test_plugins / "metadata_without_thread_safe.so").string() +
+                     "' lacks the boolean \"thread_safe\" (required since plugin ABI version 3"));
+  CHECK(load_plugin("hand_written.so", test_plugins).thread_safe());
+  // A plugin with global mutable state says so, and loads.
+  const Plugin global_state = load_plugin("global_state.so", test_plugins);
+  CHECK_FALSE(global_state.thread_safe());
+  const double q[] = {2.0};
+  double out[1];
+  global_state.create(nlohmann::json::object()).grad_V(q, out, 1);
+  CHECK(out[0] > 0.0);
 }
 
 TEST_CASE("create failing inside the plugin: its message names the parameter") {
@@ -203,6 +223,11 @@ TEST_CASE("an optional function the plugin lacks, and a batch that does not fit"
   double out[4];
   CHECK(error_of<nonsep::ModelError>([&] { model.hessian_T(x, out, 1); }) ==
         "plugin 'hand_written' does not provide hessian_T (its capability is false)");
+  CHECK_FALSE(model.plugin().has_third_derivatives());
+  CHECK(error_of<nonsep::ModelError>([&] { model.d3T(x, x, out, 1); }) ==
+        "plugin 'hand_written' does not provide d3T (its capability is false)");
+  CHECK(contains(error_of<nonsep::InvalidArgument>([&] { model.d3V(x, std::span(x, 1), out, 2); }),
+                 "d3V: a batch of 2 states of dimension 1 needs 2 direction components (found 1)"));
   CHECK(contains(error_of<nonsep::InvalidArgument>([&] { model.grad_T(std::span(x, 1), out, 2); }),
                  "grad_T: a batch of 2 states of dimension 1 needs 2 inputs and 2 outputs (found 1 and 4)"));
 }
@@ -219,7 +244,7 @@ TEST_CASE("discovery lists good plugins and the failures with their errors, firs
   CHECK(entry("paper1d")->plugin.has_value());
   REQUIRE(entry("wrong_abi_version") != nullptr);
   CHECK_FALSE(entry("wrong_abi_version")->plugin.has_value());
-  CHECK(contains(entry("wrong_abi_version")->error, "(expected 2, found 1)"));
+  CHECK(contains(entry("wrong_abi_version")->error, "(expected 3, found 2)"));
   REQUIRE(entry("not_a_library") != nullptr);
   CHECK(contains(entry("not_a_library")->error, "invalid ELF header"));
   CHECK(entry("hand_written")->path == test_plugins / "hand_written.so");

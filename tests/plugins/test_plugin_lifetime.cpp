@@ -20,7 +20,7 @@ bool is_loaded() {
 
 }  // namespace
 
-TEST_CASE("a model keeps its library loaded after the Plugin is gone; the last owner unloads it") {
+TEST_CASE("a model keeps its library loaded after the Plugin is gone, the last owner unloads it") {
   REQUIRE_FALSE(is_loaded());
   std::optional<nonsep::host::PluginModel> model;
   {

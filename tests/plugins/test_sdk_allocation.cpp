@@ -1,4 +1,5 @@
-// The SDK's evaluation path does not touch the heap, with automatic differentiation or analytic derivatives:
+// The SDK's evaluation path (values, gradients, Hessians, directional third derivatives) does not touch the heap,
+// with automatic differentiation or analytic derivatives:
 // operator new is replaced for this test program and counts the allocations made while counting is on.
 #include <doctest/doctest.h>
 
@@ -31,8 +32,9 @@ namespace {
 template <class Adapter>
 long allocations_while_evaluating(const Adapter& adapter) {
   const std::size_t n = adapter.dimension(), count = 8;
-  std::vector<double> x(n * count), gradient(n * count), hessian(n * n * count), values(count);
+  std::vector<double> x(n * count), gradient(n * count), hessian(n * n * count), values(count), u(n * count);
   for (std::size_t k = 0; k < x.size(); ++k) x[k] = 0.1 + 0.05 * static_cast<double>(k);
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] = 1.0 - 0.03 * static_cast<double>(k);
   allocations = 0;
   counting = true;
   adapter.grad_T(x, gradient, count);
@@ -41,13 +43,15 @@ long allocations_while_evaluating(const Adapter& adapter) {
   adapter.hessian_V(x, hessian, count);
   adapter.value_T(x, values, count);
   adapter.value_V(x, values, count);
+  adapter.d3T(x, u, gradient, count);
+  adapter.d3V(x, u, gradient, count);
   counting = false;
   return allocations.load();
 }
 
 }  // namespace
 
-TEST_CASE("evaluating gradients, Hessians and values allocates nothing") {
+TEST_CASE("evaluating gradients, Hessians, third derivatives and values allocates nothing") {
   using nonsep::sdk::Derivatives;
   using nonsep::sdk::ModelAdapter;
   CHECK(allocations_while_evaluating(ModelAdapter<Paper1D, Derivatives::automatic>()) == 0);

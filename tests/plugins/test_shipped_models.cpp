@@ -1,6 +1,7 @@
-// The shipped models, loaded as plugins: they pass the derivative checker, their automatic and analytic
-// derivatives agree to 1e-12, the energy the core computes from them is the Hamiltonian each documents, and a
-// plugin steps exactly like the same model compiled in.
+// The shipped models, loaded as plugins: they pass the derivative checker (third derivatives included), their
+// automatic and analytic derivatives agree to 1e-12, the energy the core computes from them is the Hamiltonian each
+// documents, its gradient is what plugin_abi.h says the third derivatives give, and a plugin steps exactly like
+// the same model compiled in.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -15,6 +16,7 @@
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "paper1d/paper1d.hpp"
+#include "paper2d/paper2d.hpp"
 #include "quadratic_kinetic/quadratic_kinetic.hpp"
 #include "radial/radial.hpp"
 #include "tao_product/tao_product.hpp"
@@ -103,6 +105,7 @@ TEST_CASE("automatic and analytic derivatives of the shipped models agree to 1e-
   SUBCASE("radial, dimension 16") { check_automatic_matches_analytic<Radial>(R"({"dimension": 16})"); }
   SUBCASE("quadratic_kinetic") { check_automatic_matches_analytic<QuadraticKinetic>(R"({"lambda": 0.7})"); }
   SUBCASE("tao_product") { check_automatic_matches_analytic<TaoProduct>(); }
+  SUBCASE("paper2d") { check_automatic_matches_analytic<Paper2D>(R"({"coupling": 0.3})"); }
 }
 
 TEST_CASE("every shipped plugin passes the derivative checker") {
@@ -110,12 +113,15 @@ TEST_CASE("every shipped plugin passes the derivative checker") {
                                                             {"radial", {{"dimension", 2}}},
                                                             {"radial", {{"dimension", 5}}},
                                                             {"quadratic_kinetic", {{"lambda", -1.5}}},
-                                                            {"tao_product", nlohmann::json::object()}};
+                                                            {"tao_product", nlohmann::json::object()},
+                                                            {"paper2d", {{"coupling", -0.1}}}};
   for (const auto& [name, parameters] : plugins) {
     CAPTURE(std::string(name));
     const PluginModel model = shipped(name, parameters);
     CHECK(model.plugin().has_values());
     CHECK(model.plugin().has_hessians());
+    CHECK(model.plugin().has_third_derivatives());
+    CHECK(model.plugin().thread_safe());
     const auto report = nonsep::check_derivatives(model);
     INFO(report.summary());
     CHECK(report.passed());
@@ -125,7 +131,7 @@ TEST_CASE("every shipped plugin passes the derivative checker") {
 }
 
 TEST_CASE("each shipped model documents T, V and the Hamiltonian it solves") {
-  for (const char* name : {"paper1d", "radial", "quadratic_kinetic", "tao_product"}) {
+  for (const char* name : {"paper1d", "radial", "quadratic_kinetic", "tao_product", "paper2d"}) {
     CAPTURE(std::string(name));
     const auto plugin = load_plugin(name, "");
     CHECK(plugin.name() == name);
@@ -159,8 +165,93 @@ TEST_CASE("the energy of each shipped model is the Hamiltonian it documents") {
       return p[0] * p[0] + p[1] * p[1] + 2 * lambda * (q[1] * p[0] * p[0] + 2 * q[0] * p[0] * p[1] - q[1] * p[1] * p[1]);
     });
   }
+  SUBCASE("paper2d: grad T . Hess V grad T, and its lower bound 2 + |p|^2 + 2c|q|^2") {
+    for (double coupling : {-0.1, 0.2, 0.3}) {
+      CAPTURE(coupling);
+      const auto closed_form = [&](auto q, auto p) {
+        const double g0 = 1 + p[0] * p[0] / 2, g1 = 1 + p[1] * p[1] / 2, radial = 1 + squared_norm(q) / 3;
+        const double h00 = radial + 2.0 / 3 * q[0] * q[0] + 2 * coupling * q[1] * q[1];
+        const double h11 = radial + 2.0 / 3 * q[1] * q[1] + 2 * coupling * q[0] * q[0];
+        const double h01 = (2.0 / 3 + 4 * coupling) * q[0] * q[1];
+        return g0 * g0 * h00 + 2 * g0 * g1 * h01 + g1 * g1 * h11;
+      };
+      check_energy(shipped("paper2d", {{"coupling", coupling}}), closed_form);
+      // The bound of paper2d.hpp that makes the shells compact, at random points of a wide box.
+      const double c = 1.0 / 3 - std::max(coupling, -3 * coupling);
+      const auto q = random_points(2000, 2, 6.0, 17), p = random_points(2000, 2, 6.0, 19);
+      for (std::size_t b = 0; b < 2000; ++b) {
+        const std::span<const double> qb(q.data() + 2 * b, 2), pb(p.data() + 2 * b, 2);
+        CHECK(closed_form(qb, pb) >= 2 + squared_norm(pb) + 2 * c * squared_norm(qb));
+      }
+    }
+  }
   SUBCASE("tao_product: (q^2 + 1)(p^2 + 1)/2") {
     check_energy(shipped("tao_product"), [](auto q, auto p) { return (q[0] * q[0] + 1) * (p[0] * p[0] + 1) / 2; });
+  }
+}
+
+namespace {
+
+// y = A x for the row-major n x n matrix A at a (one state).
+std::vector<double> times(const std::vector<double>& a, const std::vector<double>& x) {
+  const std::size_t n = x.size();
+  std::vector<double> y(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) y[i] += a[i * n + j] * x[j];
+  return y;
+}
+
+// The gradient of the solved H as plugin_abi.h gives it from the plugin's functions, against 5-point differences
+// of the core's EnergyEvaluator. TTV: dH/dp = 2 T'' V'' T', dH/dq = d3V(q, T'(p)); VVT with T and V swapped.
+void check_energy_gradient(const PluginModel& model, nonsep::HamiltonianForm form, const std::vector<double>& q,
+                           const std::vector<double>& p) {
+  const std::size_t n = q.size();
+  const bool ttv = form == nonsep::HamiltonianForm::TTV;
+  std::vector<double> grad_T(n), grad_V(n), hessian_T(n * n), hessian_V(n * n), third(n);
+  model.grad_T(p, grad_T, 1);
+  model.grad_V(q, grad_V, 1);
+  model.hessian_T(p, hessian_T, 1);
+  model.hessian_V(q, hessian_V, 1);
+  // The variable of the third derivative (q for TTV, p for VVT) and the other one (p, q), from the plugin.
+  std::vector<double> d_third(n), d_other = times(ttv ? hessian_T : hessian_V, times(ttv ? hessian_V : hessian_T,
+                                                                                  ttv ? grad_T : grad_V));
+  for (double& x : d_other) x *= 2.0;
+  if (ttv)
+    model.d3V(q, grad_T, d_third, 1);
+  else
+    model.d3T(p, grad_V, d_third, 1);
+  nonsep::EnergyEvaluator energy(form);
+  auto h = [&](const std::vector<double>& at_q, const std::vector<double>& at_p) {
+    auto x = nonsep::PhaseSpaceBatch::single(at_q, at_p);
+    return energy.evaluate_one(model, x);
+  };
+  const double step = 1e-3;
+  for (std::size_t k = 0; k < n; ++k)
+    for (const bool in_q : {true, false}) {
+      auto difference = [&](double offset) {
+        auto shifted_q = q, shifted_p = p;
+        (in_q ? shifted_q : shifted_p)[k] += offset * step;
+        return h(shifted_q, shifted_p);
+      };
+      const double expected =
+          (difference(-2) - 8 * difference(-1) + 8 * difference(1) - difference(2)) / (12 * step);
+      const double computed = in_q == ttv ? d_third[k] : d_other[k];
+      CAPTURE(k);
+      CAPTURE(in_q);
+      CHECK(computed == doctest::Approx(expected).epsilon(1e-8).scale(1.0));
+    }
+}
+
+}  // namespace
+
+TEST_CASE("the gradient of the solved H from the Hessians and third derivatives, as plugin_abi.h states it") {
+  const std::vector<double> q3 = {0.4, -0.7, 0.25}, p3 = {-0.3, 0.9, 0.6};
+  for (const auto form : {nonsep::HamiltonianForm::TTV, nonsep::HamiltonianForm::VVT}) {
+    CAPTURE(form == nonsep::HamiltonianForm::TTV);
+    check_energy_gradient(shipped("paper1d"), form, {0.7}, {-0.4});
+    check_energy_gradient(shipped("tao_product"), form, {0.7}, {-0.4});
+    check_energy_gradient(shipped("radial", {{"dimension", 3}}), form, q3, p3);
+    check_energy_gradient(shipped("quadratic_kinetic", {{"lambda", 0.8}}), form, {q3[0], q3[1]}, {p3[0], p3[1]});
   }
 }
 

@@ -2,13 +2,16 @@
 // that is wrong in exactly one way. Each defect has a test in test_loader_errors.cpp that asserts its message.
 //   0  none: a valid plugin "hand_written" (T = p^2/2, V = q^2/2), so the defects below are the only difference
 //   1  the exported symbol has another name
-//   2  abi_version is 1 (a plugin built for the previous ABI, without integrate)
-//   3  struct_size is one pointer short (a table built against a shorter header: version 1's size)
+//   2  abi_version is 2 (a plugin built for the previous ABI, which had integrate())
+//   3  struct_size is one pointer short (a table built against a shorter header: version 2's size)
 //   4  the metadata is not valid JSON
 //   5  the metadata names another plugin than the file
 //   6  the required grad_V is null
 //   7  the metadata claims hessian_T but the pointer is null
 //   8  exports ABI version 1's entry function nonsep_plugin_entry instead of the symbol nonsep_plugin
+//   9  the metadata lacks "thread_safe" (required since version 3)
+//  10  the metadata claims d3T but the pointer is null
+//  11  the table has d3V but the metadata does not claim it
 #include <cstddef>
 #include <cstring>
 
@@ -29,9 +32,10 @@ namespace {
 
 nonsep_instance the_instance = {""};
 
-#define METADATA_BODY(name, capabilities)                                                                      \
+#define METADATA_WITH(name, thread_safe, capabilities)                                                          \
   "{\"name\": \"" name "\", \"version\": \"0.1\", \"description\": \"test plugin\", \"hamiltonian\": \"p q\", " \
-  "\"dimension\": {\"fixed\": 1}, \"parameters\": [], \"capabilities\": {" capabilities "}}"
+  "\"dimension\": {\"fixed\": 1}, \"parameters\": [], " thread_safe "\"capabilities\": {" capabilities "}}"
+#define METADATA_BODY(name, capabilities) METADATA_WITH(name, "\"thread_safe\": true, ", capabilities)
 
 const char* metadata_json() {
 #if NONSEP_TEST_DEFECT == 4
@@ -40,6 +44,10 @@ const char* metadata_json() {
   return METADATA_BODY("someone_else", "");
 #elif NONSEP_TEST_DEFECT == 7
   return METADATA_BODY(NONSEP_TEST_NAME, "\"hessian_T\": true");
+#elif NONSEP_TEST_DEFECT == 9
+  return METADATA_WITH(NONSEP_TEST_NAME, "", "");
+#elif NONSEP_TEST_DEFECT == 10
+  return METADATA_BODY(NONSEP_TEST_NAME, "\"d3T\": true, \"d3V\": false");
 #else
   return METADATA_BODY(NONSEP_TEST_NAME, "");
 #endif
@@ -55,12 +63,18 @@ nonsep_status identity(nonsep_instance*, const double* x, double* out, size_t co
   std::memcpy(out, x, count * sizeof(double));
   return NONSEP_OK;
 }
+#if NONSEP_TEST_DEFECT == 11
+nonsep_status zero_third_derivative(nonsep_instance*, const double*, const double*, double* out, size_t count) {
+  for (size_t b = 0; b < count; ++b) out[b] = 0.0;  // V = q^2/2 has no third derivative
+  return NONSEP_OK;
+}
+#endif
 const char* last_error(const nonsep_instance* instance) { return instance->last_error; }
 
 
 const nonsep_plugin_api table = {
 #if NONSEP_TEST_DEFECT == 2
-    1u,
+    2u,
 #else
     NONSEP_PLUGIN_ABI_VERSION,
 #endif
@@ -84,7 +98,12 @@ const nonsep_plugin_api table = {
     nullptr,
     nullptr,
     &last_error,
-    nullptr,  // integrate: optional, absent (the host steps through grad_T and grad_V)
+    nullptr,  // d3T: optional, absent
+#if NONSEP_TEST_DEFECT == 11
+    &zero_third_derivative,
+#else
+    nullptr,  // d3V: optional, absent
+#endif
 };
 
 }  // namespace

@@ -1,18 +1,22 @@
 #pragma once
-// A derivative checker for model authors (and `nonsep inspect --check`): compares a model's gradients and
-// Hessians with finite differences at sample points, the way Ceres' GradientChecker does for cost functions.
+// A derivative checker for model authors (and `nonsep inspect --check`): compares a model's gradients, Hessians
+// and directional third derivatives with finite differences at sample points, the way Ceres' GradientChecker does
+// for cost functions.
 //
 // Input: any batched model in the layout of nonsep/core/model.hpp (a plugin's PluginModel, a
 // nonsep::sdk::ModelAdapter, a hand-written model) with
 //   dimension(), grad_T, grad_V                     always,
 //   value_T(x, out, count), value_V(x, out, count)  (one value per state) when options.check_gradients,
-//   hessian_T, hessian_V                            when options.check_hessians.
-// A model whose type lacks value_T/value_V or the Hessians is checked on what it has (those checks are skipped
-// and listed in report.skipped).
+//   hessian_T, hessian_V                            when options.check_hessians or check_third_derivatives,
+//   d3T(x, u, out, count), d3V(x, u, out, count)    when options.check_third_derivatives.
+// A model whose type lacks value_T/value_V, the Hessians or d3T/d3V is checked on what it has (those checks are
+// skipped and listed in report.skipped).
 //
 // Method: 5-point central differences, f'(x) ~ [f(x-2h) - 8 f(x-h) + 8 f(x+h) - f(x+2h)] / (12 h) with
 // h = options.step * max(1, |x_i|); truncation error O(h^4), rounding error O(eps/h), about 1e-12 relative for
-// smooth models at the default step. Gradients are differenced from the values, Hessians from the gradients.
+// smooth models at the default step. Gradients are differenced from the values, Hessians from the gradients,
+// and d3T(x, u)_k = sum_ij T_ijk u_i u_j, the derivative of u^T H(x) u along e_k, from the Hessians, with one
+// direction u per sample point drawn uniformly from [-1, 1]^n (seeded).
 // Every stencil of one check is one batched call, so a plugin is crossed once per function and sample point.
 //
 // Output: a DerivativeCheckReport. A comparison fails when |analytic - finite difference| >
@@ -37,12 +41,13 @@ struct DerivativeCheckOptions {
   double tolerance = 1e-6;                  // allowed error, relative to max(1, |finite difference|)
   bool check_gradients = true;              // grad T, grad V against differences of T, V (needs values)
   bool check_hessians = true;               // Hessians against differences of the gradients
+  bool check_third_derivatives = true;      // d3T, d3V against differences of u^T H u (needs Hessians)
 };
 
 struct DerivativeMismatch {
-  std::string function;       // "grad_T", "grad_V", "hessian_T" or "hessian_V"
+  std::string function;       // "grad_T", "grad_V", "hessian_T", "hessian_V", "d3T" or "d3V"
   std::vector<double> point;  // p for *_T, q for *_V
-  std::size_t component;      // index into the gradient (i) or row-major Hessian (i*n + j)
+  std::size_t component;      // index into the gradient or third derivative (i) or row-major Hessian (i*n + j)
   double computed;
   double finite_difference;
 };
@@ -85,6 +90,23 @@ concept ModelWithHessianFunctions =
       m.hessian_T(x, out, count);
       m.hessian_V(x, out, count);
     };
+
+template <class M>
+concept ModelWithThirdDerivativeFunctions =
+    requires(const M& m, std::span<const double> x, std::span<const double> u, std::span<double> out,
+             std::size_t count) {
+      m.d3T(x, u, out, count);
+      m.d3V(x, u, out, count);
+    };
+
+// u^T H u for the row-major n x n matrix at h.
+inline double quadratic_form(const double* h, const std::vector<double>& u) {
+  const std::size_t n = u.size();
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) sum += u[i] * h[i * n + j] * u[j];
+  return sum;
+}
 
 // The 4n stencil points x -/+ 2h e_i, x -/+ h e_i, in the order (i, offset -2, -1, +1, +2).
 inline std::vector<double> stencil(const std::vector<double>& x, double relative_step, std::vector<double>& steps) {
@@ -134,7 +156,14 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
   constexpr bool has_values = detail::ModelWithValues<M>;
   constexpr bool has_hessians = detail::ModelWithHessianFunctions<M>;
   if (options.check_gradients && !has_values) report.skipped.push_back("gradients: the model has no value_T/value_V");
+  constexpr bool has_third = detail::ModelWithThirdDerivativeFunctions<M>;
   if (options.check_hessians && !has_hessians) report.skipped.push_back("Hessians: the model has no hessian_T/hessian_V");
+  if (options.check_third_derivatives && !(has_third && has_hessians))
+    report.skipped.push_back(has_third ? "third derivatives: differencing them needs hessian_T/hessian_V"
+                                       : "third derivatives: the model has no d3T/d3V");
+  std::mt19937_64 direction_engine(options.seed + 1);
+  std::uniform_real_distribution<double> direction_component(-1.0, 1.0);
+  std::vector<double> direction(n), third(n), stencil_hessians, quadratic_forms;
 
   std::vector<double> steps, gradient(n), hessian(n * n), stencil_values, stencil_gradients;
   for (const auto& x : points) {
@@ -176,6 +205,25 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
             for (std::size_t i = 0; i < n; ++i)
               detail::compare(report, options, kinetic ? "hessian_T" : "hessian_V", x, i * n + j, hessian[i * n + j],
                               detail::five_point(stencil_gradients.data() + 4 * j * n + i, n, steps[j]));
+        }
+      }
+      if constexpr (has_third && has_hessians) {
+        if (options.check_third_derivatives) {
+          for (double& u : direction) u = direction_component(direction_engine);
+          stencil_hessians.resize(count * n * n);
+          quadratic_forms.resize(count);
+          if (kinetic) {
+            model.d3T(x, direction, third, 1);
+            model.hessian_T(shifted, stencil_hessians, count);
+          } else {
+            model.d3V(x, direction, third, 1);
+            model.hessian_V(shifted, stencil_hessians, count);
+          }
+          for (std::size_t s = 0; s < count; ++s)
+            quadratic_forms[s] = detail::quadratic_form(stencil_hessians.data() + s * n * n, direction);
+          for (std::size_t k = 0; k < n; ++k)
+            detail::compare(report, options, kinetic ? "d3T" : "d3V", x, k, third[k],
+                            detail::five_point(quadratic_forms.data() + 4 * k, 1, steps[k]));
         }
       }
     }

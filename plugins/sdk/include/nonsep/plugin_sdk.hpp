@@ -4,40 +4,35 @@
 //
 //   NONSEP_EXPORT_MODEL(Paper1D, "paper1d", "1.0.0", "one-line description", "T, V and the H it solves");
 //
-// which defines the symbol of plugin_abi.h (NONSEP_DEFINE_PLUGIN) and the constant function table it points at. The table's functions
-// parse and range-check parameters (parameters.hpp), batch over states, compute derivatives (analytic where the
-// class has them, automatic differentiation otherwise), pass non-finite results through as numbers (the host
-// reports the trajectory as diverged), and turn every C++ exception into a status code with a message
-// (EvaluationError -> NONSEP_EVALUATION_FAILED, InvalidParameter -> NONSEP_INVALID_PARAMETERS, anything else ->
-// NONSEP_INTERNAL_ERROR). Nothing throws across the boundary.
+// which defines the symbol of plugin_abi.h (NONSEP_DEFINE_PLUGIN) and the constant function table it points at.
+// The table's functions parse and range-check parameters (parameters.hpp), batch over states, compute derivatives
+// (analytic where the class has them, automatic differentiation otherwise), pass non-finite results through as
+// numbers (the host reports the trajectory as diverged), and turn every C++ exception into a status code with a
+// message (EvaluationError -> NONSEP_EVALUATION_FAILED, InvalidParameter -> NONSEP_INVALID_PARAMETERS, anything
+// else -> NONSEP_INTERNAL_ERROR). Nothing throws across the boundary.
 //
 // The plugin's file must be named <name>.so (nonsep_add_model() in CMake does that): the host refuses a file whose
-// metadata name differs from its file name. Every SDK plugin provides all optional functions (values and
-// Hessians of T and V, and integrate); its metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T and
-// hessian_V, whether it is "analytic" or "automatic".
-//
-// The table's optional integrate() (the fused path of plugin_abi.h) runs the core's nonsep::Integrator on
-// ModelAdapter<Model> inside the plugin, so every plugin links nonsep::core (a static, position-independent
-// library; nonsep_add_model() does that). The instance keeps the integrator between calls while the caller asks
-// for the same one, and a workspace of states.
+// metadata name differs from its file name. Every SDK plugin provides all optional functions of plugin_abi.h
+// (values, Hessians and directional third derivatives of T and V); its metadata adds a "derivatives" object
+// saying, for grad_T, grad_V, hessian_T, hessian_V, d3T and d3V, whether it is "analytic" or "automatic".
 //
 // Thread safety (as plugin_abi.h promises): metadata_json and create may be called concurrently; an instance
-// holds its model, its integrator and workspace for integrate(), and its last error message, so one instance is
-// for one thread at a time.
+// holds its model and its last error message, so one instance is for one thread at a time. The metadata says
+// "thread_safe": true: distinct instances share nothing mutable, provided the model class keeps no mutable
+// global or static state (a model that does is not for this SDK's export macro; see plugin_abi.h).
+//
+// The SDK is header-only: a plugin needs no nonsep library linked in (it includes a few header-only core
+// headers, nonsep/core/error.hpp).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <exception>
-#include <memory>
-#include <optional>
 #include <span>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/phase_space_batch.hpp"
 #include "nonsep/plugin_abi.h"
 #include "nonsep/sdk/dual.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
@@ -71,42 +66,7 @@ class PluginTable {
   struct Instance : nonsep_instance {
     explicit Instance(const ParameterValues& values) : adapter(values) {}
     Adapter adapter;
-    // integrate(): the integrator of the last call and what it was built from, and the states being stepped.
-    std::optional<Integrator> integrator;
-    nonsep_integrator integrator_built_from{};
-    PhaseSpaceBatch states;
   };
-
-  static bool same_integrator(const nonsep_integrator& a, const nonsep_integrator& b) {
-    return a.scheme == b.scheme && a.form == b.form && a.order_numerator == b.order_numerator &&
-           a.order_denominator == b.order_denominator && std::memcmp(&a.t2, &b.t2, sizeof(double)) == 0;
-  }
-
-  // The core's Integrator for `wanted`, built on the first call and whenever the caller asks for another one.
-  // Throws InvalidArgument for an unknown scheme or form, an order the scheme lacks, or a bad t2.
-  static Integrator& integrator_for(Instance& instance, const nonsep_integrator& wanted) {
-    if (instance.integrator && same_integrator(instance.integrator_built_from, wanted)) return *instance.integrator;
-    IntegratorSpec spec;
-    switch (wanted.scheme) {
-      case NONSEP_SCHEME_BASIC: spec.scheme = "basic"; break;
-      case NONSEP_SCHEME_TRIPLET: spec.scheme = "triplet"; break;
-      case NONSEP_SCHEME_MPE: spec.scheme = "mpe"; break;
-      default: throw InvalidArgument("integrate: unknown scheme " + std::to_string(wanted.scheme) +
-                                     " (expected 0 basic, 1 triplet or 2 mpe)");
-    }
-    switch (wanted.form) {
-      case NONSEP_FORM_TTV: spec.form = HamiltonianForm::TTV; break;
-      case NONSEP_FORM_VVT: spec.form = HamiltonianForm::VVT; break;
-      default: throw InvalidArgument("integrate: unknown form " + std::to_string(wanted.form) +
-                                     " (expected 0 TTV or 1 VVT)");
-    }
-    spec.order = Fraction(wanted.order_numerator, wanted.order_denominator);
-    spec.t2 = wanted.t2;
-    instance.integrator.reset();
-    instance.integrator.emplace(spec);
-    instance.integrator_built_from = wanted;
-    return *instance.integrator;
-  }
 
   static void record_error(nonsep_instance& instance, const std::string& message) noexcept {
     try {
@@ -163,13 +123,21 @@ class PluginTable {
         {"hamiltonian", id.hamiltonian},
         {"dimension", dimension},
         {"parameters", parameters_metadata(parameter_table<M>())},
+        {"thread_safe", true},
         {"capabilities",
-         {{"value_T", true}, {"value_V", true}, {"hessian_T", true}, {"hessian_V", true}, {"integrate", true}}},
+         {{"value_T", true},
+          {"value_V", true},
+          {"hessian_T", true},
+          {"hessian_V", true},
+          {"d3T", true},
+          {"d3V", true}}},
         {"derivatives",
          {{"grad_T", kind(Adapter::analytic_grad_T)},
           {"grad_V", kind(Adapter::analytic_grad_V)},
           {"hessian_T", kind(Adapter::analytic_hessian_T)},
-          {"hessian_V", kind(Adapter::analytic_hessian_V)}}}};
+          {"hessian_V", kind(Adapter::analytic_hessian_V)},
+          {"d3T", kind(Adapter::analytic_d3T)},
+          {"d3V", kind(Adapter::analytic_d3V)}}}};
     return metadata.dump();
   }
 
@@ -235,35 +203,20 @@ class PluginTable {
   NONSEP_SDK_BATCHED(hessian_V, n * n)
 #undef NONSEP_SDK_BATCHED
 
-  // The fused path (plugin_abi.h): `steps` steps of the core's Integrator on the adapter, the first-same-as-last
-  // cache and the evaluation counts handed in and out.
-  static nonsep_status integrate(nonsep_instance* instance, const nonsep_integrator* wanted, double* q, double* p,
-                                 double* fsal_gradient, int* fsal_valid, std::size_t count, double dt,
-                                 std::uint64_t steps, std::uint64_t* grad_T_count,
-                                 std::uint64_t* grad_V_count) noexcept {
-    return guarded(instance, "integrate", [&](Instance& self) {
-      if (wanted == nullptr || fsal_valid == nullptr || grad_T_count == nullptr || grad_V_count == nullptr ||
-          (count > 0 && (q == nullptr || p == nullptr || fsal_gradient == nullptr)))
-        throw InvalidArgument("integrate: a required pointer argument is null");
-      Integrator& integrator = integrator_for(self, *wanted);
-      if (count == 0 || steps == 0) return;
-      const std::size_t n = self.adapter.dimension(), size = count * n;
-      PhaseSpaceBatch& x = self.states;
-      if (x.count() != count || x.dimension() != n) x = PhaseSpaceBatch(n, count);
-      std::copy_n(q, size, x.q().begin());
-      std::copy_n(p, size, x.p().begin());
-      const std::span<double> gradient(fsal_gradient, size);
-      integrator.import_cache(x, gradient, *fsal_valid != 0);
-      const EvaluationCounts before = integrator.evaluations();
-      for (std::uint64_t step = 0; step < steps; ++step) integrator.step(self.adapter, x, dt);
-      const EvaluationCounts& after = integrator.evaluations();
-      *fsal_valid = integrator.export_cache(x, gradient) ? 1 : 0;
-      std::copy_n(x.q().begin(), size, q);
-      std::copy_n(x.p().begin(), size, p);
-      *grad_T_count += after.grad_T - before.grad_T;
-      *grad_V_count += after.grad_V - before.grad_V;
-    });
+  // The directional third derivatives: x, u and out each hold count*n numbers.
+#define NONSEP_SDK_DIRECTIONAL(function)                                                                        \
+  static nonsep_status function(nonsep_instance* instance, const double* x, const double* u, double* out,       \
+                                std::size_t count) noexcept {                                                   \
+    return guarded(instance, #function, [&](const Instance& self) {                                            \
+      const Adapter& adapter = self.adapter;                                                                   \
+      const std::size_t size = count * adapter.dimension();                                                    \
+      adapter.function(std::span<const double>(x, size), std::span<const double>(u, size),                    \
+                       std::span<double>(out, size), count);                                                   \
+    });                                                                                                        \
   }
+  NONSEP_SDK_DIRECTIONAL(d3T)
+  NONSEP_SDK_DIRECTIONAL(d3V)
+#undef NONSEP_SDK_DIRECTIONAL
 
  public:
   static constexpr nonsep_plugin_api api = {
@@ -280,7 +233,8 @@ class PluginTable {
       &hessian_T,
       &hessian_V,
       &last_error,
-      &integrate,
+      &d3T,
+      &d3V,
   };
 };
 
@@ -290,7 +244,9 @@ class PluginTable {
 #define NONSEP_PLUGIN_EXPORT __attribute__((visibility("default")))
 
 // Exports model class `Model` as this library's plugin, with analytic derivatives where the class has them.
-// name, version, description and hamiltonian are string literals; name must equal the file's stem.
+// The other four arguments are string literals: `name`, which must equal the file's stem and so the CMake target
+// of nonsep_add_model (the host refuses a plugin whose metadata names another file); `version` of the model;
+// `description`, one line for `nonsep models`; `hamiltonian`, what T, V and the solved H are, in words.
 #define NONSEP_EXPORT_MODEL(Model, name, version, description, hamiltonian)                                    \
   NONSEP_EXPORT_MODEL_WITH_DERIVATIVES(Model, ::nonsep::sdk::Derivatives::preferred, name, version, description, \
                                        hamiltonian)

@@ -10,14 +10,31 @@
 // K is the capacity, not necessarily the model's dimension: a model whose dimension is a run-time parameter
 // uses K = its max_dimension and seeds only the first n slots; the others stay zero.
 //
-// Supported: + - * / (with duals and with doubles, either side), unary -, compound assignment, comparisons of
-// values, and sqrt cbrt exp log pow(x, double) sin cos tan asin acos atan sinh cosh tanh asinh abs. Functions
-// with an infinite derivative at a point (sqrt(0), abs(0), ...) give inf or NaN derivatives there; the SDK
-// reports a non-finite result as an evaluation failure. Call the functions unqualified (ADL finds them) or as
-// nonsep::sdk::sqrt etc., which also accept double.
+//   Dual<Dual<Dual<double, K>, 1>, 1>   both outer slots seeded with a direction u: directional third
+//                                derivatives sum_ij f_ijk u_i u_j in one pass (automatic_derivatives.hpp).
+//
+// Supported, for every nesting: + - * / (with duals and with doubles, either side), unary -, compound assignment,
+// comparisons of values, and
+//   sqrt cbrt exp expm1 log log1p erf abs
+//   sin cos tan asin acos atan atan2 sinh cosh tanh asinh acosh atanh hypot
+//   pow(x, double)  pow(x, y)  pow(double, y)  min max
+// where the two-argument functions (atan2, hypot, pow, min, max) take two duals or a dual and a double.
+// Functions with an infinite derivative at a point (sqrt(0), abs(0), acosh(1), ...) give inf or NaN derivatives
+// there; outside its domain (log(-1), acosh(0.5)) a function's value and derivatives are NaN. Non-finite results
+// are numbers, not failures: the SDK's adapter (model_adapter.hpp) returns them as computed and the host reports
+// the trajectory as diverged. min and max at a tie take the first argument's derivatives; pow(x, y) has
+// derivative 0 in y at x <= 0 (see pow).
+//
+// Call the functions unqualified, after `using std::sin;` (ADL finds the dual versions, the using-declaration the
+// double ones), or as nonsep::sdk::sin etc., which also accept double. std::sin(x) on a dual does not compile
+// ("no matching function for call to 'sin(nonsep::sdk::Dual<...>)'"): the standard's functions take only
+// arithmetic types, and nothing may be added to namespace std. (A conversion of Dual to double that fails with a
+// friendlier static_assert was tried and rejected: it makes `x * 2` ambiguous under clang and `c ? x : 0.0`
+// ill-formed.)
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <numbers>
 
 namespace nonsep::sdk {
 
@@ -155,14 +172,23 @@ NONSEP_SDK_DUAL_COMPARISON(!=)
 // The double versions, so that nonsep::sdk::sqrt(x) works whatever x is.
 using std::abs;
 using std::acos;
+using std::acosh;
 using std::asin;
 using std::asinh;
 using std::atan;
+using std::atan2;
+using std::atanh;
 using std::cbrt;
 using std::cos;
 using std::cosh;
+using std::erf;
 using std::exp;
+using std::expm1;
+using std::hypot;
 using std::log;
+using std::log1p;
+using std::max;
+using std::min;
 using std::pow;
 using std::sin;
 using std::sinh;
@@ -179,7 +205,26 @@ Dual<S, K> chain(const Dual<S, K>& x, const S& f, const S& f_prime) {
   for (std::size_t k = 0; k < K; ++k) r.derivative[k] = f_prime * x.derivative[k];
   return r;
 }
+// f(x, y) for duals x and y, given f and its partial derivatives f_x and f_y at the values.
+template <class S, std::size_t K>
+Dual<S, K> chain(const Dual<S, K>& x, const Dual<S, K>& y, const S& f, const S& f_x, const S& f_y) {
+  Dual<S, K> r;
+  r.value = f;
+  for (std::size_t k = 0; k < K; ++k) r.derivative[k] = f_x * x.derivative[k] + f_y * y.derivative[k];
+  return r;
+}
 }  // namespace detail
+
+// The two-argument functions with one double argument: the double as a constant dual.
+#define NONSEP_SDK_DUAL_MIXED(function)                       \
+  template <class S, std::size_t K>                            \
+  Dual<S, K> function(const Dual<S, K>& x, double y) {         \
+    return function(x, Dual<S, K>(y));                         \
+  }                                                            \
+  template <class S, std::size_t K>                            \
+  Dual<S, K> function(double x, const Dual<S, K>& y) {         \
+    return function(Dual<S, K>(x), y);                         \
+  }
 
 template <class S, std::size_t K>
 Dual<S, K> sqrt(const Dual<S, K>& x) {
@@ -249,8 +294,69 @@ template <class S, std::size_t K>
 Dual<S, K> asinh(const Dual<S, K>& x) {
   return detail::chain(x, S(asinh(x.value)), S(S(1.0) / sqrt(x.value * x.value + 1.0)));
 }
-// |x| with derivative sign(x). |x| has no derivative at 0: there the derivatives are NaN, which the SDK reports
-// as an evaluation failure instead of silently picking a side.
+template <class S, std::size_t K>
+Dual<S, K> acosh(const Dual<S, K>& x) {
+  return detail::chain(x, S(acosh(x.value)), S(S(1.0) / sqrt(x.value * x.value - 1.0)));
+}
+template <class S, std::size_t K>
+Dual<S, K> atanh(const Dual<S, K>& x) {
+  return detail::chain(x, S(atanh(x.value)), S(S(1.0) / (1.0 - x.value * x.value)));
+}
+template <class S, std::size_t K>
+Dual<S, K> expm1(const Dual<S, K>& x) {
+  return detail::chain(x, S(expm1(x.value)), S(exp(x.value)));
+}
+template <class S, std::size_t K>
+Dual<S, K> log1p(const Dual<S, K>& x) {
+  // Below -1 the value is NaN, and so is the derivative (as for log).
+  const S f_prime = value_of(x) < -1.0 ? S(std::nan("")) : S(S(1.0) / (1.0 + x.value));
+  return detail::chain(x, S(log1p(x.value)), f_prime);
+}
+template <class S, std::size_t K>
+Dual<S, K> erf(const Dual<S, K>& x) {
+  return detail::chain(x, S(erf(x.value)), S(2.0 * std::numbers::inv_sqrtpi * exp(-(x.value * x.value))));
+}
+// atan2(y, x), the angle of (x, y): d/dy = x / (x^2 + y^2), d/dx = -y / (x^2 + y^2).
+template <class S, std::size_t K>
+Dual<S, K> atan2(const Dual<S, K>& y, const Dual<S, K>& x) {
+  const S inverse = S(1.0) / (x.value * x.value + y.value * y.value);
+  return detail::chain(y, x, S(atan2(y.value, x.value)), S(x.value * inverse), S(-y.value * inverse));
+}
+NONSEP_SDK_DUAL_MIXED(atan2)
+template <class S, std::size_t K>
+Dual<S, K> hypot(const Dual<S, K>& x, const Dual<S, K>& y) {
+  const S r = hypot(x.value, y.value);
+  return detail::chain(x, y, r, S(x.value / r), S(y.value / r));
+}
+NONSEP_SDK_DUAL_MIXED(hypot)
+// x^y with both variable: d/dx = y x^(y-1), d/dy = x^y log x, taken as 0 for x <= 0 (the limit at x = 0 for
+// y > 0; for x < 0, x^y is real only at integer y and has no derivative in y, and 0 lets pow(x, S(3)) work).
+template <class S, std::size_t K>
+Dual<S, K> pow(const Dual<S, K>& x, const Dual<S, K>& y) {
+  const S r = pow(x.value, y.value);
+  const S d_dy = value_of(x) <= 0.0 ? S(0.0) : S(r * log(x.value));
+  return detail::chain(x, y, r, S(y.value * pow(x.value, y.value - 1.0)), d_dy);
+}
+// a^y for a constant base a.
+template <class S, std::size_t K>
+Dual<S, K> pow(double a, const Dual<S, K>& y) {
+  return pow(Dual<S, K>(a), y);
+}
+// The smaller (larger) argument with its derivatives; at a tie, the first.
+template <class S, std::size_t K>
+Dual<S, K> min(const Dual<S, K>& a, const Dual<S, K>& b) {
+  return value_of(b) < value_of(a) ? b : a;
+}
+template <class S, std::size_t K>
+Dual<S, K> max(const Dual<S, K>& a, const Dual<S, K>& b) {
+  return value_of(a) < value_of(b) ? b : a;
+}
+NONSEP_SDK_DUAL_MIXED(min)
+NONSEP_SDK_DUAL_MIXED(max)
+#undef NONSEP_SDK_DUAL_MIXED
+
+// |x| with derivative sign(x). |x| has no derivative at 0: there the derivatives are NaN (a trajectory that reaches
+// that point diverges) instead of silently picking a side.
 template <class S, std::size_t K>
 Dual<S, K> abs(const Dual<S, K>& x) {
   const double v = value_of(x);

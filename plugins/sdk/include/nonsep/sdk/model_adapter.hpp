@@ -15,14 +15,19 @@
 //   void grad_T(nonsep::sdk::Vector<double> p, std::span<double> out) const;      analytic derivatives of one
 //   void grad_V(nonsep::sdk::Vector<double> q, std::span<double> out) const;      state (out has n entries, or
 //   void hessian_T(nonsep::sdk::Vector<double> p, std::span<double> out) const;   n*n row-major for Hessians);
-//   void hessian_V(nonsep::sdk::Vector<double> q, std::span<double> out) const;   each one replaces AD for it.
+//   void hessian_V(nonsep::sdk::Vector<double> q, std::span<double> out) const;   each one replaces AD for it;
+//   void d3T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> u, std::span<double> out) const;
+//   void d3V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> u, std::span<double> out) const;
+//                                     directional third derivatives, out[k] = sum_ij T_ijk u_i u_j (n entries).
 // Model code signals a point where it cannot be evaluated by throwing EvaluationError; the plugin returns
 // NONSEP_EVALUATION_FAILED with that message. Any other exception becomes NONSEP_INTERNAL_ERROR.
 //
-// Automatic differentiation uses Dual<double, K> for gradients (one pass) and Dual<Dual<double, K>, 1> for
-// Hessians (one pass per column), with K = dimension or max_dimension. All AD storage is on the stack
-// (std::array of K duals), so there is no heap allocation while evaluating; max_dimension bounds that stack use
-// (about 16 (K+1)^2 bytes for a Hessian column pass, 4.6 KB at K = 16).
+// Automatic differentiation (automatic_derivatives.hpp) uses Dual<double, K> for gradients (one pass),
+// Dual<Dual<double, K>, 1> for Hessians (one pass per column) and Dual<Dual<Dual<double, K>, 1>, 1> for directional
+// third derivatives (one pass), with K = dimension or max_dimension: T and V must compile for these three types
+// and double. All AD storage is on the stack (std::array of K duals), so there is no heap allocation while
+// evaluating; max_dimension bounds that stack use (about 32 (K+1) K bytes for a third-derivative pass, 8.7 KB at
+// K = 16).
 //
 // Non-finite results are numbers, not failures: a gradient, Hessian or value that overflows or is NaN is returned
 // as computed, and the host sees the state become non-finite and reports the trajectory as diverged (where, when
@@ -43,14 +48,11 @@
 #include <utility>
 
 #include "nonsep/core/error.hpp"
+#include "nonsep/sdk/automatic_derivatives.hpp"
 #include "nonsep/sdk/dual.hpp"
 #include "nonsep/sdk/parameters.hpp"
 
 namespace nonsep::sdk {
-
-// The coordinates a model's T or V receives: the n components of one state.
-template <class S>
-using Vector = std::span<const S>;
 
 // Thrown by model code where T or V cannot be evaluated (outside its domain, say). A non-finite number is not
 // an error: return it, and the host reports the trajectory as diverged.
@@ -87,14 +89,17 @@ consteval std::size_t dimension_capacity() {
 
 template <class M>
 concept ModelClass = (HasFixedDimension<M> != HasParameterDimension<M>) && (dimension_capacity<M>() > 0) &&
-                     requires(const M& m, Vector<double> x, Vector<Dual<double, dimension_capacity<M>()>> d,
-                              Vector<Dual<Dual<double, dimension_capacity<M>()>, 1>> dd) {
+                     requires(const M& m, Vector<double> x, Vector<GradientDual<dimension_capacity<M>()>> d,
+                              Vector<HessianDual<dimension_capacity<M>()>> dd,
+                              Vector<ThirdDerivativeDual<dimension_capacity<M>()>> ddd) {
                        { m.template T<double>(x) } -> std::convertible_to<double>;
                        { m.template V<double>(x) } -> std::convertible_to<double>;
-                       m.template T<Dual<double, dimension_capacity<M>()>>(d);
-                       m.template V<Dual<double, dimension_capacity<M>()>>(d);
-                       m.template T<Dual<Dual<double, dimension_capacity<M>()>, 1>>(dd);
-                       m.template V<Dual<Dual<double, dimension_capacity<M>()>, 1>>(dd);
+                       m.template T<GradientDual<dimension_capacity<M>()>>(d);
+                       m.template V<GradientDual<dimension_capacity<M>()>>(d);
+                       m.template T<HessianDual<dimension_capacity<M>()>>(dd);
+                       m.template V<HessianDual<dimension_capacity<M>()>>(dd);
+                       m.template T<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
+                       m.template V<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
                      };
 
 template <class M>
@@ -105,6 +110,14 @@ template <class M>
 concept HasAnalyticHessianT = requires(const M& m, Vector<double> x, std::span<double> out) { m.hessian_T(x, out); };
 template <class M>
 concept HasAnalyticHessianV = requires(const M& m, Vector<double> x, std::span<double> out) { m.hessian_V(x, out); };
+template <class M>
+concept HasAnalyticD3T = requires(const M& m, Vector<double> x, Vector<double> u, std::span<double> out) {
+  m.d3T(x, u, out);
+};
+template <class M>
+concept HasAnalyticD3V = requires(const M& m, Vector<double> x, Vector<double> u, std::span<double> out) {
+  m.d3V(x, u, out);
+};
 
 // The parameter table of M (empty when M declares none).
 template <class M>
@@ -145,50 +158,10 @@ consteval bool dimension_parameter_is_bounded() {
   }
 }
 
-namespace detail {
-
-// Automatic derivatives of a function that is not finite at x are meaningless (log(-1) has the "derivative" -1):
-// when the value computed alongside them is not finite, the `size` derivatives in `out` become NaN.
-// Written as a select, not a branch, so that the batch loops around it still vectorize.
-inline void poison_if_not_finite(double value, double* out, std::size_t size) {
-  const bool finite = std::isfinite(value);
-  for (std::size_t i = 0; i < size; ++i) out[i] = finite ? out[i] : std::numeric_limits<double>::quiet_NaN();
-}
-
-// Writes the gradient of f at x (n <= K components) into out, by one pass of Dual<double, K>. Returns f(x).
-template <std::size_t K, class F>
-double gradient_by_dual(const F& f, const double* x, std::size_t n, double* out) {
-  using D = Dual<double, K>;
-  std::array<D, K> xs;
-  for (std::size_t i = 0; i < n; ++i) xs[i] = D::variable(x[i], i);
-  const D y = f(Vector<D>(xs.data(), n));
-  for (std::size_t i = 0; i < n; ++i) out[i] = y.derivative[i];
-  return y.value;
-}
-
-// Writes the row-major n x n Hessian of f at x into out, column j from one pass of Dual<Dual<double, K>, 1>
-// seeded with e_j in the outer slot. Returns f(x).
-template <std::size_t K, class F>
-double hessian_by_dual(const F& f, const double* x, std::size_t n, double* out) {
-  using Inner = Dual<double, K>;
-  using D = Dual<Inner, 1>;
-  std::array<D, K> xs;
-  for (std::size_t i = 0; i < n; ++i) xs[i].value = Inner::variable(x[i], i);
-  double value = 0.0;
-  for (std::size_t j = 0; j < n; ++j) {
-    for (std::size_t i = 0; i < n; ++i) xs[i].derivative[0] = Inner(i == j ? 1.0 : 0.0);
-    const D y = f(Vector<D>(xs.data(), n));
-    for (std::size_t i = 0; i < n; ++i) out[i * n + j] = y.derivative[0].derivative[i];
-    value = y.value.value;
-  }
-  return value;
-}
-
-}  // namespace detail
-
-// A model class behind the batched interface of nonsep/core/model.hpp (it models nonsep::ModelWithHessians),
-// plus value_T / value_V. Batch layout as in model.hpp. Spans must hold at least count*n (count*n*n for
-// Hessians, count for values) entries; shorter spans are a caller bug and throw nonsep::InvalidArgument.
+// A model class behind the batched interface of nonsep/core/model.hpp (it models
+// nonsep::ModelWithThirdDerivatives), plus value_T / value_V. Batch layout as in model.hpp. Spans must hold at
+// least count*n (count*n*n for Hessians, count for values) entries; shorter spans are a caller bug and throw
+// nonsep::InvalidArgument.
 // Evaluation failures throw EvaluationError. ModelAdapter keeps no mutable state: concurrent calls are as safe
 // as M's const member functions.
 template <ModelClass M, Derivatives policy = Derivatives::preferred>
@@ -218,6 +191,8 @@ class ModelAdapter {
   static constexpr bool analytic_grad_V = policy == Derivatives::preferred && HasAnalyticGradV<M>;
   static constexpr bool analytic_hessian_T = policy == Derivatives::preferred && HasAnalyticHessianT<M>;
   static constexpr bool analytic_hessian_V = policy == Derivatives::preferred && HasAnalyticHessianV<M>;
+  static constexpr bool analytic_d3T = policy == Derivatives::preferred && HasAnalyticD3T<M>;
+  static constexpr bool analytic_d3V = policy == Derivatives::preferred && HasAnalyticD3V<M>;
 
   void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
     check_sizes(p, out, count, 1);
@@ -293,6 +268,38 @@ class ModelAdapter {
       else
         detail::poison_if_not_finite(
             detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h), h, n * n);
+    }
+  }
+
+  // out[b*n + k] = sum_ij T_ijk(p_b) u_bi u_bj (d3T), the same for V in q (d3V); u has the layout of p.
+  void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    check_sizes(p, out, count, dimension_);
+    check_sizes(u, out, count, dimension_);
+    const std::size_t n = batch_dimension();
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* x = p.data() + b * n;
+      const double* v = u.data() + b * n;
+      double* d = out.data() + b * n;
+      if constexpr (analytic_d3T)
+        model_.d3T(Vector<double>(x, n), Vector<double>(v, n), std::span<double>(d, n));
+      else
+        detail::poison_if_not_finite(
+            detail::directional_third_by_dual<capacity>([this](auto w) { return model_.T(w); }, x, v, n, d), d, n);
+    }
+  }
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    check_sizes(q, out, count, dimension_);
+    check_sizes(u, out, count, dimension_);
+    const std::size_t n = batch_dimension();
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* x = q.data() + b * n;
+      const double* v = u.data() + b * n;
+      double* d = out.data() + b * n;
+      if constexpr (analytic_d3V)
+        model_.d3V(Vector<double>(x, n), Vector<double>(v, n), std::span<double>(d, n));
+      else
+        detail::poison_if_not_finite(
+            detail::directional_third_by_dual<capacity>([this](auto w) { return model_.V(w); }, x, v, n, d), d, n);
     }
   }
 

@@ -8,10 +8,14 @@
 // and receives a ParameterValues in its constructor. The same table produces the "parameters" array of the
 // plugin metadata (plugin_abi.h), so the host can validate and document parameters without creating a model.
 //
-// Rules, identical on the host side (check_parameter_value is shared): the parameters are a JSON object; every
-// key must be in the table; an "integer" is a JSON number with an integral value, a "number" any JSON number,
-// a "boolean" true or false; minimum and maximum are inclusive. Missing keys take their defaults. Every refusal
-// throws InvalidParameter with a message that names the parameter and shows the offending value.
+// Rules: the parameters are a JSON object; every key must be in the table; each value must pass
+// parameter_fault, the one rule for a value that the SDK, the host's plugin loader and its job reader all apply:
+//   "integer"  a JSON number with an integral value (2 or 2.0, as JSON Schema counts integers) of magnitude at
+//              most 2^53, so that the double a model reads it through (ParameterValues::integer) holds it exactly;
+//   "number"   a finite JSON number (a text such as 1e999 reads as infinity);
+//   "boolean"  true or false;
+// minimum and maximum are inclusive. Missing keys take their defaults. Every refusal throws InvalidParameter with a
+// message that names the parameter and shows the offending value.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -76,26 +80,49 @@ inline nlohmann::json default_as_json(const Parameter& p) {
   return p.default_value;
 }
 
-// Checks one value against its declared type and range. Returns "" when it is acceptable, otherwise the complete
-// message, e.g. "parameter 'dimension' = 100 is above its maximum 16".
+enum class ParameterFault { none, wrong_type, below_minimum, above_maximum };
+
+// A JSON number with an integral value of magnitude at most 2^53.
+inline bool is_exact_integer(const nlohmann::json& value) {
+  constexpr std::int64_t limit = std::int64_t{1} << 53;
+  if (value.is_number_unsigned()) return value.get<std::uint64_t>() <= static_cast<std::uint64_t>(limit);
+  if (value.is_number_integer()) return value.get<std::int64_t>() >= -limit && value.get<std::int64_t>() <= limit;
+  if (!value.is_number_float()) return false;
+  const double x = value.get<double>();
+  return std::trunc(x) == x && std::abs(x) <= 0x1p53;
+}
+
+// What is wrong with one value of a parameter of `type` ("integer", "number" or "boolean") with inclusive bounds,
+// by the rules at the top of this file.
+inline ParameterFault parameter_fault(std::string_view type, std::optional<double> minimum,
+                                      std::optional<double> maximum, const nlohmann::json& value) {
+  if (type == "boolean") return value.is_boolean() ? ParameterFault::none : ParameterFault::wrong_type;
+  if (!value.is_number()) return ParameterFault::wrong_type;
+  const double x = value.get<double>();
+  if (!std::isfinite(x)) return ParameterFault::wrong_type;
+  if (type == "integer" && !is_exact_integer(value)) return ParameterFault::wrong_type;
+  if (minimum && x < *minimum) return ParameterFault::below_minimum;
+  if (maximum && x > *maximum) return ParameterFault::above_maximum;
+  return ParameterFault::none;
+}
+
+// parameter_fault as a message: "" when the value is acceptable, otherwise the complete message, e.g.
+// "parameter 'dimension' = 100 is above its maximum 16".
 inline std::string check_parameter_value(std::string_view name, std::string_view type,
                                          std::optional<double> minimum, std::optional<double> maximum,
                                          const nlohmann::json& value) {
   const std::string quoted = "parameter '" + std::string(name) + "'";
-  if (type == "boolean") {
-    if (!value.is_boolean()) return quoted + " must be true or false (found " + value.dump() + ")";
-    return "";
+  switch (parameter_fault(type, minimum, maximum, value)) {
+    case ParameterFault::none: return "";
+    case ParameterFault::wrong_type:
+      return quoted + " must be " +
+             (type == "boolean" ? "true or false" : type == "integer" ? "an integer" : "a number") +
+             " (found " + value.dump() + ")";
+    case ParameterFault::below_minimum:
+      return quoted + " = " + value.dump() + " is below its minimum " + format_number(*minimum);
+    case ParameterFault::above_maximum:
+      return quoted + " = " + value.dump() + " is above its maximum " + format_number(*maximum);
   }
-  if (!value.is_number()) return quoted + " must be a" + (type == "integer" ? "n integer" : " number") +
-                                 " (found " + value.dump() + ")";
-  const double x = value.get<double>();
-  if (type == "integer" && !value.is_number_integer() && !value.is_number_unsigned() &&
-      (std::trunc(x) != x || std::abs(x) > 9.0e15))
-    return quoted + " must be an integer (found " + value.dump() + ")";
-  if (minimum && x < *minimum)
-    return quoted + " = " + value.dump() + " is below its minimum " + format_number(*minimum);
-  if (maximum && x > *maximum)
-    return quoted + " = " + value.dump() + " is above its maximum " + format_number(*maximum);
   return "";
 }
 

@@ -1,0 +1,74 @@
+#pragma once
+// A two-dimensional analogue of the paper's model (eq. algham) with compact energy shells and a chaotic part of
+// phase space, for the dynamics diagnostics (Lyapunov exponents, MEGNO, sections):
+//   T(p) = p1 + p2 + (p1^3 + p2^3)/6,    V(q) = |q|^2/2 + |q|^4/12 + coupling q1^2 q2^2,
+// so grad T = (1 + p1^2/2, 1 + p2^2/2) and
+//   Hess V = (1 + |q|^2/3) I + (2/3) q q^T + coupling [[2 q2^2, 4 q1 q2], [4 q1 q2, 2 q1^2]],
+//   H_TTV  = grad T(p) . Hess V(q) grad T(p).
+// Parameter "coupling" (default 0.2, range [-0.1, 0.3]).
+//
+// Compact energy shells. The coupling matrix [[2 b^2, 4 a b], [4 a b, 2 a^2]] (a = q1, b = q2) has eigenvalues
+// (a^2 + b^2) +- sqrt((a^2 + b^2)^2 + 12 a^2 b^2), which lie in [-|q|^2, 3 |q|^2] because 12 a^2 b^2 <= 3 |q|^4;
+// and (2/3) q q^T is positive semi-definite. Hence Hess V >= (1 + c |q|^2) I with c = 1/3 - max(coupling,
+// -3 coupling) > 0 on the allowed range (c >= 1/30). Each component of grad T is at least 1, and
+// |grad T|^2 = 2 + |p|^2 + (p1^4 + p2^4)/4 >= 2 + |p|^2. So
+//   H_TTV >= (1 + c |q|^2)(2 + |p|^2) >= 2 + 2 c |q|^2 + |p|^2:
+// every shell H = E is bounded (|q|^2 <= (E - 2)/(2c), |p|^2 <= E - 2) and H >= 2 everywhere.
+//
+// Not integrable. At coupling 0.2, MEGNO and the largest Lyapunov exponent find regular orbits (<Y> -> 2,
+// exponent decaying like log(t)/t) next to chaotic ones (<Y> growing like lambda t/2, lambda ~ 0.2) at the same
+// energy, e.g. q = (0.25, 0.3), p = (-1.5, 0.2) (regular, H = 6.75) and q = (-0.75, 0.3), p = (-1.5, 0.2)
+// (chaotic, H = 7.49); tests/core/test_dynamics_chaos.cpp checks both against an independent reference.
+// Defined everywhere. Analytic gradients and Hessians (the tangent maps of the Lyapunov and MEGNO diagnostics
+// evaluate the Hessians 8 times per basic step; automatic differentiation checks them in tests/plugins).
+#include <nonsep/plugin_sdk.hpp>
+
+class Paper2D {
+ public:
+  static constexpr std::size_t dimension = 2;
+  static constexpr nonsep::sdk::Parameter parameters[] = {
+      {.name = "coupling",
+       .type = nonsep::sdk::ParameterType::number,
+       .default_value = 0.2,
+       .minimum = -0.1,
+       .maximum = 0.3,
+       .description = "strength of the q1^2 q2^2 term of V; the range keeps Hess V positive definite and the "
+                      "energy shells compact"}};
+
+  explicit Paper2D(const nonsep::sdk::ParameterValues& values) : coupling_(values.number("coupling")) {}
+
+  template <class S>
+  S T(nonsep::sdk::Vector<S> p) const {
+    return p[0] + p[1] + (nonsep::sdk::cube(p[0]) + nonsep::sdk::cube(p[1])) / 6.0;
+  }
+  template <class S>
+  S V(nonsep::sdk::Vector<S> q) const {
+    const S x2 = q[0] * q[0], y2 = q[1] * q[1], r2 = x2 + y2;
+    return r2 / 2.0 + r2 * r2 / 12.0 + coupling_ * x2 * y2;
+  }
+
+  void grad_T(nonsep::sdk::Vector<double> p, std::span<double> out) const {
+    out[0] = 1.0 + 0.5 * p[0] * p[0];
+    out[1] = 1.0 + 0.5 * p[1] * p[1];
+  }
+  void grad_V(nonsep::sdk::Vector<double> q, std::span<double> out) const {
+    const double x = q[0], y = q[1], radial = 1.0 + (x * x + y * y) / 3.0;
+    out[0] = x * radial + 2.0 * coupling_ * x * y * y;
+    out[1] = y * radial + 2.0 * coupling_ * x * x * y;
+  }
+
+  void hessian_T(nonsep::sdk::Vector<double> p, std::span<double> out) const {
+    out[0] = p[0];
+    out[1] = out[2] = 0.0;
+    out[3] = p[1];
+  }
+  void hessian_V(nonsep::sdk::Vector<double> q, std::span<double> out) const {
+    const double x = q[0], y = q[1], radial = 1.0 + (x * x + y * y) / 3.0;
+    out[0] = radial + 2.0 / 3.0 * x * x + 2.0 * coupling_ * y * y;
+    out[1] = out[2] = (2.0 / 3.0 + 4.0 * coupling_) * x * y;
+    out[3] = radial + 2.0 / 3.0 * y * y + 2.0 * coupling_ * x * x;
+  }
+
+ private:
+  double coupling_;
+};

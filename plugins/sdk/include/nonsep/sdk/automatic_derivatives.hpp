@@ -1,0 +1,90 @@
+#pragma once
+// The derivatives ModelAdapter computes by forward-mode automatic differentiation (dual.hpp) of a scalar function
+// f written for any scalar type, at one point x of n <= K components. K is the capacity (the model's dimension or
+// max_dimension); all storage is std::array on the stack, so none of these allocates.
+//
+//   gradient_by_dual            grad f(x)                   one pass of Dual<double, K>
+//   hessian_by_dual             the n x n Hessian, row-major  n passes of Dual<Dual<double, K>, 1>, column j seeded
+//                                                            with e_j in the outer slot
+//   directional_third_by_dual   out_k = sum_ij f_ijk(x) u_i u_j, the gradient of u^T H(x) u: one pass of
+//                               Dual<Dual<Dual<double, K>, 1>, 1>, both outer slots seeded with u, so the
+//                               e1 e2 part is d^2/ds dt f(x + (s + t) u) with its gradient in x inside. 4 (K+1)
+//                               doubles per number: cheaper than differencing n Hessian passes, and no Hessian
+//                               is formed.
+// Each returns f(x) (the value computed alongside), which poison_if_not_finite uses.
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <span>
+
+#include "nonsep/sdk/dual.hpp"
+
+namespace nonsep::sdk {
+
+// The coordinates a model's T or V receives: the n components of one state.
+template <class S>
+using Vector = std::span<const S>;
+
+// The scalar types a model's T and V are instantiated with.
+template <std::size_t K>
+using GradientDual = Dual<double, K>;
+template <std::size_t K>
+using HessianDual = Dual<Dual<double, K>, 1>;
+template <std::size_t K>
+using ThirdDerivativeDual = Dual<Dual<Dual<double, K>, 1>, 1>;
+
+namespace detail {
+
+// Automatic derivatives of a function that is not finite at x are meaningless (log(-1) has the "derivative" -1):
+// when the value computed alongside them is not finite, the `size` derivatives in `out` become NaN.
+// Written as a select, not a branch, so that the batch loops around it still vectorize.
+inline void poison_if_not_finite(double value, double* out, std::size_t size) {
+  const bool finite = std::isfinite(value);
+  for (std::size_t i = 0; i < size; ++i) out[i] = finite ? out[i] : std::numeric_limits<double>::quiet_NaN();
+}
+
+template <std::size_t K, class F>
+double gradient_by_dual(const F& f, const double* x, std::size_t n, double* out) {
+  using D = GradientDual<K>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) xs[i] = D::variable(x[i], i);
+  const D y = f(Vector<D>(xs.data(), n));
+  for (std::size_t i = 0; i < n; ++i) out[i] = y.derivative[i];
+  return y.value;
+}
+
+template <std::size_t K, class F>
+double hessian_by_dual(const F& f, const double* x, std::size_t n, double* out) {
+  using Inner = Dual<double, K>;
+  using D = HessianDual<K>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) xs[i].value = Inner::variable(x[i], i);
+  double value = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    for (std::size_t i = 0; i < n; ++i) xs[i].derivative[0] = Inner(i == j ? 1.0 : 0.0);
+    const D y = f(Vector<D>(xs.data(), n));
+    for (std::size_t i = 0; i < n; ++i) out[i * n + j] = y.derivative[0].derivative[i];
+    value = y.value.value;
+  }
+  return value;
+}
+
+template <std::size_t K, class F>
+double directional_third_by_dual(const F& f, const double* x, const double* u, std::size_t n, double* out) {
+  using Inner = Dual<double, K>;
+  using Middle = Dual<Inner, 1>;
+  using D = ThirdDerivativeDual<K>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i].value.value = Inner::variable(x[i], i);
+    xs[i].value.derivative[0] = Inner(u[i]);
+    xs[i].derivative[0] = Middle(u[i]);
+  }
+  const D y = f(Vector<D>(xs.data(), n));
+  for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[k];
+  return y.value.value.value;
+}
+
+}  // namespace detail
+}  // namespace nonsep::sdk
