@@ -1,9 +1,11 @@
 // The core library on its own: integrate the paper's 1D test H = (1 + p^2/2)^2 (1 + q^2) from (q, p) = (2, 0)
 // to its quarter period with each scheme and print the error against the exact end point (0, -sqrt(2(sqrt5-1))).
-// The quarter period is the one computed by quadrature in tests/support/paper1d_exact.hpp.
+// The quarter period is the one computed by tanh-sinh quadrature in reference/include/nonsep/reference/
+// paper1d_exact.hpp (build/bin/nonsep_paper_reference prints it).
 #include <cmath>
 #include <cstdio>
 #include <span>
+#include <string>
 
 #include "nonsep/core.hpp"
 

@@ -117,3 +117,17 @@ TEST_CASE("integrators describe themselves") {
   CHECK_FALSE(find_scheme("mpe")->symplectic);
   CHECK_FALSE(find_scheme("rk4").has_value());
 }
+
+namespace {
+template <class Base>
+constexpr bool mpe_accepts = requires {
+  typename MultiProductExpansion<Base>;
+};
+}  // namespace
+
+// A base stepper MultiProductExpansion cannot drive is refused at compile time by the concept its template names
+// (multi_product_expansion.hpp): the basic step has a step with one size per state, the triplet composition not.
+static_assert(StepperWithPerStateStepSizes<ChinBasicStep>);
+static_assert(!StepperWithPerStateStepSizes<TripletComposition<>>);
+static_assert(mpe_accepts<ChinBasicStep>);
+static_assert(!mpe_accepts<TripletComposition<>>);

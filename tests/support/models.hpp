@@ -1,6 +1,7 @@
 #pragma once
-// Models compiled into the tests, with hand-written derivatives. They are checked against finite differences in
-// test_models.cpp before anything relies on them.
+// Models compiled into the tests, with hand-written derivatives. value_T and value_V (T and V themselves, one value
+// per state) let the SDK's derivative checker (nonsep/derivative_checker.hpp) compare the gradients and Hessians
+// with finite differences in test_models.cpp before anything relies on them.
 #include <cmath>
 #include <cstddef>
 #include <span>
@@ -11,6 +12,12 @@ namespace nonsep::testing {
 // and H_VVT = (q + q^3/3)^2 p.
 struct Paper1D {
   std::size_t dimension() const { return 1; }
+  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = p[b] + p[b] * p[b] * p[b] / 6.0;
+  }
+  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = q[b] * q[b] / 2.0 + std::pow(q[b], 4) / 12.0;
+  }
   void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
     for (std::size_t b = 0; b < count; ++b) out[b] = 1.0 + 0.5 * p[b] * p[b];
   }
@@ -23,7 +30,20 @@ struct Paper1D {
   void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
     for (std::size_t b = 0; b < count; ++b) out[b] = 1.0 + q[b] * q[b];
   }
+  // d3T/dp3 = 1, d3V/dq3 = 2q.
+  void d3T(std::span<const double>, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = u[b] * u[b];
+  }
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 2.0 * q[b] * u[b] * u[b];
+  }
   static double H_TTV(double q, double p) { return std::pow(1.0 + 0.5 * p * p, 2) * (1.0 + q * q); }
+  // H_TTV for any scalar type (the references differentiate it): x = (q, p).
+  template <class S>
+  static S hamiltonian(const S* x) {
+    const S g = 1.0 + 0.5 * x[1] * x[1];
+    return g * g * (1.0 + x[0] * x[0]);
+  }
   static double H_VVT(double q, double p) { return std::pow(q + q * q * q / 3.0, 2) * p; }
 };
 
@@ -31,6 +51,18 @@ struct Paper1D {
 // T = p1 + p2/2 + (p1^2 + p2^2)^2/24 + p1 p2^2/6, V = (q1^2 + q2^2)/2 + q1^2 q2/3 + q2^4/12.
 struct Coupled2D {
   std::size_t dimension() const { return 2; }
+  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = p[2 * b], y = p[2 * b + 1], r2 = x * x + y * y;
+      out[b] = x + y / 2.0 + r2 * r2 / 24.0 + x * y * y / 6.0;
+    }
+  }
+  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = q[2 * b], y = q[2 * b + 1];
+      out[b] = (x * x + y * y) / 2.0 + x * x * y / 3.0 + std::pow(y, 4) / 12.0;
+    }
+  }
   void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
     for (std::size_t b = 0; b < count; ++b) {
       const double x = p[2 * b], y = p[2 * b + 1], r2 = x * x + y * y;
@@ -62,6 +94,114 @@ struct Coupled2D {
       h[1] = h[2] = 2.0 * x / 3.0;
       h[3] = 1.0 + y * y;
     }
+  }
+  // Third derivatives: T_000 = p1, T_001 = p2/3, T_011 = (p1 + 1)/3, T_111 = p2; V_001 = 2/3, V_111 = 2 q2, the
+  // others zero. out_k = sum_ij D_ijk u_i u_j.
+  void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = p[2 * b], y = p[2 * b + 1], u0 = u[2 * b], u1 = u[2 * b + 1];
+      out[2 * b] = x * u0 * u0 + 2.0 * y / 3.0 * u0 * u1 + (x + 1.0) / 3.0 * u1 * u1;
+      out[2 * b + 1] = y / 3.0 * u0 * u0 + 2.0 * (x + 1.0) / 3.0 * u0 * u1 + y * u1 * u1;
+    }
+  }
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double y = q[2 * b + 1], u0 = u[2 * b], u1 = u[2 * b + 1];
+      out[2 * b] = 4.0 / 3.0 * u0 * u1;
+      out[2 * b + 1] = 2.0 / 3.0 * u0 * u0 + 2.0 * y * u1 * u1;
+    }
+  }
+};
+
+// The 2D analogue of the paper's model with a coupling, hand-written twin of plugins/paper2d (whose header proves
+// the energy shells compact and explains the choice):
+//   T = p1 + p2 + (p1^3 + p2^3)/6,   V = |q|^2/2 + |q|^4/12 + coupling q1^2 q2^2.
+struct Paper2D {
+  double coupling = 0.2;
+
+  std::size_t dimension() const { return 2; }
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t i = 0; i < 2 * count; ++i) out[i] = 1.0 + 0.5 * p[i] * p[i];
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = q[2 * b], y = q[2 * b + 1], radial = 1.0 + (x * x + y * y) / 3.0;
+      out[2 * b] = x * radial + 2.0 * coupling * x * y * y;
+      out[2 * b + 1] = y * radial + 2.0 * coupling * x * x * y;
+    }
+  }
+  void hessian_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      double* h = out.data() + 4 * b;
+      h[0] = p[2 * b];
+      h[1] = h[2] = 0.0;
+      h[3] = p[2 * b + 1];
+    }
+  }
+  void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) hessian_V_at(q[2 * b], q[2 * b + 1], out.data() + 4 * b);
+  }
+  template <class S>
+  void hessian_V_at(const S& x, const S& y, S* h) const {
+    const S radial = 1.0 + (x * x + y * y) / 3.0;
+    h[0] = radial + 2.0 / 3.0 * x * x + 2.0 * coupling * y * y;
+    h[1] = 2.0 / 3.0 * x * y + 4.0 * coupling * x * y;
+    h[2] = h[1];
+    h[3] = radial + 2.0 / 3.0 * y * y + 2.0 * coupling * x * x;
+  }
+  // H_TTV = grad T . Hess V grad T for any scalar type, x = (q1, q2, p1, p2).
+  template <class S>
+  S hamiltonian(const S* x) const {
+    S h[4];
+    hessian_V_at(x[0], x[1], h);
+    const S g0 = 1.0 + 0.5 * x[2] * x[2], g1 = 1.0 + 0.5 * x[3] * x[3];
+    return g0 * (h[0] * g0 + h[1] * g1) + g1 * (h[2] * g0 + h[3] * g1);
+  }
+};
+
+// The paper's radial model (eq. hnd) in two dimensions, hand-written twin of plugins/radial: T = |p| + |p|^3/6,
+// V = |q|^2/2 + |q|^4/12. Integrable (H and the angular momentum q1 p2 - q2 p1 are conserved); undefined at p = 0.
+struct Radial2D {
+  std::size_t dimension() const { return 2; }
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double r = std::hypot(p[2 * b], p[2 * b + 1]), factor = 1.0 / r + 0.5 * r;
+      out[2 * b] = factor * p[2 * b];
+      out[2 * b + 1] = factor * p[2 * b + 1];
+    }
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double factor = 1.0 + (q[2 * b] * q[2 * b] + q[2 * b + 1] * q[2 * b + 1]) / 3.0;
+      out[2 * b] = factor * q[2 * b];
+      out[2 * b + 1] = factor * q[2 * b + 1];
+    }
+  }
+  // (1/p + p/2)(I - p_hat p_hat^T) + p p_hat p_hat^T
+  void hessian_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double r = std::hypot(p[2 * b], p[2 * b + 1]), across = 1.0 / r + 0.5 * r;
+      const double u[2] = {p[2 * b] / r, p[2 * b + 1] / r};
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) out[4 * b + 2 * i + j] = across * ((i == j) - u[i] * u[j]) + r * u[i] * u[j];
+    }
+  }
+  void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = q[2 * b], y = q[2 * b + 1], diagonal = 1.0 + (x * x + y * y) / 3.0;
+      double* h = out.data() + 4 * b;
+      h[0] = diagonal + 2.0 / 3.0 * x * x;
+      h[1] = h[2] = 2.0 / 3.0 * x * y;
+      h[3] = diagonal + 2.0 / 3.0 * y * y;
+    }
+  }
+  // H_TTV = (1 + p^2/2)^2 [1 + q^2/3 + (2/3)(p_hat . q)^2] for any scalar type, x = (q1, q2, p1, p2).
+  template <class S>
+  static S hamiltonian(const S* x) {
+    using std::sqrt;
+    const S p2 = x[2] * x[2] + x[3] * x[3], q2 = x[0] * x[0] + x[1] * x[1], dot = x[0] * x[2] + x[1] * x[3];
+    const S g = 1.0 + 0.5 * p2;
+    return g * g * (1.0 + q2 / 3.0 + 2.0 / 3.0 * dot * dot / p2);
   }
 };
 

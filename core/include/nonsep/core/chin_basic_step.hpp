@@ -19,10 +19,19 @@
 // on q in TTV, grad T on p in VVT). The last outer gradient of a step is kept with a copy of the point it was
 // evaluated at and reused by the next step when the state still holds that point bit for bit, whatever the
 // new dt. A run of steps therefore costs 4 grad T + 4 grad V evaluations per step, plus one at the start.
+//
+// Stage observers: step() takes an optional observer, called after each of the nine flows as
+//   observe(FlowStage{kick, coefficient}, eps, x)
+// kick: true for p <- p - coefficient eps grad V(q), false for q <- q + coefficient eps grad T(p) (whichever
+// form); eps as in the step (one entry, or one per state); x the states after the flow, which still hold the
+// point the flow's gradient was evaluated at (q for a kick, p for a drift). This is how the tangent map
+// (tangent_basic_step.hpp) follows the same nine stages without a second copy of the splitting; the default
+// observer does nothing and leaves the stepping numbers as they are.
 #include <cmath>
 #include <cstring>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nonsep/core/error.hpp"
@@ -48,6 +57,16 @@ struct ChinCoefficients {
   }
 };
 
+// One flow of the splitting, as seen by a stage observer (above).
+struct FlowStage {
+  bool kick;           // p <- p - coefficient eps grad V(q); otherwise the drift q <- q + coefficient eps grad T(p)
+  double coefficient;  // the splitting coefficient of this flow (v0, v1, v2, t1 or t2)
+};
+
+struct NoStageObserver {
+  void operator()(const FlowStage&, std::span<const double>, const PhaseSpaceBatch&) const {}
+};
+
 // Throws InvalidArgument unless dt is finite and non-zero.
 inline void check_step_size(double dt) {
   if (!std::isfinite(dt) || dt == 0.0)
@@ -69,26 +88,24 @@ class ChinBasicStep {
   HamiltonianForm form() const { return form_; }
   const ChinCoefficients& coefficients() const { return c_; }
   const EvaluationCounts& evaluations() const { return evaluations_; }
-  // Counts evaluations made elsewhere on this stepper's behalf (the fused plugin path, plugin_abi.h integrate).
-  void add_evaluations(const EvaluationCounts& counts) { evaluations_ += counts; }
 
   IntegratorDescription describe() const { return {"basic", Fraction(2, 3), true, true, 1, c_.t2}; }
 
   // Advances every state of `x` by dt (finite, non-zero). Throws InvalidArgument on a bad dt or a batch whose
   // dimension differs from the model's; propagates the model's exceptions.
-  template <Model M>
-  void step(const M& model, PhaseSpaceBatch& x, double dt) {
+  template <Model M, class StageObserver = NoStageObserver>
+  void step(const M& model, PhaseSpaceBatch& x, double dt, StageObserver&& observe = {}) {
     check_step_size(dt);
     check_batch_fits(model, x);
     eps_.assign(1, std::cbrt(dt));
-    advance(model, x);
+    advance(model, x, observe);
   }
 
   // Advances state b of `x` by dt[b] (one entry per state, each finite and non-zero): states of different step
   // sizes share each stage's model evaluation. State b gets bit for bit what step(model, x_b, dt[b]) gives it.
   // Throws InvalidArgument on a bad dt or dt.size() != x.count().
-  template <Model M>
-  void step(const M& model, PhaseSpaceBatch& x, std::span<const double> dt) {
+  template <Model M, class StageObserver = NoStageObserver>
+  void step(const M& model, PhaseSpaceBatch& x, std::span<const double> dt, StageObserver&& observe = {}) {
     check_batch_fits(model, x);
     if (dt.size() != x.count())
       throw InvalidArgument("a batch of " + std::to_string(x.count()) + " states needs as many step sizes (found " +
@@ -98,7 +115,7 @@ class ChinBasicStep {
       check_step_size(dt[b]);
       eps_[b] = std::cbrt(dt[b]);
     }
-    advance(model, x);
+    advance(model, x, observe);
   }
 
   // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached).
@@ -115,7 +132,7 @@ class ChinBasicStep {
   }
 
   // The first-same-as-last gradient and the point it belongs to, for wrappers that restart from a saved state
-  // (MultiProductExpansion) and for handing the cache to another copy of the stepper (Integrator::export_cache).
+  // (MultiProductExpansion).
   struct Cache {
     std::vector<double> at, gradient;
   };
@@ -127,8 +144,8 @@ class ChinBasicStep {
 
  private:
   // One basic step of every state; eps_ holds eps = cbrt(dt), one for all states or one per state.
-  template <Model M>
-  void advance(const M& model, PhaseSpaceBatch& x) {
+  template <Model M, class StageObserver>
+  void advance(const M& model, PhaseSpaceBatch& x, StageObserver& observe) {
     const bool ttv = form_ == HamiltonianForm::TTV;
     std::span<double> outer = ttv ? x.p() : x.q();
     std::span<double> inner = ttv ? x.q() : x.p();
@@ -150,10 +167,14 @@ class ChinBasicStep {
         for (std::size_t i = b * n; i < (b + 1) * n; ++i) y[i] += h * gradient[i];
       }
     };
-    auto outer_flow = [&](double coefficient) { flow(outer, outer_gradient_, outer_sign, coefficient); };
+    auto outer_flow = [&](double coefficient) {
+      flow(outer, outer_gradient_, outer_sign, coefficient);
+      observe(FlowStage{ttv, coefficient}, std::span<const double>(eps_), std::as_const(x));
+    };
     auto inner_flow = [&](double coefficient) {
       evaluate(model, !ttv, outer, inner_gradient_, count);  // TTV: grad T(p); VVT: grad V(q)
       flow(inner, inner_gradient_, inner_sign, coefficient);
+      observe(FlowStage{!ttv, coefficient}, std::span<const double>(eps_), std::as_const(x));
       evaluate(model, ttv, inner, outer_gradient_, count);   // TTV: grad V(q); VVT: grad T(p)
     };
     outer_flow(c_.v2);

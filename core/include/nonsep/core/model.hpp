@@ -39,15 +39,30 @@ concept ModelWithHessians =
       m.hessian_V(x, out, count);
     };
 
+// and nonsep::ModelWithThirdDerivatives when moreover (u of size count*n, read; out of size count*n, written):
+//   m.d3T(p, u, out, count)     writes sum_ij d3T/dp_i dp_j dp_k u_i u_j, k = 0..n-1, at each of the count momenta
+//   m.d3V(q, u, out, count)     writes sum_ij d3V/dq_i dq_j dq_k u_i u_j, k = 0..n-1, at each of the count positions
+template <class M>
+concept ModelWithThirdDerivatives =
+    ModelWithHessians<M> &&
+    requires(const M& m, std::span<const double> x, std::span<const double> u, std::span<double> out, std::size_t count) {
+      m.d3T(x, u, out, count);
+      m.d3V(x, u, out, count);
+    };
+
 // Gradient evaluations performed by an integrator, counted per state: one batched call on `count` states
-// counts `count` evaluations.
+// counts `count` evaluations. grad_H counts evaluations of the full gradient (dH/dq, dH/dp) of the solved
+// Hamiltonian by the comparator schemes (hamiltonian_gradient.hpp), each one gradient, two Hessians and one
+// third-derivative contraction of the model; those model calls are not counted again in grad_T and grad_V.
 struct EvaluationCounts {
   std::uint64_t grad_T = 0;
   std::uint64_t grad_V = 0;
+  std::uint64_t grad_H = 0;
 
   EvaluationCounts& operator+=(const EvaluationCounts& other) {
     grad_T += other.grad_T;
     grad_V += other.grad_V;
+    grad_H += other.grad_H;
     return *this;
   }
   friend bool operator==(const EvaluationCounts&, const EvaluationCounts&) = default;

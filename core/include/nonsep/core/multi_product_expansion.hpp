@@ -15,8 +15,14 @@
 // (ChinBasicStep's per-state step): round r advances every term with k > r by one basic step, so a step crosses
 // into the model 8m times instead of 4m(m+1) (one call per stage for all terms). step_term_by_term() runs the
 // terms one after the other; both give the same numbers and evaluation counts bit for bit (tests/core).
+//
+// The base stepper must be a StepperWithPerStateStepSizes (below), and the weights assume that its error is the
+// basic step's series in dt^(2/3) (eq. torder). ChinBasicStep is such a stepper. TripletComposition is not (its
+// step takes one dt for the whole batch), so MultiProductExpansion<TripletComposition<>> is refused at compile
+// time with that concept named.
 #include <algorithm>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -25,7 +31,36 @@
 
 namespace nonsep {
 
-template <class Base = ChinBasicStep>
+namespace detail {
+// A model type for checking steppers' member templates in concepts; declared only, never evaluated.
+struct ModelArchetype {
+  std::size_t dimension() const;
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const;
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const;
+};
+}  // namespace detail
+
+// What MultiProductExpansion needs of its base stepper B (b a B, cb a const B, model a Model, x a PhaseSpaceBatch):
+//   b.step(model, x, dt)           advances every state of x by one double dt
+//   b.step(model, x, sizes)        advances state i of x by sizes[i] (std::span<const double>, x.count() entries)
+//   b.prime(model, x)              makes the first-same-as-last gradient at x's point available
+//   typename B::Cache, cb.save_cache(), b.restore_cache(cache)    that gradient saved and restored
+//   cb.evaluations()               EvaluationCounts, per state
+//   cb.describe()                  IntegratorDescription
+template <class B>
+concept StepperWithPerStateStepSizes = requires(B& b, const B& cb, const detail::ModelArchetype& model,
+                                                PhaseSpaceBatch& x, double dt, std::span<const double> sizes,
+                                                const typename B::Cache& cache) {
+  b.step(model, x, dt);
+  b.step(model, x, sizes);
+  b.prime(model, x);
+  { cb.save_cache() } -> std::convertible_to<typename B::Cache>;
+  b.restore_cache(cache);
+  { cb.evaluations() } -> std::convertible_to<const EvaluationCounts&>;
+  { cb.describe() } -> std::convertible_to<IntegratorDescription>;
+};
+
+template <StepperWithPerStateStepSizes Base = ChinBasicStep>
 class MultiProductExpansion {
  public:
   static constexpr int max_terms = 16;
@@ -56,7 +91,6 @@ class MultiProductExpansion {
   Fraction order() const { return Fraction(2 * terms(), 3); }
   const Base& base() const { return base_; }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
-  void add_evaluations(const EvaluationCounts& counts) { base_.add_evaluations(counts); }
   IntegratorDescription describe() const {
     IntegratorDescription d = base_.describe();
     d.scheme = "mpe";
@@ -164,9 +198,6 @@ class MultiProductExpansion {
   }
   template <Model M>
   void prime(const M& model, const PhaseSpaceBatch& x) { base_.prime(model, x); }
-  using Cache = typename Base::Cache;
-  Cache save_cache() const { return base_.save_cache(); }
-  void restore_cache(const Cache& cache) { base_.restore_cache(cache); }
 
  private:
   static void accumulate(std::span<double> sum, double c, std::span<const double> y, std::span<const double> ym) {

@@ -40,7 +40,6 @@ class TripletComposition {
 
   const Base& base() const { return base_; }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
-  void add_evaluations(const EvaluationCounts& counts) { base_.add_evaluations(counts); }
   IntegratorDescription describe() const {
     IntegratorDescription d = base_.describe();
     d.scheme = "triplet";
@@ -52,28 +51,27 @@ class TripletComposition {
   template <Model M>
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
     check_step_size(dt);
-    compose(levels_, model, x, dt);
+    for_each_basic_step(levels_, dt, [&](double basic_dt) { base_.step(model, x, basic_dt); });
+  }
+
+  // Calls basic_step(dt_j) for the 3^levels basic steps of one composed step of dt, in order: the schedule of
+  // the composition, shared with the tangent map (tangent_triplet_composition.hpp).
+  template <class BasicStep>
+  static void for_each_basic_step(int levels, double dt, BasicStep&& basic_step) {
+    if (levels == 0) {
+      basic_step(dt);
+      return;
+    }
+    const double s = s_for_level(levels);
+    const double outer = dt / (2.0 - s);
+    for_each_basic_step(levels - 1, outer, basic_step);
+    for_each_basic_step(levels - 1, -s * outer, basic_step);
+    for_each_basic_step(levels - 1, outer, basic_step);
   }
   template <Model M>
   void prime(const M& model, const PhaseSpaceBatch& x) { base_.prime(model, x); }
-  using Cache = typename Base::Cache;
-  Cache save_cache() const { return base_.save_cache(); }
-  void restore_cache(const Cache& cache) { base_.restore_cache(cache); }
 
  private:
-  template <Model M>
-  void compose(int level, const M& model, PhaseSpaceBatch& x, double dt) {
-    if (level == 0) {
-      base_.step(model, x, dt);
-      return;
-    }
-    const double s = s_for_level(level);
-    const double outer = dt / (2.0 - s);
-    compose(level - 1, model, x, outer);
-    compose(level - 1, model, x, -s * outer);
-    compose(level - 1, model, x, outer);
-  }
-
   Base base_;
   int levels_;
 };

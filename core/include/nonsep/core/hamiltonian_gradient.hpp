@@ -1,0 +1,89 @@
+#pragma once
+// The full gradient of the solved Hamiltonian, for the comparator schemes that integrate H directly (Tao's
+// extended phase space, Gauss-Legendre collocation) instead of splitting T(p) + V(q) as Chin's schemes do.
+//
+//   TTV: H = T_i(p) V_ij(q) T_j(p)    dH/dq = d3V(q, grad T(p))        dH/dp = 2 Hess T(p) Hess V(q) grad T(p)
+//   VVT: H = V_i(q) T_ij(p) V_j(q)    dH/dq = 2 Hess V(q) Hess T(p) grad V(q)    dH/dp = d3T(p, grad V(q))
+//
+// where d3V(q, u)_k = sum_ij d3V/dq_i dq_j dq_k u_i u_j (model.hpp, ModelWithThirdDerivatives). One evaluation
+// costs the model one gradient, two Hessians and one third-derivative contraction per state, in four batched
+// calls, and counts one grad_H per state (EvaluationCounts).
+//
+// Layout: q, p, dH/dq and dH/dp are batches of `count` states of dimension n (component i of state b at b*n + i).
+// Model exceptions propagate; the outputs are then unspecified.
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "nonsep/core/error.hpp"
+#include "nonsep/core/model.hpp"
+
+namespace nonsep {
+
+class HamiltonianGradient {
+ public:
+  explicit HamiltonianGradient(HamiltonianForm form = HamiltonianForm::TTV) : form_(form) {}
+
+  HamiltonianForm form() const { return form_; }
+  const EvaluationCounts& evaluations() const { return evaluations_; }
+  void add_evaluations(const EvaluationCounts& counts) { evaluations_ += counts; }
+
+  // Writes dH/dq and dH/dp at each of the count points (q, p). All four spans hold at least count*n numbers.
+  // Throws InvalidArgument when a span is too short.
+  template <ModelWithThirdDerivatives M>
+  void evaluate(const M& model, std::span<const double> q, std::span<const double> p, std::span<double> dH_dq,
+                std::span<double> dH_dp, std::size_t count) {
+    const auto n = static_cast<std::size_t>(model.dimension());
+    const std::size_t size = n * count;
+    if (q.size() < size || p.size() < size || dH_dq.size() < size || dH_dp.size() < size)
+      throw InvalidArgument("the gradient of H of " + std::to_string(count) + " states of dimension " +
+                            std::to_string(n) + " needs spans of " + std::to_string(size) + " numbers");
+    q = q.first(size);
+    p = p.first(size);
+    dH_dq = dH_dq.first(size);
+    dH_dp = dH_dp.first(size);
+    gradient_.resize(size);
+    product_.resize(size);
+    outer_hessian_.resize(size * n);
+    inner_hessian_.resize(size * n);
+    // TTV: the gradient is grad T(p), contracted with Hess V(q) (inner) then Hess T(p) (outer); the third
+    // derivative is V's, at q. VVT: every role swapped.
+    const bool ttv = form_ == HamiltonianForm::TTV;
+    if (ttv) {
+      model.grad_T(p, std::span<double>(gradient_), count);
+      model.hessian_V(q, std::span<double>(inner_hessian_), count);
+      model.hessian_T(p, std::span<double>(outer_hessian_), count);
+      model.d3V(q, std::span<const double>(gradient_), dH_dq, count);
+    } else {
+      model.grad_V(q, std::span<double>(gradient_), count);
+      model.hessian_T(p, std::span<double>(inner_hessian_), count);
+      model.hessian_V(q, std::span<double>(outer_hessian_), count);
+      model.d3T(p, std::span<const double>(gradient_), dH_dp, count);
+    }
+    multiply(inner_hessian_, gradient_, product_, n, count, 1.0);
+    multiply(outer_hessian_, product_, ttv ? dH_dp : dH_dq, n, count, 2.0);
+    evaluations_.grad_H += count;
+  }
+
+ private:
+  // out_b = factor * A_b u_b for each state b (A row-major n x n per state).
+  static void multiply(std::span<const double> a, std::span<const double> u, std::span<double> out, std::size_t n,
+                       std::size_t count, double factor) {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* m = a.data() + b * n * n;
+      const double* v = u.data() + b * n;
+      for (std::size_t i = 0; i < n; ++i) {
+        double sum = 0.0;
+        for (std::size_t j = 0; j < n; ++j) sum += m[i * n + j] * v[j];
+        out[b * n + i] = factor * sum;
+      }
+    }
+  }
+
+  HamiltonianForm form_;
+  EvaluationCounts evaluations_;
+  std::vector<double> gradient_, product_, outer_hessian_, inner_hessian_;
+};
+
+}  // namespace nonsep

@@ -1,0 +1,48 @@
+#pragma once
+// A runtime-chosen tangent stepper: the tangent map of the integrator an IntegratorSpec describes (the scheme of
+// a job file), for diagnostics that follow tangent vectors (lyapunov_exponents.hpp, megno.hpp). The states are
+// stepped bit for bit as Integrator(spec) steps them.
+#include <variant>
+
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/tangent_basic_step.hpp"
+#include "nonsep/core/tangent_multi_product_expansion.hpp"
+#include "nonsep/core/tangent_triplet_composition.hpp"
+
+namespace nonsep {
+
+class TangentIntegrator {
+ public:
+  // Throws InvalidArgument as Integrator(spec) does (unknown scheme, an order the scheme does not have, bad t2).
+  explicit TangentIntegrator(const IntegratorSpec& spec) : spec_(spec), stepper_(make(spec)) {}
+
+  const IntegratorSpec& spec() const { return spec_; }
+
+  // Advances x by dt and maps the tangent vectors (layout of tangent_basic_step.hpp); errors as
+  // TangentBasicStep::step.
+  template <ModelWithHessians M>
+  void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, double dt) {
+    std::visit([&](auto& stepper) { stepper.step(model, x, tangents, dt); }, stepper_);
+  }
+  const EvaluationCounts& evaluations() const {
+    return std::visit([](const auto& s) -> const EvaluationCounts& { return s.evaluations(); }, stepper_);
+  }
+  const HessianCounts& hessian_evaluations() const {
+    return std::visit([](const auto& s) -> const HessianCounts& { return s.hessian_evaluations(); }, stepper_);
+  }
+
+ private:
+  using Stepper = std::variant<TangentBasicStep, TangentTripletComposition, TangentMultiProductExpansion>;
+  static Stepper make(const IntegratorSpec& spec) {
+    const Integrator validated(spec);
+    const ChinBasicStep base(spec.form, spec.t2);
+    if (spec.scheme == "triplet") return TangentTripletComposition(TripletComposition<>::for_order(base, spec.order));
+    if (spec.scheme == "mpe") return TangentMultiProductExpansion(MultiProductExpansion<>::for_order(base, spec.order));
+    return TangentBasicStep(base);
+  }
+
+  IntegratorSpec spec_;
+  Stepper stepper_;
+};
+
+}  // namespace nonsep
