@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/host/output_files.hpp"
+#include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
 
@@ -16,7 +16,7 @@ using json = nlohmann::json;
 
 namespace {
 
-constexpr const char* format_tag = "nonsep checkpoint 1";
+constexpr const char* format_tag = "nonsep checkpoint 2";
 
 json encode(double value) { return format_number(value); }
 
@@ -78,62 +78,99 @@ void append_bits(std::string& text, double value) {
 
 }  // namespace
 
-std::string job_fingerprint(const LoadedJob& loaded) {
-  const Job& job = loaded.job;
-  std::string text = loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + loaded.model.parameters().dump() +
-                     '\n' + job.integrator.scheme + '\n' + job.integrator.order.to_string() + '\n';
-  append_bits(text, job.integrator.t2);
-  text += job.integrator.form == HamiltonianForm::TTV ? "TTV\n" : "VVT\n";
-  text += std::to_string(job.initial.dimension) + ' ' + std::to_string(job.initial.count) + '\n';
-  for (double x : job.initial.q) append_bits(text, x);
-  for (double x : job.initial.p) append_bits(text, x);
-  append_bits(text, job.time.dt);
-  append_bits(text, job.time.t_end);
-  text += std::to_string(job.time.steps) + ' ' + std::to_string(job.every) + '\n';
-  if (job.analysis.closest_return_after) append_bits(text, *job.analysis.closest_return_after);
-  std::uint64_t hash = 14695981039346656037ull;
-  for (unsigned char c : text) {
+namespace {
+
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t hash = 14695981039346656037ull) {
+  for (unsigned char c : bytes) {
     hash ^= c;
     hash *= 1099511628211ull;
   }
+  return hash;
+}
+
+std::string hex(std::uint64_t hash) {
   char digits[17];
   std::snprintf(digits, sizeof digits, "%016llx", static_cast<unsigned long long>(hash));
   return digits;
 }
 
-void save_checkpoint(const std::filesystem::path& path, const RunState& state, const std::string& fingerprint) {
+// The plugin file's bytes, hashed: another library with the same name and version is another model.
+std::uint64_t file_hash(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t hash = 14695981039346656037ull;
+  std::string buffer(1 << 16, '\0');
+  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0)
+    hash = fnv1a(std::string_view(buffer.data(), static_cast<std::size_t>(in.gcount())), hash);
+  return hash;
+}
+
+// The parts of a fingerprint, "name:hash" separated by spaces, in this order.
+constexpr const char* fingerprint_parts[] = {"plugin", "parameters", "integrator", "initial", "time", "output",
+                                             "analysis"};
+
+}  // namespace
+
+std::string job_fingerprint(const LoadedJob& loaded) {
+  const Job& job = loaded.job;
+  std::string parts[7];
+  parts[0] = loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + hex(file_hash(loaded.plugin.path()));
+  parts[1] = loaded.model.parameters().dump();
+  parts[2] = job.integrator.scheme + '\n' + job.integrator.order.to_string() + '\n';
+  append_bits(parts[2], job.integrator.t2);
+  parts[2] += job.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
+  parts[3] = std::to_string(job.initial.dimension) + ' ' + std::to_string(job.initial.count) + '\n';
+  for (double x : job.initial.q) append_bits(parts[3], x);
+  for (double x : job.initial.p) append_bits(parts[3], x);
+  append_bits(parts[4], job.time.dt);
+  append_bits(parts[4], job.time.t_end);
+  parts[4] += std::to_string(job.time.steps);
+  parts[5] = std::to_string(job.every) + ' ' + std::to_string(job.energy_every);
+  if (job.analysis.closest_return_after) append_bits(parts[6], *job.analysis.closest_return_after);
+  parts[6] += '|';
+  if (job.analysis.max_relative_energy_error) append_bits(parts[6], *job.analysis.max_relative_energy_error);
+  std::string fingerprint;
+  for (std::size_t i = 0; i < 7; ++i)
+    fingerprint += (i ? " " : "") + std::string(fingerprint_parts[i]) + ":" + hex(fnv1a(parts[i]));
+  return fingerprint;
+}
+
+std::string fingerprint_difference(const std::string& a, const std::string& b) {
+  std::istringstream first(a), second(b);
+  std::string x, y, differ;
+  while (first >> x && second >> y)
+    if (x != y) differ += (differ.empty() ? "" : ", ") + x.substr(0, x.find(':'));
+  return differ.empty() ? "the job's identity" : differ;
+}
+
+void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint, const std::string& fingerprint) {
+  const DriverState& state = checkpoint.driver;
   json records = json::array();
   for (const TrajectoryRecord& record : state.records)
-    records.push_back(
-        {{"status", record.status},
-         {"final_step", record.final_step},
-         {"final_t", encode(record.final_t)},
-         {"final_q", encode(record.final_q)},
-         {"final_p", encode(record.final_p)},
-         {"energy_initial", encode(record.energy_initial)},
-         {"energy_final", encode(record.energy_final)},
-         {"max_abs_relative_error", encode(record.max_abs_relative_error)},
-         {"last_written_step", record.last_written_step ? json(*record.last_written_step) : json(nullptr)},
-         {"diverged_step", record.diverged_step},
-         {"diverged_t", encode(record.diverged_t)},
-         {"diverged_variable", record.diverged_variable},
-         {"error", record.error},
-         {"closest_distance", encode(record.closest_distance)},
-         {"closest_step", record.closest_step},
-         {"closest_t", encode(record.closest_t)}});
+    records.push_back({{"status", to_string(record.status)},
+                       {"final_step", record.final_step},
+                       {"final_t", encode(record.final_t)},
+                       {"final_q", encode(record.final_q)},
+                       {"final_p", encode(record.final_p)},
+                       {"energy_initial", encode(record.energy_initial)},
+                       {"energy_final", encode(record.energy_final)},
+                       {"stop_step", record.stop_step},
+                       {"stop_t", encode(record.stop_t)},
+                       {"stop_variable", record.stop_variable},
+                       {"message", record.message}});
   const json document = {
       {"format", format_tag},
       {"job_fingerprint", fingerprint},
       {"step", state.step},
-      {"trajectory_bytes", state.trajectory_bytes},
       {"evaluations", {{"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}}},
       {"active",
-       {{"slots", state.slots}, {"q", encode(state.q)}, {"p", encode(state.p)}, {"energies", encode(state.energies)}}},
-      {"records", std::move(records)}};
+       {{"trajectories", state.active}, {"q", encode(state.q)}, {"p", encode(state.p)},
+        {"energies", encode(state.energies)}}},
+      {"records", std::move(records)},
+      {"observers", checkpoint.observers}};
   write_file_atomically(path, document.dump() + "\n");
 }
 
-RunState load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded) {
+Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded) {
   const Job& job = loaded.job;
   std::ifstream in(path, std::ios::binary);
   if (!in)
@@ -151,39 +188,41 @@ RunState load_checkpoint(const std::filesystem::path& path, const LoadedJob& loa
   if (read.string(read.member(document, "format"), "format") != format_tag)
     damaged(path, std::string("its format is not \"") + format_tag + "\"");
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
-  if (fingerprint != job_fingerprint(loaded))
-    throw CheckpointError(path.string() + " belongs to a different job (fingerprint " + fingerprint + ", this job " +
-                          job_fingerprint(loaded) +
-                          "): the model, its parameters, the integrator, the initial states, the time grid or "
-                          "output.every differ; run without --resume to start over, or resume with the job that "
-                          "wrote it");
-  RunState state;
+  if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)
+    throw CheckpointError(path.string() + " belongs to a different job: its " +
+                          fingerprint_difference(fingerprint, expected) +
+                          " differ (the plugin part covers the plugin file's bytes, output covers output.every and "
+                          "energy_every); run with --force to start over, or resume with the job that wrote it");
+  Checkpoint checkpoint;
+  DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;
   state.step = read.unsigned_integer(read.member(document, "step"), "step");
   if (state.step > job.time.steps) damaged(path, "its step is beyond the job's last step");
-  state.trajectory_bytes = read.unsigned_integer(read.member(document, "trajectory_bytes"), "trajectory_bytes");
   const json& evaluations = read.member(document, "evaluations");
   state.evaluations.grad_T = read.unsigned_integer(read.member(evaluations, "grad_T"), "evaluations");
   state.evaluations.grad_V = read.unsigned_integer(read.member(evaluations, "grad_V"), "evaluations");
   const json& active = read.member(document, "active");
-  const json& slots = read.member(active, "slots");
-  if (!slots.is_array()) damaged(path, "active.slots is not an array");
-  std::vector<bool> seen(job.initial.count, false);
-  for (const auto& slot : slots) {
-    const auto index = read.unsigned_integer(slot, "active.slots");
-    if (index >= job.initial.count || seen[index]) damaged(path, "active.slots names a trajectory twice or not at all");
-    seen[index] = true;
-    state.slots.push_back(static_cast<std::size_t>(index));
+  const json& trajectories = read.member(active, "trajectories");
+  if (!trajectories.is_array()) damaged(path, "active.trajectories is not an array");
+  std::optional<std::size_t> previous;
+  for (const auto& entry : trajectories) {
+    const auto index = read.unsigned_integer(entry, "active.trajectories");
+    if (index >= job.initial.count || (previous && index <= *previous))
+      damaged(path, "active.trajectories is not increasing trajectory indices of the job");
+    previous = static_cast<std::size_t>(index);
+    state.active.push_back(static_cast<std::size_t>(index));
   }
-  state.q = read.numbers(read.member(active, "q"), state.slots.size() * n, "active.q");
-  state.p = read.numbers(read.member(active, "p"), state.slots.size() * n, "active.p");
-  state.energies = read.numbers(read.member(active, "energies"), state.slots.size(), "active.energies");
+  state.q = read.numbers(read.member(active, "q"), state.active.size() * n, "active.q");
+  state.p = read.numbers(read.member(active, "p"), state.active.size() * n, "active.p");
+  state.energies = read.numbers(read.member(active, "energies"), state.active.size(), "active.energies");
   const json& records = read.member(document, "records");
   if (!records.is_array() || records.size() != job.initial.count)
     damaged(path, "it does not have one record per trajectory");
   for (const auto& entry : records) {
     TrajectoryRecord record;
-    record.status = read.string(read.member(entry, "status"), "status");
+    const auto status = trajectory_status_from_string(read.string(read.member(entry, "status"), "status"));
+    if (!status) damaged(path, "a record's status is not a trajectory status");
+    record.status = *status;
     record.final_step = read.unsigned_integer(read.member(entry, "final_step"), "final_step");
     record.final_t = read.number(read.member(entry, "final_t"), "final_t");
     const json& final_q = read.member(entry, "final_q");
@@ -192,19 +231,15 @@ RunState load_checkpoint(const std::filesystem::path& path, const LoadedJob& loa
     record.final_p = read.numbers(read.member(entry, "final_p"), final_size, "final_p");
     record.energy_initial = read.optional_number(read.member(entry, "energy_initial"), "energy_initial");
     record.energy_final = read.optional_number(read.member(entry, "energy_final"), "energy_final");
-    record.max_abs_relative_error = read.number(read.member(entry, "max_abs_relative_error"), "max_abs_relative_error");
-    if (const json& last = read.member(entry, "last_written_step"); !last.is_null())
-      record.last_written_step = read.unsigned_integer(last, "last_written_step");
-    record.diverged_step = read.unsigned_integer(read.member(entry, "diverged_step"), "diverged_step");
-    record.diverged_t = read.number(read.member(entry, "diverged_t"), "diverged_t");
-    record.diverged_variable = read.string(read.member(entry, "diverged_variable"), "diverged_variable");
-    record.error = read.string(read.member(entry, "error"), "error");
-    record.closest_distance = read.optional_number(read.member(entry, "closest_distance"), "closest_distance");
-    record.closest_step = read.unsigned_integer(read.member(entry, "closest_step"), "closest_step");
-    record.closest_t = read.number(read.member(entry, "closest_t"), "closest_t");
+    record.stop_step = read.unsigned_integer(read.member(entry, "stop_step"), "stop_step");
+    record.stop_t = read.number(read.member(entry, "stop_t"), "stop_t");
+    record.stop_variable = read.string(read.member(entry, "stop_variable"), "stop_variable");
+    record.message = read.string(read.member(entry, "message"), "message");
     state.records.push_back(std::move(record));
   }
-  return state;
+  checkpoint.observers = read.member(document, "observers");
+  if (!checkpoint.observers.is_object()) damaged(path, "observers is not an object");
+  return checkpoint;
 }
 
 }  // namespace nonsep::host

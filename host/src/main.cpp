@@ -1,4 +1,18 @@
 // The nonsep executable. Everything happens in nonsep_host (command_line.hpp), which the tests also use.
-#include "nonsep/host/command_line.hpp"
+#include <csignal>
+#include <iostream>
 
-int main(int argc, char** argv) { return nonsep::host::run_command_line(argc, argv); }
+#include "nonsep/host/command_line.hpp"
+#include "nonsep/host/exit_status.hpp"
+
+int main(int argc, char** argv) {
+  // A closed standard output (`nonsep models | head -1`) is a write error reported below, not a death by SIGPIPE
+  // with a status outside the documented table.
+  std::signal(SIGPIPE, SIG_IGN);
+  const int status = nonsep::host::run_command_line(argc, argv);
+  if (!std::cout.flush()) {
+    std::cerr << "nonsep: cannot write to standard output (was it closed?)\n";
+    return status == 0 ? nonsep::host::to_int(nonsep::host::ExitStatus::run_failed) : status;
+  }
+  return status;
+}

@@ -11,7 +11,10 @@
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/host/output_files.hpp"
+#include "nonsep/host/output/csv.hpp"
+#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/run_folder.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
 
 namespace nonsep::host {
 
@@ -59,13 +62,6 @@ struct StudyRun {
   std::vector<double> final_q, final_p;
 };
 
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
-
 // c of error = c dt^n with n fixed: the geometric mean of |error| / |dt|^n over the usable points.
 double constant_at(double exponent, const std::vector<double>& dt, const std::vector<double>& error) {
   double sum = 0.0;
@@ -86,43 +82,33 @@ class StudyExecution {
  public:
   StudyExecution(const LoadedJob& loaded, const RunOptions& options)
       : loaded_(loaded), job_(loaded.job), study_(*loaded.job.study), options_(options),
-        energy_available_(loaded.plugin.has_hessians()), energy_(job_.integrator.form) {
-    std::error_code error;
-    std::filesystem::create_directories(options.output_directory, error);
-    if (error)
-      throw OutputError("cannot create the output folder " + options.output_directory.string() + ": " +
-                        error.message());
-    csv_path_ = options.output_directory / "convergence.csv";
-    csv_ = std::fopen(csv_path_.c_str(), "wb");
-    if (!csv_) throw OutputError("cannot create " + csv_path_.string());
-    write_csv(
-        "integrator,scheme,order,t2,symplectic,dt,steps,basic_steps,grad_T,grad_V,relative_energy_error,"
-        "phase_error,status\n");
-  }
+        folder_(options.output_directory, "study", loaded.job.file, folder_use(options)),
+        energy_available_(loaded.plugin.has_hessians()),
+        csv_(options.output_directory / "convergence.csv",
+             "integrator,scheme,order,t2,symplectic,dt,steps,basic_steps,grad_T,grad_V,relative_energy_error,"
+             "phase_error,status") {}
   StudyExecution(const StudyExecution&) = delete;
   StudyExecution& operator=(const StudyExecution&) = delete;
-  ~StudyExecution() {
-    if (csv_) std::fclose(csv_);
-  }
 
   RunOutcome execute() {
     const auto start = Clock::now();
     try {
-      const PhaseSpaceBatch initial = PhaseSpaceBatch::single(job_.initial.q, job_.initial.p);
-      if (energy_available_) energy_initial_ = energy_.evaluate_one(loaded_.model, initial);
       for (const auto& integrator : study_.integrators) {
         runs_.emplace_back();
         for (const std::uint64_t steps : integrator.steps) {
           if (interrupted_) break;
-          runs_.back().push_back(run_one(integrator, initial, steps));
+          runs_.back().push_back(run_one(integrator, steps));
           if (runs_.back().back().status != "interrupted") write_row(integrator, runs_.back().back());
         }
       }
     } catch (const std::exception& error) {
       run_error_ = error.what();
     }
-    if (csv_ && std::fclose(csv_) != 0 && run_error_.empty()) run_error_ = "cannot write " + csv_path_.string();
-    csv_ = nullptr;
+    try {
+      csv_.flush();
+    } catch (const OutputError& error) {
+      if (run_error_.empty()) run_error_ = error.what();
+    }
     RunOutcome outcome;
     outcome.summary = summary(std::chrono::duration<double>(Clock::now() - start).count());
     outcome.exit_status = exit_status();
@@ -136,45 +122,30 @@ class StudyExecution {
   }
 
  private:
-  StudyRun run_one(const StudyIntegrator& study_integrator, const PhaseSpaceBatch& initial, std::uint64_t steps) {
+  StudyRun run_one(const StudyIntegrator& study_integrator, std::uint64_t steps) {
     StudyRun run;
     run.steps = steps;
-    run.dt = job_.time.t_end / static_cast<double>(steps);
-    Integrator integrator(study_integrator.spec);
-    run.basic_steps = steps * integrator.describe().basic_steps_per_step;
-    PhaseSpaceBatch x = initial;
-    try {
-      for (std::uint64_t k = 0; k < steps; ++k) {
-        if (options_.stop_requested && options_.stop_requested->load()) {
-          interrupted_ = true;
-          run.status = "interrupted";
-          return run;
-        }
-        integrator.step(loaded_.model, x, run.dt);
-        const auto q = x.q(0), p = x.p(0);
-        if (!std::all_of(q.begin(), q.end(), [](double v) { return std::isfinite(v); }) ||
-            !std::all_of(p.begin(), p.end(), [](double v) { return std::isfinite(v); })) {
-          run.status = "diverged";
-          run.error = "q or p is not finite after step " + std::to_string(k + 1);
-          break;
-        }
-      }
-    } catch (const ModelError& error) {
-      run.status = "failed";
-      run.error = error.what();
-    }
-    run.evaluations = integrator.evaluations();
-    if (run.status != "completed") return run;
-    run.final_q.assign(x.q(0).begin(), x.q(0).end());
-    run.final_p.assign(x.p(0).begin(), x.p(0).end());
-    if (energy_initial_ && *energy_initial_ != 0.0) {
-      try {
-        run.relative_energy_error = (energy_.evaluate_one(loaded_.model, x) - *energy_initial_) / *energy_initial_;
-      } catch (const ModelError& error) {
-        run.status = "failed";
-        run.error = std::string("the energy could not be evaluated: ") + error.what();
-      }
-    }
+    const TimeGrid time = TimeGrid::to_end(job_.time.t_end, job_.time.t_end / static_cast<double>(steps), steps);
+    run.dt = time.dt;
+    run.basic_steps = steps * Integrator(study_integrator.spec).describe().basic_steps_per_step;
+    EnsembleDriver driver(loaded_.plugin, loaded_.model,
+                          {study_integrator.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
+                           options_.stop_requested});
+    const DriverEnd end = driver.run();
+    run.evaluations = driver.evaluations();
+    const TrajectoryRecord& record = driver.records().front();
+    if (!energy_initial_) energy_initial_ = record.energy_initial;
+    if (end == DriverEnd::failed) throw std::runtime_error(driver.error());
+    if (end == DriverEnd::interrupted) interrupted_ = true;
+    run.status = std::string(to_string(record.status));
+    if (record.status == TrajectoryStatus::diverged)
+      run.error = record.stop_variable + " is not finite after step " + std::to_string(record.stop_step);
+    else
+      run.error = record.message;
+    if (record.status != TrajectoryStatus::completed) return run;
+    run.final_q = record.final_q;
+    run.final_p = record.final_p;
+    run.relative_energy_error = relative_energy_error(record.energy_final, record.energy_initial);
     if (!study_.reference_q.empty()) {
       double sum = 0.0;
       for (std::size_t i = 0; i < run.final_q.size(); ++i) {
@@ -186,14 +157,11 @@ class StudyExecution {
     return run;
   }
 
-  void write_csv(const std::string& text) {
-    if (std::fwrite(text.data(), 1, text.size(), csv_) != text.size())
-      throw OutputError("cannot write " + csv_path_.string());
-  }
-
   void write_row(const StudyIntegrator& integrator, const StudyRun& run) {
     const auto description = Integrator(integrator.spec).describe();
-    std::string row = csv_field(integrator.label) + "," + description.scheme + "," + description.order.to_string() + ",";
+    std::string& row = csv_.row();
+    append_csv_text(row, integrator.label);
+    row += "," + description.scheme + "," + description.order.to_string() + ",";
     append_number(row, description.t2);
     row += description.symplectic ? ",true," : ",false,";
     append_number(row, run.dt);
@@ -202,8 +170,8 @@ class StudyExecution {
     if (run.relative_energy_error) append_number(row, *run.relative_energy_error);
     row += ",";
     if (run.phase_error) append_number(row, *run.phase_error);
-    row += "," + run.status + "\n";
-    write_csv(row);
+    row += "," + run.status;
+    csv_.end_row();
   }
 
   json fit_entry(const StudyIntegrator& integrator, const std::vector<StudyRun>& runs) const {
@@ -330,11 +298,10 @@ class StudyExecution {
   const Job& job_;
   const Study& study_;
   const RunOptions& options_;
+  const RunFolder folder_;
   bool energy_available_;
-  EnergyEvaluator energy_;
   std::optional<double> energy_initial_;
-  std::filesystem::path csv_path_;
-  std::FILE* csv_ = nullptr;
+  CsvAppender csv_;
   std::vector<std::vector<StudyRun>> runs_;  // per integrator, in step order
   bool interrupted_ = false;
   std::string run_error_;

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -130,6 +131,18 @@ inline Result finish(const Process& process, std::chrono::seconds timeout = std:
   return result;
 }
 
+// Polls `condition` (a callable returning bool) every few milliseconds until it holds: true as soon as it does,
+// false once `timeout` has passed without it. Tests wait on what they need (a file, a row count), never a fixed time.
+template <class Condition>
+bool wait_until(Condition condition, std::chrono::seconds timeout = std::chrono::seconds(30)) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return true;
+}
+
 // Runs `nonsep args...` to completion.
 inline Result run_nonsep(const std::vector<std::string>& args, const std::filesystem::path& folder) {
   return finish(start_nonsep(args, folder));
@@ -149,6 +162,60 @@ inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::pat
     rows.push_back(cells);
   }
   return rows;
+}
+
+
+// A run's results as one JSON value: summary.json with "trajectories" set to one object per row of
+// trajectories.csv: {index, status, final {t, step, q, p}, energy {initial, final, relative_error_final,
+// relative_error_max_abs}, stop {step, t, variable} (when it stopped early), message (when there is one),
+// closest_return {distance, t, step} or null (when the run tracked it)}. Empty cells are null; numbers are parsed
+// exactly (the host writes shortest round-trip decimals).
+inline nlohmann::json read_run(const std::filesystem::path& folder) {
+  nlohmann::json summary = read_json(folder / "summary.json");
+  const auto rows = read_csv(folder / "trajectories.csv");
+  if (rows.empty()) throw std::runtime_error("trajectories.csv has no header");
+  const auto& header = rows[0];
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    std::map<std::string, std::string> cell;
+    for (std::size_t c = 0; c < header.size(); ++c) cell[header[c]] = c < rows[r].size() ? rows[r][c] : "";
+    const auto number = [&](const std::string& name) -> nlohmann::json {
+      const std::string& text = cell.at(name);
+      if (text.empty()) return nullptr;
+      return std::strtod(text.c_str(), nullptr);
+    };
+    const auto integer = [&](const std::string& name) -> nlohmann::json {
+      const std::string& text = cell.at(name);
+      if (text.empty()) return nullptr;
+      return std::stoull(text);
+    };
+    nlohmann::json q = nlohmann::json::array(), p = nlohmann::json::array();
+    for (std::size_t i = 0; cell.count("q" + std::to_string(i)); ++i) {
+      if (cell.at("q" + std::to_string(i)).empty()) continue;
+      q.push_back(number("q" + std::to_string(i)));
+      p.push_back(number("p" + std::to_string(i)));
+    }
+    nlohmann::json entry = {{"index", std::stoull(cell.at("trajectory"))},
+                            {"status", cell.at("status")},
+                            {"final", {{"t", number("t")}, {"step", integer("step")}, {"q", q}, {"p", p}}},
+                            {"energy",
+                             {{"initial", number("H0")},
+                              {"final", number("H")},
+                              {"relative_error_final", number("relative_energy_error")},
+                              {"relative_error_max_abs", number("max_abs_relative_energy_error")}}}};
+    if (!cell.at("stop_step").empty())
+      entry["stop"] = {{"step", integer("stop_step")}, {"t", number("stop_t")}, {"variable", cell.at("stop_variable")}};
+    if (!cell.at("message").empty()) entry["message"] = cell.at("message");
+    if (cell.count("closest_return_distance"))
+      entry["closest_return"] = cell.at("closest_return_distance").empty()
+                                    ? nlohmann::json(nullptr)
+                                    : nlohmann::json{{"distance", number("closest_return_distance")},
+                                                     {"t", number("closest_return_t")},
+                                                     {"step", integer("closest_return_step")}};
+    list.push_back(std::move(entry));
+  }
+  summary["trajectories"] = std::move(list);
+  return summary;
 }
 
 }  // namespace nonsep::host_testing

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -215,6 +216,26 @@ TEST_CASE("checkpoint: every_steps and every_seconds, with defaults, and each pr
   CHECK(paths(parse(document).issues) == std::vector<std::string>{"/output/every"});
 }
 
+TEST_CASE("analysis: closest_return_after is a finite time, max_relative_energy_error a finite positive bound") {
+  json document = host_testing::quickstart_job();
+  auto parsed = parse(document);
+  CHECK_FALSE(parsed.job.analysis.closest_return_after);
+  CHECK_FALSE(parsed.job.analysis.max_relative_energy_error);
+  document["analysis"] = {{"closest_return_after", -1.5}, {"max_relative_energy_error", 1e-6}};
+  parsed = parse(document);
+  REQUIRE(parsed.issues.empty());
+  CHECK(parsed.job.analysis.closest_return_after == -1.5);
+  CHECK(parsed.job.analysis.max_relative_energy_error == 1e-6);
+  for (const json& bad :
+       {json(0), json(-1e-3), json("1e-6"), json(nullptr), json(std::numeric_limits<double>::infinity())}) {
+    CAPTURE(bad.dump());
+    document["analysis"] = {{"max_relative_energy_error", bad}};
+    parsed = parse(document);
+    REQUIRE(paths(parsed.issues) == std::vector<std::string>{"/analysis/max_relative_energy_error"});
+    CHECK(parsed.issues[0].allowed.rfind("a finite number > 0", 0) == 0);
+  }
+}
+
 TEST_CASE("every problem of a job is reported at once, each with its JSON path") {
   json document = host_testing::quickstart_job();
   document["colour"] = "blue";
@@ -256,37 +277,6 @@ TEST_CASE("strict JSON: syntax errors give line and column, duplicate keys are r
 
   parsed = parse_text(R"({"model": {"parameters": {"a/b": 1, "a/b": 2}}})");
   CHECK(paths(parsed.issues) == std::vector<std::string>{"/model/parameters/a~1b"});
-}
-
-TEST_CASE("model parameters are checked against the plugin's metadata") {
-  std::vector<PluginParameter> declared(3);
-  declared[0].name = "dimension";
-  declared[0].type = "integer";
-  declared[0].minimum = 1;
-  declared[0].maximum = 16;
-  declared[1].name = "mass";
-  declared[1].type = "number";
-  declared[1].minimum = 0;
-  declared[1].unit = "kg";
-  declared[2].name = "damped";
-  declared[2].type = "boolean";
-
-  std::vector<JobIssue> issues;
-  check_model_parameters({{"dimension", 3}, {"mass", 2.5}, {"damped", true}}, declared, issues);
-  CHECK(issues.empty());
-
-  check_model_parameters({{"dimension", 2.5}, {"mass", -1}, {"damped", 1}, {"colour", 1}, {"a/b", 1}}, declared,
-                         issues);
-  CHECK(paths(issues) == std::vector<std::string>{"/model/parameters/a~1b", "/model/parameters/colour",
-                                                  "/model/parameters/damped", "/model/parameters/dimension",
-                                                  "/model/parameters/mass"});
-  CHECK(issues[4].allowed.find(">= 0") != std::string::npos);
-  CHECK(issues[4].allowed.find("kg") != std::string::npos);
-
-  issues.clear();
-  check_model_parameters({{"dimension", 17}}, declared, issues);
-  CHECK(paths(issues) == std::vector<std::string>{"/model/parameters/dimension"});
-  CHECK(issues[0].allowed.find("<= 16") != std::string::npos);
 }
 
 TEST_CASE("initial states must have the model's dimension") {

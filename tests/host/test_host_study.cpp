@@ -138,7 +138,7 @@ TEST_CASE("closest_return is the minimum distance to the start over every step f
   const auto file = write_job(folder / "orbit.json", job);
   const auto result = run_nonsep({"run", "--quiet", "--output", (folder / "orbit").string(), file.string()}, folder.path());
   REQUIRE(result.status == 0);
-  const json summary = read_json(folder / "orbit" / "summary.json");
+  const json summary = read_run(folder / "orbit");
   const auto rows = read_csv(folder / "orbit" / "trajectory.csv");
   for (std::size_t trajectory = 0; trajectory < 2; ++trajectory) {
     double q0 = 0.0, best = std::numeric_limits<double>::infinity(), best_t = -1.0;
@@ -165,5 +165,5 @@ TEST_CASE("closest_return is the minimum distance to the start over every step f
   const auto plain_file = write_job(folder / "plain.json", plain);
   REQUIRE(run_nonsep({"run", "--quiet", "--output", (folder / "plain").string(), plain_file.string()}, folder.path())
               .status == 0);
-  CHECK_FALSE(read_json(folder / "plain" / "summary.json")["trajectories"][0].contains("closest_return"));
+  CHECK_FALSE(read_run(folder / "plain")["trajectories"][0].contains("closest_return"));
 }

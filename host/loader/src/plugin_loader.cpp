@@ -35,7 +35,6 @@ struct PluginModel::Instance {
   nonsep_instance* handle = nullptr;
   std::size_t dimension = 0;
   json parameters;
-  std::vector<double> fsal_gradient;  // integrate(): the first-same-as-last gradient crossing the ABI
 
   Instance() = default;
   Instance(const Instance&) = delete;
@@ -115,12 +114,18 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
     fail("gives \"dimension\" neither \"fixed\" nor \"parameter\"");
   }
 
+  if (!m.contains("thread_safe") || !m["thread_safe"].is_boolean())
+    fail("lacks the boolean \"thread_safe\" (required since plugin ABI version 3; true when distinct instances "
+         "share no mutable state, false to be run as one instance on one thread" +
+         (m.contains("thread_safe") ? "; found " + m["thread_safe"].dump() : std::string()) + ")");
+
   if (!m.contains("capabilities") || !m["capabilities"].is_object()) fail("lacks the object \"capabilities\"");
   const std::pair<const char*, bool> present[] = {{"value_T", api.value_T != nullptr},
                                                   {"value_V", api.value_V != nullptr},
                                                   {"hessian_T", api.hessian_T != nullptr},
                                                   {"hessian_V", api.hessian_V != nullptr},
-                                                  {"integrate", api.integrate != nullptr}};
+                                                  {"d3T", api.d3T != nullptr},
+                                                  {"d3V", api.d3V != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
@@ -129,6 +134,11 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
            " but the table's " + capability + " pointer is " + (in_table ? "set" : "null"));
   }
 }
+
+// The remedy for a plugin of another ABI version, named in both version refusals.
+const std::string rebuild_hint =
+    "rebuild the plugin against the installed SDK (find_package(nonsep) and nonsep_add_model, or the headers of "
+    "this nonsep's include/nonsep/plugin_abi.h)";
 
 bool looks_like_path(const std::string& spec) {
   return spec.find('/') != std::string::npos ||
@@ -163,7 +173,8 @@ std::string Plugin::name() const { return loaded_->metadata["name"].get<std::str
 std::string Plugin::version() const { return loaded_->metadata["version"].get<std::string>(); }
 std::string Plugin::description() const { return loaded_->metadata["description"].get<std::string>(); }
 bool Plugin::has_hessians() const { return loaded_->api->hessian_T != nullptr && loaded_->api->hessian_V != nullptr; }
-bool Plugin::has_integrate() const { return loaded_->api->integrate != nullptr; }
+bool Plugin::has_third_derivatives() const { return loaded_->api->d3T != nullptr && loaded_->api->d3V != nullptr; }
+bool Plugin::thread_safe() const { return loaded_->metadata["thread_safe"].get<bool>(); }
 bool Plugin::has_values() const { return loaded_->api->value_T != nullptr && loaded_->api->value_V != nullptr; }
 
 std::vector<PluginParameter> Plugin::parameters() const {
@@ -280,7 +291,7 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
       throw PluginError("plugin " + quoted(path) + " uses plugin ABI version 1 (it exports '"
                         NONSEP_PLUGIN_V1_ENTRY_SYMBOL "') but this host uses version " +
                         std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
-                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found 1); rebuild the plugin against this nonsep");
+                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found 1); " + rebuild_hint);
     throw PluginError(quoted(path) + " is a shared library but not a nonsep plugin: it does not export the symbol '"
                       NONSEP_PLUGIN_SYMBOL "' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp, or "
                       "NONSEP_DEFINE_PLUGIN, see plugin_abi.h)");
@@ -293,7 +304,7 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
     throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(api->abi_version) +
                       " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
                       std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found " + std::to_string(api->abi_version) +
-                      "); rebuild the plugin against this nonsep");
+                      "); " + rebuild_hint);
   if (api->struct_size != sizeof(nonsep_plugin_api))
     throw PluginError("plugin " + quoted(path) + " has a function table of " + std::to_string(api->struct_size) +
                       " bytes but ABI version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " defines " + std::to_string(sizeof(nonsep_plugin_api)) +
@@ -355,12 +366,12 @@ const json& PluginModel::parameters() const { return instance_->parameters; }
 
 namespace {
 
-using BatchedFunction = nonsep_status (*)(nonsep_instance*, const double*, double*, std::size_t);
-
-// Calls one batched function of the table, after checking the spans, and turns a failure into ModelError.
-void evaluate(const PluginModel& model, nonsep_instance* handle, const nonsep_plugin_api& api,
-              BatchedFunction function, const char* function_name, std::span<const double> in,
-              std::span<double> out, std::size_t count, std::size_t out_per_state) {
+// Checks the spans, then makes one batched call of the table, `call(handle, in, out, count)` (absent when
+// `present` is false), and turns a failure into ModelError with the plugin's message.
+template <class Call>
+void evaluate(const PluginModel& model, nonsep_instance* handle, const nonsep_plugin_api& api, bool present,
+              const char* function_name, std::span<const double> in, std::span<double> out, std::size_t count,
+              std::size_t out_per_state, const Call& call) {
   const std::size_t n = model.dimension();
   if (in.size() < count * n || out.size() < count * out_per_state)
     throw nonsep::InvalidArgument(std::string(function_name) + ": a batch of " + std::to_string(count) +
@@ -368,10 +379,10 @@ void evaluate(const PluginModel& model, nonsep_instance* handle, const nonsep_pl
                                   std::to_string(count * n) + " inputs and " + std::to_string(count * out_per_state) +
                                   " outputs (found " + std::to_string(in.size()) + " and " +
                                   std::to_string(out.size()) + ")");
-  if (function == nullptr)
+  if (!present)
     throw nonsep::ModelError("plugin '" + model.plugin().name() + "' does not provide " + function_name +
                              " (its capability is false)");
-  const nonsep_status status = function(handle, in.data(), out.data(), count);
+  const nonsep_status status = call(handle, in.data(), out.data(), count);
   if (status != NONSEP_OK) {
     const char* message = api.last_error(handle);
     throw nonsep::ModelError("plugin '" + model.plugin().name() + "' failed in " + function_name + " (" +
@@ -384,8 +395,9 @@ void evaluate(const PluginModel& model, nonsep_instance* handle, const nonsep_pl
 #define NONSEP_PLUGIN_MODEL_FUNCTION(function, out_per_state)                                                     \
   void PluginModel::function(std::span<const double> x, std::span<double> out, std::size_t count) const {         \
     const std::size_t n = instance_->dimension;                                                                   \
-    evaluate(*this, instance_->handle, *instance_->api, instance_->api->function, #function, x, out, count,       \
-             out_per_state);                                                                                      \
+    const nonsep_plugin_api& api = *instance_->api;                                                               \
+    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, x, out, count, out_per_state,     \
+             api.function);                                                                                       \
   }
 NONSEP_PLUGIN_MODEL_FUNCTION(grad_T, n)
 NONSEP_PLUGIN_MODEL_FUNCTION(grad_V, n)
@@ -395,39 +407,22 @@ NONSEP_PLUGIN_MODEL_FUNCTION(value_T, (static_cast<void>(n), 1))
 NONSEP_PLUGIN_MODEL_FUNCTION(value_V, (static_cast<void>(n), 1))
 #undef NONSEP_PLUGIN_MODEL_FUNCTION
 
-bool PluginModel::can_integrate() const { return instance_->api->integrate != nullptr; }
-
-void PluginModel::integrate(Integrator& integrator, PhaseSpaceBatch& x, double dt, std::uint64_t steps) const {
-  const nonsep_plugin_api& api = *instance_->api;
-  if (api.integrate == nullptr)
-    throw nonsep::ModelError("plugin '" + plugin().name() + "' does not provide integrate (its capability is false)");
-  if (x.dimension() != instance_->dimension)
-    throw nonsep::InvalidArgument("integrate: the plugin's model has dimension " +
-                                  std::to_string(instance_->dimension) + " but the states have dimension " +
-                                  std::to_string(x.dimension()));
-  const IntegratorSpec& spec = integrator.spec();
-  nonsep_integrator wanted{};
-  wanted.scheme = spec.scheme == "basic"     ? std::uint32_t{NONSEP_SCHEME_BASIC}
-                  : spec.scheme == "triplet" ? std::uint32_t{NONSEP_SCHEME_TRIPLET}
-                  : spec.scheme == "mpe"     ? std::uint32_t{NONSEP_SCHEME_MPE}
-                                             : 0xffffffffu;  // cannot happen: Integrator checked the name
-  wanted.form = spec.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT;
-  wanted.order_numerator = spec.order.numerator();
-  wanted.order_denominator = spec.order.denominator();
-  wanted.t2 = spec.t2;
-  std::vector<double>& gradient = instance_->fsal_gradient;
-  gradient.resize(x.q().size());
-  int valid = integrator.export_cache(x, gradient) ? 1 : 0;
-  EvaluationCounts counts;
-  const nonsep_status status = api.integrate(instance_->handle, &wanted, x.q().data(), x.p().data(), gradient.data(),
-                                             &valid, x.count(), dt, steps, &counts.grad_T, &counts.grad_V);
-  if (status != NONSEP_OK) {
-    const char* message = api.last_error(instance_->handle);
-    throw nonsep::ModelError("plugin '" + plugin().name() + "' failed in integrate (" + status_name(status) +
-                             "): " + (message != nullptr && *message ? message : "no message"));
+#define NONSEP_PLUGIN_MODEL_DIRECTIONAL(function)                                                                \
+  void PluginModel::function(std::span<const double> x, std::span<const double> u, std::span<double> out,        \
+                             std::size_t count) const {                                                          \
+    const std::size_t n = instance_->dimension;                                                                  \
+    if (u.size() < count * n)                                                                                    \
+      throw nonsep::InvalidArgument(#function ": a batch of " + std::to_string(count) + " states of dimension " + \
+                                    std::to_string(n) + " needs " + std::to_string(count * n) +                  \
+                                    " direction components (found " + std::to_string(u.size()) + ")");          \
+    const nonsep_plugin_api& api = *instance_->api;                                                             \
+    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, x, out, count, n,               \
+             [&](nonsep_instance* handle, const double* in, double* result, std::size_t size) {                 \
+               return api.function(handle, in, u.data(), result, size);                                         \
+             });                                                                                                 \
   }
-  integrator.import_cache(x, gradient, valid != 0);
-  integrator.add_evaluations(counts);
-}
+NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3T)
+NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3V)
+#undef NONSEP_PLUGIN_MODEL_DIRECTIONAL
 
 }  // namespace nonsep::host

@@ -61,6 +61,7 @@ const char* metadata() {
          {"description", "grad V returns +inf from its (n+1)-th call on; 0: never"}},
         {{"name", "sleep_ms"}, {"type", "integer"}, {"default", 0}, {"minimum", 0}, {"maximum", 10000},
          {"description", "each call of grad V sleeps this many milliseconds first"}}}},
+      {"thread_safe", true},  // the call counters are per instance
       {"capabilities",
        {{"value_T", BLOWUP_WITH_HESSIANS == 1}, {"value_V", BLOWUP_WITH_HESSIANS == 1},
         {"hessian_T", BLOWUP_WITH_HESSIANS == 1}, {"hessian_V", BLOWUP_WITH_HESSIANS == 1}}}}.dump();
@@ -158,7 +159,8 @@ const nonsep_plugin_api api = {
     BLOWUP_WITH_HESSIANS ? hessian_T : nullptr,
     BLOWUP_WITH_HESSIANS ? hessian_V : nullptr,
     last_error,
-    nullptr,  // integrate: absent, so the host steps it through grad_T and grad_V
+    nullptr,  // d3T: absent
+    nullptr,  // d3V: absent
 };
 
 }  // namespace

@@ -1,14 +1,17 @@
 #pragma once
 // Job files: reading one, checking every part of it, and reporting all problems at once.
 //
-// The shape of a job file is documented key by key in README.md ("Running nonsep: commands and job files") and formally in schemas/job.schema.json.
-// Reading happens in three passes, each adding to one list of JobIssue:
-//   1. parse_job_text  strict JSON: syntax (with line and column), duplicate keys.
+// The shape of a job file is documented key by key in README.md ("Running nonsep: commands and job files") and
+// formally in schemas/job.schema.json. Reading happens in three passes, each adding to one list of JobIssue:
+//   1. parse_job_text  strict JSON: syntax (with line and column), duplicate keys, at most max_nesting_depth levels.
 //   2. parse_job       structure and values that need no plugin: unknown keys, types, required keys, ranges,
 //                      integrator options against nonsep::scheme_catalogue(), the time grid, initial states.
-//   3. load_job        the plugin: it must load (/model/plugin), the parameters must match its metadata
+//                      The result, Job, is plain data.
+//   3. load_model      the plugin: it must load (/model/plugin), the parameters must match its metadata
 //                      (/model/parameters/<name>), and the states must have the model's dimension (/initial/...).
-// Every issue names a JSON Pointer (RFC 6901) into the job file, what was found there and what is allowed.
+// read_job is passes 1 and 2 on a file (at most max_job_file_bytes); load_job is all three, reporting the
+// problems of every pass together. Every issue names a JSON Pointer (RFC 6901) into the job file, what was found
+// there and what is allowed. The reader is split by the job file's sections, host/src/job/*.cpp.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -21,6 +24,7 @@
 
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/host/time_grid.hpp"
 
 namespace nonsep::host {
 
@@ -44,19 +48,6 @@ class InvalidJob : public std::runtime_error {
   std::vector<JobIssue> issues_;
 };
 
-// The time grid of a run. t_k = k * dt for k < steps, and t_steps = t_end exactly.
-// With `t_end` in the job: steps = ceil(r (1 - 1e-9)) for r = t_end / dt_requested (the slack keeps a t_end that
-// is a whole number of steps up to rounding from gaining a tiny extra step), and dt = t_end / steps, so the run
-// ends exactly at t_end with |dt| <= |dt_requested|. With `steps`: dt = dt_requested and t_end = steps * dt.
-struct TimeGrid {
-  double dt_requested = 0.0;
-  double dt = 0.0;
-  std::uint64_t steps = 0;
-  double t_end = 0.0;
-  bool from_t_end = false;
-
-  double time_at(std::uint64_t step) const { return step == steps ? t_end : static_cast<double>(step) * dt; }
-};
 
 // The initial states, state-major as in nonsep::PhaseSpaceBatch: component i of state b at b*dimension + i.
 // `shape` says how the job wrote them: "single" (one object), "list" (an array of objects) or "grid".
@@ -87,6 +78,9 @@ struct Analysis {
   // /analysis/closest_return_after: from this time on, the smallest Euclidean phase-space distance
   // |(q, p) - (q0, p0)| to the trajectory's initial state is tracked at every step (summary: closest_return).
   std::optional<double> closest_return_after;
+  // /analysis/max_relative_energy_error: a trajectory whose |H - H0| / |H0| exceeds it where H is evaluated retires
+  // as "inaccurate"; absent: no bound.
+  std::optional<double> max_relative_energy_error;
 };
 
 // When a run saves checkpoint.json (host/include/nonsep/host/checkpoint.hpp) so that `nonsep run --resume` can
@@ -117,14 +111,18 @@ struct Job {
 
 // Largest accepted number of initial states and of steps; larger values are reported as out of range.
 inline constexpr std::size_t max_initial_states = 1'000'000;
-inline constexpr std::uint64_t max_steps = 1'000'000'000'000;
 // Largest accepted number of initial values, states times dimension (2^24: 128 MiB for q and as much for p; a
 // million states of dimension 16 fit), so that a grid written in a few lines cannot ask for more memory and time
 // than a machine has.
 inline constexpr std::size_t max_initial_values = 16'777'216;
+// Largest accepted nesting of objects and arrays (the document is level 1). A job needs 6; the limit bounds the
+// reader's memory and the recursion of formatting a value for a message.
+inline constexpr std::size_t max_nesting_depth = 64;
+// Largest job file read (64 MiB); a longer file, or a device that never ends such as /dev/zero, is an issue at "".
+inline constexpr std::size_t max_job_file_bytes = std::size_t{64} << 20;
 
-// Pass 1. Parses `text` as JSON, refusing duplicate keys (nlohmann would keep the last one silently).
-// Returns nothing and adds issues on failure.
+// Pass 1. Parses `text` as JSON, refusing duplicate keys (nlohmann would keep the last one silently) and nesting
+// deeper than max_nesting_depth (naming the first value too deep). Returns nothing and adds issues on failure.
 std::optional<nlohmann::json> parse_job_text(const std::string& text, std::vector<JobIssue>& issues);
 
 // Pass 2. Reads `document` into a Job, adding an issue for everything wrong. `job_file` locates relative paths
@@ -132,7 +130,9 @@ std::optional<nlohmann::json> parse_job_text(const std::string& text, std::vecto
 Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_file, std::vector<JobIssue>& issues);
 
 // Pass 3 (parameters). Checks `given` (the job's /model/parameters, an object) against a plugin's declared
-// parameters: known names, types (integer, number, boolean), minimum and maximum.
+// parameters: known names, then the one rule of nonsep::sdk::check_parameter_value that the SDK and the plugin
+// loader apply too (nonsep/sdk/parameters.hpp: an integer is an integral number, 2.0 included, of magnitude at
+// most 2^53; a number is finite; bounds are inclusive).
 void check_model_parameters(const nlohmann::json& given, const std::vector<PluginParameter>& declared,
                             std::vector<JobIssue>& issues);
 
@@ -145,6 +145,15 @@ struct LoadedJob {
   Plugin plugin;
   PluginModel model;
 };
+
+// Passes 1 and 2 on the file at `job_file`. Nothing when the file cannot be read (missing, a directory, larger than
+// max_job_file_bytes: an issue at "") or is not strict JSON; otherwise the Job, meaningful only if no issue was added.
+std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<JobIssue>& issues);
+
+// Pass 3 on a job read by read_job, whether or not it had issues (so that all are reported at once): loads
+// job.plugin, checks the parameters, creates the model and checks the states' dimension. Nothing when the job
+// names no plugin (/model/plugin was missing or invalid) or this pass added an issue.
+std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues);
 
 // All three passes on the file at `job_file`. Throws InvalidJob listing every issue (an unreadable file is an
 // issue at path ""). Exceptions other than InvalidJob mean a bug or an exhausted machine.

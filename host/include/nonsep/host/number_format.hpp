@@ -2,7 +2,9 @@
 // Shortest round-trip decimal text of a double (std::to_chars): reading the text back gives the same double bit
 // for bit. Used for every number nonsep writes to CSV.
 #include <charconv>
+#include <optional>
 #include <string>
+#include <string_view>
 
 namespace nonsep::host {
 
@@ -17,6 +19,18 @@ inline std::string format_number(double value) {
   std::string text;
   append_number(text, value);
   return text;
+}
+
+}  // namespace nonsep::host
+
+namespace nonsep::host {
+
+// The double written by append_number (the whole of `text`, nothing else), or nothing.
+inline std::optional<double> parse_number(std::string_view text) {
+  double x = 0.0;
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), x);
+  if (result.ec != std::errc() || result.ptr != text.data() + text.size()) return std::nullopt;
+  return x;
 }
 
 }  // namespace nonsep::host

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 namespace nonsep::host {
 
@@ -15,8 +16,10 @@ class ProgressBar {
   ProgressBar& operator=(const ProgressBar&) = delete;
   ~ProgressBar() { finish(); }
 
-  // Called after each step; cheap when nothing is drawn (one clock read).
-  void update(std::uint64_t step, double t, std::size_t active_trajectories);
+  // Called after each chunk; cheap when nothing is drawn (one clock read). Shows the largest relative energy error
+  // of the ensemble so far when it is known.
+  void update(std::uint64_t step, double t, std::size_t active_trajectories,
+              std::optional<double> largest_energy_error = std::nullopt);
   // Erases the bar if it was drawn.
   void finish();
 

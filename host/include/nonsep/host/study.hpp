@@ -17,7 +17,7 @@
 #include <span>
 
 #include "nonsep/host/job.hpp"
-#include "nonsep/host/runner.hpp"
+#include "nonsep/host/run/run_job.hpp"
 
 namespace nonsep::host {
 

@@ -26,8 +26,6 @@
 #include <nlohmann/json.hpp>
 
 #include "nonsep/core/error.hpp"
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/phase_space_batch.hpp"
 
 struct nonsep_plugin_api;
 struct nonsep_instance;
@@ -58,9 +56,11 @@ class Plugin {
   std::string version() const;
   std::string description() const;
   std::vector<PluginParameter> parameters() const;
-  bool has_hessians() const;  // both hessian_T and hessian_V
-  bool has_values() const;    // both value_T and value_V
-  bool has_integrate() const; // the fused stepping loop integrate() (ABI version 2, optional)
+  bool has_hessians() const;            // both hessian_T and hessian_V
+  bool has_values() const;              // both value_T and value_V
+  bool has_third_derivatives() const;   // both d3T and d3V
+  // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
+  bool thread_safe() const;
 
   // Creates an instance. `parameters` must be a JSON object; unknown names, wrong types and values out of range
   // are refused with a PluginError naming the parameter (checked by the host against the metadata first, then by
@@ -74,7 +74,9 @@ class Plugin {
 };
 
 // Throws PluginError: file not found (listing every place tried), not a shared library, no plugin symbol,
-// ABI version mismatch (also a version-1 plugin, recognised by its entry function), wrong table size, invalid metadata.
+// ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 3, found N"
+// and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
+// (including capabilities that disagree with the table and a missing "thread_safe").
 Plugin load_plugin(const std::string& name_or_path, const std::filesystem::path& base_directory);
 
 std::vector<std::filesystem::path> plugin_search_path();
@@ -88,7 +90,7 @@ struct DiscoveredPlugin {
 };
 std::vector<DiscoveredPlugin> discover_plugins();
 
-// A plugin instance as a nonsep::ModelWithHessians. One instance must be used by one thread at a time.
+// A plugin instance as a nonsep::ModelWithThirdDerivatives. One instance must be used by one thread at a time.
 class PluginModel {
  public:
   std::size_t dimension() const;
@@ -100,13 +102,10 @@ class PluginModel {
   void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const;
   void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const;
 
-  // The fused path (plugin_abi.h integrate): whether the plugin has it, and `steps` steps of dt on x with
-  // `integrator`'s scheme run inside the plugin. integrator's first-same-as-last cache goes in and comes back
-  // and the plugin's evaluations are added to its counts, so stepping on with `integrator` gives what stepping
-  // with it all along would have. Throws nonsep::ModelError when the plugin lacks integrate or fails (x and the
-  // integrator's cache are then unspecified: the caller goes back to a copy).
-  bool can_integrate() const;
-  void integrate(Integrator& integrator, PhaseSpaceBatch& x, double dt, std::uint64_t steps) const;
+  // Directional third derivatives (plugin_abi.h d3T, d3V): u has the layout of x, out receives count*n numbers.
+  // Throw nonsep::ModelError when the plugin lacks the function, or it fails.
+  void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const;
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const;
 
   const Plugin& plugin() const;
   // The parameters in effect: the metadata's defaults overlaid with those given to create().

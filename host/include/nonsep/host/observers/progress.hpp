@@ -1,0 +1,33 @@
+#pragma once
+// The progress bar (progress_bar.hpp) as an observer: redrawn after chunks, with the step, the active trajectories
+// and the largest relative energy error so far.
+#include "nonsep/host/observers/energy_error.hpp"
+#include "nonsep/host/progress_bar.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+#include "nonsep/host/run/observer.hpp"
+
+namespace nonsep::host {
+
+class ProgressObserver : public Observer {
+ public:
+  // `energy` may be null.
+  ProgressObserver(bool enabled, const EnsembleDriver& driver, const EnergyErrorObserver* energy)
+      : enabled_(enabled), bar_(enabled, driver.time().steps), driver_(driver), energy_(energy) {}
+
+  void after_chunk(std::uint64_t step) override {
+    if (!enabled_) return;
+    std::optional<double> largest;
+    if (energy_)
+      if (const auto l = energy_->largest()) largest = l->value;
+    bar_.update(step, driver_.time().time_at(step), driver_.active_count(), largest);
+  }
+  void before_finish(std::uint64_t, bool) override { bar_.finish(); }
+
+ private:
+  bool enabled_;
+  ProgressBar bar_;
+  const EnsembleDriver& driver_;
+  const EnergyErrorObserver* energy_;
+};
+
+}  // namespace nonsep::host

@@ -1,0 +1,108 @@
+#pragma once
+// The ensemble driver: advances every trajectory of a run from step 0 (or a checkpoint) to the last step, and
+// nothing else. No I/O: everything a run writes or tracks is an observer (observer.hpp).
+//
+// Blocks and threads. The trajectories are split into fixed blocks of `run_block_size` consecutive trajectories,
+// whatever the number of threads; each block is one nonsep::PhaseSpaceBatch with its own Integrator (one plugin
+// call per stage for the whole block). Blocks run on `threads` OpenMP threads, each thread with its own plugin
+// instance (the ABI's contract). The plugin evaluates every state on its own and the blocks do not depend on the
+// thread count, so every number, and every observer's output, is the same for any number of threads.
+//
+// Chunks. From one event (an observer's next_event, the end; at most `run_chunk_state_steps` state-steps) to the
+// next, each block advances without per-step checks. When a block's chunk ends with a non-finite number or the
+// plugin fails in it, the block goes back to its state at the chunk's start (integrator and every-step observers
+// included) and redoes the chunk step by step with the checks below, so the numbers, evaluation counts and
+// statuses are those of a run checked at every step.
+//
+// Per trajectory, at every step:
+//   - a state with a non-finite q or p retires as "diverged" (stop step and the first non-finite variable, e.g.
+//     "p[0]"); its final state is its last finite one;
+//   - when the plugin fails on the block (nonsep::ModelError), the step is redone state by state from the previous
+//     step's copy, and only the states the plugin fails on retire, as "failed" with the plugin's message.
+// Removing a state from a block does not change the others' numbers.
+//
+// Energy: H (nonsep::EnergyEvaluator, needs the plugin's Hessians) is evaluated at step 0, at every event step an
+// observer asks for (needs_energy), at the last step, and for the final state of a trajectory that stops early.
+// A state whose H cannot be evaluated at an event retires as "failed".
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/host/run/observer.hpp"
+#include "nonsep/host/run/trajectory.hpp"
+#include "nonsep/host/time_grid.hpp"
+
+namespace nonsep::host {
+
+inline constexpr std::size_t run_block_size = 256;              // trajectories per block
+inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chunk: state-steps of all active states
+
+// What the driver integrates.
+struct EnsembleSetup {
+  IntegratorSpec integrator;
+  TimeGrid time;
+  std::size_t dimension = 0;
+  std::span<const double> q, p;  // initial states, state-major (count * dimension each)
+  unsigned threads = 0;  // worker threads; 0: all cores (omp_get_max_threads); 1 for a plugin that is not thread-safe
+  const std::atomic<bool>* stop_requested = nullptr;  // checked between chunks
+};
+
+// The driver's state between two steps, for checkpoints.
+struct DriverState {
+  std::uint64_t step = 0;                 // steps completed
+  std::vector<std::size_t> active;        // the active trajectories, in trajectory order
+  std::vector<double> q, p;               // their states, state-major
+  std::vector<double> energies;           // their H at `step` (NaN when not evaluated there)
+  std::vector<TrajectoryRecord> records;  // every trajectory, by index
+  EvaluationCounts evaluations;
+};
+
+// How the stepping ended.
+enum class DriverEnd {
+  completed,    // the last step was reached (or every trajectory stopped early)
+  interrupted,  // stop_requested was set
+  failed,       // an error that is not one trajectory's (thrown by an observer, the machine, ...): error()
+};
+
+class EnsembleDriver {
+ public:
+  // `model` is an instance of `plugin` created with the job's parameters; other threads get their own instances.
+  EnsembleDriver(const Plugin& plugin, const PluginModel& model, EnsembleSetup setup);
+  ~EnsembleDriver();
+  EnsembleDriver(const EnsembleDriver&) = delete;
+  EnsembleDriver& operator=(const EnsembleDriver&) = delete;
+
+  // Observers, called in the order added. Not owned; must outlive run().
+  void add_observer(Observer& observer);
+  // Continue from a checkpoint instead of step 0 (before run()).
+  void restore(DriverState state);
+  // The state after the last completed step (between chunks; observers call it from after_chunk or
+  // before_finish).
+  DriverState state() const;
+
+  // Steps to the end, then retires every active state (completed, or interrupted when the run stopped early) and
+  // calls on_end. Never throws for one trajectory's problems; an error of the run as a whole ends it as failed.
+  DriverEnd run();
+
+  const std::vector<TrajectoryRecord>& records() const;
+  EvaluationCounts evaluations() const;
+  std::uint64_t steps_completed() const;
+  std::size_t active_count() const;
+  const std::string& error() const;  // why the run failed (DriverEnd::failed)
+  const TimeGrid& time() const;
+  bool energy_available() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace nonsep::host

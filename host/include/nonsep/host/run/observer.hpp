@@ -1,0 +1,106 @@
+#pragma once
+// Observers watch an ensemble that the EnsembleDriver (ensemble_driver.hpp) advances; everything that happens
+// during a run besides stepping is one: the trajectory.csv writer, the energy-error tracker, the closest-return
+// analysis, the checkpoint saver, the progress bar. Adding one does not touch the driver (Odeint's integrate_*
+// with an observer; STYLE.md lesson 11).
+//
+// What the driver calls, and when (all on the driver's thread unless said otherwise):
+//   next_event(step)       the first step after `step` at which the observer must see the ensemble; the driver
+//                          ends its chunk of unchecked stepping there. Default: none.
+//   needs_energy(step)     whether H must be evaluated at event `step` (the driver then evaluates it for every
+//                          active state before on_event). H is always evaluated at step 0 and at the last step.
+//   on_event(event)        at step 0 (a fresh run) and at every event step of any observer, after the states that
+//                          stopped in the chunk were retired: the active states in trajectory order, with H where
+//                          it was evaluated. May ask for trajectories to be retired (event.retire).
+//   on_retire(...)         a trajectory stopped: early (diverged, failed, inaccurate) in the order a step-by-step
+//                          run finds them (step, then energy failures, then trajectory index), or at the end of the
+//                          run (completed, interrupted), in trajectory order. Its record is final.
+//   after_chunk(step)      after every chunk (at most run_chunk_state_steps state-steps, a fraction of a second).
+//   before_finish(step, interrupted)  the stepping is over, before the active states are retired.
+//   on_end()               after the last retirement: flush, close.
+// Observers that watch every step (watches_every_step() true) are called inside chunks, on the worker thread of
+// each block, with that block's states only (on_step); they must touch nothing but their state for those
+// trajectories. Before a chunk the driver calls save_block; when a chunk is redone step by step (a state stopped
+// being finite, or the plugin failed, somewhere in it) restore_block puts the block's trajectories back.
+//
+// Checkpoints: save() returns the observer's state as JSON (numbers as shortest round-trip strings: see
+// checkpoint.hpp), restore() takes it back after a resume; a resumed run must end bit for bit as an uninterrupted
+// one. trajectories.csv: columns() names the observer's per-trajectory columns, cells() writes them.
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nonsep/host/run/trajectory.hpp"
+
+namespace nonsep::host {
+
+inline constexpr std::uint64_t no_event = std::numeric_limits<std::uint64_t>::max();
+
+// One active state at an event.
+struct StateView {
+  std::size_t trajectory = 0;
+  std::span<const double> q, p;
+  std::optional<double> energy;          // H at this step, when it was evaluated and finite
+  const TrajectoryRecord* record = nullptr;  // energy_initial etc.
+};
+
+// A retirement an observer asks for at an event: the trajectory stops there with `status` and `message`.
+struct RetirementRequest {
+  std::size_t trajectory = 0;
+  TrajectoryStatus status = TrajectoryStatus::inaccurate;
+  std::string message;
+};
+
+struct Event {
+  std::uint64_t step = 0;
+  double t = 0.0;
+  std::span<const StateView> states;  // trajectory order
+  bool energy_evaluated = false;      // H was evaluated at this step (StateView::energy may still be empty)
+  std::vector<RetirementRequest>* retire = nullptr;
+};
+
+// The states of one block inside a chunk (on_step): trajectories[s] is the index of slot s, its q at
+// q[s*n .. s*n+n), p likewise.
+struct BlockView {
+  std::size_t block = 0;
+  std::size_t dimension = 0;
+  std::span<const std::size_t> trajectories;
+  std::span<const double> q, p;
+};
+
+class Observer {
+ public:
+  virtual ~Observer() = default;
+
+  virtual std::uint64_t next_event(std::uint64_t /*step*/) const { return no_event; }
+  virtual bool needs_energy(std::uint64_t /*step*/) const { return false; }
+  virtual void on_event(const Event& /*event*/) {}
+  virtual void on_retire(std::size_t /*trajectory*/, const TrajectoryRecord& /*record*/) {}
+  virtual void after_chunk(std::uint64_t /*step*/) {}
+  virtual void before_finish(std::uint64_t /*step*/, bool /*interrupted*/) {}
+  virtual void on_end() {}
+
+  virtual bool watches_every_step() const { return false; }
+  // Called once before stepping with the number of blocks.
+  virtual void prepare_blocks(std::size_t /*blocks*/) {}
+  virtual void on_step(std::uint64_t /*step*/, double /*t*/, const BlockView& /*block*/) {}
+  virtual void save_block(const BlockView& /*block*/) {}
+  virtual void restore_block(const BlockView& /*block*/) {}
+
+  // Checkpoints. `name()` keys the observer's state in checkpoint.json; empty: nothing to save.
+  virtual std::string name() const { return ""; }
+  virtual nlohmann::json save() { return nullptr; }
+  virtual void restore(const nlohmann::json& /*state*/) {}
+
+  // trajectories.csv
+  virtual void columns(std::vector<std::string>& /*names*/) const {}
+  virtual void cells(std::size_t /*trajectory*/, std::string& /*row*/) const {}
+};
+
+}  // namespace nonsep::host

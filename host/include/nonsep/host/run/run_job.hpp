@@ -1,0 +1,74 @@
+#pragma once
+// Running a loaded job (or resuming one): an EnsembleDriver with the observers the job asks for, then the
+// run's files. In the output folder:
+//   trajectory.csv    the samples (observers/sample_writer.hpp), streamed; none when output.every is 0
+//   trajectories.csv  one row per trajectory, written at the end (header below)
+//   summary.json      the run's facts (status, job, model, integrator, time grid, energy, counts, evaluations)
+//   checkpoint.json   while the run is interrupted (observers/checkpoint_saver.hpp)
+// trajectories.csv header:
+//   trajectory,status,step,t,q0,...,q<n-1>,p0,...,p<n-1>,H0,H,relative_energy_error,stop_step,stop_t,
+//   stop_variable,message, then the observers' columns: max_abs_relative_energy_error, and with
+//   /analysis/closest_return_after closest_return_distance,closest_return_t,closest_return_step.
+// step, t, q, p and H are the final state's; stop_* say where a trajectory that stopped early (diverged, failed,
+// inaccurate) stopped; empty cells are unknown or not applicable.
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/observers/energy_error.hpp"
+#include "nonsep/host/output/run_folder.hpp"
+#include "nonsep/host/run/trajectory.hpp"
+
+namespace nonsep::host {
+
+struct RunOptions {
+  std::filesystem::path output_directory;  // created if missing
+  bool show_progress = false;              // draw a ProgressBar on stderr (the caller checks for a terminal)
+  // Checked between chunks (a fraction of a second apart); when true the run stops with status "interrupted"
+  // (set from a SIGINT handler).
+  const std::atomic<bool>* stop_requested = nullptr;
+  bool resume = false;   // continue from output_directory/checkpoint.json (checkpoint.hpp)
+  bool force = false;    // start over in a folder holding another job's results or a checkpoint (run_folder.hpp)
+  unsigned threads = 0;  // worker threads; 0: all cores
+};
+
+// How many trajectories ended with each status.
+struct StatusCounts {
+  std::size_t completed = 0, diverged = 0, failed = 0, inaccurate = 0, interrupted = 0;
+  std::size_t& operator[](TrajectoryStatus status);
+};
+
+struct RunOutcome {
+  ExitStatus exit_status = ExitStatus::success;  // success, run_failed or interrupted
+  // The run's status: interrupted, failed (the run as a whole, or a trajectory), diverged, inaccurate, completed:
+  // the first that applies.
+  TrajectoryStatus status = TrajectoryStatus::completed;
+  std::string error;  // why the run as a whole failed (an output could not be written, ...); "" otherwise
+  std::uint64_t steps_completed = 0;
+  StatusCounts counts;
+  std::vector<TrajectoryRecord> trajectories;  // one per trajectory, in job order
+  std::optional<LargestEnergyError> largest_energy_error;  // over the steps where H was evaluated
+  nlohmann::ordered_json summary;  // what summary.json holds
+  std::vector<std::string> notes;  // for the user, not errors (e.g. "ran on one thread: ...")
+};
+
+// The output folder as `options` ask to use it (output/run_folder.hpp).
+FolderUse folder_use(const RunOptions& options);
+
+// Runs `job`. Throws, before anything is computed: FolderInUse when the output folder is another run's or holds
+// results this run may not replace (run_folder.hpp), OutputError when the folder or trajectory.csv cannot be
+// created, and CheckpointError when asked to resume from a checkpoint that is missing, damaged or another job's.
+// A resumed run ends with the same files, bit for bit, as an uninterrupted one (but summary.json's wall_seconds;
+// its evaluation counts may exceed those by one gradient: the reused last gradient of the basic step is not in the
+// checkpoint). Every failure after the start is reported in the outcome and in summary.json rather than thrown.
+RunOutcome run_job(const LoadedJob& job, const RunOptions& options);
+
+}  // namespace nonsep::host

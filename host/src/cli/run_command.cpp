@@ -1,0 +1,198 @@
+#include <iostream>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/number_format.hpp"
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <optional>
+
+#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/progress_bar.hpp"
+#include "nonsep/host/run/run_job.hpp"
+#include "nonsep/host/study.hpp"
+
+namespace nonsep::host::cli {
+
+namespace {
+
+std::atomic<bool> stop_requested{false};
+std::atomic<int> stop_signal{0};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free,
+              "the stop flags must be lock-free to be set in a signal handler");
+
+extern "C" void request_stop(int signal) {
+  stop_signal.store(signal);
+  stop_requested.store(true);
+}
+
+// Catches the first SIGINT or SIGTERM (the run finishes its step, flushes trajectory.csv and writes its checkpoint
+// and summary); SA_RESETHAND restores the default action, so a second signal of the same kind ends the process at
+// once. No SA_RESTART: a plugin sleeping or waiting in a system call sees EINTR and returns sooner.
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    struct sigaction action = {};
+    action.sa_handler = request_stop;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &action, &previous_interrupt_);
+    sigaction(SIGTERM, &action, &previous_terminate_);
+  }
+  ~InterruptGuard() {
+    sigaction(SIGINT, &previous_interrupt_, nullptr);
+    sigaction(SIGTERM, &previous_terminate_, nullptr);
+  }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  struct sigaction previous_interrupt_ = {}, previous_terminate_ = {};
+};
+
+// The end of a study: one line per integrator with its fitted exponent, or what went wrong.
+int report_study(const RunOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
+  const auto& summary = outcome.summary;
+  const auto& runs = summary["study"]["runs"];
+  std::string line = summary["status"].get<std::string>() + ": study of " + std::to_string(summary["fits"].size()) +
+                     " integrators, " + std::to_string(runs["completed"].get<std::size_t>()) + " runs completed";
+  for (const char* other : {"diverged", "failed", "interrupted"})
+    if (runs[other].get<std::size_t>() > 0) line += ", " + std::to_string(runs[other].get<std::size_t>()) + " " + other;
+  line += "; results in " + directory.string();
+  std::ostream& out = outcome.exit_status == ExitStatus::success ? std::cout : std::cerr;
+  if (outcome.exit_status != ExitStatus::success || !quiet) {
+    out << (outcome.exit_status == ExitStatus::success ? "" : "nonsep: ") << line << "\n";
+    for (const auto& fit : summary["fits"])
+      out << "  " << fit["integrator"].get<std::string>() << ": energy error exponent "
+          << (fit["exponent"].is_null() ? std::string("(no fit)") : format_number(fit["exponent"].get<double>()))
+          << " (nominal " << fit["order"].get<std::string>() << ")\n";
+  }
+  if (summary.contains("error")) std::cerr << "nonsep: " << summary["error"].get<std::string>() << "\n";
+  if (summary.contains("failures"))
+    for (const auto& failure : summary["failures"])
+      std::cerr << "nonsep: " << failure["integrator"].get<std::string>() << " with " << failure["steps"]
+                << " steps " << failure["status"].get<std::string>() << ": " << failure["error"].get<std::string>()
+                << "\n";
+  return to_int(outcome.exit_status);
+}
+
+}  // namespace
+
+namespace {
+
+// A run whose relative energy error grew larger than this gets a warning even without a bound.
+constexpr double warn_relative_energy_error = 0.1;
+
+std::string counts_text(const StatusCounts& counts) {
+  std::string text = std::to_string(counts.completed) + " completed";
+  const std::pair<const char*, std::size_t> others[] = {{"diverged", counts.diverged},
+                                                        {"failed", counts.failed},
+                                                        {"inaccurate", counts.inaccurate},
+                                                        {"interrupted", counts.interrupted}};
+  for (const auto& [name, count] : others)
+    if (count > 0) text += ", " + std::to_string(count) + " " + name;
+  return text;
+}
+
+// One line per trajectory that stopped early, up to a screenful (an ensemble may have thousands; trajectories.csv
+// has them all), and a warning when the energy error grew large.
+void report_trajectories(const RunOutcome& outcome, const std::filesystem::path& directory) {
+  constexpr std::size_t shown_at_most = 20;
+  std::size_t stopped = 0;
+  for (std::size_t index = 0; index < outcome.trajectories.size(); ++index) {
+    const TrajectoryRecord& trajectory = outcome.trajectories[index];
+    if (!stopped_early(trajectory.status) || ++stopped > shown_at_most) continue;
+    if (trajectory.status == TrajectoryStatus::diverged)
+      std::cerr << "nonsep: trajectory " << index << " diverged at step " << trajectory.stop_step
+                << ", t = " << format_number(trajectory.stop_t) << " (" << trajectory.stop_variable
+                << " is not finite)\n";
+    else
+      std::cerr << "nonsep: trajectory " << index << " " << to_string(trajectory.status) << ": " << trajectory.message
+                << "\n";
+  }
+  if (stopped > shown_at_most)
+    std::cerr << "nonsep: ... and " << stopped - shown_at_most << " more trajectories that stopped early; "
+              << (directory / "trajectories.csv").string() << " lists them all\n";
+  if (const auto& largest = outcome.largest_energy_error; largest && largest->value > warn_relative_energy_error)
+    std::cerr << "nonsep: warning: the relative energy error |dH/H0| reached " << format_number(largest->value)
+              << " (trajectory " << largest->trajectory << "), above " << format_number(warn_relative_energy_error)
+              << ": the results are not accurate; use a smaller dt or a higher order "
+                 "(analysis.max_relative_energy_error stops trajectories past a bound)\n";
+}
+
+int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& arguments,
+               const std::filesystem::path& directory, int signal) {
+  const std::size_t trajectories = outcome.trajectories.size();
+  std::string line = std::string(to_string(outcome.status)) + ": " + std::to_string(trajectories) +
+                     (trajectories == 1 ? " trajectory (" : " trajectories (") + counts_text(outcome.counts) + "), " +
+                     time_text(job.time);
+  if (const auto& largest = outcome.largest_energy_error)
+    line += "; largest |dH/H0| " + format_number(largest->value) + " (trajectory " +
+            std::to_string(largest->trajectory) + ")";
+  line += "; results in " + directory.string();
+  if (outcome.exit_status == ExitStatus::success) {
+    if (!arguments.quiet) std::cout << line << "\n";
+  } else {
+    std::cerr << "nonsep: " << line << "\n";
+    if (!outcome.error.empty()) std::cerr << "nonsep: " << outcome.error << "\n";
+    if (outcome.status == TrajectoryStatus::interrupted)
+      std::cerr << "nonsep: stopped by " << (signal == SIGTERM ? "SIGTERM" : "SIGINT") << " after step "
+                << outcome.steps_completed << "; `nonsep run " << arguments.job_file
+                << (arguments.output.empty() ? "" : " --output " + arguments.output)
+                << " --resume` continues from there\n";
+  }
+  for (const std::string& note : outcome.notes) std::cerr << "nonsep: note: " << note << "\n";
+  report_trajectories(outcome, directory);
+  return to_int(outcome.exit_status);
+}
+
+}  // namespace
+
+int command_run(const RunArguments& arguments) {
+  std::optional<LoadedJob> loaded;
+  try {
+    loaded.emplace(load_job(arguments.job_file));
+  } catch (const InvalidJob& error) {
+    return report_invalid_job(error);
+  }
+  if (arguments.resume && loaded->job.study) {
+    std::cerr << "nonsep: cannot resume: " << arguments.job_file
+              << " is a convergence study (/study), which is not resumed; run it again without --resume\n";
+    return to_int(ExitStatus::invalid_input);
+  }
+  RunOptions options;
+  options.output_directory =
+      arguments.output.empty() ? loaded->job.output_directory : std::filesystem::path(arguments.output);
+  options.show_progress = !arguments.quiet && stderr_is_terminal();
+  options.stop_requested = &stop_requested;
+  options.resume = arguments.resume;
+  options.force = arguments.force;
+  options.threads = arguments.threads;
+  stop_requested.store(false);
+  stop_signal.store(0);
+  RunOutcome outcome;
+  {
+    InterruptGuard guard;
+    try {
+      outcome = loaded->job.study ? run_study(*loaded, options) : run_job(*loaded, options);
+    } catch (const OutputError& error) {
+      std::cerr << "nonsep: " << error.what() << "\n";
+      return to_int(ExitStatus::invalid_input);
+    } catch (const FolderInUse& error) {
+      std::cerr << "nonsep: " << error.what() << "\n";
+      return to_int(ExitStatus::invalid_input);
+    } catch (const CheckpointError& error) {
+      std::cerr << "nonsep: cannot resume: " << error.what() << "\n";
+      return to_int(ExitStatus::invalid_input);
+    }
+  }
+  if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() == SIGTERM)
+    outcome.exit_status = ExitStatus::terminated;
+  if (loaded->job.study) return report_study(outcome, options.output_directory, arguments.quiet);
+  return report_run(outcome, loaded->job, arguments, options.output_directory, stop_signal.load());
+}
+
+}  // namespace nonsep::host::cli

@@ -1,0 +1,51 @@
+#include <iostream>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/core/integrator_description.hpp"
+
+namespace nonsep::host::cli {
+
+std::string exit_status_text() {
+  return "Exit status:\n"
+         "  0    success\n"
+         "  1    the run started but failed: a trajectory diverged or the plugin failed mid-run (summary.json\n"
+         "       says which and where); an output could not be written; `inspect --check` found wrong derivatives\n"
+         "  2    invalid input, nothing was run: usage, job file, parameters, a plugin that cannot be loaded,\n"
+         "       an output folder that cannot be created\n"
+         "  130  interrupted (SIGINT): the current step was finished, outputs written with status \"interrupted\",\n"
+         "       and a checkpoint: `nonsep run JOB --resume` continues the run\n"
+         "  143  terminated (SIGTERM): the same as 130\n";
+}
+
+// Generated from nonsep::scheme_catalogue(), like the job reader's checks.
+std::string schemes_text() {
+  std::string text = "Integrator schemes (job file: \"integrator\": {\"scheme\": name, option: value, ...}):\n";
+  for (const auto& scheme : scheme_catalogue()) {
+    text += "  " + scheme.name + ": " + scheme.method + ", " + scheme.equations + "; " +
+            (scheme.symplectic ? "symplectic" : "not symplectic") + ", " +
+            (scheme.time_reversible ? "time-reversible" : "not time-reversible") + "\n";
+    text += "      " + scheme.summary + "\n";
+    for (const auto& parameter : scheme.parameters)
+      text += "      " + parameter.name + " (" +
+              (parameter.default_text.empty() ? std::string("required") : "default " + parameter.default_text) +
+              "): " + parameter.description + "\n";
+  }
+  return text;
+}
+
+int report_invalid_job(const InvalidJob& error) {
+  std::cerr << "nonsep: " << error.what() << "\n";
+  return to_int(ExitStatus::invalid_input);
+}
+
+std::string time_text(const TimeGrid& time) {
+  return std::to_string(time.steps) + " steps of dt = " + format_number(time.dt) + " to t_end = " +
+         format_number(time.t_end) +
+         (time.from_t_end && time.dt != time.dt_requested ? " (dt requested " + format_number(time.dt_requested) + ")"
+                                                          : "");
+}
+
+}  // namespace nonsep::host::cli

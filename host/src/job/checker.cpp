@@ -1,0 +1,131 @@
+#include "checker.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nonsep::host::job_reader {
+
+namespace {
+std::string escape_pointer_token(const std::string& token) {
+  std::string escaped;
+  for (char c : token) {
+    if (c == '~')
+      escaped += "~0";
+    else if (c == '/')
+      escaped += "~1";
+    else
+      escaped += c;
+  }
+  return escaped;
+}
+}  // namespace
+
+std::string child(const std::string& path, const std::string& key) { return path + "/" + escape_pointer_token(key); }
+std::string child(const std::string& path, std::size_t index) { return path + "/" + std::to_string(index); }
+
+std::string describe(const json& value) {
+  std::string text = value.dump();
+  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  return text;
+}
+
+std::optional<std::int64_t> integral_value(const json& value) {
+  if (value.is_number_unsigned()) {
+    const auto x = value.get<std::uint64_t>();
+    if (x <= static_cast<std::uint64_t>(INT64_MAX)) return static_cast<std::int64_t>(x);
+  } else if (value.is_number_integer()) {
+    return value.get<std::int64_t>();
+  } else if (value.is_number_float()) {
+    // The bounds are checked on the double first: converting one outside the range of std::int64_t is undefined.
+    const double x = value.get<double>();
+    if (std::floor(x) == x && x >= -0x1p63 && x < 0x1p63) return static_cast<std::int64_t>(x);
+  }
+  return std::nullopt;
+}
+
+void Checker::issue(std::string path, std::string found, std::string allowed) {
+  issues_.push_back({std::move(path), std::move(found), std::move(allowed)});
+}
+
+bool Checker::object(const json& value, const std::string& path, const std::string& what) {
+  if (value.is_object()) return true;
+  issue(path, describe(value), what);
+  return false;
+}
+
+void Checker::known_keys(const json& object, const std::string& path, const std::vector<std::string>& allowed) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+    std::string list;
+    for (const auto& name : allowed) list += (list.empty() ? "" : ", ") + name;
+    issue(child(path, key), "the unknown key \"" + key + "\"", "only the keys " + list);
+  }
+}
+
+const json* Checker::member(const json& object, const std::string& path, const std::string& key, bool required,
+                            const std::string& what) {
+  const auto it = object.find(key);
+  if (it != object.end()) return &*it;
+  if (required) issue(child(path, key), "nothing (the key is missing)", what);
+  return nullptr;
+}
+
+std::optional<double> Checker::finite_number(const json& value, const std::string& path, const std::string& what) {
+  if (value.is_number()) {
+    const double x = value.get<double>();
+    if (std::isfinite(x)) return x;
+  }
+  issue(path, describe(value), what);
+  return std::nullopt;
+}
+
+std::optional<double> Checker::positive_number(const json& value, const std::string& path, const std::string& what) {
+  if (value.is_number()) {
+    const double x = value.get<double>();
+    if (std::isfinite(x) && x > 0.0) return x;
+  }
+  issue(path, describe(value), what);
+  return std::nullopt;
+}
+
+std::optional<std::int64_t> Checker::integer(const json& value, const std::string& path, std::int64_t minimum,
+                                             std::int64_t maximum, const std::string& what) {
+  if (const auto x = integral_value(value); x && *x >= minimum && *x <= maximum) return x;
+  issue(path, describe(value), what);
+  return std::nullopt;
+}
+
+std::optional<std::string> Checker::string(const json& value, const std::string& path, const std::string& what) {
+  if (value.is_string() && !value.get<std::string>().empty()) return value.get<std::string>();
+  issue(path, describe(value), what);
+  return std::nullopt;
+}
+
+std::optional<std::string> Checker::path_string(const json& value, const std::string& path, const std::string& what) {
+  auto text = string(value, path, what);
+  if (text && text->find('\0') != std::string::npos) {
+    issue(path, describe(value) + ", which contains NUL (\\u0000)", what + ", without NUL characters");
+    return std::nullopt;
+  }
+  return text;
+}
+
+std::optional<std::vector<double>> Checker::vector(const json& value, const std::string& path) {
+  if (!value.is_array() || value.empty()) {
+    issue(path, describe(value), "a non-empty array of finite numbers, one per degree of freedom");
+    return std::nullopt;
+  }
+  std::vector<double> result;
+  result.reserve(value.size());
+  bool ok = true;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    if (const auto x = finite_number(value[i], child(path, i), "a finite number"))
+      result.push_back(*x);
+    else
+      ok = false;
+  }
+  if (!ok) return std::nullopt;
+  return result;
+}
+
+}  // namespace nonsep::host::job_reader

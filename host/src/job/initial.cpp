@@ -1,0 +1,227 @@
+// /initial: one state, a list of states or a grid, into InitialStates (state-major: component i of state b at
+// b * dimension + i). Every shape is held to max_initial_states and max_initial_values, checked on the sizes of
+// the JSON arrays before their numbers are copied.
+#include "sections.hpp"
+
+namespace nonsep::host::job_reader {
+
+namespace {
+
+const std::string values_limit =
+    "at most " + std::to_string(max_initial_values) + " numbers in q (states times dimension)";
+
+// The number of elements of value[key] when it is an array, else 0.
+std::size_t array_size(const json& value, const char* key) {
+  if (!value.is_object()) return 0;
+  const auto it = value.find(key);
+  return it != value.end() && it->is_array() ? it->size() : 0;
+}
+
+// One axis of a grid: a number, {"from", "to", "count"} or {"values": [...]}.
+std::optional<std::vector<double>> read_axis(Checker& check, const json& value, const std::string& path) {
+  const std::string what =
+      "a number (a fixed value), {\"from\": a, \"to\": b, \"count\": n} (n evenly spaced values from a to b) or "
+      "{\"values\": [...]} (the values listed)";
+  if (value.is_number()) {
+    const auto x = check.finite_number(value, path, "a finite number");
+    if (!x) return std::nullopt;
+    return std::vector<double>{*x};
+  }
+  if (!value.is_object()) {
+    check.issue(path, describe(value), what);
+    return std::nullopt;
+  }
+  if (value.contains("values")) {
+    check.known_keys(value, path, {"values"});
+    const json& values = value["values"];
+    if (values.is_array() && values.size() > max_initial_states) {
+      check.issue(child(path, "values"), std::to_string(values.size()) + " values",
+                  "at most " + std::to_string(max_initial_states) + " values");
+      return std::nullopt;
+    }
+    return check.vector(values, child(path, "values"));
+  }
+  check.known_keys(value, path, {"from", "to", "count"});
+  std::optional<double> from, to;
+  std::optional<std::int64_t> count;
+  if (const json* v = check.member(value, path, "from", true, "the first value, a finite number"))
+    from = check.finite_number(*v, child(path, "from"), "the first value, a finite number");
+  if (const json* v = check.member(value, path, "to", true, "the last value, a finite number"))
+    to = check.finite_number(*v, child(path, "to"), "the last value, a finite number");
+  if (const json* v = check.member(value, path, "count", true, "the number of values, an integer >= 1"))
+    count = check.integer(*v, child(path, "count"), 1, static_cast<std::int64_t>(max_initial_states),
+                          "the number of values, an integer from 1 to " + std::to_string(max_initial_states));
+  if (!from || !to || !count) return std::nullopt;
+  std::vector<double> values(static_cast<std::size_t>(*count));
+  const auto n = values.size();
+  for (std::size_t i = 0; i < n; ++i)
+    values[i] = i + 1 == n && n > 1 ? *to : *from + (*to - *from) * static_cast<double>(i) / static_cast<double>(n - 1);
+  return values;
+}
+
+// Fills `states` with every combination of `axes` (q0, q1, ..., p0, p1, ...), row-major: the last axis varies
+// fastest. `count` is the product of the axes' sizes, count * n within max_initial_values.
+void fill_grid(const std::vector<std::vector<double>>& axes, std::size_t n, std::size_t count, InitialStates& states) {
+  states.dimension = n;
+  states.count = count;
+  states.q.resize(count * n);
+  states.p.resize(count * n);
+  // Axis a repeats each of its values `stride` times (the product of the later axes' sizes), the whole pattern
+  // count / (size * stride) times; no division per value.
+  std::size_t stride = count;
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    const std::vector<double>& axis = axes[a];
+    stride /= axis.size();
+    double* column = a < n ? states.q.data() + a : states.p.data() + (a - n);
+    std::size_t b = 0;
+    while (b < count)
+      for (const double value : axis)
+        for (std::size_t r = 0; r < stride; ++r, ++b) column[b * n] = value;
+  }
+}
+
+void read_grid(Checker& check, const json& grid, InitialStates& states) {
+  const std::string path = "/initial/grid";
+  if (!check.object(grid, path, "an object {\"q\": [axis, ...], \"p\": [axis, ...]}, one axis per component")) return;
+  check.known_keys(grid, path, {"q", "p"});
+  std::vector<std::vector<double>> axes;
+  std::size_t count = 1;  // states: the product of the axes' sizes
+  std::size_t sizes[2] = {0, 0};
+  bool ok = true;
+  for (int which = 0; which < 2; ++which) {
+    const std::string name = which == 0 ? "q" : "p";
+    const json* list = check.member(grid, path, name, true, "an array of axes, one per component");
+    if (!list) {
+      ok = false;
+      continue;
+    }
+    if (!list->is_array() || list->empty()) {
+      check.issue(child(path, name), describe(*list), "a non-empty array of axes, one per component");
+      ok = false;
+      continue;
+    }
+    sizes[which] = list->size();
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      auto axis = read_axis(check, (*list)[i], child(child(path, name), i));
+      if (!axis) {
+        ok = false;
+        continue;
+      }
+      // Stops at the first axis that makes the grid too large, before reading (and allocating) the others.
+      if (count > max_initial_states / axis->size()) {
+        check.issue(path, "a grid of more than " + std::to_string(max_initial_states) + " states",
+                    "at most " + std::to_string(max_initial_states) + " states");
+        return;
+      }
+      count *= axis->size();
+      axes.push_back(std::move(*axis));
+    }
+  }
+  if (sizes[0] && sizes[1] && sizes[0] != sizes[1]) {
+    check.issue(child(path, "p"), std::to_string(sizes[1]) + " axes", std::to_string(sizes[0]) + ", as many as q has");
+    ok = false;
+  }
+  if (!ok) return;
+  const std::size_t n = sizes[0];
+  if (count > max_initial_values / n) {
+    check.issue(path, "a grid of " + std::to_string(count) + " states of dimension " + std::to_string(n),
+                values_limit);
+    return;
+  }
+  fill_grid(axes, n, count, states);
+}
+
+}  // namespace
+
+void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
+                const std::string& first_path) {
+  if (!check.object(value, path, "a state {\"q\": [...], \"p\": [...]}")) return;
+  check.known_keys(value, path, {"q", "p"});
+  const json* q_value = check.member(value, path, "q", true, "the positions, an array of finite numbers");
+  const json* p_value = check.member(value, path, "p", true, "the momenta, an array of finite numbers");
+  // Sizes first, so that an array over the limit is not copied.
+  const std::size_t q_size = q_value && q_value->is_array() ? q_value->size() : 0;
+  if (q_size > max_initial_values) {
+    check.issue(child(path, "q"), std::to_string(q_size) + " components", values_limit);
+    return;
+  }
+  if (p_value && p_value->is_array() && p_value->size() > max_initial_values) {
+    check.issue(child(path, "p"), std::to_string(p_value->size()) + " components",
+                q_size != 0 ? std::to_string(q_size) + ", as many as q has" : values_limit);
+    return;
+  }
+  std::optional<std::vector<double>> q, p;
+  if (q_value) q = check.vector(*q_value, child(path, "q"));
+  if (p_value) p = check.vector(*p_value, child(path, "p"));
+  if (!q || !p) return;
+  if (q->size() != p->size()) {
+    check.issue(child(path, "p"), std::to_string(p->size()) + " components",
+                std::to_string(q->size()) + ", as many as q has");
+    return;
+  }
+  if (states.dimension == 0) {
+    states.dimension = q->size();
+  } else if (q->size() != states.dimension) {
+    check.issue(child(path, "q"), std::to_string(q->size()) + " components",
+                std::to_string(states.dimension) + ", as many as the first state (" + first_path + ") has");
+    return;
+  }
+  states.q.insert(states.q.end(), q->begin(), q->end());
+  states.p.insert(states.p.end(), p->begin(), p->end());
+  ++states.count;
+}
+
+InitialStates read_initial(Checker& check, const json& document) {
+  InitialStates states;
+  const std::string what =
+      "one state {\"q\": [...], \"p\": [...]}, an array of such states, or {\"grid\": {\"q\": [axes], \"p\": [axes]}}";
+  const json* initial = check.member(document, "", "initial", true, what);
+  if (!initial) return states;
+  if (initial->is_array()) {
+    states.shape = "list";
+    if (initial->empty()) check.issue("/initial", "an empty array", "at least one state");
+    if (initial->size() > max_initial_states) {
+      check.issue("/initial", std::to_string(initial->size()) + " states",
+                  "at most " + std::to_string(max_initial_states) + " states");
+      return states;
+    }
+    std::size_t values = 0;  // numbers in q of the states so far, counting those refused
+    for (std::size_t i = 0; i < initial->size(); ++i) {
+      const std::size_t dimension = array_size((*initial)[i], "q");
+      values += dimension;
+      if (values > max_initial_values) {
+        const std::size_t shown = states.dimension != 0 ? states.dimension : dimension;
+        check.issue("/initial", std::to_string(initial->size()) + " states of dimension " + std::to_string(shown),
+                    values_limit);
+        break;
+      }
+      read_state(check, (*initial)[i], child("/initial", i), states, "/initial/0");
+    }
+  } else if (initial->is_object() && initial->contains("grid")) {
+    states.shape = "grid";
+    check.known_keys(*initial, "/initial", {"grid"});
+    read_grid(check, (*initial)["grid"], states);
+  } else if (initial->is_object()) {
+    states.shape = "single";
+    read_state(check, *initial, "/initial", states, "/initial");
+  } else {
+    check.issue("/initial", describe(*initial), what);
+  }
+  return states;
+}
+
+}  // namespace nonsep::host::job_reader
+
+namespace nonsep::host {
+
+void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues) {
+  if (initial.count == 0 || initial.dimension == model_dimension) return;
+  const std::string path =
+      initial.shape == "list" ? "/initial/0/q" : initial.shape == "grid" ? "/initial/grid/q" : "/initial/q";
+  issues.push_back({path,
+                    std::to_string(initial.dimension) + (initial.shape == "grid" ? " axes" : " components") +
+                        (initial.shape == "list" && initial.count > 1 ? " (in every state)" : ""),
+                    std::to_string(model_dimension) + ", the dimension of the model (for q and p alike)"});
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,155 @@
+// /hamiltonian and /integrator: the scheme and its options, read against the core's catalogue
+// (nonsep::scheme_catalogue()); whether an option's value is valid is decided by the core, by building the scheme.
+#include <algorithm>
+#include <charconv>
+#include <stdexcept>
+
+#include "nonsep/core/error.hpp"
+#include "nonsep/core/integrator_description.hpp"
+#include "sections.hpp"
+
+namespace nonsep::host::job_reader {
+
+namespace {
+
+std::string scheme_names() {
+  std::string list;
+  for (const auto& scheme : scheme_catalogue()) list += (list.empty() ? "\"" : ", \"") + scheme.name + "\"";
+  return list;
+}
+
+// The value of one catalogue parameter, as the job wrote it or as its default text.
+struct OptionValue {
+  double number = 0.0;
+  Fraction order;
+};
+
+// The only place where a catalogue parameter name meets IntegratorSpec's fields. A catalogue parameter without a
+// field here is a programming error, caught by the host tests (which read every scheme's defaults).
+void set_option(IntegratorSpec& spec, const ParameterDescription& parameter, const OptionValue& value) {
+  if (parameter.name == "order" && parameter.kind == ParameterDescription::Kind::Order)
+    spec.order = value.order;
+  else if (parameter.name == "t2" && parameter.kind == ParameterDescription::Kind::Number)
+    spec.t2 = value.number;
+  else
+    throw std::logic_error("the host does not know the integrator parameter '" + parameter.name + "'");
+}
+
+OptionValue default_option(const ParameterDescription& parameter) {
+  OptionValue value;
+  if (parameter.kind == ParameterDescription::Kind::Order) {
+    value.order = Fraction::parse(parameter.default_text);
+  } else {
+    const auto& text = parameter.default_text;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value.number);
+    if (ec != std::errc() || end != text.data() + text.size())
+      throw std::logic_error("catalogue default '" + text + "' of '" + parameter.name + "' is not a number");
+  }
+  return value;
+}
+
+std::optional<OptionValue> read_option(Checker& check, const ParameterDescription& parameter, const json& value,
+                                       const std::string& path) {
+  OptionValue result;
+  if (parameter.kind == ParameterDescription::Kind::Number) {
+    const auto x = check.finite_number(value, path, "a finite number: " + parameter.description);
+    if (!x) return std::nullopt;
+    result.number = *x;
+    return result;
+  }
+  try {
+    if (value.is_string()) {
+      result.order = Fraction::parse(value.get<std::string>());
+      return result;
+    }
+    if (const auto integral = integral_value(value)) {
+      result.order = Fraction(*integral);
+      return result;
+    }
+  } catch (const InvalidArgument&) {
+  }
+  check.issue(path, describe(value),
+              "an exact fraction as a string (\"4/3\") or an integer (2): " + parameter.description);
+  return std::nullopt;
+}
+
+// The options of the scheme, or with an unknown scheme the options of every scheme (so that their problems are
+// reported too).
+std::vector<ParameterDescription> options_of(const std::optional<SchemeDescription>& scheme) {
+  if (scheme) return scheme->parameters;
+  std::vector<ParameterDescription> parameters;
+  for (const auto& entry : scheme_catalogue())
+    for (const auto& parameter : entry.parameters)
+      if (std::none_of(parameters.begin(), parameters.end(),
+                       [&](const ParameterDescription& known) { return known.name == parameter.name; }))
+        parameters.push_back(parameter);
+  return parameters;
+}
+
+}  // namespace
+
+HamiltonianForm read_hamiltonian(Checker& check, const json& document) {
+  if (const json* form = check.member(document, "", "hamiltonian", false, "")) {
+    if (*form == "TTV") return HamiltonianForm::TTV;
+    if (*form == "VVT") return HamiltonianForm::VVT;
+    check.issue("/hamiltonian", describe(*form),
+                "\"TTV\" (H = T_i V_ij T_j, the default) or \"VVT\" (H = V_i T_ij V_j)");
+  }
+  return HamiltonianForm::TTV;
+}
+
+IntegratorSpec read_integrator_object(Checker& check, const json& integrator, const std::string& path,
+                                      HamiltonianForm form, const std::vector<std::string>& extra_keys) {
+  IntegratorSpec spec;
+  spec.form = form;
+  std::optional<SchemeDescription> scheme;
+  if (const json* name = check.member(integrator, path, "scheme", true, "one of " + scheme_names())) {
+    if (name->is_string()) scheme = find_scheme(name->get<std::string>());
+    if (scheme)
+      spec.scheme = scheme->name;
+    else
+      check.issue(child(path, "scheme"), describe(*name), "one of " + scheme_names());
+  }
+  const std::vector<ParameterDescription> parameters = options_of(scheme);
+  std::vector<std::string> keys{"scheme"};
+  for (const auto& parameter : parameters) keys.push_back(parameter.name);
+  keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
+  check.known_keys(integrator, path, keys);
+
+  for (const auto& parameter : parameters) {
+    const std::string option_path = child(path, parameter.name);
+    const json* given = check.member(integrator, path, parameter.name, parameter.default_text.empty(),
+                                     parameter.description);
+    if (!given) {
+      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option(parameter));
+      continue;
+    }
+    const auto value = read_option(check, parameter, *given, option_path);
+    if (!value || !scheme) continue;
+    // The core decides what is valid: build the scheme with this one option set and the others at their defaults.
+    IntegratorSpec probe{scheme->name, {}, {}, spec.form};
+    for (const auto& other : parameters)
+      if (!other.default_text.empty()) set_option(probe, other, default_option(other));
+    set_option(probe, parameter, *value);
+    try {
+      const Integrator probe_integrator(probe);
+      set_option(spec, parameter, *value);
+    } catch (const InvalidArgument& error) {
+      check.issue(option_path, describe(*given), error.what());
+    }
+  }
+  return spec;
+}
+
+IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form) {
+  const json* integrator =
+      check.member(document, "", "integrator", true, "an object with \"scheme\" (" + scheme_names() + ") and options");
+  if (!integrator || !check.object(*integrator, "/integrator", "an object with \"scheme\" and the scheme's options")) {
+    IntegratorSpec spec;
+    spec.form = form;
+    return spec;
+  }
+  return read_integrator_object(check, *integrator, "/integrator", form);
+}
+
+}  // namespace nonsep::host::job_reader

@@ -1,0 +1,111 @@
+// Reading a job file (at most max_job_file_bytes, never a directory), pass 3 (the plugin: load_model), and
+// load_job, which runs all passes and throws InvalidJob with the issues of every pass together.
+#include <fstream>
+
+#include "checker.hpp"
+
+namespace nonsep::host {
+
+std::string to_string(const JobIssue& issue) {
+  return (issue.path.empty() ? std::string("(document)") : issue.path) + ": found " + issue.found +
+         "; allowed: " + issue.allowed;
+}
+
+namespace {
+
+std::string report(const std::filesystem::path& job_file, const std::vector<JobIssue>& issues) {
+  std::string text = "invalid job file " + job_file.string() + " (" + std::to_string(issues.size()) +
+                     (issues.size() == 1 ? " problem)" : " problems)");
+  for (const auto& issue : issues) text += "\n  " + to_string(issue);
+  return text;
+}
+
+// The text of the job file, or nothing and an issue at "": no such file, a directory, not readable, or more than
+// max_job_file_bytes (known from the size of a regular file; otherwise found by reading one byte past the limit,
+// so that a device without end such as /dev/zero is refused too).
+std::optional<std::string> read_job_text(const std::filesystem::path& job_file, std::vector<JobIssue>& issues) {
+  const std::string limit = "a job file of at most " + std::to_string(max_job_file_bytes) + " bytes (64 MiB)";
+  std::error_code error;
+  const auto status = std::filesystem::status(job_file, error);
+  if (!error && std::filesystem::is_directory(status)) {
+    issues.push_back({"", "a directory at " + job_file.string(), "the path of a job file (a JSON file, not a folder)"});
+    return std::nullopt;
+  }
+  if (!error && std::filesystem::is_regular_file(status)) {
+    const auto size = std::filesystem::file_size(job_file, error);
+    if (!error && size > max_job_file_bytes) {
+      issues.push_back({"", "a file of " + std::to_string(size) + " bytes", limit});
+      return std::nullopt;
+    }
+  }
+  std::ifstream in(job_file, std::ios::binary);
+  std::string text;
+  if (in) {
+    char buffer[1 << 16];
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+      text.append(buffer, static_cast<std::size_t>(in.gcount()));
+      if (text.size() > max_job_file_bytes) {
+        issues.push_back({"", "more than " + std::to_string(max_job_file_bytes) + " bytes at " + job_file.string(),
+                          limit});
+        return std::nullopt;
+      }
+    }
+  }
+  if (!in.is_open() || in.bad()) {
+    issues.push_back({"", "no readable file at " + job_file.string(), "the path of a readable job file"});
+    return std::nullopt;
+  }
+  return text;
+}
+
+}  // namespace
+
+InvalidJob::InvalidJob(const std::filesystem::path& job_file, std::vector<JobIssue> issues)
+    : std::runtime_error(report(job_file, issues)), issues_(std::move(issues)) {}
+
+std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<JobIssue>& issues) {
+  const auto text = read_job_text(job_file, issues);
+  if (!text) return std::nullopt;
+  const auto document = parse_job_text(*text, issues);
+  if (!document) return std::nullopt;
+  return parse_job(*document, job_file, issues);
+}
+
+std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
+  if (job.plugin.empty()) return std::nullopt;
+  LoadedJob loaded{std::move(job), {}, {}};
+  const Job& checked = loaded.job;
+  try {
+    loaded.plugin = load_plugin(checked.plugin, checked.directory);
+  } catch (const std::exception& error) {
+    issues.push_back({"/model/plugin", "\"" + checked.plugin + "\", which cannot be loaded: " + error.what(),
+                      "a plugin name listed by `nonsep models`, or the path of a plugin file"});
+    return std::nullopt;
+  }
+  const std::size_t before = issues.size();
+  check_model_parameters(checked.parameters, loaded.plugin.parameters(), issues);
+  if (issues.size() != before) return std::nullopt;
+  try {
+    loaded.model = loaded.plugin.create(checked.parameters);
+  } catch (const std::exception& error) {
+    issues.push_back({"/model/parameters",
+                      job_reader::describe(checked.parameters) + ", refused by the plugin: " + error.what(),
+                      "parameters the plugin accepts (see `nonsep inspect " + checked.plugin + "`)"});
+    return std::nullopt;
+  }
+  check_dimension(checked.initial, loaded.model.dimension(), issues);
+  if (issues.size() != before) return std::nullopt;
+  return loaded;
+}
+
+LoadedJob load_job(const std::filesystem::path& job_file) {
+  std::vector<JobIssue> issues;
+  auto job = read_job(job_file, issues);
+  if (!job) throw InvalidJob(job_file, std::move(issues));
+  auto loaded = load_model(std::move(*job), issues);
+  if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
+  if (!loaded) throw std::logic_error("load_model refused " + job_file.string() + " without saying why");
+  return std::move(*loaded);
+}
+
+}  // namespace nonsep::host

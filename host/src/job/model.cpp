@@ -1,0 +1,64 @@
+// /model: the plugin's name or path and its parameters as written (pass 2), and the parameters against the loaded
+// plugin's metadata (pass 3, check_model_parameters) by the rule the SDK and the loader share,
+// nonsep::sdk::parameter_fault.
+#include <algorithm>
+
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/sdk/parameters.hpp"
+#include "sections.hpp"
+
+namespace nonsep::host::job_reader {
+
+void read_model(Checker& check, const json& document, Job& job) {
+  const std::string what = "an object {\"plugin\": name or path, \"parameters\": {...}}";
+  const json* model = check.member(document, "", "model", true, what);
+  if (!model || !check.object(*model, "/model", what)) return;
+  check.known_keys(*model, "/model", {"plugin", "parameters"});
+  const std::string plugin_what = "a plugin name (see `nonsep models`) or a path to a .so file";
+  if (const json* plugin = check.member(*model, "/model", "plugin", true, plugin_what))
+    if (auto name = check.path_string(*plugin, "/model/plugin", plugin_what)) job.plugin = *name;
+  if (const json* parameters = check.member(*model, "/model", "parameters", false, ""))
+    if (check.object(*parameters, "/model/parameters", "an object of the plugin's parameters (see `nonsep inspect`)"))
+      job.parameters = *parameters;
+}
+
+}  // namespace nonsep::host::job_reader
+
+namespace nonsep::host {
+
+void check_model_parameters(const nlohmann::json& given, const std::vector<PluginParameter>& declared,
+                            std::vector<JobIssue>& issues) {
+  job_reader::Checker check(issues);
+  std::string names;
+  for (const auto& parameter : declared) names += (names.empty() ? "" : ", ") + parameter.name;
+  for (const auto& [name, value] : given.items()) {
+    const std::string path = job_reader::child("/model/parameters", name);
+    const auto it = std::find_if(declared.begin(), declared.end(),
+                                 [&key = name](const PluginParameter& parameter) { return parameter.name == key; });
+    if (it == declared.end()) {
+      check.issue(path, "the unknown parameter \"" + name + "\"",
+                  names.empty() ? "none: this plugin has no parameters" : "the plugin's parameters " + names);
+      continue;
+    }
+    std::string range;
+    if (it->minimum) range += " >= " + format_number(*it->minimum);
+    if (it->minimum && it->maximum) range += " and";
+    if (it->maximum) range += " <= " + format_number(*it->maximum);
+    if (!it->unit.empty()) range += " (" + it->unit + ")";
+    const std::string type_text = it->type == "boolean"   ? "true or false"
+                                  : it->type == "integer" ? "an integer" + range
+                                                          : "a finite number" + range;
+    switch (sdk::parameter_fault(it->type, it->minimum, it->maximum, value)) {
+      case sdk::ParameterFault::none: break;
+      case sdk::ParameterFault::wrong_type:
+        check.issue(path, job_reader::describe(value), type_text + ": " + it->description);
+        break;
+      case sdk::ParameterFault::below_minimum:
+      case sdk::ParameterFault::above_maximum:
+        check.issue(path, job_reader::describe(value), "a value" + range + ": " + it->description);
+        break;
+    }
+  }
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,48 @@
+#pragma once
+// Internal to the job reader (host/src/job/): one reader per section of a job file, each in its own file, called by
+// parse_job (parse_job.cpp) in the order of README.md's key-by-key table. Each takes the parsed document (or the
+// section's value) and a Checker, returns what it read, and adds one issue per problem; what it returns is
+// meaningful only if it added none.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "checker.hpp"
+
+namespace nonsep::host::job_reader {
+
+// /model (model.cpp): sets job.plugin and job.parameters.
+void read_model(Checker& check, const json& document, Job& job);
+
+// /hamiltonian and /integrator (integrator.cpp). read_integrator_object reads one integrator object at `path`
+// (a run's /integrator or a study's /study/integrators/<i>); `extra_keys` are keys its caller reads itself.
+HamiltonianForm read_hamiltonian(Checker& check, const json& document);
+IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form);
+IntegratorSpec read_integrator_object(Checker& check, const json& integrator, const std::string& path,
+                                      HamiltonianForm form, const std::vector<std::string>& extra_keys = {});
+
+// /time (time.cpp): a run's {"dt", "t_end" or "steps"}, a study's {"t_end"}.
+TimeGrid read_time(Checker& check, const json& document);
+TimeGrid read_study_time(Checker& check, const json& document);
+// The step count from t_end and dt (TimeGrid's steps_to_reach) within max_steps, or an issue at `path` that shows
+// `found` and the count it would need. t_end / dt must be positive and finite.
+std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt, const std::string& path,
+                                        const std::string& found);
+
+// /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
+// `first_path` names the state whose dimension the others must have.
+InitialStates read_initial(Checker& check, const json& document);
+void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
+                const std::string& first_path);
+
+// /study (study.cpp), with the study's end time (0 when /time/t_end is invalid: the step sizes are then only
+// checked, not turned into counts).
+Study read_study(Checker& check, const json& study, HamiltonianForm form, double t_end);
+
+// /output, /analysis and /checkpoint (outputs.cpp). read_output sets job.output_directory, every, energy_every.
+void read_output(Checker& check, const json& document, Job& job);
+Analysis read_analysis(Checker& check, const json& value);
+CheckpointPolicy read_checkpoint(Checker& check, const json& value);
+
+}  // namespace nonsep::host::job_reader

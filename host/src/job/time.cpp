@@ -1,0 +1,85 @@
+// /time: a run's time grid {"dt", "t_end" or "steps"} and a study's {"t_end"}. Step counts from an end time come
+// from steps_to_reach (nonsep/host/time_grid.hpp) through step_count, here and in a study's step sizes alike.
+#include <cmath>
+
+#include "nonsep/host/number_format.hpp"
+#include "sections.hpp"
+
+namespace nonsep::host::job_reader {
+
+std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt, const std::string& path,
+                                        const std::string& found) {
+  const double rounded = *steps_to_reach(t_end, dt);
+  if (rounded <= static_cast<double>(max_steps)) return static_cast<std::uint64_t>(rounded);
+  check.issue(path, found + ", which needs " + format_number(rounded) + " steps",
+              "at most " + std::to_string(max_steps) + " steps");
+  return std::nullopt;
+}
+
+TimeGrid read_time(Checker& check, const json& document) {
+  TimeGrid grid;
+  const std::string what = "an object with \"dt\" and either \"t_end\" or \"steps\"";
+  const json* time = check.member(document, "", "time", true, what);
+  if (!time || !check.object(*time, "/time", what)) return grid;
+  check.known_keys(*time, "/time", {"dt", "t_end", "steps"});
+  // NaN marks a value that is missing or invalid (and already reported).
+  double dt = std::nan("");
+  if (const json* value = check.member(*time, "/time", "dt", true, "the time step, a finite non-zero number")) {
+    if (const auto x = check.finite_number(*value, "/time/dt", "the time step, a finite non-zero number")) {
+      if (*x == 0.0)
+        check.issue("/time/dt", describe(*value), "a finite non-zero number (negative integrates backwards in time)");
+      else
+        dt = *x;
+    }
+  }
+  const json* t_end_value = check.member(*time, "/time", "t_end", false, "");
+  const json* steps_value = check.member(*time, "/time", "steps", false, "");
+  if (t_end_value && steps_value) {
+    check.issue("/time/steps", describe(*steps_value) + " together with /time/t_end",
+                "either \"t_end\" or \"steps\", not both");
+    return grid;
+  }
+  if (!t_end_value && !steps_value) {
+    check.issue("/time/t_end", "nothing (neither \"t_end\" nor \"steps\" is given)",
+                "either \"t_end\" (the time to end at) or \"steps\" (the number of steps of dt)");
+    return grid;
+  }
+  if (t_end_value) {
+    const auto t_end = check.finite_number(*t_end_value, "/time/t_end", "the end time, a finite non-zero number");
+    if (!t_end || std::isnan(dt)) return grid;
+    const std::string found = describe(*t_end_value) + " with dt = " + format_number(dt);
+    if (!(*t_end / dt > 0.0)) {
+      check.issue("/time/t_end", found, "a non-zero end time of the same sign as dt (the run starts at t = 0)");
+      return grid;
+    }
+    if (const auto steps = step_count(check, *t_end, dt, "/time/t_end", found))
+      grid = TimeGrid::to_end(*t_end, dt, *steps);
+    return grid;
+  }
+  const auto steps = check.integer(*steps_value, "/time/steps", 1, static_cast<std::int64_t>(max_steps),
+                                   "an integer from 1 to " + std::to_string(max_steps));
+  if (!steps || std::isnan(dt)) return grid;
+  grid = TimeGrid::of_steps(static_cast<std::uint64_t>(*steps), dt);
+  if (!std::isfinite(grid.t_end))
+    check.issue("/time/steps", describe(*steps_value) + " with dt = " + format_number(dt),
+                "a number of steps whose end time steps * dt is finite");
+  return grid;
+}
+
+TimeGrid read_study_time(Checker& check, const json& document) {
+  TimeGrid grid;
+  const std::string what = "an object {\"t_end\": T}: a study runs every integrator to T with its own step counts";
+  const json* time = check.member(document, "", "time", true, what);
+  if (!time || !check.object(*time, "/time", what)) return grid;
+  check.known_keys(*time, "/time", {"t_end"});
+  if (const json* value = check.member(*time, "/time", "t_end", true, "the end time, a finite non-zero number"))
+    if (const auto t_end = check.finite_number(*value, "/time/t_end", "the end time, a finite non-zero number")) {
+      if (*t_end == 0.0)
+        check.issue("/time/t_end", describe(*value), "a finite non-zero number (negative integrates backwards)");
+      else
+        grid.t_end = *t_end;
+    }
+  return grid;
+}
+
+}  // namespace nonsep::host::job_reader

@@ -1,0 +1,73 @@
+#include "nonsep/host/observers/energy_error.hpp"
+
+#include <cmath>
+
+#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/csv.hpp"
+
+namespace nonsep::host {
+
+EnergyErrorObserver::EnergyErrorObserver(std::size_t trajectories, std::uint64_t energy_every,
+                                         std::optional<double> bound)
+    : energy_every_(energy_every), bound_(bound), max_abs_(trajectories) {}
+
+std::uint64_t EnergyErrorObserver::next_event(std::uint64_t step) const {
+  return energy_every_ > 0 ? (step / energy_every_ + 1) * energy_every_ : no_event;
+}
+
+void EnergyErrorObserver::on_event(const Event& event) {
+  if (!event.energy_evaluated) return;
+  for (const StateView& state : event.states) {
+    if (!state.energy) continue;
+    const auto error = relative_energy_error(state.energy, state.record->energy_initial);
+    if (!error) continue;
+    auto& max = max_abs_[state.trajectory];
+    max = std::max(max.value_or(0.0), std::abs(*error));
+    if (bound_ && !(std::abs(*error) <= *bound_))
+      event.retire->push_back({state.trajectory, TrajectoryStatus::inaccurate,
+                               "the relative energy error " + format_number(*error) + " at step " +
+                                   std::to_string(event.step) + " exceeds analysis.max_relative_energy_error = " +
+                                   format_number(*bound_)});
+  }
+}
+
+std::optional<LargestEnergyError> EnergyErrorObserver::largest() const {
+  std::optional<LargestEnergyError> result;
+  for (std::size_t i = 0; i < max_abs_.size(); ++i)
+    if (max_abs_[i] && (!result || *max_abs_[i] > result->value)) result = LargestEnergyError{*max_abs_[i], i};
+  return result;
+}
+
+nlohmann::json EnergyErrorObserver::save() {
+  nlohmann::json values = nlohmann::json::array();
+  for (const auto& max : max_abs_) values.push_back(max ? nlohmann::json(format_number(*max)) : nlohmann::json());
+  return {{"max_abs", std::move(values)}};
+}
+
+void EnergyErrorObserver::restore(const nlohmann::json& state) {
+  const nlohmann::json* values = state.is_object() && state.contains("max_abs") ? &state["max_abs"] : nullptr;
+  if (!values || !values->is_array() || values->size() != max_abs_.size())
+    throw CheckpointError("its energy_error state is damaged (not one value per trajectory)");
+  for (std::size_t i = 0; i < max_abs_.size(); ++i) {
+    const nlohmann::json& value = (*values)[i];
+    if (value.is_null()) {
+      max_abs_[i].reset();
+      continue;
+    }
+    const auto x = value.is_string() ? parse_number(value.get<std::string>()) : std::nullopt;
+    if (!x || !(*x >= 0.0)) throw CheckpointError("its energy_error state is damaged (not a number >= 0)");
+    max_abs_[i] = *x;
+  }
+}
+
+void EnergyErrorObserver::columns(std::vector<std::string>& names) const {
+  names.push_back("max_abs_relative_energy_error");
+}
+
+void EnergyErrorObserver::cells(std::size_t trajectory, std::string& row) const {
+  row += ',';
+  append_csv_number(row, max_abs_[trajectory]);
+}
+
+}  // namespace nonsep::host

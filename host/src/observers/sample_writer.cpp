@@ -1,0 +1,94 @@
+#include "nonsep/host/observers/sample_writer.hpp"
+
+#include "nonsep/host/checkpoint.hpp"
+
+namespace nonsep::host {
+
+SampleWriter::SampleWriter(const std::filesystem::path& path, std::size_t dimension, std::size_t trajectories,
+                           std::uint64_t every, const TimeGrid& time, bool resuming)
+    : path_(path), dimension_(dimension), every_(every), steps_(time.steps), time_(time),
+      last_written_(trajectories, none), next_flush_(std::chrono::steady_clock::now() + std::chrono::seconds(1)) {
+  std::string header = "trajectory,step,t";
+  for (const char* name : {"q", "p"})
+    for (std::size_t i = 0; i < dimension; ++i) {
+      header += ',';
+      header += name;
+      header += std::to_string(i);
+    }
+  header += ",H,relative_energy_error";
+  if (!resuming) file_.emplace(path, header);
+}
+
+void SampleWriter::write_row(std::size_t trajectory, std::uint64_t step, std::span<const double> q,
+                             std::span<const double> p, std::optional<double> energy,
+                             std::optional<double> energy_initial) {
+  if (last_written_[trajectory] == step) return;
+  std::string& row = file_->row();
+  row += std::to_string(trajectory);
+  row += ',';
+  row += std::to_string(step);
+  row += ',';
+  append_number(row, time_.time_at(step));
+  for (double x : q) {
+    row += ',';
+    append_number(row, x);
+  }
+  for (double x : p) {
+    row += ',';
+    append_number(row, x);
+  }
+  row += ',';
+  append_csv_number(row, energy);
+  row += ',';
+  append_csv_number(row, relative_energy_error(energy, energy_initial));
+  file_->end_row();
+  last_written_[trajectory] = step;
+}
+
+void SampleWriter::on_event(const Event& event) {
+  if (event.step % every_ != 0 && event.step != steps_) return;
+  for (const StateView& state : event.states)
+    write_row(state.trajectory, event.step, state.q, state.p, state.energy, state.record->energy_initial);
+}
+
+void SampleWriter::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
+  write_row(trajectory, record.final_step, record.final_q, record.final_p, record.energy_final,
+            record.energy_initial);
+}
+
+void SampleWriter::after_chunk(std::uint64_t) {
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_flush_) return;
+  file_->flush();
+  next_flush_ = now + std::chrono::seconds(1);
+}
+
+nlohmann::json SampleWriter::save() {
+  file_->flush();
+  nlohmann::json last = nlohmann::json::array();
+  for (std::uint64_t step : last_written_) last.push_back(step == none ? nlohmann::json(nullptr) : nlohmann::json(step));
+  return {{"bytes", file_->flushed_size()}, {"last_written_step", std::move(last)}};
+}
+
+void SampleWriter::restore(const nlohmann::json& state) {
+  const auto damaged = [](const std::string& what) {
+    throw CheckpointError("its trajectory_csv state is damaged (" + what + ")");
+  };
+  if (!state.is_object() || !state.contains("bytes") || !state["bytes"].is_number_unsigned())
+    damaged("no byte count");
+  const nlohmann::json& last = state.contains("last_written_step") ? state["last_written_step"] : nlohmann::json();
+  if (!last.is_array() || last.size() != last_written_.size()) damaged("not one last row per trajectory");
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    if (last[i].is_null()) {
+      last_written_[i] = none;
+    } else if (last[i].is_number_unsigned() && last[i].get<std::uint64_t>() <= steps_) {
+      last_written_[i] = last[i].get<std::uint64_t>();
+    } else {
+      damaged("a last row's step is not a step of the run");
+    }
+  }
+  file_.reset();
+  file_.emplace(path_, state["bytes"].get<std::uint64_t>());
+}
+
+}  // namespace nonsep::host

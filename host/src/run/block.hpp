@@ -1,0 +1,157 @@
+#pragma once
+// Internal to the ensemble driver: a block of consecutive trajectories stepped together (one PhaseSpaceBatch, one
+// Integrator), what it needs to redo a chunk, and the helpers that isolate one state's failure from the others.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "nonsep/core/error.hpp"
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/phase_space_batch.hpp"
+#include "nonsep/host/run/trajectory.hpp"
+
+namespace nonsep::host {
+
+// A trajectory that stops before the end of the run, as found by its block's worker. The driver retires them in
+// (step, phase, trajectory) order, the order a step-by-step run finds them.
+struct Departure {
+  std::size_t trajectory = 0;
+  std::uint64_t step = 0;        // the step at which it was found
+  int phase = 0;                 // 0: while stepping, 1: while evaluating H at `step`, 2: asked by an observer
+  std::uint64_t final_step = 0;  // the step of its final state
+  TrajectoryStatus status = TrajectoryStatus::failed;
+  std::string variable;          // diverged: the first non-finite variable
+  std::string message;
+  std::vector<double> q, p;      // the final state
+  std::optional<double> energy;  // H of the final state, when known
+};
+
+// The first non-finite variable of state `slot` ("q[0]", "p[2]"), or "".
+inline std::string first_non_finite(const PhaseSpaceBatch& x, std::size_t slot) {
+  const auto q = x.q(slot), p = x.p(slot);
+  for (std::size_t i = 0; i < q.size(); ++i)
+    if (!std::isfinite(q[i])) return "q[" + std::to_string(i) + "]";
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!std::isfinite(p[i])) return "p[" + std::to_string(i) + "]";
+  return "";
+}
+
+inline PhaseSpaceBatch single_state(const PhaseSpaceBatch& x, std::size_t slot) {
+  return PhaseSpaceBatch::single(x.q(slot), x.p(slot));
+}
+
+inline void copy_state(const PhaseSpaceBatch& from, std::size_t from_slot, PhaseSpaceBatch& to, std::size_t to_slot) {
+  const auto q = from.q(from_slot), p = from.p(from_slot);
+  std::copy(q.begin(), q.end(), to.q(to_slot).begin());
+  std::copy(p.begin(), p.end(), to.p(to_slot).begin());
+}
+
+// Runs `action` on the whole batch; when the model fails on it and the batch holds several states, reruns it state
+// by state so that one failing state does not take the others down. `action(batch, first_slot)` works on a batch
+// whose state 0 is slot `first_slot` of the original. Returns the model's message per slot ("" for success).
+template <class Action>
+std::vector<std::string> isolate_failures(PhaseSpaceBatch& x, const PhaseSpaceBatch& before, Action&& action) {
+  std::vector<std::string> errors(x.count());
+  try {
+    action(x, 0);
+    return errors;
+  } catch (const ModelError& error) {
+    if (x.count() == 1) {
+      errors[0] = error.what();
+      if (errors[0].empty()) errors[0] = "the model failed without a message";
+      x = before;
+      return errors;
+    }
+  }
+  x = before;
+  for (std::size_t slot = 0; slot < x.count(); ++slot) {
+    PhaseSpaceBatch one = single_state(before, slot);
+    try {
+      action(one, slot);
+      copy_state(one, 0, x, slot);
+    } catch (const ModelError& error) {
+      errors[slot] = error.what();
+      if (errors[slot].empty()) errors[slot] = "the model failed without a message";
+    }
+  }
+  return errors;
+}
+
+// Consecutive trajectories stepped together; the unit of work of a thread.
+struct alignas(64) Block {  // a cache line of its own: threads count evaluations in neighbouring blocks
+  PhaseSpaceBatch batch;
+  std::vector<std::size_t> trajectories;   // slot in batch -> trajectory index
+  Integrator integrator;
+  std::vector<double> energies;            // per slot at energy_step (NaN when unknown)
+  std::optional<std::uint64_t> energy_step;
+  std::vector<Departure> departures;       // found in the current chunk
+  PhaseSpaceBatch chunk_start;             // the block at the start of the current chunk
+  std::optional<Integrator> chunk_start_integrator;
+  std::exception_ptr error;                // anything but a ModelError, thrown in the current chunk
+
+  Block(const IntegratorSpec& spec, std::size_t dimension, std::span<const std::size_t> members,
+        std::span<const double> q, std::span<const double> p)
+      : batch(dimension, members.size()), trajectories(members.begin(), members.end()), integrator(spec),
+        energies(members.size(), std::nan("")) {
+    std::copy(q.begin(), q.end(), batch.q().begin());
+    std::copy(p.begin(), p.end(), batch.p().begin());
+  }
+
+  bool empty() const { return trajectories.empty(); }
+  void clear() { trajectories.clear(); }
+
+  // H of `slot` at energy_step when it is finite.
+  std::optional<double> energy(std::size_t slot) const {
+    return std::isfinite(energies[slot]) ? std::optional<double>(energies[slot]) : std::nullopt;
+  }
+
+  bool all_finite() const {
+    bool finite = true;
+    for (double v : batch.q()) finite &= std::isfinite(v);
+    for (double v : batch.p()) finite &= std::isfinite(v);
+    return finite;
+  }
+
+  void begin_chunk() {
+    chunk_start = batch;
+    chunk_start_integrator = integrator;
+  }
+  // Back to the chunk's start, to redo it step by step.
+  void rollback_chunk() {
+    batch = chunk_start;
+    integrator = *chunk_start_integrator;
+  }
+  // Back to the chunk's start for good: the run ends there.
+  void abandon_chunk() {
+    if (!chunk_start_integrator) return;
+    rollback_chunk();
+    departures.clear();
+  }
+
+  // Removes the slots marked in `retire`, keeping the others in order.
+  void compact(const std::vector<bool>& retire) {
+    std::size_t kept = 0;
+    for (bool r : retire) kept += r ? 0 : 1;
+    if (kept == trajectories.size()) return;
+    PhaseSpaceBatch next(batch.dimension(), kept);
+    std::vector<std::size_t> next_trajectories;
+    std::vector<double> next_energies;
+    for (std::size_t slot = 0; slot < trajectories.size(); ++slot) {
+      if (retire[slot]) continue;
+      copy_state(batch, slot, next, next_trajectories.size());
+      next_trajectories.push_back(trajectories[slot]);
+      next_energies.push_back(energies[slot]);
+    }
+    batch = std::move(next);
+    trajectories = std::move(next_trajectories);
+    energies = std::move(next_energies);
+  }
+};
+
+}  // namespace nonsep::host

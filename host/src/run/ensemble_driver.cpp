@@ -1,0 +1,438 @@
+#include "nonsep/host/run/ensemble_driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <numeric>
+#include <optional>
+#include <tuple>
+
+#include <omp.h>
+
+#include "nonsep/core/energy.hpp"
+#include "nonsep/core/error.hpp"
+#include "run/block.hpp"
+#include "run/worker_pool.hpp"
+
+namespace nonsep::host {
+
+// What one thread owns: a plugin instance and an energy evaluator's workspace.
+struct alignas(64) Worker {
+  PluginModel model;
+  EnergyEvaluator energy;
+};
+
+struct EnsembleDriver::Impl {
+  const Plugin& plugin;
+  EnsembleSetup setup;
+  bool energy_available;
+  std::vector<TrajectoryRecord> records;
+  std::vector<Block> blocks;
+  std::vector<Worker> workers;
+  std::vector<Observer*> observers;
+  std::vector<Observer*> step_watchers;
+  std::unique_ptr<WorkerPool> pool;  // after `workers`: destroyed (its threads joined) before them
+  std::uint64_t completed = 0;
+  bool resumed = false;
+  EvaluationCounts evaluations_before;
+  std::string error;
+
+  Impl(const Plugin& p, const PluginModel& model, EnsembleSetup s)
+      : plugin(p), setup(std::move(s)), energy_available(p.has_hessians()), records(setup.q.size() / setup.dimension) {
+    const std::size_t n = setup.dimension, count = records.size();
+    for (std::size_t first = 0; first < count; first += run_block_size) {
+      const std::size_t size = std::min(run_block_size, count - first);
+      std::vector<std::size_t> members(size);
+      std::iota(members.begin(), members.end(), first);
+      blocks.emplace_back(setup.integrator, n, members, setup.q.subspan(first * n, size * n),
+                          setup.p.subspan(first * n, size * n));
+    }
+    // A plugin that is not thread-safe ("thread_safe": false, plugin_abi.h) gets one instance on one thread.
+    const unsigned requested = !plugin.thread_safe() ? 1u
+                               : setup.threads > 0   ? setup.threads
+                                                     : static_cast<unsigned>(omp_get_max_threads());
+    const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(requested, blocks.size()));
+    workers.push_back(Worker{model, EnergyEvaluator(setup.integrator.form)});
+    for (std::size_t t = 1; t < threads; ++t)
+      workers.push_back(Worker{plugin.create(model.parameters()), EnergyEvaluator(setup.integrator.form)});
+    pool = std::make_unique<WorkerPool>(workers.size());
+  }
+
+  // Runs `action(block, worker)` on every block with a state left, blocks spread over the workers' threads.
+  // Exceptions are kept per block; the first in block order is rethrown after all blocks are done.
+  template <class Action>
+  void for_each_block(Action&& action) {
+    // Threads of a WorkerPool, not an OpenMP region: they sleep between chunks instead of spinning (worker_pool.hpp).
+    pool->run(blocks.size(), [&](std::size_t index, std::size_t thread) {
+      Block& block = blocks[index];
+      if (block.empty()) return;
+      try {
+        action(block, workers[thread]);
+      } catch (...) {
+        block.error = std::current_exception();
+      }
+    });
+    for (Block& block : blocks)
+      if (block.error) {
+        const auto thrown = block.error;
+        for (Block& b : blocks) b.error = nullptr;
+        std::rethrow_exception(thrown);
+      }
+  }
+
+  std::size_t active_count() const {
+    std::size_t count = 0;
+    for (const Block& block : blocks) count += block.trajectories.size();
+    return count;
+  }
+
+  bool energy_step(std::uint64_t step) const {
+    if (!energy_available) return false;
+    if (step == setup.time.steps) return true;
+    return std::any_of(observers.begin(), observers.end(), [&](Observer* o) { return o->needs_energy(step); });
+  }
+
+  std::uint64_t next_event(std::uint64_t from) const {
+    std::uint64_t to = setup.time.steps;
+    for (Observer* observer : observers) to = std::min(to, std::max(from + 1, observer->next_event(from)));
+    const std::uint64_t longest =
+        std::max<std::uint64_t>(1, run_chunk_state_steps / std::max<std::size_t>(1, active_count()));
+    return std::min(to, from + longest);
+  }
+
+  BlockView view(const Block& block, std::size_t index) const {
+    return {index, setup.dimension, block.trajectories, block.batch.q(), block.batch.p()};
+  }
+
+  void watch_step(const Block& block, std::uint64_t step) {
+    if (step_watchers.empty()) return;
+    const std::size_t index = static_cast<std::size_t>(&block - blocks.data());
+    const auto v = view(block, index);
+    for (Observer* watcher : step_watchers) watcher->on_step(step, setup.time.time_at(step), v);
+  }
+
+  void advance_block(Block& block, Worker& worker, std::uint64_t from, std::uint64_t to) {
+    const std::size_t index = static_cast<std::size_t>(&block - blocks.data());
+    block.begin_chunk();
+    for (Observer* watcher : step_watchers) watcher->save_block(view(block, index));
+    const double dt = setup.time.dt;
+    bool clean = true;
+    try {
+      for (std::uint64_t step = from; step < to; ++step) {
+        block.integrator.step(worker.model, block.batch, dt);
+        watch_step(block, step + 1);
+      }
+    } catch (const ModelError&) {
+      clean = false;
+    }
+    if (clean && block.all_finite()) return;
+    block.rollback_chunk();
+    for (Observer* watcher : step_watchers) watcher->restore_block(view(block, index));
+    for (std::uint64_t step = from + 1; step <= to && !block.empty(); ++step) {
+      checked_step(block, worker, step);
+      watch_step(block, step);
+    }
+  }
+
+  // One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge.
+  void checked_step(Block& block, Worker& worker, std::uint64_t step) {
+    const PhaseSpaceBatch before = block.batch;
+    const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t) {
+      block.integrator.step(worker.model, x, setup.time.dt);
+    });
+    std::vector<bool> retire(block.trajectories.size(), false);
+    for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
+      Departure departure;
+      if (!errors[slot].empty()) {
+        departure.status = TrajectoryStatus::failed;
+        departure.message = "the model failed at step " + std::to_string(step) + ": " + errors[slot];
+      } else if (auto variable = first_non_finite(block.batch, slot); !variable.empty()) {
+        departure.status = TrajectoryStatus::diverged;
+        departure.variable = variable;
+      } else {
+        continue;
+      }
+      retire[slot] = true;
+      departure.trajectory = block.trajectories[slot];
+      departure.step = step;
+      departure.final_step = step - 1;
+      departure.q.assign(before.q(slot).begin(), before.q(slot).end());
+      departure.p.assign(before.p(slot).begin(), before.p(slot).end());
+      departure.energy = energy_of(worker, before, slot);
+      block.departures.push_back(std::move(departure));
+    }
+    block.compact(retire);
+  }
+
+  // H of state `slot` of x alone, or nothing when unknown.
+  std::optional<double> energy_of(Worker& worker, const PhaseSpaceBatch& x, std::size_t slot) const {
+    if (!energy_available) return std::nullopt;
+    try {
+      const double energy = worker.energy.evaluate_one(worker.model, single_state(x, slot));
+      if (std::isfinite(energy)) return energy;
+    } catch (const ModelError&) {
+    }
+    return std::nullopt;
+  }
+
+  // H of the block's states at `step`; the states the model fails on retire as "failed". Sets H0 at step 0 (each
+  // trajectory belongs to one block: no two threads touch the same record).
+  void evaluate_energies(Block& block, Worker& worker, std::uint64_t step) {
+    const auto errors = compute_energies(block, worker, step);
+    std::vector<bool> retire(block.trajectories.size(), false);
+    for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
+      if (errors[slot].empty()) {
+        if (step == 0) records[block.trajectories[slot]].energy_initial = block.energy(slot);
+        continue;
+      }
+      retire[slot] = true;
+      Departure departure;
+      departure.trajectory = block.trajectories[slot];
+      departure.step = departure.final_step = step;
+      departure.phase = 1;
+      departure.status = TrajectoryStatus::failed;
+      departure.message = "the energy could not be evaluated at step " + std::to_string(step) + ": " + errors[slot];
+      departure.q.assign(block.batch.q(slot).begin(), block.batch.q(slot).end());
+      departure.p.assign(block.batch.p(slot).begin(), block.batch.p(slot).end());
+      block.departures.push_back(std::move(departure));
+    }
+    block.compact(retire);
+  }
+
+  // Fills block.energies at `step` (NaN where the model fails); returns the model's message per slot.
+  static std::vector<std::string> compute_energies(Block& block, Worker& worker, std::uint64_t step) {
+    block.energies.assign(block.trajectories.size(), std::nan(""));
+    block.energy_step = step;
+    PhaseSpaceBatch x = block.batch;
+    auto errors = isolate_failures(x, block.batch, [&](PhaseSpaceBatch& part, std::size_t first) {
+      worker.energy.evaluate(worker.model, part, std::span<double>(block.energies).subspan(first, part.count()));
+    });
+    for (std::size_t slot = 0; slot < errors.size(); ++slot)
+      if (!errors[slot].empty()) block.energies[slot] = std::nan("");
+    return errors;
+  }
+
+  // Records the final state of a trajectory and tells the observers.
+  void retire(std::size_t trajectory, std::uint64_t step, std::span<const double> q, std::span<const double> p,
+              std::optional<double> energy) {
+    TrajectoryRecord& record = records[trajectory];
+    record.final_step = step;
+    record.final_t = setup.time.time_at(step);
+    record.final_q.assign(q.begin(), q.end());
+    record.final_p.assign(p.begin(), p.end());
+    record.energy_final = energy;
+    for (Observer* observer : observers) observer->on_retire(trajectory, record);
+  }
+
+  // Moves the blocks' departures into the records, in the order a step-by-step run finds them.
+  void apply_departures() {
+    std::vector<Departure> departures;
+    for (Block& block : blocks) {
+      std::move(block.departures.begin(), block.departures.end(), std::back_inserter(departures));
+      block.departures.clear();
+    }
+    std::sort(departures.begin(), departures.end(), [](const Departure& a, const Departure& b) {
+      return std::tie(a.step, a.phase, a.trajectory) < std::tie(b.step, b.phase, b.trajectory);
+    });
+    for (const Departure& departure : departures) {
+      TrajectoryRecord& record = records[departure.trajectory];
+      record.status = departure.status;
+      record.message = departure.message;
+      record.stop_step = departure.step;
+      record.stop_t = setup.time.time_at(departure.step);
+      record.stop_variable = departure.variable;
+      retire(departure.trajectory, departure.final_step, departure.q, departure.p, departure.energy);
+    }
+  }
+
+  // The event at `step`: the active states to every observer; retirements they ask for are applied after all.
+  void notify_event(std::uint64_t step, bool energy_evaluated) {
+    std::vector<StateView> states;
+    states.reserve(active_count());
+    for (const Block& block : blocks)
+      for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
+        states.push_back({block.trajectories[slot], block.batch.q(slot), block.batch.p(slot),
+                          block.energy_step == step ? block.energy(slot) : std::nullopt,
+                          &records[block.trajectories[slot]]});
+    std::vector<RetirementRequest> requests;
+    const Event event{step, setup.time.time_at(step), states, energy_evaluated, &requests};
+    for (Observer* observer : observers) observer->on_event(event);
+    if (requests.empty()) return;
+    std::sort(requests.begin(), requests.end(),
+              [](const RetirementRequest& a, const RetirementRequest& b) { return a.trajectory < b.trajectory; });
+    for (Block& block : blocks) {
+      std::vector<bool> retire(block.trajectories.size(), false);
+      for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
+        const auto found = std::lower_bound(
+            requests.begin(), requests.end(), block.trajectories[slot],
+            [](const RetirementRequest& r, std::size_t trajectory) { return r.trajectory < trajectory; });
+        if (found == requests.end() || found->trajectory != block.trajectories[slot]) continue;
+        retire[slot] = true;
+        Departure departure;
+        departure.trajectory = found->trajectory;
+        departure.step = departure.final_step = step;
+        departure.phase = 2;
+        departure.status = found->status;
+        departure.message = found->message;
+        departure.q.assign(block.batch.q(slot).begin(), block.batch.q(slot).end());
+        departure.p.assign(block.batch.p(slot).begin(), block.batch.p(slot).end());
+        departure.energy = block.energy_step == step ? block.energy(slot) : std::nullopt;
+        block.departures.push_back(std::move(departure));
+      }
+      block.compact(retire);
+    }
+    apply_departures();
+  }
+
+  // Every block from step `from` to `to`, then H at `to` when asked for, then the event.
+  void advance(std::uint64_t from, std::uint64_t to) {
+    try {
+      for_each_block([&](Block& block, Worker& worker) { advance_block(block, worker, from, to); });
+    } catch (...) {
+      for (Block& block : blocks) block.abandon_chunk();  // the run ends at `from`
+      throw;
+    }
+    apply_departures();
+    completed = to;
+    const bool energy = energy_step(to);
+    if (energy) {
+      for_each_block([&](Block& block, Worker& worker) { evaluate_energies(block, worker, to); });
+      apply_departures();
+    }
+    notify_event(to, energy);
+  }
+
+  void start() {
+    if (energy_available)
+      for_each_block([&](Block& block, Worker& worker) { evaluate_energies(block, worker, 0); });
+    apply_departures();
+    notify_event(0, energy_available);
+  }
+
+  // The states still active when the stepping ends: completed or interrupted. Their H is evaluated at `completed`
+  // unless it already was; a state whose H then fails keeps a null energy.
+  void finish_active(TrajectoryStatus status) {
+    if (energy_available) {
+      try {
+        for_each_block([&](Block& block, Worker& worker) {
+          if (block.energy_step != completed) compute_energies(block, worker, completed);
+        });
+      } catch (const std::exception& thrown) {
+        if (error.empty()) error = thrown.what();
+      }
+    }
+    for (Block& block : blocks) {
+      for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
+        TrajectoryRecord& record = records[block.trajectories[slot]];
+        record.status = status;
+        if (!error.empty()) record.message = error;
+        try {
+          retire(block.trajectories[slot], completed, block.batch.q(slot), block.batch.p(slot),
+                 block.energy_step == completed ? block.energy(slot) : std::nullopt);
+        } catch (const std::exception& thrown) {
+          if (error.empty()) error = thrown.what();
+        }
+      }
+      block.clear();
+    }
+  }
+};
+
+EnsembleDriver::EnsembleDriver(const Plugin& plugin, const PluginModel& model, EnsembleSetup setup)
+    : impl_(std::make_unique<Impl>(plugin, model, std::move(setup))) {}
+EnsembleDriver::~EnsembleDriver() = default;
+
+void EnsembleDriver::add_observer(Observer& observer) {
+  impl_->observers.push_back(&observer);
+  if (observer.watches_every_step()) impl_->step_watchers.push_back(&observer);
+}
+
+DriverEnd EnsembleDriver::run() {
+  Impl& d = *impl_;
+  for (Observer* observer : d.observers) observer->prepare_blocks(d.blocks.size());
+  bool interrupted = false;
+  try {
+    if (!d.resumed) d.start();
+    while (d.completed < d.setup.time.steps && d.active_count() > 0) {
+      if (d.setup.stop_requested && d.setup.stop_requested->load()) {
+        interrupted = true;
+        break;
+      }
+      d.advance(d.completed, d.next_event(d.completed));
+      for (Observer* observer : d.observers) observer->after_chunk(d.completed);
+    }
+    for (Observer* observer : d.observers) observer->before_finish(d.completed, interrupted);
+  } catch (const std::exception& thrown) {
+    d.error = thrown.what();
+  }
+  const bool finished = d.completed == d.setup.time.steps && !interrupted;
+  d.finish_active(!d.error.empty() ? TrajectoryStatus::failed
+                  : finished       ? TrajectoryStatus::completed
+                                   : TrajectoryStatus::interrupted);
+  for (Observer* observer : d.observers) {
+    try {
+      observer->on_end();
+    } catch (const std::exception& thrown) {
+      if (d.error.empty()) d.error = thrown.what();
+    }
+  }
+  if (!d.error.empty()) return DriverEnd::failed;
+  return interrupted ? DriverEnd::interrupted : DriverEnd::completed;
+}
+
+void EnsembleDriver::restore(DriverState state) {
+  Impl& d = *impl_;
+  const std::size_t n = d.setup.dimension;
+  std::vector<std::vector<std::size_t>> members(d.blocks.size());
+  for (std::size_t k = 0; k < state.active.size(); ++k) members[state.active[k] / run_block_size].push_back(k);
+  for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+    std::vector<std::size_t> trajectories;
+    std::vector<double> q, p, energies;
+    for (std::size_t k : members[b]) {
+      trajectories.push_back(state.active[k]);
+      q.insert(q.end(), state.q.begin() + static_cast<std::ptrdiff_t>(k * n),
+               state.q.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+      p.insert(p.end(), state.p.begin() + static_cast<std::ptrdiff_t>(k * n),
+               state.p.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+      energies.push_back(state.energies[k]);
+    }
+    d.blocks[b] = Block(d.setup.integrator, n, trajectories, q, p);
+    d.blocks[b].energies = std::move(energies);
+    d.blocks[b].energy_step = state.step;
+  }
+  d.records = std::move(state.records);
+  d.completed = state.step;
+  d.evaluations_before = state.evaluations;
+  d.resumed = true;
+}
+
+DriverState EnsembleDriver::state() const {
+  const Impl& d = *impl_;
+  DriverState state;
+  state.step = d.completed;
+  for (const Block& block : d.blocks) {
+    state.active.insert(state.active.end(), block.trajectories.begin(), block.trajectories.end());
+    state.q.insert(state.q.end(), block.batch.q().begin(), block.batch.q().end());
+    state.p.insert(state.p.end(), block.batch.p().begin(), block.batch.p().end());
+    for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
+      state.energies.push_back(block.energy_step == d.completed ? block.energies[slot] : std::nan(""));
+  }
+  state.records = d.records;
+  state.evaluations = evaluations();
+  return state;
+}
+
+const std::vector<TrajectoryRecord>& EnsembleDriver::records() const { return impl_->records; }
+EvaluationCounts EnsembleDriver::evaluations() const {
+  EvaluationCounts counts = impl_->evaluations_before;
+  for (const Block& block : impl_->blocks) counts += block.integrator.evaluations();
+  return counts;
+}
+std::uint64_t EnsembleDriver::steps_completed() const { return impl_->completed; }
+std::size_t EnsembleDriver::active_count() const { return impl_->active_count(); }
+const std::string& EnsembleDriver::error() const { return impl_->error; }
+const TimeGrid& EnsembleDriver::time() const { return impl_->setup.time; }
+bool EnsembleDriver::energy_available() const { return impl_->energy_available; }
+
+}  // namespace nonsep::host

@@ -1,0 +1,150 @@
+#include "run/run_files.hpp"
+
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/csv.hpp"
+#include "nonsep/host/output/files.hpp"
+
+namespace nonsep::host {
+
+using json = nlohmann::ordered_json;
+
+namespace {
+
+json optional_number(std::optional<double> value) {
+  return value && std::isfinite(*value) ? json(*value) : json(nullptr);
+}
+
+std::string hamiltonian_text(HamiltonianForm form) {
+  return form == HamiltonianForm::TTV ? "H = T_i(p) V_ij(q) T_j(p)" : "H = V_i(q) T_ij(p) V_j(q)";
+}
+
+json energy_facts(const RunFacts& facts) {
+  const Job& job = facts.loaded.job;
+  const std::string hamiltonian = hamiltonian_text(job.integrator.form);
+  if (!facts.driver.energy_available())
+    return {{"available", false},
+            {"hamiltonian", hamiltonian},
+            {"reason", "the plugin '" + facts.loaded.plugin.name() +
+                           "' provides no Hessians (hessian_T and hessian_V), which " + hamiltonian + " needs"}};
+  json largest = nullptr;
+  if (const auto& l = facts.outcome.largest_energy_error)
+    largest = {{"value", l->value}, {"trajectory", l->trajectory}};
+  return {{"available", true},
+          {"hamiltonian", hamiltonian},
+          {"relative_error_definition", "(H - H0) / H0; unknown when H0 = 0"},
+          {"evaluated_at",
+           "step 0, every written sample (output.every), " +
+               (job.energy_every > 0 ? "every " + std::to_string(job.energy_every) + "-th step (output.energy_every), "
+                                     : std::string()) +
+               "the last step, and the final state of a trajectory that stopped early"},
+          {"largest_relative_error", largest},
+          {"max_relative_error_bound", optional_number(job.analysis.max_relative_energy_error)}};
+}
+
+}  // namespace
+
+json run_summary(const RunFacts& facts) {
+  const Job& job = facts.loaded.job;
+  const auto description = Integrator(job.integrator).describe();
+  const RunOutcome& outcome = facts.outcome;
+  json summary;
+  summary["status"] = to_string(outcome.status);
+  if (!outcome.error.empty()) summary["error"] = outcome.error;
+  summary["job"] = job.file.string();
+  summary["model"] = {{"plugin", facts.loaded.plugin.name()},
+                      {"version", facts.loaded.plugin.version()},
+                      {"path", facts.loaded.plugin.path().string()},
+                      {"dimension", job.initial.dimension},
+                      {"parameters", json(facts.loaded.model.parameters())}};
+  summary["hamiltonian"] = job.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
+  summary["integrator"] = {{"scheme", description.scheme},
+                           {"order", description.order.to_string()},
+                           {"t2", description.t2},
+                           {"symplectic", description.symplectic},
+                           {"time_reversible", description.time_reversible},
+                           {"basic_steps_per_step", description.basic_steps_per_step}};
+  summary["time"] = {{"dt", job.time.dt},
+                     {"dt_requested", job.time.dt_requested},
+                     {"steps", job.time.steps},
+                     {"t_end", job.time.t_end},
+                     {"steps_completed", outcome.steps_completed}};
+  summary["energy"] = energy_facts(facts);
+  summary["output"] = {{"directory", facts.directory.string()},
+                       {"trajectory", facts.samples_written ? json("trajectory.csv") : json(nullptr)},
+                       {"trajectories", trajectories_file_name},
+                       {"every", job.every},
+                       {"energy_every", job.energy_every}};
+  summary["trajectories"] = job.initial.count;
+  summary["counts"] = {{"completed", outcome.counts.completed},
+                       {"diverged", outcome.counts.diverged},
+                       {"failed", outcome.counts.failed},
+                       {"inaccurate", outcome.counts.inaccurate},
+                       {"interrupted", outcome.counts.interrupted}};
+  const auto evaluations = facts.driver.evaluations();
+  summary["evaluations"] = {{"grad_T", evaluations.grad_T}, {"grad_V", evaluations.grad_V}};
+  summary["wall_seconds"] = facts.wall_seconds;
+  return summary;
+}
+
+void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& facts,
+                            std::span<const Observer* const> observers) {
+  const std::size_t n = facts.loaded.job.initial.dimension;
+  std::string text = "trajectory,status,step,t";
+  for (const char* name : {"q", "p"})
+    for (std::size_t i = 0; i < n; ++i) {
+      text += ',';
+      text += name;
+      text += std::to_string(i);
+    }
+  text += ",H0,H,relative_energy_error,stop_step,stop_t,stop_variable,message";
+  std::vector<std::string> columns;
+  for (const Observer* observer : observers) observer->columns(columns);
+  for (const std::string& column : columns) text += "," + column;
+  text += '\n';
+  AtomicFile file(path);
+  const auto& records = facts.outcome.trajectories;
+  for (std::size_t index = 0; index < records.size(); ++index) {
+    const TrajectoryRecord& record = records[index];
+    text += std::to_string(index);
+    text += ',';
+    text += to_string(record.status);
+    text += ',';
+    text += std::to_string(record.final_step);
+    text += ',';
+    append_number(text, record.final_t);
+    for (const auto* values : {&record.final_q, &record.final_p})
+      for (std::size_t i = 0; i < n; ++i) {
+        text += ',';
+        if (i < values->size()) append_number(text, (*values)[i]);
+      }
+    text += ',';
+    append_csv_number(text, record.energy_initial);
+    text += ',';
+    append_csv_number(text, record.energy_final);
+    text += ',';
+    append_csv_number(text, relative_energy_error(record.energy_final, record.energy_initial));
+    text += ',';
+    if (stopped_early(record.status)) {
+      text += std::to_string(record.stop_step);
+      text += ',';
+      append_number(text, record.stop_t);
+    } else {
+      text += ',';
+    }
+    text += ',';
+    append_csv_text(text, record.stop_variable);
+    text += ',';
+    append_csv_text(text, record.message);
+    for (const Observer* observer : observers) observer->cells(index, text);
+    text += '\n';
+    if (text.size() >= (1 << 16)) {
+      file.write(text);
+      text.clear();
+    }
+  }
+  file.write(text);
+  file.commit();
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,35 @@
+#pragma once
+// What a run writes at its end: summary.json (the run's facts, written with nlohmann-json) and trajectories.csv
+// (one row per trajectory; columns in run_job.hpp). Both are replaced atomically.
+#include <filesystem>
+#include <span>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+#include "nonsep/host/run/observer.hpp"
+#include "nonsep/host/run/run_job.hpp"
+
+namespace nonsep::host {
+
+inline constexpr const char* summary_file_name = "summary.json";
+inline constexpr const char* trajectories_file_name = "trajectories.csv";
+
+struct RunFacts {
+  const LoadedJob& loaded;
+  const std::filesystem::path& directory;
+  const EnsembleDriver& driver;
+  const RunOutcome& outcome;
+  bool samples_written;
+  double wall_seconds;
+};
+
+nlohmann::ordered_json run_summary(const RunFacts& facts);
+
+// Throws OutputError.
+void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& facts,
+                            std::span<const Observer* const> observers);
+
+}  // namespace nonsep::host

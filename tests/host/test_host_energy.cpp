@@ -1,0 +1,123 @@
+// Energies in the `nonsep` executable's outputs: when they are sampled and summarised, and what the outputs say
+// when the plugin has no Hessians.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "host_run_support.hpp"
+#include "support/nan_aware.hpp"
+
+using nlohmann::json;
+using namespace nonsep::host_testing;
+
+TEST_CASE("without Hessians the energy is null, the CSV's energy cells empty, and the summary says why") {
+  TemporaryFolder folder;
+  const json summary = run_job(folder, "no-energy", blowup_job(state(1.0, 0.5), json::object(), "blowup_gradients_only"));
+  CHECK(summary["status"] == "completed");
+  CHECK(summary["energy"]["available"] == false);
+  CHECK(summary["energy"]["reason"].get<std::string>().find("Hessians") != std::string::npos);
+  CHECK(summary["trajectories"][0]["energy"]["initial"].is_null());
+  CHECK(summary["trajectories"][0]["energy"]["relative_error_max_abs"].is_null());
+  const json with_energy = run_job(folder, "energy", blowup_job(state(1.0, 0.5)));
+  CHECK(summary["trajectories"][0]["final"] == with_energy["trajectories"][0]["final"]);
+  CHECK(number(with_energy["trajectories"][0]["energy"]["initial"]) == 0.75);  // 3 q^2 p^2
+  for (const auto& row : read_csv(folder / "no-energy" / "trajectory.csv")) {
+    REQUIRE(row.size() == 7);
+    if (row[0] == "trajectory") continue;
+    CHECK(row[5].empty());
+    CHECK(row[6].empty());
+  }
+}
+
+namespace {
+
+// The largest |relative_energy_error| over the rows of a trajectory.csv (the numbers round-trip exactly).
+double largest_csv_energy_error(const std::filesystem::path& csv) {
+  double largest = 0.0;
+  for (const auto& row : read_csv(csv))
+    if (row[0] != "trajectory" && !row.back().empty())
+      largest = nonsep::testing::max_or_nan(largest, std::abs(std::stod(row.back())));
+  return largest;
+}
+
+}  // namespace
+
+TEST_CASE("energy: H at step 0, the samples, every energy_every-th step and the end, max_abs over exactly those") {
+  TemporaryFolder folder;
+  json job = quickstart_job();
+  job["time"] = {{"dt", 0.005}, {"steps", 120}};  // past the quarter period: the error is largest mid-run
+  job["output"] = {{"every", 1}};
+  const json all = run_job(folder, "every1", job);
+  const json& all_energy = all["trajectories"][0]["energy"];
+  CHECK(number(all_energy["relative_error_max_abs"]) == largest_csv_energy_error(folder / "every1" / "trajectory.csv"));
+  CHECK(all["energy"]["evaluated_at"].get<std::string>().find("every written sample") != std::string::npos);
+  CHECK(number(all["energy"]["largest_relative_error"]["value"]) == number(all_energy["relative_error_max_abs"]));
+
+  job["output"] = {{"every", 0}, {"energy_every", 1}};
+  const json strided = run_job(folder, "energy_every1", job);
+  CHECK(strided["output"]["energy_every"] == 1);
+  CHECK(strided["trajectories"][0]["energy"] == all_energy);
+  CHECK(strided["trajectories"][0]["final"] == all["trajectories"][0]["final"]);
+
+  job["output"] = {{"every", 0}};
+  const json ends = run_job(folder, "ends_only", job);
+  const json& ends_energy = ends["trajectories"][0]["energy"];
+  CHECK(ends_energy["final"] == all_energy["final"]);
+  CHECK(number(ends_energy["relative_error_max_abs"]) == std::abs(number(ends_energy["relative_error_final"])));
+  CHECK(number(ends_energy["relative_error_max_abs"]) < number(all_energy["relative_error_max_abs"]));
+
+  job["output"] = {{"every", 10}};
+  const json sampled = run_job(folder, "every10", job);
+  CHECK(number(sampled["trajectories"][0]["energy"]["relative_error_max_abs"]) ==
+        largest_csv_energy_error(folder / "every10" / "trajectory.csv"));
+  CHECK(sampled["trajectories"][0]["final"] == all["trajectories"][0]["final"]);
+}
+
+TEST_CASE("analysis.max_relative_energy_error retires a trajectory past the bound as inaccurate, the others go on") {
+  TemporaryFolder folder;
+  json job = quickstart_job();
+  job["initial"] = json::array({state(0.5, 0.0), state(2.0, 0.0)});  // |dH/H0| ~ 5e-3 and ~ 3.6e-2 at dt = 0.005
+  job["output"] = {{"every", 1}};
+  job["analysis"] = {{"max_relative_energy_error", 0.02}};
+  const json summary = run_job(folder, "bounded", job, 1);
+  CHECK(summary["status"] == "inaccurate");
+  CHECK(summary["counts"]["inaccurate"] == 1);
+  CHECK(summary["counts"]["completed"] == 1);
+  const json& small = summary["trajectories"][0];
+  const json& large = summary["trajectories"][1];
+  CHECK(small["status"] == "completed");
+  CHECK(number(small["energy"]["relative_error_max_abs"]) <= 0.02);
+  CHECK(large["status"] == "inaccurate");
+  const auto step = large["stop"]["step"].get<std::uint64_t>();
+  CHECK(large["final"]["step"] == step);  // it stops where the bound was crossed
+  CHECK(std::abs(number(large["energy"]["relative_error_final"])) > 0.02);
+  CHECK(large["message"].get<std::string>().find("exceeds analysis.max_relative_energy_error = 0.02") !=
+        std::string::npos);
+  // Without the bound the same trajectory completes, and passes the bound exactly at that step first.
+  job.erase("analysis");
+  const json free = run_job(folder, "free", job);
+  CHECK(free["trajectories"][1]["status"] == "completed");
+  for (const auto& row : read_csv(folder / "free" / "trajectory.csv")) {
+    if (row[0] != "1" || row.back().empty()) continue;
+    if (std::stoull(row[1]) < step) CHECK(std::abs(std::stod(row.back())) <= 0.02);
+    if (std::stoull(row[1]) == step) CHECK(std::abs(std::stod(row.back())) > 0.02);
+  }
+}
+
+TEST_CASE("the completion line names the largest relative energy error, and a warning comes above 0.1") {
+  TemporaryFolder folder;
+  json job = quickstart_job();
+  const auto file = write_job(folder / "q.json", job);
+  auto result = run_nonsep({"run", "--output", (folder / "q").string(), file.string()}, folder.path());
+  CHECK(result.status == 0);
+  CHECK(result.out.find("largest |dH/H0| 0.03592251724420663 (trajectory 0)") != std::string::npos);
+  CHECK(result.err.find("warning") == std::string::npos);
+  job["integrator"] = {{"scheme", "basic"}, {"t2", -2.0}};
+  job["time"] = {{"dt", 0.05}, {"steps", 40}};  // the basic step at a coarse dt: |dH/H0| well above 0.1
+  write_job(file, job);
+  result = run_nonsep({"run", "--quiet", "--output", (folder / "coarse").string(), file.string()}, folder.path());
+  CHECK(result.status == 0);
+  CHECK(result.err.find("nonsep: warning: the relative energy error |dH/H0| reached 0.312") != std::string::npos);
+}

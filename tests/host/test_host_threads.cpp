@@ -1,0 +1,82 @@
+// The `nonsep` executable's ensemble driver: results that do not depend on the number of threads, on stepping in
+// chunks or sample by sample, nor on replaying a chunk; the --threads option.
+#include <doctest/doctest.h>
+
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "host_run_support.hpp"
+
+using nlohmann::json;
+using namespace nonsep::host_testing;
+
+TEST_CASE("threads: 1, 2 and 3 threads write byte-identical trajectory.csv, trajectories.csv and summary.json (but wall_seconds)") {
+  TemporaryFolder folder;
+  use_test_plugins();
+  // 600 trajectories: three blocks of run_block_size = 256. A diverging state in the first block and, in the
+  // second job, a failing state in the last block make blocks replay their chunk step by step.
+  json diverging = json::array(), failing = json::array(), completing = json::array();
+  for (int i = 0; i < 600; ++i) {
+    const double q = 0.5 + 0.001 * i;
+    diverging.push_back(i == 100 ? state(1e103, 1.0) : state(q, 0.25));
+    failing.push_back(i == 550 ? state(5.0, 0.0) : state(q, 0.25));
+    completing.push_back(state(q, 0.25));
+  }
+  for (const auto& [name, job, expected] : {std::tuple{"diverging", blowup_job(diverging), 1},
+                                            std::tuple{"failing", blowup_job(failing, {{"fail_above", 3.0}}), 1},
+                                            std::tuple{"paper1d", paper1d_job(completing, {{"dt", 0.002}, {"steps", 30}}), 0}}) {
+    const std::string job_name = name;
+    CAPTURE(job_name);
+    const auto file = write_job(folder / (std::string(name) + ".json"), job);
+    std::vector<std::string> csv, table;
+    std::vector<json> summaries;
+    for (const char* threads : {"1", "2", "3"}) {
+      const auto out = folder / (std::string(name) + "-" + threads);
+      const auto result =
+          run_nonsep({"run", "--quiet", "--threads", threads, "--output", out.string(), file.string()}, folder.path());
+      CHECK(result.status == expected);
+      csv.push_back(read_text(out / "trajectory.csv"));
+      table.push_back(read_text(out / "trajectories.csv"));
+      summaries.push_back(comparable(read_json(out / "summary.json")));
+    }
+    CHECK(read_csv(folder / (std::string(name) + "-1") / "trajectories.csv").size() == 601);
+    CHECK(table[1] == table[0]);
+    CHECK(table[2] == table[0]);
+    CHECK(csv[0].size() > 10000);
+    CHECK(csv[1] == csv[0]);
+    CHECK(csv[2] == csv[0]);
+    CHECK(summaries[1] == summaries[0]);
+    CHECK(summaries[2] == summaries[0]);
+  }
+}
+
+TEST_CASE("--threads must be a whole number from 1 to 4096") {
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", quickstart_job());
+  const auto zero = run_nonsep({"run", "--threads", "0", file.string()}, folder.path());
+  CHECK(zero.status == 2);
+  CHECK(zero.err.find("--threads: Value 0 not in range 1 to 4096") != std::string::npos);
+  CHECK(run_nonsep({"run", "--threads", "two", file.string()}, folder.path()).status == 2);
+}
+
+TEST_CASE("closest_return is the same whether the run steps in chunks (every = 0) or sample by sample, and on a replay") {
+  TemporaryFolder folder;
+  use_test_plugins();
+  // Blowup with a diverging middle state: the block replays its first chunk step by step.
+  json job = blowup_job(json::array({state(1.0, 0.5), state(1e103, 1.0), state(-0.5, 0.25)}));
+  job["analysis"] = {{"closest_return_after", 0.01}};
+  job["time"] = {{"dt", 0.001}, {"steps", 400}};
+  job["output"] = {{"every", 1}};
+  const json sampled = run_job(folder, "sampled", job, 1);
+  job["output"] = {{"every", 0}};
+  const json chunked = run_job(folder, "chunked", job, 1);
+  for (std::size_t i : {0u, 2u}) {
+    CAPTURE(i);
+    REQUIRE(sampled["trajectories"][i]["closest_return"].is_object());
+    CHECK(chunked["trajectories"][i]["closest_return"] == sampled["trajectories"][i]["closest_return"]);
+    CHECK(chunked["trajectories"][i]["final"] == sampled["trajectories"][i]["final"]);
+  }
+  CHECK(chunked["trajectories"][1]["closest_return"] == sampled["trajectories"][1]["closest_return"]);
+}
+
