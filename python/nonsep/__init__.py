@@ -1,0 +1,16 @@
+"""nonsep from Python: run job files (or dicts) with the `nonsep` executable and load what the runs leave behind.
+
+    import nonsep
+    result = nonsep.run("examples/jobs/ensemble.json", output="ensemble.out")
+    result.trajectories["relative_energy_error"]     # one row per trajectory
+    orbit = result.orbit(0)                            # orbit.t, orbit.q [n, d], orbit.p, orbit.H, ...
+
+run(), validate() and the executable: nonsep.process; load() and Result: nonsep.results; figures: nonsep.plot
+(imported on its own, as it needs matplotlib).
+"""
+from .process import (ExecutableNotFound, Problem, RunError, RunInterrupted, executable, parse_problems, run,
+                      validate)
+from .results import Orbit, Result, load
+
+__all__ = ["ExecutableNotFound", "Orbit", "Problem", "Result", "RunError", "RunInterrupted", "executable", "load",
+           "parse_problems", "run", "validate"]

@@ -1,0 +1,84 @@
+"""nonsep.plot: each function returns labelled axes whose lines hold exactly the loaded data, with a legend when
+there are several series; headless (Agg)."""
+import unittest
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+import nonsep  # noqa: E402
+import nonsep.plot  # noqa: E402
+from support import FolderTestCase, paper1d_job, state  # noqa: E402
+
+
+class PlotTest(FolderTestCase):
+    def tearDown(self):
+        plt.close("all")
+        super().tearDown()
+
+    def test_orbit_in_the_phase_plane(self):
+        result = nonsep.run(paper1d_job([state(0.5, 0.0), state(2.0, 0.0)], steps=60, every=3), output="out")
+        ax = nonsep.plot.orbit(result)
+        self.assertEqual((ax.get_xlabel(), ax.get_ylabel()), ("$q$", "$p$"))
+        self.assertEqual(len(ax.get_lines()), 2)
+        for line, i in zip(ax.get_lines(), (0, 1)):
+            np.testing.assert_array_equal(line.get_xdata(), result.orbit(i).q[:, 0])
+            np.testing.assert_array_equal(line.get_ydata(), result.orbit(i).p[:, 0])
+        self.assertEqual([t.get_text() for t in ax.get_legend().get_texts()],
+                         ["trajectory 0: (q, p)(0) = (0.5, 0)", "trajectory 1: (q, p)(0) = (2, 0)"])
+        _, given = plt.subplots()
+        one = nonsep.plot.orbit(result, 1, ax=given)
+        self.assertIs(one, given)
+        self.assertEqual(len(one.get_lines()), 1)
+        self.assertIsNone(one.get_legend())
+
+    def test_orbit_in_the_configuration_plane_in_2d(self):
+        job = {"model": {"plugin": "radial"}, "integrator": {"scheme": "triplet", "order": "4/3"},
+               "initial": {"q": [0.8, 0.0], "p": [0.0, 0.439]}, "time": {"dt": 0.01, "steps": 40}}
+        result = nonsep.run(job, output="out")
+        ax = nonsep.plot.orbit(result, 0)
+        self.assertEqual((ax.get_xlabel(), ax.get_ylabel()), ("$q_1$", "$q_2$"))
+        np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), result.orbit(0).q[:, 1])
+
+    def test_energy_error_against_time(self):
+        result = nonsep.run(paper1d_job([state(0.5, 0.0), state(1.0, 0.0), state(2.0, 0.0)], steps=60),
+                            output="out")
+        ax = nonsep.plot.energy_error(result)
+        self.assertEqual(ax.get_xlabel(), "$t$")
+        self.assertIn("relative energy error", ax.get_ylabel())
+        series = [line for line in ax.get_lines() if len(line.get_xdata()) > 2]  # not the zero line
+        self.assertEqual(len(series), 3)
+        for line, i in zip(series, range(3)):
+            np.testing.assert_array_equal(line.get_xdata(), result.orbit(i).t)
+            np.testing.assert_array_equal(line.get_ydata(), result.orbit(i).relative_energy_error)
+        self.assertEqual(len(ax.get_legend().get_texts()), 3)
+
+    def test_convergence_with_the_fitted_lines(self):
+        job = {"model": {"plugin": "paper1d"}, "initial": state(2.0, 0.0), "time": {"t_end": 0.3863765573361232},
+               "study": {"integrators": [{"scheme": "basic", "t2": -2.0, "steps": [1024, 2048, 4096]},
+                                         {"scheme": "mpe", "order": "4/3", "t2": -2.0, "steps": [128, 256, 512]}]}}
+        result = nonsep.run(job, output="out")
+        ax = nonsep.plot.convergence(result)
+        self.assertEqual((ax.get_xscale(), ax.get_yscale()), ("log", "log"))
+        self.assertIn("dt", ax.get_xlabel())
+        self.assertIn("relative energy error", ax.get_ylabel())
+        points, fits = [], []
+        for line in ax.get_lines():
+            (points if line.get_linestyle() == "None" else fits).append(line)
+        self.assertEqual(len(points), 2)
+        self.assertEqual(points[1].get_marker(), "s")  # MPE is not symplectic: open squares
+        for line, fit in zip(fits, result.fits):
+            x, y = line.get_xdata(), line.get_ydata()
+            self.assertAlmostEqual(np.log(y[1] / y[0]) / np.log(x[1] / x[0]), fit["exponent"], places=12)
+        ax.figure.canvas.draw()  # the labels' mathtext renders
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        self.assertEqual(len(labels), 2)
+        self.assertTrue(labels[0].startswith("basic: $") and f"{result.exponents['basic']:.3f}" in labels[0])
+        with self.assertRaises(ValueError):
+            nonsep.plot.convergence(nonsep.run(paper1d_job(state(1.0, 0.0), steps=3), output="run"))
+
+
+if __name__ == "__main__":
+    unittest.main()
