@@ -1,31 +1,37 @@
-// The figures of docs/performance.md, each a ratio against a reference measured in the same run (configurations
-// interleaved, median of the repetitions), all on the paper's 1D model (paper1d) with the basic step, dt = 1e-4:
+// The figures of docs/performance.md, each a ratio measured in one run of this program (configurations
+// interleaved, median of the repetitions, the spread of the per-repetition ratios reported), all on the paper's 1D
+// model (paper1d) with the basic step, dt = 1e-4. The reference is the physical limit: the basic step written out
+// by hand (bench/hand_written.hpp: nine stages, gradients inline, no Integrator, no batch types, no plugin),
+// compiled with the same flags as the host.
 //
-//   1. one trajectory:       ns per basic step of `nonsep run` (nonsep::host::run_job on paper1d.so, output every
-//                            = 0) over the same ChinBasicStep on the same model class compiled in (ModelAdapter).
-//                            The host runs chunks through the plugin's integrate() (the fused path, the default);
-//   1u.                      the same with the fused path off (RunOptions::fused = false: a plugin call per stage).
-//   2. ensemble of 1024:     ns per basic step per trajectory, run_job with 1 thread over the compiled-in batched
-//                            loop (ChinBasicStep on one PhaseSpaceBatch of 1024 states); 2u with the fused path off.
-//   3. threads:              run_job on a large ensemble, 1 thread over 2 threads (speed-up); 3c the same for
-//                            the compiled-in loop cut into the host's blocks, on std::threads: the machine's own
-//                            speed-up, which bounds figure 3.
-//   4. AD over analytic:     run_job on 1024 trajectories, paper1d_autodiff.so (T and V only, gradients by the
-//                            SDK's dual numbers) over paper1d.so (hand-written gradients), 1 thread.
-//   6b. output:              run_job on one trajectory writing trajectory.csv every 10^4 steps (with H at each
-//                            row) over the same run with every = 0.
-//   6c. energy:              the same with H at every step (output.energy_every = 1) over H at start and end.
-// Host runs keep the evaluations of H it always does (start and end) and write summary.json (an entry per
-// trajectory, then fsync and rename): a fixed cost per run and per trajectory that the step counts amortize, and
-// that counts against the host in figures 2 and 3. Every host run's final state is checked bit for bit against the
-// compiled-in loop, so a faster but wrong path cannot pass.
+//   1. one trajectory:     ns per basic step of `nonsep run` (nonsep::host::run_job on paper1d.so, no output) over
+//                          the hand-written loop on one (q, p). 1c: the core's ChinBasicStep compiled in, over the
+//                          same hand-written loop (how much of figure 1 is the core's, not the host's).
+//   2. 1024 trajectories:  ns per basic step per trajectory, run_job on 1 thread over the faster of two hand-written
+//                          loops over 1024 states (state by state; stage by stage), vectorized at the build's SIMD
+//                          width (SSE2 by default, the machine's with cmake -DNONSEP_NATIVE=ON: figure 2n).
+//                          2c: ChinBasicStep on one batch over the same limit.
+//   3. threads:            8192 trajectories, run_job on 1 thread over 2 threads (speed-up); 3b the same while a
+//                          child process of this program spins on one core; 3c the hand-written loop cut into the
+//                          host's blocks on std::threads, 1 over 2: what the machine itself gives two threads.
+//   4. AD over analytic:   run_job on 1024 trajectories, paper1d_autodiff.so (T and V only, gradients by the
+//                          SDK's dual numbers) over paper1d.so (hand-written gradients), 1 thread.
+//   6b. output:            run_job on one trajectory writing trajectory.csv every 10^4 steps (with H at each
+//                          row) over the same run with every = 0.
+//   6c. energy:            the same with H at every step (output.energy_every = 1) over H at start and end.
+// Host runs keep the evaluations of H they always do (start and end) and write summary.json and trajectories.csv:
+// a fixed cost per run and per trajectory that the step counts amortize, and that counts against the host.
+// Every host run's final states are checked against the hand-written loop: bit for bit when the build cannot
+// contract into fused multiply-adds (no __FMA__), else to 1e-9 (the plugin and this program may fuse different
+// pairs) and the output says which; 2 threads must give the states of 1 thread bit for bit.
 //
-// Usage: nonsep_bench_performance [--smoke] [--repetitions N] [--scale X]
+// Usage: nonsep_bench_performance [--smoke] [--repetitions N] [--scale X] [--only F]
 //   --smoke         a few repetitions of short runs (< 10 s; the ctest bench.performance.smoke)
 //   --repetitions   timed repetitions per configuration (default 7; smoke 3)
 //   --scale         multiplies every run's step count (default 1; smoke 0.05)
-// Exit status 1 when a host run disagrees with the compiled-in loop; the figures' targets are reported, not
-// enforced (timings on a shared machine are not a test).
+//   --only          one group of figures: 1, 2, 3 (3, 3b, 3c), 4, 6b or 6c (e.g. to run one under callgrind)
+// Exit status 1 when a check fails; the figures' targets are reported, not enforced (timings on a shared machine
+// are not a test).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -38,13 +44,17 @@
 #include <thread>
 #include <vector>
 
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
 #include "nonsep/core/chin_basic_step.hpp"
 #include "nonsep/host/job.hpp"
-#include "nonsep/host/runner.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+#include "nonsep/host/run/run_job.hpp"
+#include "hand_written.hpp"
 #include "paper1d/paper1d.hpp"
 
 namespace {
@@ -83,13 +93,10 @@ nonsep::host::LoadedJob make_job(const std::filesystem::path& folder, const std:
 }
 
 // Seconds for the host to run `job` on `threads` threads; `final_q` receives every trajectory's final q.
-// `fused` = false switches the fused path (the plugin's integrate()) off.
-double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q,
-                 bool fused = true) {
+double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
   nonsep::host::RunOptions options;
   options.output_directory = job.job.output_directory;
   options.threads = threads;
-  options.fused = fused;
   const auto start = Clock::now();
   const auto outcome = nonsep::host::run_job(job, options);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
@@ -98,10 +105,30 @@ double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vect
   return elapsed.count();
 }
 
-// Seconds for the compiled-in loop: ChinBasicStep on one batch of `job`'s states. dt and t2 are taken from the
-// loaded job, not from constants: the compiler would fold cbrt(dt) with correctly rounded arithmetic, which can
-// differ in the last bit from the run-time cbrt the host uses.
-double time_compiled(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
+// Seconds for the hand-written loop on `job`'s states: one (q, p) through the scalar loop when the job has one
+// trajectory, else all of them through both loops over states (the faster one's time). dt and t2 are taken from the loaded job, not from
+// constants, so that cbrt runs at run time as in the host (a compile-time cbrt may round differently).
+double time_hand_written(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
+  const bench::HandWrittenStep c(job.job.time.dt, job.job.integrator.t2);
+  std::vector<double> q(job.job.initial.q), p(job.job.initial.p), g(q.size());
+  const std::uint64_t steps = job.job.time.steps;
+  const auto start = Clock::now();
+  if (q.size() == 1) bench::hand_written_run(c, q[0], p[0], steps);
+  else bench::hand_written_run(c, q.data(), p.data(), g.data(), q.size(), steps);
+  const std::chrono::duration<double> elapsed = Clock::now() - start;
+  final_q = q;
+  if (q.size() == 1) return elapsed.count();
+  // More than one state: the stage-by-stage loop too, and the faster of the two is the limit. Both must agree.
+  std::vector<double> q2(job.job.initial.q), p2(job.job.initial.p);
+  const auto start2 = Clock::now();
+  bench::hand_written_run_staged(c, q2.data(), p2.data(), g.data(), q2.size(), steps);
+  const std::chrono::duration<double> elapsed2 = Clock::now() - start2;
+  if (q2 != q) final_q.clear();  // fails the caller's check
+  return std::min(elapsed.count(), elapsed2.count());
+}
+
+// Seconds for the core's ChinBasicStep on one batch of `job`'s states, the model compiled in (ModelAdapter).
+double time_core(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
   const CompiledPaper1D model;
   nonsep::PhaseSpaceBatch x(1, job.job.initial.count);
   std::copy(job.job.initial.q.begin(), job.job.initial.q.end(), x.q().begin());
@@ -116,50 +143,63 @@ double time_compiled(const nonsep::host::LoadedJob& job, std::vector<double>& fi
   return elapsed.count();
 }
 
-// Seconds for the compiled-in loop cut as the host cuts an ensemble: blocks of nonsep::host::run_block_size states,
-// each stepped to the end on its own, the blocks shared by `threads` std::threads (contiguous halves for 2). No
-// plugin, no host: on 2 threads against 1, what the machine itself gives (figure 3c).
-double time_compiled_blocks(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
-  const CompiledPaper1D model;
-  const std::size_t count = job.job.initial.count, block = nonsep::host::run_block_size;
-  std::vector<nonsep::PhaseSpaceBatch> blocks;
-  for (std::size_t first = 0; first < count; first += block) {
-    const std::size_t size = std::min(block, count - first);
-    nonsep::PhaseSpaceBatch x(1, size);
-    std::copy_n(job.job.initial.q.begin() + static_cast<std::ptrdiff_t>(first), size, x.q().begin());
-    std::copy_n(job.job.initial.p.begin() + static_cast<std::ptrdiff_t>(first), size, x.p().begin());
-    blocks.push_back(std::move(x));
-  }
-  const double step_size = job.job.time.dt;
+// Seconds for the hand-written loop cut as the host cuts an ensemble: blocks of nonsep::host::run_block_size
+// states, each stepped to the end on its own, the blocks shared by `threads` std::threads (contiguous parts).
+double time_hand_written_blocks(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
+  const bench::HandWrittenStep c(job.job.time.dt, job.job.integrator.t2);
+  std::vector<double> q(job.job.initial.q), p(job.job.initial.p), g(q.size());
+  const std::size_t count = q.size(), block = nonsep::host::run_block_size;
+  const std::size_t blocks = (count + block - 1) / block;
   const std::uint64_t steps = job.job.time.steps;
   const auto run = [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
-      nonsep::ChinBasicStep stepper(job.job.integrator.form, job.job.integrator.t2);
-      for (std::uint64_t k = 0; k < steps; ++k) stepper.step(model, blocks[b], step_size);
+      const std::size_t first = b * block, size = std::min(block, count - first);
+      bench::hand_written_run(c, q.data() + first, p.data() + first, g.data() + first, size, steps);
     }
   };
   const auto start = Clock::now();
   std::vector<std::thread> workers;
-  for (unsigned t = 1; t < threads; ++t)
-    workers.emplace_back(run, t * blocks.size() / threads, (t + 1) * blocks.size() / threads);
-  run(0, blocks.size() / threads);
+  for (unsigned t = 1; t < threads; ++t) workers.emplace_back(run, t * blocks / threads, (t + 1) * blocks / threads);
+  run(0, blocks / threads);
   for (auto& worker : workers) worker.join();
   const std::chrono::duration<double> elapsed = Clock::now() - start;
-  final_q.clear();
-  for (const auto& x : blocks) final_q.insert(final_q.end(), x.q().begin(), x.q().end());
+  final_q = q;
   return elapsed.count();
 }
 
-struct Figure {
-  std::string name, unit, target;
-  double value;     // the ratio
-  double measured;  // of the configuration, in `unit`
-  double reference; // of the reference, in `unit`
+// A child process spinning on one core for as long as it lives (figure 3b); killed by the destructor.
+class BusyCore {
+ public:
+  BusyCore() : pid_(::fork()) {
+    if (pid_ == 0) {
+      volatile unsigned long spin = 0;
+      for (;;) spin = spin + 1;
+    }
+  }
+  ~BusyCore() {
+    if (pid_ <= 0) return;
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+  }
+  BusyCore(const BusyCore&) = delete;
+  BusyCore& operator=(const BusyCore&) = delete;
+  bool running() const { return pid_ > 0; }
+
+ private:
+  pid_t pid_;
 };
 
-// Runs `a` and `b` interleaved `repetitions` times (after one warm-up each) and returns their median times.
-std::pair<double, double> interleaved(int repetitions, const std::function<double()>& a,
-                                      const std::function<double()>& b) {
+struct Figure {
+  std::string name, unit, target;
+  double value;          // median measured / median reference
+  double low, high;      // smallest and largest per-repetition ratio
+  double measured;       // median of the configuration, in `unit`
+  double reference;      // median of the reference, in `unit`
+};
+
+// Runs `a` and `b` interleaved `repetitions` times (after one warm-up each); their times, in seconds.
+std::pair<std::vector<double>, std::vector<double>> interleaved(int repetitions, const std::function<double()>& a,
+                                                                const std::function<double()>& b) {
   a();
   b();
   std::vector<double> ta, tb;
@@ -167,7 +207,17 @@ std::pair<double, double> interleaved(int repetitions, const std::function<doubl
     ta.push_back(a());
     tb.push_back(b());
   }
-  return {median(ta), median(tb)};
+  return {ta, tb};
+}
+
+// The figure of times `a` (measured) over `b` (reference), `per` converting seconds into `unit`.
+Figure figure(std::string name, std::string target, std::string unit, const std::vector<double>& a,
+              const std::vector<double>& b, double per) {
+  std::vector<double> ratios;
+  for (std::size_t r = 0; r < a.size(); ++r) ratios.push_back(a[r] / b[r]);
+  const auto [low, high] = std::minmax_element(ratios.begin(), ratios.end());
+  return {std::move(name), std::move(unit), std::move(target), median(a) / median(b), *low, *high,
+          median(a) * per, median(b) * per};
 }
 
 }  // namespace
@@ -176,13 +226,15 @@ int main(int argc, char** argv) {
   bool smoke = false;
   int repetitions = 0;
   double scale = 0.0;
+  std::string only;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--smoke") smoke = true;
     else if (arg == "--repetitions" && i + 1 < argc) repetitions = std::max(1, std::atoi(argv[++i]));
     else if (arg == "--scale" && i + 1 < argc) scale = std::atof(argv[++i]);
+    else if (arg == "--only" && i + 1 < argc) only = argv[++i];
     else {
-      std::fprintf(stderr, "usage: %s [--smoke] [--repetitions N] [--scale X]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--smoke] [--repetitions N] [--scale X] [--only F]\n", argv[0]);
       return 2;
     }
   }
@@ -190,6 +242,16 @@ int main(int argc, char** argv) {
   if (scale <= 0.0) scale = smoke ? 0.05 : 1.0;
   auto scaled = [&](double steps) { return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(steps * scale)); };
 
+#if defined(__AVX512F__)
+  const char* simd = "AVX-512 (-march)";
+  constexpr bool native = true;
+#elif defined(__AVX2__)
+  const char* simd = "AVX2 (-march)";
+  constexpr bool native = true;
+#else
+  const char* simd = "SSE2 (portable x86-64)";
+  constexpr bool native = false;
+#endif
   const auto folder = std::filesystem::temp_directory_path() /
                       ("nonsep_bench_performance_" + std::to_string(static_cast<long>(::getpid())));
   std::filesystem::create_directories(folder);
@@ -198,76 +260,97 @@ int main(int argc, char** argv) {
 
   std::vector<Figure> figures;
   bool agree = true;
-  auto check = [&](const char* what, const std::vector<double>& host, const std::vector<double>& compiled) {
-    if (host != compiled) {
-      std::fprintf(stderr, "%s: the host's final states differ from the compiled-in loop's (%zu, %zu states; "
-                   "first q %.17g, %.17g)\n", what, host.size(), compiled.size(), host.empty() ? 0.0 : host[0],
-                   compiled.empty() ? 0.0 : compiled[0]);
-      agree = false;
-    }
+#ifdef __FMA__
+  constexpr bool exact_expected = false;  // the plugin and the hand-written loop may fuse different pairs
+#else
+  constexpr bool exact_expected = true;
+#endif
+  bool all_exact = true;
+  // Final q of a host run against the hand-written loop's: equal bit for bit, or (FMA builds) within 1e-9.
+  auto check = [&](const char* what, const std::vector<double>& host, const std::vector<double>& reference) {
+    bool close = host.size() == reference.size();
+    for (std::size_t b = 0; close && b < host.size(); ++b) close = std::abs(host[b] - reference[b]) < 1e-9;
+    const bool exact = host == reference;
+    all_exact = all_exact && exact;
+    if (exact || (close && !exact_expected)) return;
+    std::fprintf(stderr, "%s: the host's final states differ from the hand-written loop's (%zu, %zu states; "
+                 "first q %.17g, %.17g)\n", what, host.size(), reference.size(), host.empty() ? 0.0 : host[0],
+                 reference.empty() ? 0.0 : reference[0]);
+    agree = false;
   };
-  std::vector<double> host_q, compiled_q;
+  std::vector<double> host_q, reference_q, core_q;
+  auto wanted = [&](const char* group) { return only.empty() || only == group; };
 
-  {  // 1. one trajectory
+  if (wanted("1")) {  // 1. one trajectory
     const auto steps = scaled(4e6);
     const auto job = make_job(folder, "single", analytic, 1, steps);
-    const auto [host, compiled] = interleaved(
-        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_compiled(job, compiled_q); });
-    check("figure 1", host_q, compiled_q);
     const double per = 1e9 / static_cast<double>(steps);
-    figures.push_back({"1. one trajectory: host / compiled in", "ns per basic step", "<= 1.15", host / compiled,
-                       host * per, compiled * per});
-    const auto [unfused, compiled_again] = interleaved(
-        repetitions, [&] { return time_host(job, 1, host_q, false); },
-        [&] { return time_compiled(job, compiled_q); });
-    check("figure 1u", host_q, compiled_q);
-    figures.push_back({"1u. one trajectory: host, fused path off / compiled in", "ns per basic step", "(report)",
-                       unfused / compiled_again, unfused * per, compiled_again * per});
+    const auto [host, limit] = interleaved(
+        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_hand_written(job, reference_q); });
+    check("figure 1", host_q, reference_q);
+    figures.push_back(figure("1. one trajectory: host / hand-written", "<= 1.2", "ns per basic step", host, limit,
+                             per));
+    const auto [core, limit_c] = interleaved(
+        repetitions, [&] { return time_core(job, core_q); }, [&] { return time_hand_written(job, reference_q); });
+    check("figure 1c", core_q, reference_q);
+    figures.push_back(figure("1c. one trajectory: ChinBasicStep compiled in / hand-written", "(report)",
+                             "ns per basic step", core, limit_c, per));
   }
-  {  // 2. ensemble of 1024, one thread
+  if (wanted("2")) {  // 2. 1024 trajectories, one thread
     const std::size_t count = 1024;
     const auto steps = scaled(4000);
     const auto job = make_job(folder, "ensemble", analytic, count, steps);
-    const auto [host, compiled] =
-        interleaved(repetitions, [&] { return time_host(job, 1, host_q); },
-                    [&] { return time_compiled(job, compiled_q); });
-    check("figure 2", host_q, compiled_q);
     const double per = 1e9 / static_cast<double>(steps * count);
-    figures.push_back({"2. 1024 trajectories: host (1 thread) / compiled-in batch", "ns per basic step per trajectory",
-                       "<= 1.2", host / compiled, host * per, compiled * per});
-    const auto [unfused, compiled_again] =
-        interleaved(repetitions, [&] { return time_host(job, 1, host_q, false); },
-                    [&] { return time_compiled(job, compiled_q); });
-    check("figure 2u", host_q, compiled_q);
-    figures.push_back({"2u. 1024 trajectories: host (1 thread), fused path off / compiled-in batch",
-                       "ns per basic step per trajectory", "(report)", unfused / compiled_again, unfused * per,
-                       compiled_again * per});
+    const auto [host, limit] = interleaved(
+        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_hand_written(job, reference_q); });
+    check("figure 2", host_q, reference_q);
+    figures.push_back(figure(std::string("2") + (native ? "n" : "") + ". 1024 trajectories: host (1 thread) / " +
+                                 "hand-written over 1024 states",
+                             "<= 1.15", "ns per basic step per trajectory", host, limit, per));
+    const auto [core, limit_c] = interleaved(
+        repetitions, [&] { return time_core(job, core_q); }, [&] { return time_hand_written(job, reference_q); });
+    check("figure 2c", core_q, reference_q);
+    figures.push_back(figure("2c. 1024 trajectories: ChinBasicStep on one batch / hand-written", "(report)",
+                             "ns per basic step per trajectory", core, limit_c, per));
   }
-  {  // 3. two threads over one, large ensemble
+  if (wanted("3")) {  // 3. 2 threads over 1, 8192 trajectories: idle (3), a busy core (3b), hand-written (3c)
     const std::size_t count = 8192;
     const auto steps = scaled(2000);
     const auto job = make_job(folder, "threads", analytic, count, steps);
-    std::vector<double> two_q;
-    const auto [one, two] = interleaved(
-        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_host(job, 2, two_q); });
-    if (host_q != two_q) {
-      std::fprintf(stderr, "figure 3: 2 threads give other final states than 1\n");
-      agree = false;
-    }
     const double per = 1e9 / static_cast<double>(steps * count);
-    figures.push_back({"3. 8192 trajectories: 1 thread / 2 threads (speed-up)", "ns per basic step per trajectory",
-                       ">= 1.8", one / two, two * per, one * per});
-    std::vector<double> compiled_two_q;
-    const auto [compiled_one, compiled_two] =
-        interleaved(repetitions, [&] { return time_compiled_blocks(job, 1, compiled_q); },
-                    [&] { return time_compiled_blocks(job, 2, compiled_two_q); });
-    check("figure 3c (1 thread)", host_q, compiled_q);
-    check("figure 3c (2 threads)", host_q, compiled_two_q);
-    figures.push_back({"3c. 8192 trajectories, compiled in: 1 thread / 2 threads (the machine's own speed-up)",
-                       "ns per basic step per trajectory", "(ceiling of 3)", compiled_one / compiled_two,
-                       compiled_two * per, compiled_one * per});
+    std::vector<double> two_q;
+    auto threads = [&](const char* what) {
+      const auto [one, two] = interleaved(
+          repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_host(job, 2, two_q); });
+      if (host_q != two_q) {
+        std::fprintf(stderr, "%s: 2 threads give other final states than 1\n", what);
+        agree = false;
+      }
+      return std::pair{one, two};
+    };
+    const auto [one, two] = threads("figure 3");
+    figures.push_back(figure("3. 8192 trajectories: host 1 thread / 2 threads (speed-up)", ">= 1.8",
+                             "ns per basic step per trajectory", one, two, per));
+    {
+      const BusyCore busy;
+      if (!busy.running()) {
+        std::fprintf(stderr, "figure 3b: could not start the busy process\n");
+        agree = false;
+      }
+      const auto [busy_one, busy_two] = threads("figure 3b");
+      figures.push_back(figure("3b. the same, another process spinning on one core", ">= 1",
+                               "ns per basic step per trajectory", busy_one, busy_two, per));
+    }
+    std::vector<double> limit_two_q;
+    const auto [limit_one, limit_two] =
+        interleaved(repetitions, [&] { return time_hand_written_blocks(job, 1, reference_q); },
+                    [&] { return time_hand_written_blocks(job, 2, limit_two_q); });
+    check("figure 3c (1 thread)", host_q, reference_q);
+    check("figure 3c (2 threads)", host_q, limit_two_q);
+    figures.push_back(figure("3c. 8192 trajectories, hand-written: 1 thread / 2 threads (the machine's speed-up)",
+                             "(ceiling of 3)", "ns per basic step per trajectory", limit_one, limit_two, per));
   }
-  {  // 4. AD over analytic gradients, through the host
+  if (wanted("4")) {  // 4. AD over analytic gradients, through the host
     const std::size_t count = 1024;
     const auto steps = scaled(4000);
     const auto job_automatic = make_job(folder, "automatic", automatic, count, steps);
@@ -282,11 +365,10 @@ int main(int argc, char** argv) {
         agree = false;
         break;
       }
-    const double per = 1e9 / static_cast<double>(steps * count);
-    figures.push_back({"4. 1024 trajectories: AD plugin / analytic plugin", "ns per basic step per trajectory",
-                       "<= 2", ad / exact, ad * per, exact * per});
+    figures.push_back(figure("4. 1024 trajectories: AD plugin / analytic plugin", "<= 2",
+                             "ns per basic step per trajectory", ad, exact, 1e9 / static_cast<double>(steps * count)));
   }
-  {  // 6b. output every 10^4 steps over no output, one trajectory
+  if (wanted("6b")) {  // 6b. output every 10^4 steps over no output, one trajectory
     const auto steps = scaled(4e6);
     const auto job_output = make_job(folder, "output", analytic, 1, steps, 10000);
     const auto job_silent = make_job(folder, "silent", analytic, 1, steps, 0);
@@ -294,12 +376,14 @@ int main(int argc, char** argv) {
     const auto [output, silent] = interleaved(
         repetitions, [&] { return time_host(job_output, 1, host_q); },
         [&] { return time_host(job_silent, 1, silent_q); });
-    check("figure 6b", host_q, silent_q);
-    const double per = 1e9 / static_cast<double>(steps);
-    figures.push_back({"6b. one trajectory: output every 10^4 steps / no output", "ns per basic step", "~ 1",
-                       output / silent, output * per, silent * per});
+    if (host_q != silent_q) {
+      std::fprintf(stderr, "figure 6b: output changes the final state\n");
+      agree = false;
+    }
+    figures.push_back(figure("6b. one trajectory: output every 10^4 steps / no output", "~ 1", "ns per basic step",
+                             output, silent, 1e9 / static_cast<double>(steps)));
   }
-  {  // 6c. H at every step (energy_every = 1, the old default) over H at start and end only
+  if (wanted("6c")) {  // 6c. H at every step (energy_every = 1) over H at start and end only
     const auto steps = scaled(4e6);
     const auto job_energy = make_job(folder, "energy", analytic, 1, steps, 0, 1);
     const auto job_silent = make_job(folder, "silent", analytic, 1, steps, 0, 0);
@@ -307,21 +391,27 @@ int main(int argc, char** argv) {
     const auto [energy, silent] = interleaved(
         repetitions, [&] { return time_host(job_energy, 1, host_q); },
         [&] { return time_host(job_silent, 1, silent_q); });
-    check("figure 6c", host_q, silent_q);
-    const double per = 1e9 / static_cast<double>(steps);
-    figures.push_back({"6c. one trajectory: H at every step / H at start and end", "ns per basic step",
-                       "(informative)", energy / silent, energy * per, silent * per});
+    if (host_q != silent_q) {
+      std::fprintf(stderr, "figure 6c: evaluating H changes the final state\n");
+      agree = false;
+    }
+    figures.push_back(figure("6c. one trajectory: H at every step / H at start and end", "(informative)",
+                             "ns per basic step", energy, silent, 1e9 / static_cast<double>(steps)));
   }
   std::filesystem::remove_all(folder);
 
-  std::printf("paper1d, basic step, dt = %g; median of %d interleaved repetitions%s; %u hardware threads\n", dt,
-              repetitions, smoke ? " (smoke run: short, not for the record)" : "",
-              std::thread::hardware_concurrency());
-  std::printf("| figure | ratio | target | measured | reference | unit |\n|---|---|---|---|---|---|\n");
+  double load[3] = {0, 0, 0};
+  if (::getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = -1;
+  std::printf("paper1d, basic step, dt = %g; median of %d interleaved repetitions%s; %u hardware threads; "
+              "SIMD: %s; load average at the end %.2f %.2f %.2f\n",
+              dt, repetitions, smoke ? " (smoke run: short, not for the record)" : "",
+              std::thread::hardware_concurrency(), simd, load[0], load[1], load[2]);
+  std::printf("| figure | ratio | spread (min-max) | target | measured | reference | unit |\n"
+              "|---|---|---|---|---|---|---|\n");
   for (const auto& f : figures)
-    std::printf("| %s | %.3f | %s | %.4g | %.4g | %s |\n", f.name.c_str(), f.value, f.target.c_str(), f.measured,
-                f.reference, f.unit.c_str());
-  std::printf("final states: host = compiled in (bit for bit), 2 threads = 1 thread, AD ~ analytic: %s\n",
-              agree ? "yes" : "NO");
+    std::printf("| %s | %.3f | %.3f-%.3f | %s | %.4g | %.4g | %s |\n", f.name.c_str(), f.value, f.low, f.high,
+                f.target.c_str(), f.measured, f.reference, f.unit.c_str());
+  std::printf("final states: host = hand-written %s, 2 threads = 1 thread, AD ~ analytic: %s\n",
+              all_exact ? "(bit for bit)" : "(within 1e-9, not bit for bit: FMA build)", agree ? "yes" : "NO");
   return agree ? 0 : 1;
 }

@@ -1,0 +1,113 @@
+#pragma once
+// The physical limit the host is measured against (bench/performance.cpp): the basic step of eq. (expalg) on the
+// paper's 1D model written out by hand, nine stages with the gradients inline, no Integrator, no batch types, no
+// plugin. Form TTV, paper1d: grad T(p) = 1 + p^2/2, grad V(q) = q + q^3/3 (eq. algham).
+//
+//   p -= v2 eps V'(q); q += t2 eps T'(p); p -= v1 eps V'(q); q += t1 eps T'(p); p -= v0 eps V'(q);
+//   q += t1 eps T'(p); p -= v1 eps V'(q); q += t2 eps T'(p); p -= v2 eps V'(q)
+//
+// with eps = cbrt(dt), t1 = -t2, v1 = 1/t2^2, v2 = -v1/2, v0 = -2 (v1 + v2). First-same-as-last: V'(q) of the
+// last stage is kept for the first stage of the next step (4 T' + 4 V' per step).
+// The operations are the ones ChinBasicStep and the shipped paper1d plugin do, in the same order (h = (-c) eps,
+// y += h g; T' = 1 + 0.5 p p; V' = q (1 + q q / 3)), so the results are equal bit for bit as long as the compiler
+// contracts nothing into fused multiply-adds (x86-64 without -march: no FMA instructions exist). With
+// -march=native, GCC may fuse (C++ defaults to -ffp-contract=fast) differently here and in the plugin; the
+// benchmark then checks closeness instead and says so.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+namespace bench {
+
+struct HandWrittenStep {
+  double v2, t2, v1, t1, v0;  // each already multiplied by eps, kicks with their minus sign
+
+  HandWrittenStep(double dt, double t2_free) {
+    const double eps = std::cbrt(dt);
+    const double c1 = 1.0 / (t2_free * t2_free), c2 = -c1 / 2.0, c0 = -2.0 * (c1 + c2);
+    v2 = -c2 * eps;
+    v1 = -c1 * eps;
+    v0 = -c0 * eps;
+    t2 = t2_free * eps;
+    t1 = -t2_free * eps;
+  }
+};
+
+inline double grad_T(double p) { return 1.0 + 0.5 * p * p; }
+inline double grad_V(double q) { return q * (1.0 + q * q / 3.0); }
+
+// `steps` basic steps of one trajectory (q, p), in place.
+inline void hand_written_run(const HandWrittenStep& c, double& q, double& p, std::uint64_t steps) {
+  double x = q, y = p, g = grad_V(x);
+  for (std::uint64_t k = 0; k < steps; ++k) {
+    y += c.v2 * g;
+    x += c.t2 * grad_T(y);
+    g = grad_V(x);
+    y += c.v1 * g;
+    x += c.t1 * grad_T(y);
+    g = grad_V(x);
+    y += c.v0 * g;
+    x += c.t1 * grad_T(y);
+    g = grad_V(x);
+    y += c.v1 * g;
+    x += c.t2 * grad_T(y);
+    g = grad_V(x);
+    y += c.v2 * g;
+  }
+  q = x;
+  p = y;
+}
+
+// `steps` basic steps of `count` trajectories q[b], p[b], in place; g[b] holds V'(q[b]) (set here). The states
+// are independent: one loop over them per step, nine stages each, which the compiler vectorizes at the SIMD
+// width it is allowed (SSE2 by default, AVX2 and FMA with -march=native).
+inline void hand_written_run(const HandWrittenStep& c, double* q, double* p, double* g, std::size_t count,
+                             std::uint64_t steps) {
+  for (std::size_t b = 0; b < count; ++b) g[b] = grad_V(q[b]);
+  for (std::uint64_t k = 0; k < steps; ++k)
+    for (std::size_t b = 0; b < count; ++b) {
+      double x = q[b], y = p[b] + c.v2 * g[b];
+      x += c.t2 * grad_T(y);
+      y += c.v1 * grad_V(x);
+      x += c.t1 * grad_T(y);
+      y += c.v0 * grad_V(x);
+      x += c.t1 * grad_T(y);
+      y += c.v1 * grad_V(x);
+      x += c.t2 * grad_T(y);
+      const double gx = grad_V(x);
+      q[b] = x;
+      p[b] = y + c.v2 * gx;
+      g[b] = gx;
+    }
+}
+
+// The same, written stage by stage: each of the nine stages one loop over all states (as the Integrator goes).
+// Same operations per state, so the same bits as the loop above; which of the two is faster depends on the
+// build (the loop above is latency-bound without wide SIMD, this one is throughput-bound), so the benchmark
+// takes the faster as the limit.
+inline void hand_written_run_staged(const HandWrittenStep& c, double* q, double* p, double* g, std::size_t count,
+                                    std::uint64_t steps) {
+  for (std::size_t b = 0; b < count; ++b) g[b] = grad_V(q[b]);
+  const auto kick = [&](double h) {
+    for (std::size_t b = 0; b < count; ++b) p[b] += h * g[b];
+  };
+  const auto drift = [&](double h) {
+    for (std::size_t b = 0; b < count; ++b) {
+      q[b] += h * grad_T(p[b]);
+      g[b] = grad_V(q[b]);
+    }
+  };
+  for (std::uint64_t k = 0; k < steps; ++k) {
+    kick(c.v2);
+    drift(c.t2);
+    kick(c.v1);
+    drift(c.t1);
+    kick(c.v0);
+    drift(c.t1);
+    kick(c.v1);
+    drift(c.t2);
+    kick(c.v2);
+  }
+}
+
+}  // namespace bench
