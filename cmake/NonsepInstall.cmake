@@ -3,7 +3,8 @@
 #
 # Layout under the prefix:
 #   include/nonsep/...                  core, SDK (plugin_abi.h, plugin_sdk.hpp, derivative_checker.hpp), loader
-#   lib/libnonsep_core.a, lib/libnonsep_loader.a  (position-independent: plugins link nonsep_core)
+#   lib/libnonsep_core.a, lib/libnonsep_loader.a  (for programs that integrate or load plugins; a plugin links
+#                                                  neither: nonsep::sdk is header-only)
 #   lib/nonsep/plugins/<name>.so        shipped models (NONSEP_INSTALL_PLUGINDIR; the host finds it from bin/)
 #   lib/cmake/nonsep/                   nonsepConfig.cmake, targets, NonsepAddModel.cmake
 include(CMakePackageConfigHelpers)
@@ -29,7 +30,10 @@ install(EXPORT nonsepTargets NAMESPACE nonsep:: DESTINATION ${NONSEP_INSTALL_CMA
 configure_package_config_file(cmake/nonsepConfig.cmake.in "${PROJECT_BINARY_DIR}/nonsepConfig.cmake"
   INSTALL_DESTINATION ${NONSEP_INSTALL_CMAKEDIR}
   PATH_VARS NONSEP_INSTALL_PLUGINDIR)
-write_basic_package_version_file("${PROJECT_BINARY_DIR}/nonsepConfigVersion.cmake" COMPATIBILITY SameMinorVersion)
+# SameMajorVersion: find_package(nonsep 0.1) accepts any later 0.x. What a plugin must match is the plugin ABI,
+# which the host checks at load time ("expected 3, found 2", with the advice to rebuild), so the CMake package
+# need not refuse a newer minor version; a new major version is where the C++ API (core, loader) may break.
+write_basic_package_version_file("${PROJECT_BINARY_DIR}/nonsepConfigVersion.cmake" COMPATIBILITY SameMajorVersion)
 install(FILES
   "${PROJECT_BINARY_DIR}/nonsepConfig.cmake"
   "${PROJECT_BINARY_DIR}/nonsepConfigVersion.cmake"

@@ -18,11 +18,20 @@ set(CMAKE_LIBRARY_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/lib")
 set(NONSEP_BUILD_PLUGIN_DIR "${PROJECT_BINARY_DIR}/plugins")
 
 option(NONSEP_SANITIZE "Build everything with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)
+# Compile everything (core, host, plugins, benchmarks) for the building machine's instruction set, SIMD included
+# (-march=native). Off by default: binaries then run on any x86-64. See docs/performance.md, figure 2n.
+option(NONSEP_NATIVE "Compile for this machine's instruction set (-march=native); binaries are not portable" OFF)
+if(NONSEP_NATIVE)
+  add_compile_options(-march=native)
+endif()
+
 option(NONSEP_WARNINGS_AS_ERRORS "Treat compiler warnings as errors" OFF)
 
 add_library(nonsep_warnings INTERFACE)
 target_compile_options(nonsep_warnings INTERFACE -Wall -Wextra -Wpedantic
-  $<$<BOOL:${NONSEP_WARNINGS_AS_ERRORS}>:-Werror>)
+  $<$<BOOL:${NONSEP_WARNINGS_AS_ERRORS}>:-Werror>
+  # GCC 12 reports -Wrestrict inside libstdc++ for std::string's operator+ at -O2 and above (GCC bug 105329).
+  $<$<AND:$<CXX_COMPILER_ID:GNU>,$<VERSION_LESS:$<CXX_COMPILER_VERSION>,13>>:-Wno-restrict>)
 
 if(NONSEP_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 packages=(
   ca-certificates cmake g++ make pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev doctest-dev libcli11-dev
-  python3 python3-jsonschema python3-matplotlib python3-numpy
+  python3 python3-jsonschema python3-matplotlib python3-numpy python3-h5py
   clang libclang-rt-14-dev valgrind  # CI: fuzzing (tests/fuzz) and memcheck (tests/ci)
   libgsl-dev  # benchmark-only (GPL): the peer integrators of bench/peers; nothing in the product links it
 )

@@ -3,6 +3,7 @@
 # `nonsep inspect NAME --check` (load, metadata, create, every function at sample points, destroy, unload) and a
 # short ensemble run with energies (every function again, through the runner, writing both outputs). Fails on any
 # memcheck error and on definite, indirect or possible leaks. valgrind.supp lists the suppressed reports, each explained.
+# A step of scripts/test.sh (CI).
 # Usage: run_valgrind_plugins.sh NONSEP_EXECUTABLE SOURCE_DIR
 set -euo pipefail
 nonsep=$1

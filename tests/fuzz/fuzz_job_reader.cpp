@@ -1,4 +1,4 @@
-// libFuzzer harness over job-file reading: pass 1 (parse_job_text: strict JSON, duplicate keys) and pass 2
+// libFuzzer harness over job-file reading: pass 1 (parse_job_text: strict JSON, duplicate keys, nesting) and pass 2
 // (parse_job: structure, values, integrator options, time grid, initial states), then pass 3's checks that need no
 // plugin (check_model_parameters against a fixed fake metadata, check_dimension). Nothing from the input is ever
 // loaded as a plugin or written to disk. Any crash, hang, sanitizer report or uncaught exception is a finding:
@@ -6,6 +6,7 @@
 //
 // Built with clang by -DNONSEP_FUZZ=ON (tests/fuzz/CMakeLists.txt); the same function is also linked to
 // replay_corpus.cpp in every build, so the kept corpus (tests/fuzz/corpus) is a regression test under gcc too.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -39,7 +40,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   const Job job = parse_job(*document, "fuzz/job.json", issues);
-  if (job.initial.q.size() != job.initial.count * job.initial.dimension && issues.empty()) __builtin_trap();
+  if (issues.empty()) {  // what an accepted job promises
+    if (job.initial.q.size() != job.initial.count * job.initial.dimension) __builtin_trap();
+    if (job.initial.q.size() > max_initial_values) __builtin_trap();
+    if (job.plugin.find('\0') != std::string::npos) __builtin_trap();
+    if (job.output_directory.string().find('\0') != std::string::npos) __builtin_trap();
+    const auto bound = job.analysis.max_relative_energy_error;
+    if (bound && !(*bound > 0.0 && std::isfinite(*bound))) __builtin_trap();
+  }
   check_model_parameters(job.parameters, fake_parameters(), issues);
   for (std::size_t dimension : {std::size_t{1}, std::size_t{2}}) check_dimension(job.initial, dimension, issues);
   for (const auto& issue : issues) (void)to_string(issue);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# A short fuzzing pass for CI: configures a clang build with libFuzzer, ASan and UBSan in BUILD_DIR, builds only
-# the harness, and fuzzes job-file reading for SECONDS seconds starting from the kept corpus (which is not
-# modified: new inputs go to a scratch folder). Fails on any crash, leak, timeout or sanitizer report.
+# A short fuzzing pass for CI (a step of scripts/test.sh): configures a clang build with libFuzzer, ASan and UBSan
+# in BUILD_DIR, builds only the harness, and fuzzes job-file reading for SECONDS seconds starting from the kept
+# corpus (corpus/ and corpus_minimized.tar.xz; neither is modified: the archive is unpacked into, and new inputs go
+# to, a scratch folder). Fails on any crash, leak, timeout or sanitizer report.
 # Usage: run_fuzz_smoke.sh SOURCE_DIR BUILD_DIR [SECONDS]
 set -euo pipefail
 source_dir=$1
@@ -12,6 +13,9 @@ CC=clang CXX=clang++ cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=R
 cmake --build "$build_dir" -j2 --target fuzz_job_reader
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
+mkdir "$scratch/new" "$scratch/minimized"
+(cd "$scratch/minimized" && cmake -E tar xf "$source_dir/tests/fuzz/corpus_minimized.tar.xz")
 cd "$scratch"
-"$build_dir/bin/fuzz_job_reader" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
-  -dict="$source_dir/tests/fuzz/job.dict" -print_final_stats=1 "$scratch" "$source_dir/tests/fuzz/corpus"
+"$build_dir/bin/fuzz_job_reader" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
+  -dict="$source_dir/tests/fuzz/job.dict" -print_final_stats=1 "$scratch/new" "$source_dir/tests/fuzz/corpus" \
+  "$scratch/minimized"

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The whole test suite, exactly as CI runs it (.ci/run) and README.md shows it, from a fresh Debian 12 machine:
+#   1. setup    scripts/setup.sh: the Debian packages, configure and build build/ (Release);
+#   2. ctest    every ctest test of build/ (labels core, plugins, host, examples, python, slow);
+#   3. sanitize the suite again built with ASan + UBSan in build-sanitize/ (tests/ci/run_sanitized_suite.sh);
+#   4. fuzz     30 s of libFuzzer on job-file reading from the kept corpus, clang build in build/fuzz
+#               (tests/fuzz/run_fuzz_smoke.sh);
+#   5. valgrind memcheck of loading, using and unloading every shipped plugin (tests/ci/run_valgrind_plugins.sh).
+# Steps 2 to 5 each run even when an earlier one failed; a failed setup stops everything (nothing to test).
+# Output: each step's own output, a line "test.sh: STEP passed|failed (N s)" after it, and as the last line
+# "N passed, N failed" over steps 2 to 5. Exit status 0 when all passed, 1 otherwise.
+# Usage: bash scripts/test.sh
+set -uo pipefail
+cd "$(dirname "$0")/.." || exit 1
+root=$PWD
+
+if ! bash scripts/setup.sh; then
+  echo "test.sh: setup failed"
+  echo "0 passed, 1 failed"
+  exit 1
+fi
+
+passed=0
+failed=0
+failed_steps=()
+step() {
+  local name=$1
+  shift
+  local start=$SECONDS
+  echo "test.sh: $name"
+  if "$@"; then
+    passed=$((passed + 1))
+    echo "test.sh: $name passed ($((SECONDS - start)) s)"
+  else
+    failed=$((failed + 1))
+    failed_steps+=("$name")
+    echo "test.sh: $name failed ($((SECONDS - start)) s)"
+  fi
+}
+
+step ctest ctest --test-dir build --output-on-failure -j2
+step sanitize bash tests/ci/run_sanitized_suite.sh "$root"
+step fuzz bash tests/fuzz/run_fuzz_smoke.sh "$root" "$root/build/fuzz" 30
+step valgrind bash tests/ci/run_valgrind_plugins.sh "$root/build/bin/nonsep" "$root"
+
+((failed == 0)) || echo "test.sh: failed steps: ${failed_steps[*]}"
+echo "$passed passed, $failed failed"
+((failed == 0))
