@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
@@ -76,33 +77,27 @@ void append_bits(std::string& text, double value) {
   text += ',';
 }
 
+// What the checksum cannot catch (a checkpoint written by a faulty build, or rewritten with a fresh checksum):
+// active trajectories have finite states and the status "running", retired ones another status.
+void check_consistency(const std::filesystem::path& path, const DriverState& state, std::size_t n) {
+  for (std::size_t i = 0; i < state.q.size(); ++i)
+    if (!std::isfinite(state.q[i]) || !std::isfinite(state.p[i]))
+      damaged(path, "active trajectory " + std::to_string(state.active[i / n]) + " has a state that is not finite");
+  std::vector<bool> active(state.records.size(), false);
+  for (std::size_t index : state.active) active[index] = true;
+  for (std::size_t i = 0; i < state.records.size(); ++i)
+    if (active[i] != (state.records[i].status == TrajectoryStatus::running))
+      damaged(path, "trajectory " + std::to_string(i) + (active[i] ? " is active but its record says \"" :
+                                                                     " is not active but its record says \"") +
+                        std::string(to_string(state.records[i].status)) + "\"");
+}
+
 }  // namespace
 
 namespace {
 
-std::uint64_t fnv1a(std::string_view bytes, std::uint64_t hash = 14695981039346656037ull) {
-  for (unsigned char c : bytes) {
-    hash ^= c;
-    hash *= 1099511628211ull;
-  }
-  return hash;
-}
-
-std::string hex(std::uint64_t hash) {
-  char digits[17];
-  std::snprintf(digits, sizeof digits, "%016llx", static_cast<unsigned long long>(hash));
-  return digits;
-}
-
 // The plugin file's bytes, hashed: another library with the same name and version is another model.
-std::uint64_t file_hash(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::uint64_t hash = 14695981039346656037ull;
-  std::string buffer(1 << 16, '\0');
-  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0)
-    hash = fnv1a(std::string_view(buffer.data(), static_cast<std::size_t>(in.gcount())), hash);
-  return hash;
-}
+std::uint64_t file_hash(const std::filesystem::path& path) { return file_content_hash(path).value_or(0); }
 
 // The parts of a fingerprint, "name:hash" separated by spaces, in this order.
 constexpr const char* fingerprint_parts[] = {"plugin", "parameters", "integrator", "initial", "time", "output",
@@ -113,7 +108,7 @@ constexpr const char* fingerprint_parts[] = {"plugin", "parameters", "integrator
 std::string job_fingerprint(const LoadedJob& loaded) {
   const Job& job = loaded.job;
   std::string parts[7];
-  parts[0] = loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + hex(file_hash(loaded.plugin.path()));
+  parts[0] = loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + content_hash_hex(file_hash(loaded.plugin.path()));
   parts[1] = loaded.model.parameters().dump();
   parts[2] = job.integrator.scheme + '\n' + job.integrator.order.to_string() + '\n';
   append_bits(parts[2], job.integrator.t2);
@@ -130,7 +125,7 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   if (job.analysis.max_relative_energy_error) append_bits(parts[6], *job.analysis.max_relative_energy_error);
   std::string fingerprint;
   for (std::size_t i = 0; i < 7; ++i)
-    fingerprint += (i ? " " : "") + std::string(fingerprint_parts[i]) + ":" + hex(fnv1a(parts[i]));
+    fingerprint += (i ? " " : "") + std::string(fingerprint_parts[i]) + ":" + content_hash_hex(content_hash(parts[i]));
   return fingerprint;
 }
 
@@ -167,7 +162,11 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
         {"energies", encode(state.energies)}}},
       {"records", std::move(records)},
       {"observers", checkpoint.observers}};
-  write_file_atomically(path, document.dump() + "\n");
+  // The checksum covers everything else, as dumped (keys sorted, numbers as strings): an edited or damaged
+  // checkpoint is refused instead of changing the results.
+  json signed_document = document;
+  signed_document["checksum"] = content_hash_hex(content_hash(document.dump()));
+  write_file_atomically(path, signed_document.dump() + "\n");
 }
 
 Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded) {
@@ -187,6 +186,10 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   const Reader read{path};
   if (read.string(read.member(document, "format"), "format") != format_tag)
     damaged(path, std::string("its format is not \"") + format_tag + "\"");
+  const std::string checksum = read.string(read.member(document, "checksum"), "checksum");
+  document.erase("checksum");
+  if (checksum != content_hash_hex(content_hash(document.dump())))
+    damaged(path, "its content does not match its checksum: it was edited or damaged");
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
   if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)
     throw CheckpointError(path.string() + " belongs to a different job: its " +
@@ -237,6 +240,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     record.message = read.string(read.member(entry, "message"), "message");
     state.records.push_back(std::move(record));
   }
+  check_consistency(path, state, n);
   checkpoint.observers = read.member(document, "observers");
   if (!checkpoint.observers.is_object()) damaged(path, "observers is not an object");
   return checkpoint;

@@ -148,10 +148,10 @@ inline Result run_nonsep(const std::vector<std::string>& args, const std::filesy
   return finish(start_nonsep(args, folder));
 }
 
-// The rows of a CSV file, split at commas (no quoting in nonsep's files); row 0 is the header.
-inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& path) {
+// The rows of CSV text, split at commas (no quoting in nonsep's files); row 0 is the header.
+inline std::vector<std::vector<std::string>> parse_csv(const std::string& csv) {
   std::vector<std::vector<std::string>> rows;
-  std::istringstream text(read_text(path));
+  std::istringstream text(csv);
   std::string line;
   while (std::getline(text, line)) {
     std::vector<std::string> cells;
@@ -162,6 +162,11 @@ inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::pat
     rows.push_back(cells);
   }
   return rows;
+}
+
+// The rows of a CSV file, as parse_csv.
+inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& path) {
+  return parse_csv(read_text(path));
 }
 
 

@@ -143,9 +143,14 @@ TEST_CASE("a new run of the same job that is killed leaves no summary of the ear
   CHECK(!std::filesystem::exists(folder / "out" / "trajectories.csv"));
 }
 
-TEST_CASE("after SIGKILL trajectory.csv ends in a whole row, every time") {
+// One write() per buffer ending on a row boundary, but Linux may end a write() to a file between two pages when
+// SIGKILL arrives (generic_perform_write checks for a fatal signal per page), so a hard kill can leave a last line
+// without its newline, cut at a page boundary. What is guaranteed, and what the README's reader rule relies on:
+// every line that ends in a newline is a whole row, and only the last line can lack one.
+TEST_CASE("after SIGKILL every line of trajectory.csv that ends in a newline is a whole row, every time") {
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", paper1d_job(1.0, 1'000'000'000, 1));
+  int torn = 0;
   for (int kill = 0; kill < 8; ++kill) {
     CAPTURE(kill);
     const Process running = start_nonsep({"run", "--quiet", "--force", file.string()}, folder.path());
@@ -153,12 +158,18 @@ TEST_CASE("after SIGKILL trajectory.csv ends in a whole row, every time") {
     wait_until([&] { return size_of(folder / "out" / "trajectory.csv") > target; }, "rows");
     ::kill(running.pid, SIGKILL);
     finish(running);
-    const std::string text = read_text(folder / "out" / "trajectory.csv");
+    std::string text = read_text(folder / "out" / "trajectory.csv");
     REQUIRE(!text.empty());
-    CHECK(text.back() == '\n');
-    const auto rows = read_csv(folder / "out" / "trajectory.csv");
-    CHECK(rows.back().size() == rows.front().size());
+    if (text.back() != '\n') {
+      ++torn;
+      CHECK(text.size() % 4096 == 0);  // cut where the kernel stopped copying, at a page boundary
+      text.erase(text.rfind('\n') + 1);
+    }
+    const auto rows = parse_csv(text);
+    REQUIRE(rows.size() > 1);
+    for (const auto& row : rows) CHECK(row.size() == rows.front().size());
   }
+  MESSAGE(torn << " of 8 kills left a last line without its newline");
 }
 
 TEST_CASE("writes stay inside the folder: a linked output is replaced, not followed, orphaned temporaries go") {

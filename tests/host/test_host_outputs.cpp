@@ -14,6 +14,7 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/output/files.hpp"
 
@@ -75,26 +76,35 @@ TEST_CASE("CsvAppender: rows reach the file whole, when the buffer fills and whe
   CHECK(read_csv(path).size() == rows_written + 1);
 }
 
-TEST_CASE("CsvAppender resumes a file cut back to a recorded size, and refuses one shorter than that") {
+TEST_CASE("CsvAppender resumes a file cut back to a recorded size and content, and refuses any other file") {
   TemporaryFolder folder;
   const auto path = folder / "trajectory.csv";
-  std::uint64_t size = 0;
+  std::uint64_t size = 0, hash = 0;
   {
     CsvAppender file(path, "step");
     file.row() += "1";
     file.end_row();
     file.flush();
     size = file.flushed_size();
+    hash = file.flushed_hash();
     file.row() += "2";
     file.end_row();
   }
+  CHECK(hash == content_hash("step\n1\n"));
   {
-    CsvAppender file(path, size);
+    CsvAppender file(path, size, hash);
     file.row() += "3";
     file.end_row();
+    file.flush();
+    CHECK(file.flushed_hash() == content_hash("step\n1\n3\n"));
   }
   CHECK(read_text(path) == "step\n1\n3\n");
-  CHECK_THROWS_WITH_AS(CsvAppender(path, 1000), doctest::Contains("fewer than the 1000"), OutputError);
+  CHECK_THROWS_WITH_AS(CsvAppender(path, 1000, hash), doctest::Contains("fewer than the 1000"), OutputError);
+  // Same length, other bytes (another run's rows): refused, and the file is left as it was.
+  write_file_atomically(path, "step\n7\n3\n");
+  CHECK_THROWS_WITH_AS(CsvAppender(path, size, hash), doctest::Contains("not the ones the checkpoint recorded"),
+                       OutputError);
+  CHECK(read_text(path) == "step\n7\n3\n");
 }
 
 TEST_CASE("a CSV file that cannot be created is an OutputError naming the file") {

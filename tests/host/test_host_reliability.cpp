@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "host_test_support.hpp"
+#include "nonsep/host/output/content_hash.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host_testing;
@@ -357,4 +358,64 @@ TEST_CASE("resume refuses a missing checkpoint and another job's, with exit 2 an
   const auto damaged = run_nonsep({"run", "--quiet", "--resume", file.string()}, folder.path());
   CHECK(damaged.status == 2);
   CHECK(contains(damaged.err, "is damaged (not JSON"));
+}
+
+TEST_CASE("resume checks content: an edited checkpoint or trajectory.csv is refused with exit 2, nothing changed") {
+  TemporaryFolder folder;
+  json job = resumable_job();
+  job["initial"] = state(1.0, 0.0);
+  job["time"]["steps"] = 100000000;
+  job["checkpoint"] = {{"every_steps", 1000}, {"every_seconds", 0}};
+  const auto file = write_job(folder / "job.json", job);
+  const auto process = start_nonsep({"run", "--quiet", file.string()}, folder.path());
+  wait_for_file(folder / "out/checkpoint.json");
+  REQUIRE(::kill(process.pid, SIGTERM) == 0);
+  CHECK(finish(process).status == 143);
+  const auto checkpoint_path = folder / "out/checkpoint.json";
+  const std::string original = read_text(checkpoint_path);
+  const json checkpoint = read_json(checkpoint_path);
+  REQUIRE(checkpoint["active"]["trajectories"].size() == 1);
+  const auto resume = [&](const std::string& expected) {
+    const std::string csv_before = read_text(folder / "out/trajectory.csv");
+    const auto resumed = run_nonsep({"run", "--quiet", "--resume", file.string()}, folder.path());
+    INFO("stderr: " << resumed.err);
+    CHECK(resumed.status == 2);
+    CHECK(contains(resumed.err, expected));
+    CHECK(read_text(folder / "out/trajectory.csv") == csv_before);
+  };
+  // Signs a changed checkpoint as the host does: the checksum of the rest, as dumped.
+  const auto signed_text = [](json document) {
+    document.erase("checksum");
+    const std::string checksum = nonsep::host::content_hash_hex(nonsep::host::content_hash(document.dump()));
+    document["checksum"] = checksum;
+    return document.dump();
+  };
+
+  SUBCASE("a changed value without a matching checksum") {
+    json edited = checkpoint;
+    edited["records"][0]["status"] = "completed";
+    write_text(checkpoint_path, edited.dump());
+    resume("its content does not match its checksum");
+  }
+  SUBCASE("a checksum that matches, over a state that is not finite") {
+    json edited = checkpoint;
+    edited["active"]["q"][0] = "inf";
+    write_text(checkpoint_path, signed_text(edited));
+    resume("active trajectory 0 has a state that is not finite");
+  }
+  SUBCASE("a checksum that matches, over an active trajectory whose record says it ended") {
+    json edited = checkpoint;
+    edited["records"][0]["status"] = "completed";
+    write_text(checkpoint_path, signed_text(edited));
+    resume("trajectory 0 is active but its record says \"completed\"");
+  }
+  SUBCASE("trajectory.csv of the recorded length with other rows (another run's)") {
+    write_text(checkpoint_path, original);
+    std::string csv = read_text(folder / "out/trajectory.csv");
+    const auto first_row = csv.find('\n');
+    REQUIRE(first_row + 1 < checkpoint["observers"]["trajectory_csv"]["bytes"].get<std::uint64_t>());
+    csv[first_row + 1] = csv[first_row + 1] == '0' ? '1' : '0';  // the trajectory index of the first row
+    write_text(folder / "out/trajectory.csv", csv);
+    resume("are not the ones the checkpoint recorded");
+  }
 }

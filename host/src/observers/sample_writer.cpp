@@ -1,6 +1,9 @@
 #include "nonsep/host/observers/sample_writer.hpp"
 
+#include <charconv>
+
 #include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/output/content_hash.hpp"
 
 namespace nonsep::host {
 
@@ -67,7 +70,9 @@ nlohmann::json SampleWriter::save() {
   file_->flush();
   nlohmann::json last = nlohmann::json::array();
   for (std::uint64_t step : last_written_) last.push_back(step == none ? nlohmann::json(nullptr) : nlohmann::json(step));
-  return {{"bytes", file_->flushed_size()}, {"last_written_step", std::move(last)}};
+  return {{"bytes", file_->flushed_size()},
+          {"content_hash", content_hash_hex(file_->flushed_hash())},
+          {"last_written_step", std::move(last)}};
 }
 
 void SampleWriter::restore(const nlohmann::json& state) {
@@ -87,8 +92,14 @@ void SampleWriter::restore(const nlohmann::json& state) {
       damaged("a last row's step is not a step of the run");
     }
   }
+  const nlohmann::json& hash = state.contains("content_hash") ? state["content_hash"] : nlohmann::json();
+  std::uint64_t prefix_hash = 0;
+  if (!hash.is_string() || hash.get_ref<const std::string&>().size() != 16 ||
+      std::from_chars(hash.get_ref<const std::string&>().data(), hash.get_ref<const std::string&>().data() + 16,
+                      prefix_hash, 16).ec != std::errc())
+    damaged("no content hash of trajectory.csv");
   file_.reset();
-  file_.emplace(path_, state["bytes"].get<std::uint64_t>());
+  file_.emplace(path_, state["bytes"].get<std::uint64_t>(), prefix_hash);
 }
 
 }  // namespace nonsep::host

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
@@ -35,19 +36,25 @@ void CsvAppender::open(int flags) {
   buffer_.reserve(buffer_capacity + 4096);
 }
 
-CsvAppender::CsvAppender(const std::filesystem::path& path, std::string_view header) : path_(path) {
+CsvAppender::CsvAppender(const std::filesystem::path& path, std::string_view header)
+    : path_(path), flushed_hash_(content_hash_start) {
   open(O_CREAT | O_TRUNC);
   buffer_ += header;
   end_row();
 }
 
-CsvAppender::CsvAppender(const std::filesystem::path& path, std::uint64_t size) : path_(path), flushed_size_(size) {
+CsvAppender::CsvAppender(const std::filesystem::path& path, std::uint64_t size, std::uint64_t prefix_hash)
+    : path_(path), flushed_size_(size), flushed_hash_(prefix_hash) {
   std::error_code error;
   const auto existing = std::filesystem::file_size(path, error);
   if (error) throw OutputError("cannot resume " + path.string() + ": " + error.message());
   if (existing < size)
     throw OutputError("cannot resume " + path.string() + ": it has " + std::to_string(existing) +
                       " bytes, fewer than the " + std::to_string(size) + " the checkpoint recorded");
+  if (file_content_hash(path, size) != prefix_hash)
+    throw OutputError("cannot resume " + path.string() + ": its first " + std::to_string(size) +
+                      " bytes are not the ones the checkpoint recorded (another run wrote into this folder, or the "
+                      "file was edited); run with --force to start over");
   std::filesystem::resize_file(path, size, error);
   if (error) throw OutputError("cannot resume " + path.string() + ": " + error.message());
   open(O_APPEND);
@@ -74,12 +81,14 @@ void CsvAppender::flush() {
     if (written <= 0) {
       const std::string reason = written < 0 ? std::strerror(errno) : "nothing was written";
       flushed_size_ += done;
+      flushed_hash_ = content_hash(std::string_view(buffer_.data(), done), flushed_hash_);
       buffer_.clear();
       throw OutputError("cannot write " + path_.string() + ": " + reason);
     }
     done += static_cast<std::size_t>(written);
   }
   flushed_size_ += done;
+  flushed_hash_ = content_hash(buffer_, flushed_hash_);
   buffer_.clear();
 }
 

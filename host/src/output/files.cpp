@@ -1,13 +1,36 @@
 #include "nonsep/host/output/files.hpp"
 
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <string>
+
+#include "nonsep/host/output/content_hash.hpp"
+
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 
-
 namespace nonsep::host {
+
+std::optional<std::uint64_t> file_content_hash(const std::filesystem::path& path, std::optional<std::uint64_t> size) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::uint64_t hash = content_hash_start, left = size.value_or(UINT64_MAX);
+  std::string buffer(1 << 16, '\0');
+  while (left > 0) {
+    const auto want = static_cast<std::streamsize>(std::min<std::uint64_t>(left, buffer.size()));
+    in.read(buffer.data(), want);
+    const auto got = static_cast<std::size_t>(in.gcount());
+    hash = content_hash(std::string_view(buffer.data(), got), hash);
+    left -= got;
+    if (got < static_cast<std::size_t>(want)) break;
+  }
+  if (size && left > 0) return std::nullopt;
+  return hash;
+}
 
 namespace {
 std::string system_reason() { return std::strerror(errno); }

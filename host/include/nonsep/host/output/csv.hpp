@@ -30,8 +30,9 @@ class CsvAppender {
   // Creates or truncates `path` and writes `header` (without its '\n'). Throws OutputError.
   CsvAppender(const std::filesystem::path& path, std::string_view header);
   // Continues the file at `path` from its first `size` bytes (what a checkpoint recorded): the rest is cut off.
-  // Throws OutputError when the file is missing or shorter than `size`.
-  CsvAppender(const std::filesystem::path& path, std::uint64_t size);
+  // Throws OutputError, changing nothing, when the file is missing, shorter than `size`, or its first `size` bytes
+  // do not have the content hash `prefix_hash` (content_hash.hpp) that flushed_hash() gave when they were written.
+  CsvAppender(const std::filesystem::path& path, std::uint64_t size, std::uint64_t prefix_hash);
   CsvAppender(const CsvAppender&) = delete;
   CsvAppender& operator=(const CsvAppender&) = delete;
   // Hands what is buffered to the file; a failure here is lost, so callers flush() at the end of a run.
@@ -46,6 +47,8 @@ class CsvAppender {
   const std::filesystem::path& path() const { return path_; }
   // Bytes in the file after flush(), header included.
   std::uint64_t flushed_size() const { return flushed_size_; }
+  // The content hash of those bytes.
+  std::uint64_t flushed_hash() const { return flushed_hash_; }
 
  private:
   void open(int flags);
@@ -53,6 +56,7 @@ class CsvAppender {
   std::filesystem::path path_;
   int descriptor_ = -1;
   std::uint64_t flushed_size_ = 0;
+  std::uint64_t flushed_hash_;
   std::string buffer_;
 };
 
