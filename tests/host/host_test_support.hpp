@@ -79,8 +79,8 @@ struct Process {
   std::filesystem::path out, err;
 };
 
-// Starts `nonsep args...` with stdout and stderr going to files in `folder`.
-inline Process start_nonsep(const std::vector<std::string>& args, const std::filesystem::path& folder) {
+// Starts the program argv[0] (a path) with arguments argv[1...], stdout and stderr going to files in `folder`.
+inline Process start_process(std::vector<std::string> argv_storage, const std::filesystem::path& folder) {
   use_test_plugins();
   static int serial = 0;
   Process process;
@@ -90,15 +90,20 @@ inline Process start_nonsep(const std::vector<std::string>& args, const std::fil
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 1, process.out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_addopen(&actions, 2, process.err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::vector<std::string> argv_storage{NONSEP_EXECUTABLE};
-  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& arg : argv_storage) argv.push_back(arg.data());
   argv.push_back(nullptr);
-  const int error = posix_spawn(&process.pid, NONSEP_EXECUTABLE, &actions, nullptr, argv.data(), environ);
+  const int error = posix_spawn(&process.pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) throw std::runtime_error("cannot start " + std::string(NONSEP_EXECUTABLE));
+  if (error != 0) throw std::runtime_error("cannot start " + argv_storage[0]);
   return process;
+}
+
+// Starts `nonsep args...` with stdout and stderr going to files in `folder`.
+inline Process start_nonsep(const std::vector<std::string>& args, const std::filesystem::path& folder) {
+  std::vector<std::string> argv{NONSEP_EXECUTABLE};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return start_process(std::move(argv), folder);
 }
 
 struct Result {

@@ -190,6 +190,47 @@ TEST_CASE("writes stay inside the folder: a linked output is replaced, not follo
   CHECK(!std::filesystem::exists(folder / "out" / ".summary.json.tmp-AbC123"));
 }
 
+TEST_CASE("resume never follows a linked trajectory.csv: the link's target is neither read nor cut") {
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", paper1d_job(1.0, 1'000'000'000, 1000));
+  const Process running = start_nonsep({"run", "--quiet", file.string()}, folder.path());
+  wait_until([&] { return size_of(folder / "out" / "trajectory.csv") > 0; }, "rows");
+  ::kill(running.pid, SIGINT);
+  REQUIRE(finish(running).status == 130);
+  // The trajectory file is moved out and replaced by a link to it: a longer file elsewhere that resume would cut.
+  std::filesystem::rename(folder / "out" / "trajectory.csv", folder / "elsewhere.csv");
+  {
+    std::ofstream append(folder / "elsewhere.csv", std::ios::binary | std::ios::app);
+    append << "not nonsep's\n";
+  }
+  const std::string before = read_text(folder / "elsewhere.csv");
+  std::filesystem::create_symlink(folder / "elsewhere.csv", folder / "out" / "trajectory.csv");
+  const auto refused = run_nonsep({"run", "--quiet", "--resume", file.string()}, folder.path());
+  CHECK(refused.status == 2);
+  CHECK(contains(refused.err, "symbolic link"));
+  CHECK(read_text(folder / "elsewhere.csv") == before);
+}
+
+TEST_CASE("a full disk (a file size limit) leaves trajectory.csv ending in a whole row, and says so") {
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", paper1d_job(1.0, 10'000'000, 1));
+  // 64 blocks of 512 bytes: the limit is hit partway through a buffer; SIGXFSZ ignored, so write() comes back
+  // short and then fails with EFBIG, as on a full disk.
+  const Process running = start_process(
+      {"/bin/sh", "-c", "ulimit -f 64 && trap '' XFSZ && exec \"$0\" run --quiet \"$1\"", NONSEP_EXECUTABLE,
+       file.string()},
+      folder.path());
+  const Result result = finish(running);
+  CHECK(result.status == 1);
+  CHECK(contains(result.err, "trajectory.csv"));
+  const std::string text = read_text(folder / "out" / "trajectory.csv");
+  REQUIRE(text.size() > 1000);
+  CHECK(text.size() <= 64 * 512);
+  CHECK(text.back() == '\n');
+  const auto rows = parse_csv(text);
+  for (const auto& row : rows) CHECK(row.size() == rows.front().size());
+}
+
 TEST_CASE("an output that cannot be written is found before computing: exit 2 at once, nothing run") {
   TemporaryFolder folder;
   // A folder where the run's manifest cannot be put in place (a non-empty folder of that name): as a full or
@@ -200,6 +241,19 @@ TEST_CASE("an output that cannot be written is found before computing: exit 2 at
   CHECK(result.status == 2);
   CHECK(contains(result.err, ".nonsep-run.json"));
   CHECK(!std::filesystem::exists(folder / "out" / "summary.json"));
+}
+
+TEST_CASE("a folder in the way of summary.json is found before computing, for a fresh and a resumed run") {
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", paper1d_job(1.0, 1'000'000'000'000, 0));
+  std::filesystem::create_directories(folder / "out" / "summary.json" / "inside");
+  for (const char* flag : {"--force", "--resume"}) {
+    CAPTURE(flag);
+    const auto result = run_nonsep({"run", "--quiet", flag, file.string()}, folder.path());
+    CHECK(result.status == 2);
+    CHECK(contains(result.err, "summary.json: a folder is in the way"));
+  }
+  CHECK(std::filesystem::exists(folder / "out" / "summary.json" / "inside"));
 }
 
 TEST_CASE("resume refuses a checkpoint of another plugin file with the same name and version, naming the part") {

@@ -237,6 +237,9 @@ PluginModel Plugin::create(const json& parameters_or_null) const {
     throw PluginError(who + ": create() reported success but returned no instance");
 
   instance->dimension = api.dimension(instance->handle);
+  if (instance->dimension == 0)
+    throw PluginError(who + ": the instance has dimension 0 (the ABI requires at least one degree of freedom; "
+                            "check the parameters that set the dimension)");
   const json& dimension = loaded_->metadata["dimension"];
   const std::size_t expected = dimension.contains("fixed")
                                    ? dimension["fixed"].get<std::size_t>()

@@ -94,6 +94,10 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
     return std::nullopt;
   }
   check_dimension(checked.initial, loaded.model.dimension(), issues);
+  if (const std::size_t n = loaded.model.dimension(); loaded.plugin.has_hessians() && n > max_hessian_values / n)
+    issues.push_back({"/model", "a model of dimension " + std::to_string(n) + ", whose Hessian (for H) would take " +
+                                    std::to_string(n * n / (std::size_t{1} << 27)) + " GiB",
+                      "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians"});
   if (issues.size() != before) return std::nullopt;
   return loaded;
 }

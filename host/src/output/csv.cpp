@@ -1,6 +1,7 @@
 #include "nonsep/host/output/csv.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -45,19 +46,29 @@ CsvAppender::CsvAppender(const std::filesystem::path& path, std::string_view hea
 
 CsvAppender::CsvAppender(const std::filesystem::path& path, std::uint64_t size, std::uint64_t prefix_hash)
     : path_(path), flushed_size_(size), flushed_hash_(prefix_hash) {
-  std::error_code error;
-  const auto existing = std::filesystem::file_size(path, error);
-  if (error) throw OutputError("cannot resume " + path.string() + ": " + error.message());
-  if (existing < size)
-    throw OutputError("cannot resume " + path.string() + ": it has " + std::to_string(existing) +
-                      " bytes, fewer than the " + std::to_string(size) + " the checkpoint recorded");
-  if (file_content_hash(path, size) != prefix_hash)
-    throw OutputError("cannot resume " + path.string() + ": its first " + std::to_string(size) +
-                      " bytes are not the ones the checkpoint recorded (another run wrote into this folder, or the "
-                      "file was edited); run with --force to start over");
-  std::filesystem::resize_file(path, size, error);
-  if (error) throw OutputError("cannot resume " + path.string() + ": " + error.message());
-  open(O_APPEND);
+  // Everything through one descriptor opened without following links: a trajectory.csv replaced by a link to a
+  // file elsewhere is refused before anything is read or cut, not truncated through the link.
+  descriptor_ = ::open(path.c_str(), O_RDWR | O_APPEND | O_CLOEXEC | O_NOFOLLOW);
+  if (descriptor_ < 0)
+    throw OutputError("cannot resume " + path.string() + ": " +
+                      (errno == ELOOP ? std::string("it is a symbolic link") : std::strerror(errno)));
+  const auto refuse = [&](const std::string& reason) {
+    ::close(descriptor_);
+    descriptor_ = -1;
+    throw OutputError("cannot resume " + path.string() + ": " + reason);
+  };
+  struct stat status{};
+  if (::fstat(descriptor_, &status) != 0) refuse(std::strerror(errno));
+  if (!S_ISREG(status.st_mode)) refuse("it is not a regular file");
+  if (static_cast<std::uint64_t>(status.st_size) < size)
+    refuse("it has " + std::to_string(status.st_size) + " bytes, fewer than the " + std::to_string(size) +
+           " the checkpoint recorded");
+  if (descriptor_content_hash(descriptor_, size) != prefix_hash)
+    refuse("its first " + std::to_string(size) +
+           " bytes are not the ones the checkpoint recorded (another run wrote into this folder, or the file was "
+           "edited); run with --force to start over");
+  if (::ftruncate(descriptor_, static_cast<off_t>(size)) != 0) refuse(std::strerror(errno));
+  buffer_.reserve(buffer_capacity + 4096);
 }
 
 CsvAppender::~CsvAppender() {
@@ -80,10 +91,18 @@ void CsvAppender::flush() {
     if (written < 0 && errno == EINTR) continue;
     if (written <= 0) {
       const std::string reason = written < 0 ? std::strerror(errno) : "nothing was written";
-      flushed_size_ += done;
-      flushed_hash_ = content_hash(std::string_view(buffer_.data(), done), flushed_hash_);
+      // A full disk or a file size limit: keep whole rows only. The file is cut back to the end of the last row
+      // this flush wrote completely, so that no reader (and no resume) sees a row cut short.
+      const std::size_t last_newline = done ? buffer_.rfind('\n', done - 1) : std::string::npos;
+      const std::size_t whole = last_newline == std::string::npos ? 0 : last_newline + 1;
+      const std::string cut =
+          ::ftruncate(descriptor_, static_cast<off_t>(flushed_size_ + whole)) == 0
+              ? "; the file ends at its last whole row"
+              : "; the last row may be cut short (" + std::string(std::strerror(errno)) + ")";
+      flushed_size_ += whole;
+      flushed_hash_ = content_hash(std::string_view(buffer_.data(), whole), flushed_hash_);
       buffer_.clear();
-      throw OutputError("cannot write " + path_.string() + ": " + reason);
+      throw OutputError("cannot write " + path_.string() + ": " + reason + cut);
     }
     done += static_cast<std::size_t>(written);
   }

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <fstream>
 #include <string>
 
 #include "nonsep/host/output/content_hash.hpp"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -15,20 +15,28 @@
 
 namespace nonsep::host {
 
-std::optional<std::uint64_t> file_content_hash(const std::filesystem::path& path, std::optional<std::uint64_t> size) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::uint64_t hash = content_hash_start, left = size.value_or(UINT64_MAX);
+std::optional<std::uint64_t> descriptor_content_hash(int descriptor, std::optional<std::uint64_t> size) {
+  std::uint64_t hash = content_hash_start, offset = 0;
+  const std::uint64_t end = size.value_or(UINT64_MAX);
   std::string buffer(1 << 16, '\0');
-  while (left > 0) {
-    const auto want = static_cast<std::streamsize>(std::min<std::uint64_t>(left, buffer.size()));
-    in.read(buffer.data(), want);
-    const auto got = static_cast<std::size_t>(in.gcount());
-    hash = content_hash(std::string_view(buffer.data(), got), hash);
-    left -= got;
-    if (got < static_cast<std::size_t>(want)) break;
+  while (offset < end) {
+    const auto want = static_cast<std::size_t>(std::min<std::uint64_t>(end - offset, buffer.size()));
+    const ssize_t got = ::pread(descriptor, buffer.data(), want, static_cast<off_t>(offset));
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) return std::nullopt;
+    if (got == 0) break;
+    hash = content_hash(std::string_view(buffer.data(), static_cast<std::size_t>(got)), hash);
+    offset += static_cast<std::uint64_t>(got);
   }
-  if (size && left > 0) return std::nullopt;
+  if (size && offset < *size) return std::nullopt;
+  return hash;
+}
+
+std::optional<std::uint64_t> file_content_hash(const std::filesystem::path& path, std::optional<std::uint64_t> size) {
+  const int descriptor = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (descriptor < 0) return std::nullopt;
+  const auto hash = descriptor_content_hash(descriptor, size);
+  ::close(descriptor);
   return hash;
 }
 

@@ -56,6 +56,22 @@ std::optional<Manifest> read_manifest(const std::filesystem::path& directory) {
   }
 }
 
+// Every output name is free or a regular file: a folder, a link or a device where the run must write a file would
+// make it fail at its end (the rename of summary.json), after all the computing.
+void check_outputs_placeable(const std::filesystem::path& directory) {
+  for (const auto& name : RunFolder::output_files()) {
+    std::error_code error;
+    const auto status = std::filesystem::symlink_status(directory / name, error);
+    if (!std::filesystem::exists(status) || std::filesystem::is_regular_file(status)) continue;
+    const std::string what = std::filesystem::is_directory(status) ? "a folder"
+                             : std::filesystem::is_symlink(status) ? "a symbolic link"
+                                                                   : "not a regular file";
+    throw OutputError("cannot write " + (directory / name).string() + ": " + what +
+                      " is in the way of the run's file of that name; move it, or give this run another folder "
+                      "(--output)");
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& RunFolder::output_files() {
@@ -93,7 +109,13 @@ RunFolder::RunFolder(const std::filesystem::path& directory, const std::string& 
   for (const auto& entry : std::filesystem::directory_iterator(directory, error))
     if (is_temporary(entry.path().filename().string())) std::filesystem::remove(entry.path(), error);
 
-  if (use == FolderUse::resume) return;
+  if (use == FolderUse::resume) {
+    check_outputs_placeable(directory);
+    // Proves, before anything is computed, that the folder still takes files and renames.
+    const auto manifest = read_head(directory / manifest_name, 1 << 16);
+    if (!manifest.empty()) write_file_atomically(directory / manifest_name, manifest);
+    return;
+  }
   const std::string job = std::filesystem::weakly_canonical(std::filesystem::absolute(job_file)).string();
   if (use == FolderUse::fresh) {
     if (std::filesystem::exists(std::filesystem::symlink_status(directory / "checkpoint.json")))
@@ -115,6 +137,7 @@ RunFolder::RunFolder(const std::filesystem::path& directory, const std::string& 
                         "); `--force` replaces them, or give this run another folder (--output)");
   }
   for (const auto& name : output_files()) std::filesystem::remove(directory / name, error);
+  check_outputs_placeable(directory);
   // Also proves, before anything is computed, that the folder takes files and renames.
   write_file_atomically(directory / manifest_name, nlohmann::json{{"kind", kind}, {"job", job}}.dump(2) + "\n");
 }

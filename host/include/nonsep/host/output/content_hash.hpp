@@ -32,5 +32,7 @@ inline std::string content_hash_hex(std::uint64_t hash) {
 // file cannot be read or is shorter than `size`.
 std::optional<std::uint64_t> file_content_hash(const std::filesystem::path& path,
                                                std::optional<std::uint64_t> size = std::nullopt);
+// The same for an open file (read with pread: the descriptor's offset does not move).
+std::optional<std::uint64_t> descriptor_content_hash(int descriptor, std::optional<std::uint64_t> size = std::nullopt);
 
 }  // namespace nonsep::host

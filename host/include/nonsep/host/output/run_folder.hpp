@@ -15,8 +15,9 @@
 // leaves the earlier run's summary beside its own partial files. Temporary files of dead runs (".*.tmp-*") are
 // removed too. Resuming keeps everything.
 //
-// Before anything is computed the folder is checked to be writable, so that a run that could not save its results
-// fails at once (exit 2), not after its steps.
+// Before anything is computed (fresh, forced or resumed) the folder is checked to take files and renames, and every
+// output name to be free or a regular file (not a folder, link or device in the way), so that a run that could not
+// save its results fails at once (exit 2), not after its steps.
 #include <filesystem>
 #include <stdexcept>
 #include <string>
