@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <algorithm>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -205,6 +207,58 @@ TEST_CASE("energy of the solved Hamiltonian in both forms") {
   Coupled2D{}.hessian_V(y.q(), h, 1);
   const double expected = g[0] * (h[0] * g[0] + h[1] * g[1]) + g[1] * (h[2] * g[0] + h[3] * g[1]);
   CHECK(ttv.evaluate_one(Coupled2D{}, y) == doctest::Approx(expected).epsilon(1e-15));
+}
+
+namespace {
+// A chain of dimension n: T = |p|^2/2, V = sum q_i^4/4 + sum q_i q_(i+1) / 2, so H_TTV = sum 3 q_i^2 p_i^2 +
+// sum p_i p_(i+1). Large enough that its Hessians do not fit in one EnergyEvaluator call for a few states.
+struct Chain {
+  std::size_t n;
+  std::size_t dimension() const { return n; }
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t i = 0; i < count * n; ++i) out[i] = p[i];
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t i = 0; i < count * n; ++i) out[i] = q[i] * q[i] * q[i];
+  }
+  void hessian_T(std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b)
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j) out[(b * n + i) * n + j] = i == j ? 1.0 : 0.0;
+  }
+  void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b)
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j)
+          out[(b * n + i) * n + j] = i == j ? 3.0 * q[b * n + i] * q[b * n + i] : (i + 1 == j || j + 1 == i) ? 0.5 : 0.0;
+  }
+};
+}  // namespace
+
+TEST_CASE("energy of many large states: evaluated a few at a time, each state's H as when evaluated alone") {
+  const Chain chain{400};  // 160000 Hessian entries a state: the evaluator takes 6 states per call
+  const std::size_t count = 13;
+  PhaseSpaceBatch x(chain.n, count);
+  for (std::size_t i = 0; i < chain.n * count; ++i) {
+    x.q()[i] = std::sin(0.37 * static_cast<double>(i));
+    x.p()[i] = std::cos(0.11 * static_cast<double>(i));
+  }
+  EnergyEvaluator energy(HamiltonianForm::TTV);
+  std::vector<double> energies(count);
+  energy.evaluate(chain, x, energies);
+  for (std::size_t b = 0; b < count; ++b) {
+    CAPTURE(b);
+    PhaseSpaceBatch one(chain.n, 1);
+    std::copy_n(x.q().begin() + static_cast<std::ptrdiff_t>(b * chain.n), chain.n, one.q().begin());
+    std::copy_n(x.p().begin() + static_cast<std::ptrdiff_t>(b * chain.n), chain.n, one.p().begin());
+    CHECK(energies[b] == energy.evaluate_one(chain, one));
+    double expected = 0.0;
+    for (std::size_t i = 0; i < chain.n; ++i) {
+      const double q = one.q()[i], p = one.p()[i];
+      expected += 3.0 * q * q * p * p + (i + 1 < chain.n ? p * one.p()[i + 1] : 0.0);
+    }
+    CHECK(energies[b] == doctest::Approx(expected).epsilon(1e-12));
+  }
 }
 
 TEST_CASE("the VVT form converges to the exact flow of H_VVT = (q + q^3/3)^2 p") {

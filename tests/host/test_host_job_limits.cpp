@@ -168,3 +168,33 @@ TEST_CASE("max_initial_values applies to every kind of initial state, not only g
   CHECK(issues[0].allowed == "at most 16777216 numbers in q (states times dimension)");
   CHECK(job.initial.count == 1);
 }
+
+TEST_CASE("the model's size: dimension 0 is refused, and so is a Hessian too large to hold, before any step") {
+  nonsep::host_testing::TemporaryFolder folder;
+  const auto job_of = [](const std::string& plugin, std::size_t dimension) {
+    return json{{"model", {{"plugin", plugin}, {"parameters", {{"dimension", dimension}}}}},
+                {"integrator", {{"scheme", "basic"}}},
+                {"initial", {{"q", json::array_t(dimension, json(0.5))}, {"p", json::array_t(dimension, json(0.1))}}},
+                {"time", {{"dt", 1e-3}, {"steps", 2}}},
+                {"output", {{"directory", "out"}, {"every", 0}}}};
+  };
+  const auto zero = nonsep::host_testing::write_job(folder / "zero.json", job_of("blowup", 0));
+  for (const char* command : {"validate", "run"}) {
+    CAPTURE(command);
+    const auto result = nonsep::host_testing::run_nonsep({command, zero.string()}, folder.path());
+    CHECK(result.status == 2);
+    CHECK(result.err.find("/model/parameters") != std::string::npos);
+    CHECK(result.err.find("dimension 0") != std::string::npos);
+  }
+  // 20000 x 20000 doubles are 3 GiB: refused at /model when the plugin has Hessians (H needs them) ...
+  const auto huge = nonsep::host_testing::write_job(folder / "huge.json", job_of("blowup", 20000));
+  const auto refused = nonsep::host_testing::run_nonsep({"run", "--quiet", huge.string()}, folder.path());
+  CHECK(refused.status == 2);
+  CHECK(refused.err.find("/model: found a model of dimension 20000, whose Hessian (for H) would take 3.0 GiB") !=
+        std::string::npos);
+  CHECK(!std::filesystem::exists(folder / "out" / "summary.json"));
+  // ... and runs without them, when there is no energy to evaluate.
+  const auto gradients_only =
+      nonsep::host_testing::write_job(folder / "gradients.json", job_of("blowup_gradients_only", 20000));
+  CHECK(nonsep::host_testing::run_nonsep({"run", "--quiet", gradients_only.string()}, folder.path()).status == 0);
+}

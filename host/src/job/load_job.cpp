@@ -1,5 +1,6 @@
 // Reading a job file (at most max_job_file_bytes, never a directory), pass 3 (the plugin: load_model), and
 // load_job, which runs all passes and throws InvalidJob with the issues of every pass together.
+#include <cstdio>
 #include <fstream>
 
 #include "checker.hpp"
@@ -12,6 +13,12 @@ std::string to_string(const JobIssue& issue) {
 }
 
 namespace {
+
+std::string gibibytes(std::size_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(bytes) / static_cast<double>(std::size_t{1} << 30));
+  return text;
+}
 
 std::string report(const std::filesystem::path& job_file, const std::vector<JobIssue>& issues) {
   std::string text = "invalid job file " + job_file.string() + " (" + std::to_string(issues.size()) +
@@ -96,7 +103,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   check_dimension(checked.initial, loaded.model.dimension(), issues);
   if (const std::size_t n = loaded.model.dimension(); loaded.plugin.has_hessians() && n > max_hessian_values / n)
     issues.push_back({"/model", "a model of dimension " + std::to_string(n) + ", whose Hessian (for H) would take " +
-                                    std::to_string(n * n / (std::size_t{1} << 27)) + " GiB",
+                                    gibibytes(n * n * sizeof(double)) + " GiB",
                       "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians"});
   if (issues.size() != before) return std::nullopt;
   return loaded;

@@ -2,6 +2,7 @@
 // The energy of the Hamiltonian the integrators solve (paper, eq. (httv) and section III):
 //   H_TTV = grad T(p) . (Hess V(q) grad T(p))      H_VVT = grad V(q) . (Hess T(p) grad V(q))
 // Needs a model with Hessians (model.hpp). Not part of stepping: used for reporting and testing.
+#include <algorithm>
 #include <span>
 #include <vector>
 
@@ -21,26 +22,33 @@ class EnergyEvaluator {
       throw InvalidArgument("energy output has " + std::to_string(energies.size()) + " entries for " +
                             std::to_string(x.count()) + " states");
     const std::size_t n = x.dimension();
-    const std::size_t count = x.count();
-    gradient_.resize(n * count);
-    hessian_.resize(n * n * count);
-    if (form_ == HamiltonianForm::TTV) {
-      model.grad_T(x.p(), gradient_, count);
-      model.hessian_V(x.q(), hessian_, count);
-    } else {
-      model.grad_V(x.q(), gradient_, count);
-      model.hessian_T(x.p(), hessian_, count);
-    }
-    for (std::size_t b = 0; b < count; ++b) {
-      const double* g = gradient_.data() + b * n;
-      const double* h = hessian_.data() + b * n * n;
-      double sum = 0.0;
-      for (std::size_t i = 0; i < n; ++i) {
-        double row = 0.0;
-        for (std::size_t j = 0; j < n; ++j) row += h[i * n + j] * g[j];
-        sum += g[i] * row;
+    // A few states at a time, so that the Hessians take at most about hessian_values_per_call numbers (8 MiB)
+    // whatever the batch: each state's H depends on that state alone, so the numbers are the same.
+    const std::size_t per_call = std::max<std::size_t>(1, hessian_values_per_call / (n * n));
+    for (std::size_t first = 0; first < x.count(); first += per_call) {
+      const std::size_t count = std::min(per_call, x.count() - first);
+      const auto q = x.q().subspan(first * n, count * n);
+      const auto p = x.p().subspan(first * n, count * n);
+      gradient_.resize(n * count);
+      hessian_.resize(n * n * count);
+      if (form_ == HamiltonianForm::TTV) {
+        model.grad_T(p, gradient_, count);
+        model.hessian_V(q, hessian_, count);
+      } else {
+        model.grad_V(q, gradient_, count);
+        model.hessian_T(p, hessian_, count);
       }
-      energies[b] = sum;
+      for (std::size_t b = 0; b < count; ++b) {
+        const double* g = gradient_.data() + b * n;
+        const double* h = hessian_.data() + b * n * n;
+        double sum = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+          double row = 0.0;
+          for (std::size_t j = 0; j < n; ++j) row += h[i * n + j] * g[j];
+          sum += g[i] * row;
+        }
+        energies[first + b] = sum;
+      }
     }
   }
 
@@ -52,6 +60,7 @@ class EnergyEvaluator {
   }
 
  private:
+  static constexpr std::size_t hessian_values_per_call = std::size_t{1} << 20;
   HamiltonianForm form_;
   std::vector<double> gradient_, hessian_;
 };
