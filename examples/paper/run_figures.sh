@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Reproduces the paper's three figures: the exact references, the jobs of this folder, and the PNGs.
+# Reproduces the paper's three figures: the exact references, the jobs of this folder, and the plots.
 #
 #   bash examples/paper/run_figures.sh [OUT_DIR] [BUILD_DIR]
 #
 # OUT_DIR (default build/paper-figures) receives reference/ (nonsep_paper_reference), one folder per job
-# (figure1/, figure2_paper_circle/, ..., figure3/) and figure1.png, figure2.png, figure3.png. BUILD_DIR (default
-# build) holds bin/nonsep and bin/nonsep_paper_reference. Exits non-zero if any step fails.
+# (figure1/, figure2_paper_circle/, ..., figure3/) and figure1, figure2 and figure3, each as .png (150 dpi) and
+# .pdf. BUILD_DIR (default build) holds bin/nonsep and bin/nonsep_paper_reference. Exits non-zero if any step
+# fails.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"

@@ -29,7 +29,8 @@ def _label(result, i):
 
 def orbit(result, i=None, ax=None, **style):
     """Trajectory `i` (an index, a list of indices, or None for all) from trajectory.csv: p against q for a model of
-    dimension 1 (the phase plane), q2 against q1 otherwise (the configuration plane, the paper's Figure 2).
+    dimension 1 (the phase plane), q1 against q0 otherwise (the configuration plane, the paper's Figure 2). Axis
+    labels name the columns of trajectory.csv, whose components are numbered from 0.
     `style` goes to ax.plot (default: small stars, the paper's Figure 1)."""
     ax = _axes(ax)
     style = {"marker": "*", "linestyle": "none", "markersize": 2.5, **style}
@@ -39,8 +40,8 @@ def orbit(result, i=None, ax=None, **style):
         x, y = (o.q[:, 0], o.p[:, 0]) if o.q.shape[1] == 1 else (o.q[:, 0], o.q[:, 1])
         ax.plot(x, y, label=_label(result, index), **style)
     one_dimensional = result.orbit(indices[0]).q.shape[1] == 1
-    ax.set_xlabel("$q$" if one_dimensional else "$q_1$")
-    ax.set_ylabel("$p$" if one_dimensional else "$q_2$")
+    ax.set_xlabel("$q$" if one_dimensional else "$q_0$")
+    ax.set_ylabel("$p$" if one_dimensional else "$q_1$")
     ax.set_aspect("equal", adjustable="datalim")
     if 1 < len(indices) <= MAX_LEGEND:
         ax.legend(fontsize="small")

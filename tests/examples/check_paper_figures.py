@@ -12,7 +12,8 @@ figure2    the paper's settings close the circle and the triangle (and, with a 1
            paper's circle and twisted states
 figure3    every fitted exponent within 0.1 of its order; the basic constant at exponent 2/3 near the paper's -2;
            the plot script's fit (from convergence.csv) equals summary.json's
-plots      figure1.png, figure2.png and figure3.png exist, are PNG files and are not tiny
+plots      figure1, figure2 and figure3 exist as PNG files of at least 150 dpi (their pHYs chunk) and 800 pixels
+           wide, not tiny and not over 600 kB, and as PDF files
 Exits 1 listing every failed check."""
 import argparse
 import csv
@@ -140,14 +141,35 @@ def check_figure3(out, examples):
           "figure3: MPE 4 does not beat MPE 2 by 1000x at 1e5 gradient evaluations")
 
 
+def png_chunks(data):
+    """(type, payload) of every chunk of a PNG file's bytes, after the 8-byte signature."""
+    at = 8
+    while at + 8 <= len(data):
+        length = int.from_bytes(data[at:at + 4], "big")
+        yield data[at + 4:at + 8], data[at + 8:at + 8 + length]
+        at += 12 + length
+
+
 def check_plots(out, examples):
-    for name in ("figure1.png", "figure2.png", "figure3.png"):
-        path = out / name
+    for name in ("figure1", "figure2", "figure3"):
+        path = out / f"{name}.png"
         check(path.exists(), f"{path} was not produced")
         if path.exists():
             data = path.read_bytes()
             check(data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG file")
-            check(len(data) > 10_000, f"{path} has only {len(data)} bytes")
+            check(10_000 < len(data) <= 600_000, f"{path} has {len(data)} bytes (expected 10 kB to 600 kB)")
+            chunks = dict(png_chunks(data))
+            width = int.from_bytes(chunks.get(b"IHDR", bytes(4))[:4], "big")
+            check(width >= 800, f"{path} is {width} pixels wide")
+            phys = chunks.get(b"pHYs")
+            # pixels per unit in x and y, and the unit (1: metre); 150 dpi = 5905.5 pixels per metre
+            dpi = int.from_bytes(phys[:4], "big") * 0.0254 if phys and phys[8] == 1 else None
+            check(dpi is not None and dpi >= 149.5, f"{path}: {dpi} dpi, expected at least 150")
+        pdf = out / f"{name}.pdf"
+        check(pdf.exists(), f"{pdf} was not produced")
+        if pdf.exists():
+            data = pdf.read_bytes()
+            check(data[:5] == b"%PDF-" and len(data) > 5_000, f"{pdf} is not a PDF file of some size")
 
 
 def main():

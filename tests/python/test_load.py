@@ -93,17 +93,17 @@ class TrajectoriesTest(FolderTestCase):
         last = result.orbit(0)
         self.assertEqual((last.q[-1, 0].hex(), last.p[-1, 0].hex()), (table["q0"][0].hex(), table["p0"][0].hex()))
 
-    def test_trajectories_csv_is_read_by_header_and_gives_the_summarys_array(self):
+    def test_trajectories_csv_is_read_by_header_in_any_column_order_with_extra_columns_and_quoted_messages(self):
         result = nonsep.run(paper1d_job([state(0.5, 0.0), state(2.0, 0.0)], steps=40), output="out")
-        from_summary = result.trajectories
-        # The file as the host will write it, with its columns in another order, an extra (dynamics) column,
-        # and a message holding a comma and quotes; then load() reads it instead of summary.json's entries.
+        as_written = result.trajectories
+        # The host's file rewritten with its columns in another order, an extra (dynamics) column, and a message
+        # holding a comma and quotes; load() must find every column by its header and give the same numbers.
         order = list(reversed(TRAJECTORIES_HEADER)) + ["lyapunov_1"]
         message = 'plugin said "no", then, stopped'
         with open(self.folder / "out" / "trajectories.csv", "w", newline="") as f:
             writer = csv.writer(f, lineterminator="\n")
             writer.writerow(order)
-            for row in from_summary:
+            for row in as_written:
                 cells = {name: _cell(row[name]) for name in TRAJECTORIES_HEADER}
                 cells["message"] = message if row["trajectory"] == 1 else ""
                 writer.writerow([cells.get(name, "0.125") for name in order])
@@ -113,7 +113,7 @@ class TrajectoriesTest(FolderTestCase):
             if name == "message":
                 self.assertEqual(list(loaded[name]), ["", message])
             else:
-                self.assertEqual(from_summary[name].tobytes(), loaded[name].astype(from_summary[name].dtype).tobytes(),
+                self.assertEqual(as_written[name].tobytes(), loaded[name].astype(as_written[name].dtype).tobytes(),
                                  name)
         self.assertEqual(loaded["lyapunov_1"].dtype, np.float64)
         self.assertEqual(list(loaded["lyapunov_1"]), [0.125, 0.125])

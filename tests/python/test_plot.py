@@ -39,7 +39,7 @@ class PlotTest(FolderTestCase):
                "initial": {"q": [0.8, 0.0], "p": [0.0, 0.439]}, "time": {"dt": 0.01, "steps": 40}}
         result = nonsep.run(job, output="out")
         ax = nonsep.plot.orbit(result, 0)
-        self.assertEqual((ax.get_xlabel(), ax.get_ylabel()), ("$q_1$", "$q_2$"))
+        self.assertEqual((ax.get_xlabel(), ax.get_ylabel()), ("$q_0$", "$q_1$"))
         np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), result.orbit(0).q[:, 1])
 
     def test_energy_error_against_time(self):
