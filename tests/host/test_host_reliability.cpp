@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <string>
 #include <vector>
@@ -418,4 +419,34 @@ TEST_CASE("resume checks content: an edited checkpoint or trajectory.csv is refu
     write_text(folder / "out/trajectory.csv", csv);
     resume("are not the ones the checkpoint recorded");
   }
+}
+
+TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3), and the rows written before whole") {
+  // The trust model (README): a plugin runs inside nonsep, so its crash is nonsep's: the status is the signal's
+  // 128 + n (SIGABRT 134, SIGSEGV 139) or the plugin's own exit code, and what was flushed before stays readable.
+#if defined(__SANITIZE_ADDRESS__)
+  // The sanitized suite: ASan catches the fault itself and aborts (abort_on_error=1, tests/ci), and LeakSanitizer
+  // would turn exit(3) into its own status by reporting what the interrupted run still held.
+  const std::pair<int, int> cases[] = {{0, 134}, {1, 134}, {2, 3}};
+  const std::string sanitizer_options = std::getenv("ASAN_OPTIONS") ? std::getenv("ASAN_OPTIONS") : "";
+  ::setenv("ASAN_OPTIONS", (sanitizer_options + ":detect_leaks=0").c_str(), 1);
+#else
+  const std::pair<int, int> cases[] = {{0, 134}, {1, 139}, {2, 3}};
+#endif
+  for (const auto& [how, status] : cases) {
+    CAPTURE(how);
+    TemporaryFolder folder;
+    const auto file = write_job(
+        folder / "job.json",
+        job_with("blowup", state(0.5, 0.5), {{"crash_after", 50000}, {"crash_how", how}}, {{"dt", 1e-4}, {"steps", 1000000}}));
+    const Result result = run_nonsep({"run", "--quiet", file.string()}, folder.path());
+    CHECK(result.status == status);
+    CHECK(result.killed == (how != 2));
+    const auto rows = check_complete_csv(folder / "out/trajectory.csv", 1);
+    CHECK(rows.size() > 1000);  // buffers of 64 KiB were flushed before the crash, each ending on a row
+    CHECK(!std::filesystem::exists(folder / "out/summary.json"));
+  }
+#if defined(__SANITIZE_ADDRESS__)
+  ::setenv("ASAN_OPTIONS", sanitizer_options.c_str(), 1);
+#endif
 }

@@ -51,6 +51,27 @@ TEST_CASE("threads: 1, 2 and 3 threads write byte-identical trajectory.csv, traj
   }
 }
 
+TEST_CASE("a plugin that declares \"thread_safe\": false runs on one thread with a note, as with --threads 1") {
+  // global_state keeps its coupling in a global that every create() overwrites: a second instance for a second
+  // thread would change every number. The host must keep to the one instance it checked the job with.
+  TemporaryFolder folder;
+  json states = json::array();
+  for (int i = 0; i < 600; ++i) states.push_back(state(0.5 + 0.001 * i, 0.25));
+  const auto file = write_job(
+      folder / "job.json", blowup_job(states, json::object(), std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/global_state.so"));
+  std::vector<std::string> tables;
+  for (const char* threads : {"1", "2"}) {
+    const auto out = folder / (std::string("out-") + threads);
+    const auto result =
+        run_nonsep({"run", "--quiet", "--threads", threads, "--output", out.string(), file.string()}, folder.path());
+    CHECK(result.status == 0);
+    CHECK((result.err.find("ran on one thread: the plugin 'global_state' declares \"thread_safe\": false") !=
+           std::string::npos) == (std::string(threads) == "2"));
+    tables.push_back(read_text(out / "trajectories.csv"));
+  }
+  CHECK(tables[0] == tables[1]);
+}
+
 TEST_CASE("--threads must be a whole number from 1 to 4096") {
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", quickstart_job());

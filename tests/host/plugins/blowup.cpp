@@ -9,13 +9,16 @@
 // non-finite in its first step. Parameter fail_above: grad V reports NONSEP_EVALUATION_FAILED at any finite |q_i|
 // above it. Parameters nan_after and inf_after: grad V returns NaN (or +inf) in every component from its
 // (n+1)-th call on (0: never). Parameter sleep_ms: every call of grad V sleeps that long first (a very slow model,
-// to test that the host stays interruptible). Built three times: "blowup" (all functions), "blowup_gradients_only"
+// to test that the host stays interruptible). Parameters crash_after and crash_how: from its (n+1)-th call on
+// (0: never), grad V crashes the process as a faulty plugin would: crash_how 0 abort() (SIGABRT), 1 a write
+// through a null pointer (SIGSEGV), 2 exit(3) (the plugin's own exit status). Built three times: "blowup" (all functions), "blowup_gradients_only"
 // (no values, no Hessians: no energy) and "blowup_wrong_hessian" (Hess V = diag(2 q_i^2), wrong on purpose, for the
 // derivative check).
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <new>
@@ -36,12 +39,21 @@
 struct nonsep_instance {
   std::size_t dimension = 1;
   double fail_above = 1e300;
-  std::uint64_t nan_after = 0, inf_after = 0, sleep_ms = 0;
+  std::uint64_t nan_after = 0, inf_after = 0, sleep_ms = 0, crash_after = 0, crash_how = 0;
   std::uint64_t grad_V_calls = 0;
   std::string last_error;
 };
 
 namespace {
+
+[[noreturn]] void crash(std::uint64_t how) {
+  if (how == 1) {
+    volatile int* nowhere = nullptr;
+    *nowhere = 1;
+  }
+  if (how == 2) std::exit(3);
+  std::abort();
+}
 
 const char* metadata() {
   static const std::string text = nlohmann::json{
@@ -59,6 +71,10 @@ const char* metadata() {
          {"description", "grad V returns NaN from its (n+1)-th call on; 0: never"}},
         {{"name", "inf_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
          {"description", "grad V returns +inf from its (n+1)-th call on; 0: never"}},
+        {{"name", "crash_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
+         {"description", "grad V crashes the process from its (n+1)-th call on; 0: never"}},
+        {{"name", "crash_how"}, {"type", "integer"}, {"default", 0}, {"minimum", 0}, {"maximum", 2},
+         {"description", "0 abort(), 1 a write through a null pointer, 2 exit(3)"}},
         {{"name", "sleep_ms"}, {"type", "integer"}, {"default", 0}, {"minimum", 0}, {"maximum", 10000},
          {"description", "each call of grad V sleeps this many milliseconds first"}}}},
       {"thread_safe", true},  // the call counters are per instance
@@ -78,6 +94,8 @@ nonsep_status create(const char* parameters_json, nonsep_instance** out, char* m
     instance->nan_after = parameters.value("nan_after", std::uint64_t{0});
     instance->inf_after = parameters.value("inf_after", std::uint64_t{0});
     instance->sleep_ms = parameters.value("sleep_ms", std::uint64_t{0});
+    instance->crash_after = parameters.value("crash_after", std::uint64_t{0});
+    instance->crash_how = parameters.value("crash_how", std::uint64_t{0});
     *out = instance;
     return NONSEP_OK;
   } catch (const std::exception& error) {
@@ -96,6 +114,7 @@ nonsep_status grad_T(nonsep_instance* instance, const double* p, double* out, st
 nonsep_status grad_V(nonsep_instance* instance, const double* q, double* out, std::size_t count) {
   if (instance->sleep_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(instance->sleep_ms));
   const std::uint64_t call = ++instance->grad_V_calls;
+  if (instance->crash_after > 0 && call > instance->crash_after) crash(instance->crash_how);
   const bool nan = instance->nan_after > 0 && call > instance->nan_after;
   const bool inf = instance->inf_after > 0 && call > instance->inf_after;
   if (nan || inf) {
