@@ -31,7 +31,8 @@ json encode(const std::optional<double>& value) { return value ? encode(*value) 
 
 // Every read of a malformed file ends here, with what was wrong.
 [[noreturn]] void damaged(const std::filesystem::path& path, const std::string& what) {
-  throw CheckpointError(path.string() + " is damaged (" + what + "); run the job without --resume to start it over");
+  throw CheckpointError(path.string() + " is damaged (" + what +
+                        "); run the job with --force instead of --resume to start it over");
 }
 
 struct Reader {
