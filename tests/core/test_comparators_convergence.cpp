@@ -17,6 +17,7 @@
 #include "nonsep/reference/hamiltonian_flow.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "support/convergence.hpp"
+#include "support/finite_difference.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;
@@ -83,7 +84,7 @@ TEST_CASE("the gradient of H is the derivative of the energy, both forms") {
             (in_q ? qs : ps)[k] += shift;
             return energy.evaluate_one(Coupled2D{}, PhaseSpaceBatch::single(qs, ps));
           };
-          const double difference = (at(h) - at(-h)) / (2 * h);
+          const double difference = nonsep::testing::central_difference(at, 0.0, h);
           CHECK(std::abs(difference - (in_q ? dq : dp)[2 * b + k]) < 1e-8);
         }
   }

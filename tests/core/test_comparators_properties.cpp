@@ -15,6 +15,7 @@
 #include "nonsep/core/gauss_legendre.hpp"
 #include "nonsep/core/tao_extended_phase_space.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
+#include "support/phase_space_jacobian.hpp"
 #include "support/models.hpp"
 #include "support/nan_aware.hpp"
 
@@ -29,26 +30,11 @@ using Map = std::function<Vector(const Vector&)>;
 
 const HamiltonianForm forms[] = {HamiltonianForm::TTV, HamiltonianForm::VVT};
 
-// max |J^T Omega J - Omega| of the map's Jacobian J by central differences, Omega = [[0, I], [-I, 0]] for the
-// variables ordered (positions..., momenta...). Zero for a symplectic map up to the differencing error (~1e-9);
+// max |J^T Omega J - Omega| of the map's Jacobian J by central differences (support/finite_difference.hpp), for
+// the variables ordered (positions..., momenta...). Zero for a symplectic map up to the differencing error (~1e-9);
 // NaN when the map is not finite.
 double symplecticity_defect(const Map& map, const Vector& z0) {
-  const auto N = static_cast<Eigen::Index>(z0.size()), n = N / 2;
-  const double h = 1e-6;
-  Eigen::MatrixXd J(N, N);
-  for (Eigen::Index k = 0; k < N; ++k) {
-    Vector plus = z0, minus = z0;
-    plus[static_cast<std::size_t>(k)] += h;
-    minus[static_cast<std::size_t>(k)] -= h;
-    const Vector a = map(plus), b = map(minus);
-    for (Eigen::Index i = 0; i < N; ++i)
-      J(i, k) = (a[static_cast<std::size_t>(i)] - b[static_cast<std::size_t>(i)]) / (2 * h);
-  }
-  if (!J.allFinite()) return std::numeric_limits<double>::quiet_NaN();
-  Eigen::MatrixXd omega = Eigen::MatrixXd::Zero(N, N);
-  omega.topRightCorner(n, n).setIdentity();
-  omega.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
-  return (J.transpose() * omega * J - omega).cwiseAbs().maxCoeff();
+  return nonsep::testing::symplecticity_defect(nonsep::testing::jacobian_by_differences(map, z0, 1e-6));
 }
 
 Vector concat(std::span<const double> a, std::span<const double> b) {

@@ -13,6 +13,7 @@
 
 #include "nonsep/core.hpp"
 #include "support/convergence.hpp"
+#include "support/phase_space_jacobian.hpp"
 #include "support/models.hpp"
 #include "support/nan_aware.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
@@ -32,30 +33,13 @@ double max_difference(const PhaseSpaceBatch& a, const PhaseSpaceBatch& b) {
   return d;
 }
 
-// One-step Jacobian J = d(q', p')/d(q, p) by central differences, and max |J^T Omega J - Omega| with
-// Omega = [[0, I], [-I, 0]]: zero for a symplectic map (up to the differencing error, ~1e-9 here); NaN when the
-// step is not finite.
+// max |J^T Omega J - Omega| of the one-step Jacobian J = d(q', p')/d(q, p) by central differences
+// (support/finite_difference.hpp): zero for a symplectic map up to the differencing error (~1e-9 here); NaN when
+// the step is not finite.
 template <class M>
 double symplecticity_defect(const M& model, const IntegratorSpec& spec, const PhaseSpaceBatch& x0, double dt) {
-  const auto n = static_cast<Eigen::Index>(x0.dimension()), N = 2 * n;
-  const double h = 1e-6;
-  const auto component = [n](PhaseSpaceBatch& x, Eigen::Index i) -> double& {
-    return i < n ? x.q()[static_cast<std::size_t>(i)] : x.p()[static_cast<std::size_t>(i - n)];
-  };
-  Eigen::MatrixXd J(N, N);
-  for (Eigen::Index k = 0; k < N; ++k) {
-    std::array<PhaseSpaceBatch, 2> ends{x0, x0};
-    component(ends[0], k) += h;
-    component(ends[1], k) -= h;
-    for (auto& x : ends) Integrator(spec).step(model, x, dt);
-    for (Eigen::Index i = 0; i < N; ++i) J(i, k) = (component(ends[0], i) - component(ends[1], i)) / (2 * h);
-  }
-  // A step that overflowed has no Jacobian: NaN fails every comparison the tests make, both ways.
-  if (!J.allFinite()) return std::numeric_limits<double>::quiet_NaN();
-  Eigen::MatrixXd omega = Eigen::MatrixXd::Zero(N, N);
-  omega.topRightCorner(n, n).setIdentity();
-  omega.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
-  return (J.transpose() * omega * J - omega).cwiseAbs().maxCoeff();
+  return testing::symplecticity_defect(
+      testing::jacobian_by_differences(testing::integrator_map(model, spec, dt), testing::phase_point(x0), 1e-6));
 }
 
 const std::array<HamiltonianForm, 2> forms{HamiltonianForm::TTV, HamiltonianForm::VVT};

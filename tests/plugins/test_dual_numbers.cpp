@@ -9,17 +9,15 @@
 #include <vector>
 
 #include "nonsep/sdk/dual.hpp"
+#include "support/finite_difference.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 
 using nonsep::sdk::Dual;
 
 namespace {
 
-template <class F>
-double central_difference(const F& f, double x) {
-  const double h = 1e-5;
-  return (f(x + h) - f(x - h)) / (2.0 * h);
-}
+using nonsep::testing::central_difference;
+using nonsep::testing::central_difference_along;
 
 struct UnaryCase {
   const char* name;
@@ -68,7 +66,7 @@ TEST_CASE("each function of dual.hpp has the derivative a finite difference give
     CAPTURE(std::string(c.name));
     const D result = c.on_dual(D::variable(c.at, 0));
     CHECK(result.value == doctest::Approx(c.on_double(c.at)).epsilon(1e-15));
-    CHECK(result.derivative[0] == doctest::Approx(central_difference(c.on_double, c.at)).epsilon(1e-8));
+    CHECK(result.derivative[0] == doctest::Approx(central_difference(c.on_double, c.at, 1e-5)).epsilon(1e-8));
   }
 }
 
@@ -147,14 +145,12 @@ struct BinaryCase {
 // Central difference of g (a vector of `size` numbers at a 2-point) along e_k, component i.
 template <class G>
 double difference(const G& g, std::array<double, 2> at, std::size_t k, std::size_t i, std::size_t size) {
-  const double h = 1e-5;
-  std::vector<double> plus(size), minus(size);
-  auto shifted = at;
-  shifted[k] += h;
-  g(shifted.data(), plus.data());
-  shifted[k] = at[k] - h;
-  g(shifted.data(), minus.data());
-  return (plus[i] - minus[i]) / (2.0 * h);
+  const auto values = [&](const std::vector<double>& point) {
+    std::vector<double> out(size);
+    g(point.data(), out.data());
+    return out;
+  };
+  return central_difference_along(values, {at[0], at[1]}, k, 1e-5)[i];
 }
 
 }  // namespace
