@@ -8,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/installation.hpp"
 
 #ifndef NONSEP_VERSION
 #error "NONSEP_VERSION must be defined by the build"
@@ -21,8 +22,8 @@ int run_command_line(int argc, char** argv) {
   try {
     CLI::App app{"nonsep " NONSEP_VERSION
                  ": explicit symplectic integrators for non-separable Hamiltonians H = T_i(p) V_ij(q) T_j(p)\n"
-                 "(S. A. Chin). Models are plugins; runs are described by JSON job files (README.md, section\n"
-                 "Running nonsep).",
+                 "(S. A. Chin). Models are plugins; runs are described by JSON job files. The manual (section\n"
+                 "Running nonsep): " + manual_location(),
                  "nonsep"};
     app.set_version_flag("--version", "nonsep " NONSEP_VERSION);
     app.require_subcommand(1);
@@ -70,11 +71,25 @@ int run_command_line(int argc, char** argv) {
     auto* models = app.add_subcommand("models", "List the plugins on the search path, one line each");
     models->footer(exit_status_text());
 
+    ExampleArguments example_arguments;
+    auto* example = app.add_subcommand(
+        "example", "Write a starting job file: the quickstart job, or the example NAME (see --list), to standard "
+                   "output or FILE; it passes `nonsep validate` as written");
+    example->add_option("NAME", example_arguments.name, "the example (default: quickstart)");
+    example->add_option("--output,-o", example_arguments.output, "the file to write (never overwritten)");
+    example->add_flag("--list", example_arguments.list, "list the examples, one line each")
+        ->excludes(example->get_option("NAME"))
+        ->excludes(example->get_option("--output"));
+    example->footer(exit_status_text());
+
     // CLI11 would call an unknown command a missing subcommand without naming it.
     const auto named = [&](const CLI::App* command) { return command->check_name(argv[1]); };
     if (argc > 1 && argv[1][0] != '-' && app.get_subcommands(named).empty()) {
-      std::cerr << "nonsep: unknown command '" << argv[1]
-                << "'; the commands are run, validate, inspect and models (see nonsep --help)\n";
+      std::string commands;
+      for (const CLI::App* command : app.get_subcommands({}))
+        commands += (commands.empty() ? "" : ", ") + command->get_name();
+      std::cerr << "nonsep: unknown command '" << argv[1] << "'; the commands are " << commands
+                << " (see nonsep --help)\n";
       return to_int(ExitStatus::invalid_input);
     }
     try {
@@ -87,6 +102,7 @@ int run_command_line(int argc, char** argv) {
     if (validate->parsed()) return command_validate(job_file);
     if (inspect->parsed()) return command_inspect(plugin_name, as_json, check);
     if (models->parsed()) return command_models();
+    if (example->parsed()) return command_example(example_arguments);
     return to_int(ExitStatus::invalid_input);
   } catch (const std::exception& error) {
     std::cerr << "nonsep: unexpected error: " << error.what() << "\n";
