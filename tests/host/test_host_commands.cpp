@@ -131,7 +131,7 @@ TEST_CASE("inspect shows the metadata, --json the raw metadata, --check the deri
   result = run_nonsep({"inspect", "blowup_wrong_hessian", "--check"}, folder.path());
   CHECK(result.status == 1);
   CHECK(result.out.find("derivative check FAILED") != std::string::npos);
-  CHECK(result.out.find("  hessian_V[0] at (") != std::string::npos);
+  CHECK(result.out.find("  hessian_V[0] at q = (") != std::string::npos);
 
   result = run_nonsep({"inspect", "no_such_plugin"}, folder.path());
   CHECK(result.status == 2);
