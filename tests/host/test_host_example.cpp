@@ -47,7 +47,7 @@ TEST_CASE("example without a name writes the quickstart job, which validates, an
   CHECK(validated.out.find("valid: ") == 0);
 }
 
-TEST_CASE("every listed example is written with --output and passes nonsep validate; files are never overwritten") {
+TEST_CASE("every listed example is written with --output and passes nonsep validate, and no file is overwritten") {
   TemporaryFolder folder;
   const auto list = run_nonsep({"example", "--list"}, folder.path());
   REQUIRE(list.status == 0);
