@@ -14,7 +14,8 @@ endif()
 set(CMAKE_RUNTIME_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/bin")
 set(CMAKE_ARCHIVE_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/lib")
 set(CMAKE_LIBRARY_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/lib")
-# Shipped plugins land here; the host searches this folder last (see host/plugin_search_path).
+# Shipped plugins land here; the host searches this folder last, as bin/../plugins from its executable (see
+# host/loader: plugin_search_path).
 set(NONSEP_BUILD_PLUGIN_DIR "${PROJECT_BINARY_DIR}/plugins")
 
 option(NONSEP_SANITIZE "Build everything with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)

@@ -212,6 +212,24 @@ class StudyExecution {
     entry["constant_at_nominal_exponent"] = energy_fit ? json(sign * constant_at(description.order.value(), dts, energy_errors))
                                                        : json(nullptr);
     entry["energy_error_changes_sign"] = positive > 0 && negative > 0;
+    // Where round-off shows: the smallest |error| fitted, and how many times the |error| at the smallest dt
+    // exceeds the nominal power law through the largest dt, |e(dt_max)| (dt_min / dt_max)^order (about 1 in the
+    // asymptotic range; round-off, which flattens the errors, makes it large). The runs are in increasing step
+    // order: the first usable one has the largest |dt|, the last the smallest.
+    std::optional<double> smallest, excess;
+    std::vector<std::size_t> usable;
+    for (std::size_t i = 0; i < dts.size(); ++i)
+      if (std::isfinite(energy_errors[i]) && energy_errors[i] != 0.0) {
+        smallest = std::min(smallest.value_or(INFINITY), std::abs(energy_errors[i]));
+        usable.push_back(i);
+      }
+    if (usable.size() >= 2) {
+      const std::size_t large = usable.front(), small = usable.back();
+      excess = std::abs(energy_errors[small]) /
+               (std::abs(energy_errors[large]) * std::pow(std::abs(dts[small] / dts[large]), description.order.value()));
+    }
+    entry["energy_error_smallest"] = optional_number(smallest);
+    entry["energy_error_excess_at_smallest_dt"] = optional_number(excess);
     if (!dts.empty()) {
       const auto [dt_min, dt_max] = std::minmax_element(dts.begin(), dts.end(), [](double a, double b) {
         return std::abs(a) < std::abs(b);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host_test_support.hpp"
+#include "nonsep/host/run/trajectory.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host_testing;
@@ -120,4 +121,24 @@ TEST_CASE("README: the example of errors in a job file is what `nonsep validate`
   CHECK(result.status == 2);
   result.err.replace(result.err.find(absolute), absolute.size(), job);  // as run from the repository's root
   CHECK(result.err == shown.substr(command_end + 1));
+}
+
+TEST_CASE("README and --help: exit status 1 names every status with which a trajectory stops early") {
+  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / "README.md");
+  const auto row = readme.find("\n| 1 | ");
+  REQUIRE(row != std::string::npos);
+  const std::string readme_row = readme.substr(row + 1, readme.find('\n', row + 1) - row - 1);
+  TemporaryFolder folder;
+  const auto help = run_nonsep({"--help"}, folder.path());
+  REQUIRE(help.status == 0);
+  const auto from = help.out.find("  1    ");
+  REQUIRE(from != std::string::npos);
+  const std::string help_entry = help.out.substr(from, help.out.find("  2    ", from) - from);
+  using nonsep::host::TrajectoryStatus;
+  for (const auto status : {TrajectoryStatus::diverged, TrajectoryStatus::failed, TrajectoryStatus::inaccurate}) {
+    const std::string name(nonsep::host::to_string(status));
+    CAPTURE(name);
+    CHECK(readme_row.find(name) != std::string::npos);
+    CHECK(help_entry.find(name) != std::string::npos);
+  }
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -166,4 +167,35 @@ TEST_CASE("closest_return is the minimum distance to the start over every step f
   REQUIRE(run_nonsep({"run", "--quiet", "--output", (folder / "plain").string(), plain_file.string()}, folder.path())
               .status == 0);
   CHECK_FALSE(read_run(folder / "plain")["trajectories"][0].contains("closest_return"));
+}
+
+TEST_CASE("the study's report: exponents to 4 significant digits, and a warning for a fit that reaches round-off") {
+  TemporaryFolder folder;
+  // MPE 4 to 4096 steps reaches the round-off of paper1d (about 1e-11, of random sign); triplet 4/3 on these step
+  // counts stays in its asymptotic range (the control: no warning).
+  json job = study_job({{{"scheme", "mpe"}, {"order", "4"}, {"t2", -2.5},
+                         {"steps", {64, 128, 256, 512, 1024, 2048, 4096}}},
+                        {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}, {"steps", {256, 512, 1024, 2048}}}},
+                       json::array());
+  job["study"].erase("steps");  // each integrator has its own
+  const auto file = write_job(folder / "round_off.json", job);
+  const auto result = run_nonsep({"run", "--output", (folder / "out").string(), file.string()}, folder.path());
+  INFO(result.out, result.err);
+  CHECK(result.status == 0);
+  CHECK(std::regex_search(result.out, std::regex(R"(  mpe 4: energy error exponent \d\.\d{3} \(nominal 4 = 4\.000\) \(see warning\)\n)")));
+  CHECK(std::regex_search(result.out, std::regex(R"(  triplet 4/3: energy error exponent 1\.\d{3} \(nominal 4/3 = 1\.333\)\n)")));
+  CHECK(result.err.find("nonsep: warning: mpe 4: the energy error reaches round-off") != std::string::npos);
+  CHECK(result.err.find("move its step range to larger dt (fewer steps)") != std::string::npos);
+  CHECK(result.err.find("nonsep: warning: mpe 4: the energy error changes sign") != std::string::npos);
+  CHECK(result.err.find("triplet 4/3: the energy") == std::string::npos);
+  const json summary = read_json(folder / "out" / "summary.json");
+  CHECK(summary["fits"][0]["energy_error_excess_at_smallest_dt"].get<double>() > 10.0);
+  CHECK(summary["fits"][0]["energy_error_smallest"].get<double>() < 1e-11);
+  CHECK(std::abs(summary["fits"][1]["energy_error_excess_at_smallest_dt"].get<double>() - 1.0) < 0.2);
+
+  // --quiet keeps the warnings (on stderr) and drops the report.
+  const auto quiet = run_nonsep({"run", "--quiet", "--force", "--output", (folder / "out").string(), file.string()},
+                                folder.path());
+  CHECK(quiet.out.empty());
+  CHECK(quiet.err.find("nonsep: warning: mpe 4: the energy error reaches round-off") != std::string::npos);
 }

@@ -162,8 +162,13 @@ std::vector<fs::path> plugin_search_path() {
   }
   std::error_code error;
   const fs::path executable = boost::dll::program_location(error);
-  if (!error) add(executable.parent_path() / NONSEP_PLUGIN_DIR_FROM_EXECUTABLE);
-  add(NONSEP_BUILD_PLUGIN_DIR);
+  if (!error) {
+    const fs::path bin = executable.parent_path();
+    add(bin / NONSEP_PLUGIN_DIR_FROM_EXECUTABLE);
+    // Only in a build tree (build/bin/nonsep, build/CMakeCache.txt), never beside an installed bin/.
+    if (fs::is_regular_file(bin / NONSEP_BUILD_ROOT_FROM_EXECUTABLE / "CMakeCache.txt", error))
+      add(bin / NONSEP_BUILD_PLUGIN_DIR_FROM_EXECUTABLE);
+  }
   return directories;
 }
 

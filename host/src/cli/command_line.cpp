@@ -8,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/installation.hpp"
 
 #ifndef NONSEP_VERSION
 #error "NONSEP_VERSION must be defined by the build"
@@ -21,8 +22,8 @@ int run_command_line(int argc, char** argv) {
   try {
     CLI::App app{"nonsep " NONSEP_VERSION
                  ": explicit symplectic integrators for non-separable Hamiltonians H = T_i(p) V_ij(q) T_j(p)\n"
-                 "(S. A. Chin). Models are plugins; runs are described by JSON job files (README.md, section\n"
-                 "Running nonsep).",
+                 "(S. A. Chin). Models are plugins; runs are described by JSON job files. The manual (section\n"
+                 "Running nonsep): " + manual_location(),
                  "nonsep"};
     app.set_version_flag("--version", "nonsep " NONSEP_VERSION);
     app.require_subcommand(1);
@@ -31,8 +32,8 @@ int run_command_line(int argc, char** argv) {
                "tree's plugin folders.");
 
     RunArguments arguments;
-    std::string job_file, plugin_name;
-    bool as_json = false, check = false;
+    std::string job_file;
+    InspectArguments inspect_arguments;
 
     auto* run = app.add_subcommand("run",
                                    "Run a job: trajectory.csv (streamed), trajectories.csv and summary.json in the output folder; a "
@@ -59,22 +60,54 @@ int run_command_line(int argc, char** argv) {
     validate->footer(exit_status_text());
 
     auto* inspect = app.add_subcommand("inspect", "Show a plugin's metadata: parameters with defaults, ranges, units");
-    inspect->add_option("PLUGIN", plugin_name, "a plugin name (see `nonsep models`) or the path of a .so file")
+    inspect->add_option("PLUGIN", inspect_arguments.name,
+                        "a plugin name (see `nonsep models`) or the path of a .so file")
         ->required();
-    inspect->add_flag("--json", as_json, "print the raw metadata JSON");
-    inspect->add_flag("--check", check,
-                      "also compare the plugin's derivatives with finite differences (default parameters); exit 1 "
-                      "if they disagree");
+    inspect->add_flag("--json", inspect_arguments.as_json, "print the raw metadata JSON");
+    auto* check = inspect->add_flag("--check", inspect_arguments.check,
+                                    "also compare the plugin's derivatives with finite differences; exit 1 if they "
+                                    "disagree, 2 if nothing could be compared (dimension 0)");
+    inspect->add_option("--parameter", inspect_arguments.parameters,
+                        "name=value: a model parameter for --check (repeatable; default: the plugin's defaults)")
+        ->needs(check);
+    inspect->add_option("--job", inspect_arguments.parameters_job,
+                        "JOB.json: --check with the model parameters of this job (--parameter overrides them)")
+        ->needs(check);
+    inspect->add_option("--box", inspect_arguments.box,
+                        "LO,HI: --check at 16 random points in [LO, HI]^n, each as p and as q (default -1.5,1.5)")
+        ->needs(check);
+    inspect->add_option("--points-from", inspect_arguments.points_job,
+                        "JOB.json: --check at the job's initial states (p for T, q for V) instead of random points "
+                        "(as well, with --box)")
+        ->needs(check);
+    inspect->add_option("--tolerance", inspect_arguments.tolerance,
+                        "allowed error relative to max(1, |finite difference|) (default 1e-6)")
+        ->check(CLI::PositiveNumber)
+        ->needs(check);
     inspect->footer(exit_status_text());
 
     auto* models = app.add_subcommand("models", "List the plugins on the search path, one line each");
     models->footer(exit_status_text());
 
+    ExampleArguments example_arguments;
+    auto* example = app.add_subcommand(
+        "example", "Write a starting job file: the quickstart job, or the example NAME (see --list), to standard "
+                   "output or FILE; it passes `nonsep validate` as written");
+    example->add_option("NAME", example_arguments.name, "the example (default: quickstart)");
+    example->add_option("--output,-o", example_arguments.output, "the file to write (never overwritten)");
+    example->add_flag("--list", example_arguments.list, "list the examples, one line each")
+        ->excludes(example->get_option("NAME"))
+        ->excludes(example->get_option("--output"));
+    example->footer(exit_status_text());
+
     // CLI11 would call an unknown command a missing subcommand without naming it.
     const auto named = [&](const CLI::App* command) { return command->check_name(argv[1]); };
     if (argc > 1 && argv[1][0] != '-' && app.get_subcommands(named).empty()) {
-      std::cerr << "nonsep: unknown command '" << argv[1]
-                << "'; the commands are run, validate, inspect and models (see nonsep --help)\n";
+      std::string commands;
+      for (const CLI::App* command : app.get_subcommands({}))
+        commands += (commands.empty() ? "" : ", ") + command->get_name();
+      std::cerr << "nonsep: unknown command '" << argv[1] << "'; the commands are " << commands
+                << " (see nonsep --help)\n";
       return to_int(ExitStatus::invalid_input);
     }
     try {
@@ -85,8 +118,9 @@ int run_command_line(int argc, char** argv) {
     }
     if (run->parsed()) return command_run(arguments);
     if (validate->parsed()) return command_validate(job_file);
-    if (inspect->parsed()) return command_inspect(plugin_name, as_json, check);
+    if (inspect->parsed()) return command_inspect(inspect_arguments);
     if (models->parsed()) return command_models();
+    if (example->parsed()) return command_example(example_arguments);
     return to_int(ExitStatus::invalid_input);
   } catch (const std::exception& error) {
     std::cerr << "nonsep: unexpected error: " << error.what() << "\n";

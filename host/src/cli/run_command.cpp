@@ -5,9 +5,11 @@
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
 #include <cmath>
+#include <cstdio>
 #include <csignal>
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/output/files.hpp"
@@ -53,7 +55,53 @@ class InterruptGuard {
   struct sigaction previous_interrupt_ = {}, previous_terminate_ = {};
 };
 
-// The end of a study: one line per integrator with its fitted exponent, or what went wrong.
+// Below this |relative energy error| a study's errors are at the round-off of double precision (about 500 units
+// of 1.1e-16: H is a sum of products, and its error accumulates over the steps).
+constexpr double round_off_energy_error = 5e-14;
+// Round-off also shows as errors at the smallest dt this many times above the nominal power law through the
+// largest dt (the fit's energy_error_excess_at_smallest_dt), when they are small enough to be round-off at all.
+constexpr double flattened_excess = 10.0;
+constexpr double round_off_at_most = 1e-8;
+
+std::string four_digits(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%#.4g", x);
+  return text;
+}
+
+// What makes a study's fit unreliable, with what to do: an energy error that changes sign in the range, one that
+// reaches round-off or flattens at the smallest dt. One sentence each; none for a clean fit.
+std::vector<std::string> fit_warnings(const nlohmann::ordered_json& fit) {
+  std::vector<std::string> warnings;
+  const auto number = [&](const char* key) {
+    return fit.contains(key) && fit[key].is_number() ? std::optional<double>(fit[key].get<double>()) : std::nullopt;
+  };
+  const auto smallest = number("energy_error_smallest"), excess = number("energy_error_excess_at_smallest_dt"),
+             nominal = number("nominal_exponent"), dt_min = number("dt_min");
+  std::string round_off;
+  if (smallest && *smallest < round_off_energy_error)
+    round_off = "its smallest |dH/H0| is " + four_digits(*smallest) + ", at the round-off of double precision";
+  else if (excess && smallest && *excess > flattened_excess && *smallest < round_off_at_most)
+    round_off = "at the smallest dt it is " + four_digits(*excess) + " times what the nominal exponent " +
+                (nominal ? four_digits(*nominal) : std::string("?")) +
+                " predicts from the largest dt: the errors flatten, as round-off makes them";
+  const std::string label = fit["integrator"].get<std::string>();
+  if (!round_off.empty())
+    warnings.push_back(label + ": the energy error reaches round-off: " + round_off +
+                       (dt_min ? " (dt_min = " + four_digits(*dt_min) + ")" : std::string()) +
+                       "; move its step range to larger dt (fewer steps) so that every point is above it");
+  if (fit.value("energy_error_changes_sign", false))
+    warnings.push_back(label + ": the energy error changes sign within the fitted range, so the fit mixes a zero "
+                       "crossing into the power law; move its step range to where the error keeps one sign (" +
+                       (round_off.empty() ? std::string("smaller dt, more steps, when the larger dt are not yet "
+                                                        "asymptotic")
+                                          : std::string("larger dt, fewer steps, away from round-off")) +
+                       ")");
+  return warnings;
+}
+
+// The end of a study: one line per integrator with its fitted exponent, or what went wrong; then warnings about
+// fits that round-off or a sign change make unreliable (on stderr, also with --quiet).
 int report_study(const RunOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
   const auto& summary = outcome.summary;
   const auto& runs = summary["study"]["runs"];
@@ -67,9 +115,14 @@ int report_study(const RunOutcome& outcome, const std::filesystem::path& directo
     out << (outcome.exit_status == ExitStatus::success ? "" : "nonsep: ") << line << "\n";
     for (const auto& fit : summary["fits"])
       out << "  " << fit["integrator"].get<std::string>() << ": energy error exponent "
-          << (fit["exponent"].is_null() ? std::string("(no fit)") : format_number(fit["exponent"].get<double>()))
-          << " (nominal " << fit["order"].get<std::string>() << ")\n";
+          << (fit["exponent"].is_null() ? std::string("(no fit)") : four_digits(fit["exponent"].get<double>()))
+          << " (nominal " << fit["order"].get<std::string>() << " = "
+          << four_digits(fit["nominal_exponent"].get<double>()) << ")" << (fit_warnings(fit).empty() ? "" : " (see warning)")
+          << "\n";
   }
+  out.flush();
+  for (const auto& fit : summary["fits"])
+    for (const auto& warning : fit_warnings(fit)) std::cerr << "nonsep: warning: " << warning << "\n";
   if (summary.contains("error")) std::cerr << "nonsep: " << summary["error"].get<std::string>() << "\n";
   if (summary.contains("failures"))
     for (const auto& failure : summary["failures"])

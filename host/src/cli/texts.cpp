@@ -11,7 +11,8 @@ namespace nonsep::host::cli {
 std::string exit_status_text() {
   return "Exit status:\n"
          "  0    success\n"
-         "  1    the run started but failed: a trajectory diverged or the plugin failed mid-run (summary.json\n"
+         "  1    the run started but failed: a trajectory diverged, the plugin failed mid-run, or a trajectory\n"
+         "       was retired as inaccurate (its |dH/H0| passed analysis.max_relative_energy_error; summary.json\n"
          "       says which and where); an output could not be written; `inspect --check` found wrong derivatives\n"
          "  2    invalid input, nothing was run: usage, job file, parameters, a plugin that cannot be loaded,\n"
          "       an output folder that cannot be created\n"

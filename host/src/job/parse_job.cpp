@@ -3,6 +3,8 @@
 // dimension.
 #include "sections.hpp"
 
+#include "nonsep/host/installation.hpp"
+
 namespace nonsep::host {
 
 using namespace job_reader;
@@ -13,7 +15,8 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
   job.file = job_file;
   job.directory = job_file.parent_path().empty() ? std::filesystem::path(".") : job_file.parent_path();
   if (!check.object(document, "",
-                    "a JSON object with the keys model, integrator, initial, time (README.md, section Running nonsep)"))
+                    "a JSON object with the keys model, integrator, initial, time (" + manual_location() +
+                        ", section Running nonsep)"))
     return job;
   check.known_keys(document, "",
                    {"$schema", "description", "model", "hamiltonian", "integrator", "initial", "time", "output",

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "checker.hpp"
+#include "nonsep/host/installation.hpp"
 
 namespace nonsep::host {
 
@@ -42,7 +43,7 @@ class StrictDocumentBuilder : public nlohmann::json_sax<json> {
     std::string message = error.what();
     const auto bracket = message.find("] ");
     if (message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos) message = message.substr(bracket + 2);
-    issues_.push_back({"", "text that is not JSON (" + message + ")", "a JSON object as described in README.md"});
+    issues_.push_back({"", "text that is not JSON (" + message + ")", "a JSON object as described in " + manual_location() + ", section Running nonsep"});
     return false;
   }
 

@@ -6,7 +6,8 @@ namespace nonsep::host {
 enum class ExitStatus : int {
   success = 0,        // the command did what was asked (every trajectory completed, the job is valid, ...)
   run_failed = 1,     // a run started but did not complete: a trajectory diverged, the plugin failed mid-run,
-                      // an output could not be written; `inspect --check` found wrong derivatives
+                      // a trajectory was retired as inaccurate (analysis.max_relative_energy_error), an output
+                      // could not be written; `inspect --check` found wrong derivatives
   invalid_input = 2,  // nothing was run: bad usage, an invalid job file or parameters, a plugin that cannot load
   interrupted = 130,  // SIGINT: the current step was finished and the outputs written with status "interrupted"
   terminated = 143,   // SIGTERM: the same as SIGINT (128 + the signal number, as a shell reports it)

@@ -1,6 +1,8 @@
 #pragma once
 // What `nonsep inspect` and `nonsep models` print, and the derivative check of `nonsep inspect --check`.
+#include <cstddef>
 #include <string>
+#include <vector>
 
 #include "nonsep/host/plugin_loader.hpp"
 
@@ -15,18 +17,36 @@ std::string describe_plugin(const Plugin& plugin);
 std::string describe_discovered(const DiscoveredPlugin& discovered);
 
 // `nonsep inspect --check`: the SDK's derivative checker (nonsep/derivative_checker.hpp: 5-point finite
-// differences at seeded random points in [-1.5, 1.5]^n, tolerance 1e-6 relative) on a plugin instance, checking
-// grad T and grad V against value_T / value_V when the plugin has values, the Hessians against the gradients
-// when it has Hessians, and d3T, d3V against the Hessians when it has both; plus batch consistency: one call on
-// all points gives the same numbers, bit for bit, as one call per point (the runner relies on it to retire
-// states from an ensemble without changing the others); plus, for a plugin declaring "thread_safe": true, two
+// differences, tolerance relative to max(1, |finite difference|)) on a plugin instance, checking grad T and grad V
+// against value_T / value_V when the plugin has values, the Hessians against the gradients when it has Hessians,
+// and d3T, d3V against the Hessians when it has both; plus batch consistency: one call on all points gives the
+// same numbers, bit for bit, as one call per point (the runner relies on it to retire states from an ensemble
+// without changing the others; NaN in both agrees); plus, for a plugin declaring "thread_safe": true, two
 // instances used at once on two threads give the numbers of one instance on one thread (the runner gives each
 // worker thread its own instance; reported as skipped for "thread_safe": false).
-// Throws nonsep::ModelError when the plugin fails to evaluate at a sample point.
+//
+// Sample points: `random_points` seeded points in [box_low, box_high]^n, each used as p for the T functions and
+// as q for the V functions; then `p_points` for the T functions only and `q_points` for the V functions only (a
+// job's initial states, which lie in the model's domain where a box may not).
+struct DerivativeCheckSettings {
+  double box_low = -1.5, box_high = 1.5;
+  std::size_t random_points = 16;
+  std::vector<std::vector<double>> p_points, q_points;  // each of the model's dimension
+  double tolerance = 1e-6;
+};
+
+// Throws nonsep::ModelError when the plugin fails to evaluate at a sample point, std::bad_alloc when the check's
+// buffers do not fit in memory (they grow as n^2 per point, n^3 with third derivatives).
 struct DerivativeCheck {
   bool passed = true;
+  std::size_t comparisons = 0;  // derivative entries compared with finite differences; 0: nothing was checked
   std::string text;  // several lines, each ending in '\n'; the last says "passed" or "FAILED"
 };
-DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin);
+DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin,
+                                  const DerivativeCheckSettings& settings = {});
+
+// The number of bytes the check of a model of dimension n with these settings holds at its largest (an estimate
+// within a small factor, computed without overflow: saturates at the largest double).
+double derivative_check_bytes(std::size_t n, bool third_derivatives, const DerivativeCheckSettings& settings);
 
 }  // namespace nonsep::host

@@ -20,11 +20,14 @@
 // Every stencil of one check is one batched call, so a plugin is crossed once per function and sample point.
 //
 // Output: a DerivativeCheckReport. A comparison fails when |analytic - finite difference| >
-// options.tolerance * max(1, |finite difference|). Evaluation failures of the model propagate (ModelError).
+// options.tolerance * max(1, |finite difference|). A NaN derivative where the finite difference is NaN too (a
+// point outside the model's domain, such as log(q) at q < 0) agrees: it is counted in report.not_a_number, not
+// as a mismatch. Evaluation failures of the model propagate (ModelError).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <random>
 #include <span>
 #include <string>
@@ -42,6 +45,8 @@ struct DerivativeCheckOptions {
   bool check_gradients = true;              // grad T, grad V against differences of T, V (needs values)
   bool check_hessians = true;               // Hessians against differences of the gradients
   bool check_third_derivatives = true;      // d3T, d3V against differences of u^T H u (needs Hessians)
+  bool check_kinetic = true;                // the T functions, with each sample point as p
+  bool check_potential = true;              // the V functions, with each sample point as q
 };
 
 struct DerivativeMismatch {
@@ -55,25 +60,41 @@ struct DerivativeMismatch {
 struct DerivativeCheckReport {
   std::size_t comparisons = 0;
   double largest_error = 0.0;  // max |computed - finite difference| / max(1, |finite difference|)
+  std::size_t not_a_number = 0;  // comparisons (included in `comparisons`) where both were NaN: agreement
   std::vector<DerivativeMismatch> mismatches;
   std::vector<std::string> skipped;  // checks not made, with the reason
 
   bool passed() const { return mismatches.empty(); }
-  // Several lines: counts, the largest error, then up to `shown` mismatches and the skipped checks.
+  // Several lines: counts, the largest error, then up to `shown` mismatches and the skipped checks. Numbers in
+  // scientific notation: errors with 4 significant digits, points and values with 7.
   std::string summary(std::size_t shown = 10) const {
     std::string text = std::to_string(comparisons) + " derivative entries compared with finite differences, " +
                        std::to_string(mismatches.size()) + " mismatches; largest relative error " +
-                       std::to_string(largest_error) + "\n";
+                       scientific(largest_error, 3) + "\n";
+    if (not_a_number > 0)
+      text += "  " + std::to_string(not_a_number) +
+              " entries were NaN both computed and differenced (points outside the model's domain): agreement\n";
     for (std::size_t k = 0; k < std::min(shown, mismatches.size()); ++k) {
       const auto& m = mismatches[k];
       std::string point;
-      for (double x : m.point) point += (point.empty() ? "" : ", ") + std::to_string(x);
-      text += "  " + m.function + "[" + std::to_string(m.component) + "] at (" + point +
-              "): computed " + std::to_string(m.computed) + ", finite difference " +
-              std::to_string(m.finite_difference) + "\n";
+      for (double x : m.point) point += (point.empty() ? "" : ", ") + scientific(x, 6);
+      const bool kinetic = m.function.back() == 'T';
+      text += "  " + m.function + "[" + std::to_string(m.component) + "] at " + (kinetic ? "p" : "q") + " = (" +
+              point + "): computed " + scientific(m.computed, 6) + ", finite difference " +
+              scientific(m.finite_difference, 6) + ", relative error " +
+              scientific(std::abs(m.computed - m.finite_difference) / std::max(1.0, std::abs(m.finite_difference)), 3) +
+              "\n";
     }
+    if (mismatches.size() > shown) text += "  ... and " + std::to_string(mismatches.size() - shown) + " more\n";
     for (const auto& s : skipped) text += "  skipped: " + s + "\n";
     return text;
+  }
+
+  // "1.234e-07" for digits = 3 (digits after the point); "nan", "inf".
+  static std::string scientific(double x, int digits) {
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, "%.*e", digits, x);
+    return buffer;
   }
 };
 
@@ -131,8 +152,12 @@ inline double five_point(const double* f, std::size_t stride, double h) {
 
 inline void compare(DerivativeCheckReport& report, const DerivativeCheckOptions& options, const char* function,
                     const std::vector<double>& point, std::size_t component, double computed, double difference) {
-  const double error = std::abs(computed - difference) / std::max(1.0, std::abs(difference));
   ++report.comparisons;
+  if (std::isnan(computed) && std::isnan(difference)) {
+    ++report.not_a_number;
+    return;
+  }
+  const double error = std::abs(computed - difference) / std::max(1.0, std::abs(difference));
   report.largest_error = std::max(report.largest_error, std::isfinite(error) ? error : INFINITY);
   if (!(error <= options.tolerance))
     report.mismatches.push_back({function, point, component, computed, difference});
@@ -175,6 +200,7 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
     const std::vector<double> shifted = detail::stencil(x, options.step, steps);
     const std::size_t count = 4 * n;
     for (const bool kinetic : {true, false}) {
+      if (kinetic ? !options.check_kinetic : !options.check_potential) continue;
       if constexpr (has_values) {
         if (options.check_gradients) {
           stencil_values.resize(count);

@@ -5,8 +5,9 @@
 // Naming and search. A plugin file is `<name>.so`. `load_plugin(spec, base)` treats `spec` as a path when it
 // contains a '/' or ends in ".so" (relative paths resolve against `base`, the job file's folder); otherwise as a
 // name, looked up as `<dir>/<name>.so` in plugin_search_path(): the directories of NONSEP_PLUGIN_PATH (':'
-// separated), then the install's plugin directory (<prefix>/lib/nonsep/plugins, found relative to the running
-// executable), then the build tree's (build/plugins). A failure lists every place tried and the loader's text.
+// separated), then the install's plugin directory (<prefix>/lib/nonsep/plugins), then, for an executable of a
+// build tree, the build tree's (build/plugins); both are found relative to the running executable, so no path of
+// the building machine is compiled in. A failure lists every place tried and the loader's text.
 //
 // Lifetime. Plugin and PluginModel share ownership of the loaded library (boost::dll::shared_library, loaded with
 // RTLD_NOW so unresolved symbols fail at load time); the library stays loaded while any of them is alive.
