@@ -70,11 +70,20 @@ int run_command_line(int argc, char** argv) {
     auto* models = app.add_subcommand("models", "List the plugins on the search path, one line each");
     models->footer(exit_status_text());
 
+    auto* schema = app.add_subcommand(
+        "schema", "Print the JSON Schema of job files (schemas/job.schema.json), generated from the job reader's "
+                  "tables and the scheme catalogue");
+    schema->footer(exit_status_text());
+
     // CLI11 would call an unknown command a missing subcommand without naming it.
     const auto named = [&](const CLI::App* command) { return command->check_name(argv[1]); };
     if (argc > 1 && argv[1][0] != '-' && app.get_subcommands(named).empty()) {
-      std::cerr << "nonsep: unknown command '" << argv[1]
-                << "'; the commands are run, validate, inspect and models (see nonsep --help)\n";
+      const auto commands = app.get_subcommands([](const CLI::App*) { return true; });
+      std::string names;
+      for (std::size_t i = 0; i < commands.size(); ++i)
+        names += (i == 0 ? "" : i + 1 == commands.size() ? " and " : ", ") + commands[i]->get_name();
+      std::cerr << "nonsep: unknown command '" << argv[1] << "'; the commands are " << names
+                << " (see nonsep --help)\n";
       return to_int(ExitStatus::invalid_input);
     }
     try {
@@ -87,6 +96,7 @@ int run_command_line(int argc, char** argv) {
     if (validate->parsed()) return command_validate(job_file);
     if (inspect->parsed()) return command_inspect(plugin_name, as_json, check);
     if (models->parsed()) return command_models();
+    if (schema->parsed()) return command_schema();
     return to_int(ExitStatus::invalid_input);
   } catch (const std::exception& error) {
     std::cerr << "nonsep: unexpected error: " << error.what() << "\n";

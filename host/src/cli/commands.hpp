@@ -18,6 +18,7 @@ int command_run(const RunArguments& arguments);
 int command_validate(const std::string& job_file);
 int command_inspect(const std::string& name, bool as_json, bool check);
 int command_models();
+int command_schema();
 
 // Texts of --help, generated from the scheme catalogue and the exit statuses.
 std::string exit_status_text();

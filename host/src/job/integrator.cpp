@@ -90,8 +90,8 @@ std::vector<ParameterDescription> options_of(const Scheme* scheme) {
 
 HamiltonianForm read_hamiltonian(Checker& check, const json& document) {
   if (const json* form = check.member(document, "", "hamiltonian", false, "")) {
-    if (*form == "TTV") return HamiltonianForm::TTV;
-    if (*form == "VVT") return HamiltonianForm::VVT;
+    for (const auto& [name, value] : hamiltonian_forms())
+      if (*form == name) return value;
     check.issue("/hamiltonian", describe(*form),
                 "\"TTV\" (H = T_i V_ij T_j, the default) or \"VVT\" (H = V_i T_ij V_j)");
   }

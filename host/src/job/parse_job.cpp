@@ -15,9 +15,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
   if (!check.object(document, "",
                     "a JSON object with the keys model, integrator, initial, time (README.md, section Running nonsep)"))
     return job;
-  check.known_keys(document, "",
-                   {"$schema", "description", "model", "hamiltonian", "integrator", "initial", "time", "output",
-                    "analysis", "study", "checkpoint"});
+  check.known_keys(document, "", document_keys().names());
   if (const json* value = check.member(document, "", "$schema", false, ""))
     check.string(*value, "/$schema", "a string (the JSON Schema the file follows; ignored by nonsep)");
   if (const json* value = check.member(document, "", "description", false, ""))

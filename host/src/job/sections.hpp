@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "checker.hpp"
+#include "job_keys.hpp"
 
 namespace nonsep::host::job_reader {
 
