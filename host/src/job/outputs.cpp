@@ -1,7 +1,5 @@
 // /output (where results go and how often), /analysis (per-trajectory analyses of a run) and /checkpoint (when a
 // run saves checkpoint.json).
-#include <limits>
-
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
