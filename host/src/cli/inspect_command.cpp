@@ -1,12 +1,12 @@
+// `nonsep inspect PLUGIN [--json] [--check]`: a plugin's metadata, and with --check its derivatives against finite
+// differences.
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "cli/commands.hpp"
-#include "nonsep/host/exit_status.hpp"
-#include "nonsep/host/number_format.hpp"
-#include <optional>
-
 #include "nonsep/core/error.hpp"
+#include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/plugin_report.hpp"
 
@@ -39,17 +39,6 @@ int command_inspect(const std::string& name, bool as_json, bool check) {
     std::cerr << "nonsep: derivative check failed: the plugin could not evaluate: " << error.what() << "\n";
     return to_int(ExitStatus::run_failed);
   }
-}
-
-int command_models() {
-  const auto discovered = discover_plugins();
-  for (const auto& entry : discovered) std::cout << describe_discovered(entry) << "\n";
-  if (discovered.empty()) {
-    std::cerr << "nonsep: no plugins found; searched:";
-    for (const auto& directory : plugin_search_path()) std::cerr << " " << directory.string();
-    std::cerr << "\n";
-  }
-  return to_int(ExitStatus::success);
 }
 
 }  // namespace nonsep::host::cli

@@ -54,28 +54,29 @@ class InterruptGuard {
 };
 
 // The end of a study: one line per integrator with its fitted exponent, or what went wrong.
-int report_study(const RunOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
-  const auto& summary = outcome.summary;
-  const auto& runs = summary["study"]["runs"];
-  std::string line = summary["status"].get<std::string>() + ": study of " + std::to_string(summary["fits"].size()) +
-                     " integrators, " + std::to_string(runs["completed"].get<std::size_t>()) + " runs completed";
-  for (const char* other : {"diverged", "failed", "interrupted"})
-    if (runs[other].get<std::size_t>() > 0) line += ", " + std::to_string(runs[other].get<std::size_t>()) + " " + other;
+int report_study(const StudyOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
+  const StatusCounts& runs = outcome.run_counts;
+  std::string line = std::string(to_string(outcome.status)) + ": study of " + std::to_string(outcome.fits.size()) +
+                     " integrators, " + std::to_string(runs.completed) + " runs completed";
+  const std::pair<const char*, std::size_t> others[] = {
+      {"diverged", runs.diverged}, {"failed", runs.failed}, {"interrupted", runs.interrupted}};
+  for (const auto& [other, count] : others)
+    if (count > 0) line += ", " + std::to_string(count) + " " + other;
   line += "; results in " + directory.string();
   std::ostream& out = outcome.exit_status == ExitStatus::success ? std::cout : std::cerr;
   if (outcome.exit_status != ExitStatus::success || !quiet) {
     out << (outcome.exit_status == ExitStatus::success ? "" : "nonsep: ") << line << "\n";
-    for (const auto& fit : summary["fits"])
-      out << "  " << fit["integrator"].get<std::string>() << ": energy error exponent "
-          << (fit["exponent"].is_null() ? std::string("(no fit)") : format_number(fit["exponent"].get<double>()))
-          << " (nominal " << fit["order"].get<std::string>() << ")\n";
+    for (const auto& fit : outcome.fits)
+      out << "  " << fit.integrator << ": energy error exponent "
+          << (fit.exponent ? format_number(*fit.exponent) : std::string("(no fit)"))
+          << " (nominal " << fit.description.order.to_string() << ")\n";
   }
-  if (summary.contains("error")) std::cerr << "nonsep: " << summary["error"].get<std::string>() << "\n";
-  if (summary.contains("failures"))
-    for (const auto& failure : summary["failures"])
-      std::cerr << "nonsep: " << failure["integrator"].get<std::string>() << " with " << failure["steps"]
-                << " steps " << failure["status"].get<std::string>() << ": " << failure["error"].get<std::string>()
-                << "\n";
+  if (!outcome.error.empty()) std::cerr << "nonsep: " << outcome.error << "\n";
+  for (std::size_t i = 0; i < outcome.fits.size(); ++i)
+    for (const StudyRun& run : outcome.runs[i])
+      if (run.status == TrajectoryStatus::diverged || run.status == TrajectoryStatus::failed)
+        std::cerr << "nonsep: " << outcome.fits[i].integrator << " with " << run.steps << " steps "
+                  << to_string(run.status) << ": " << run.error << "\n";
   return to_int(outcome.exit_status);
 }
 
@@ -121,6 +122,27 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
               << " (trajectory " << largest->trajectory << "), above " << format_number(warn_relative_energy_error)
               << ": the results are not accurate; use a smaller dt or a higher order "
                  "(analysis.max_relative_energy_error stops trajectories past a bound)\n";
+}
+
+// Runs `run` (run_job or run_study) with SIGINT and SIGTERM caught. Nothing, after saying why on stderr, when it
+// could not start (the output folder, a checkpoint to resume from); an interrupted outcome becomes "terminated"
+// after SIGTERM.
+template <class Run>
+auto run_guarded(Run run) -> std::optional<decltype(run())> {
+  InterruptGuard guard;
+  try {
+    auto outcome = run();
+    if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() == SIGTERM)
+      outcome.exit_status = ExitStatus::terminated;
+    return outcome;
+  } catch (const OutputError& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+  } catch (const FolderInUse& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+  } catch (const CheckpointError& error) {
+    std::cerr << "nonsep: cannot resume: " << error.what() << "\n";
+  }
+  return std::nullopt;
 }
 
 int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& arguments,
@@ -173,26 +195,14 @@ int command_run(const RunArguments& arguments) {
   options.threads = arguments.threads;
   stop_requested.store(false);
   stop_signal.store(0);
-  RunOutcome outcome;
-  {
-    InterruptGuard guard;
-    try {
-      outcome = loaded->job.study ? run_study(*loaded, options) : run_job(*loaded, options);
-    } catch (const OutputError& error) {
-      std::cerr << "nonsep: " << error.what() << "\n";
-      return to_int(ExitStatus::invalid_input);
-    } catch (const FolderInUse& error) {
-      std::cerr << "nonsep: " << error.what() << "\n";
-      return to_int(ExitStatus::invalid_input);
-    } catch (const CheckpointError& error) {
-      std::cerr << "nonsep: cannot resume: " << error.what() << "\n";
-      return to_int(ExitStatus::invalid_input);
-    }
+  if (loaded->job.study) {
+    auto outcome = run_guarded([&] { return run_study(*loaded, options); });
+    return outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
+                   : to_int(ExitStatus::invalid_input);
   }
-  if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() == SIGTERM)
-    outcome.exit_status = ExitStatus::terminated;
-  if (loaded->job.study) return report_study(outcome, options.output_directory, arguments.quiet);
-  return report_run(outcome, loaded->job, arguments, options.output_directory, stop_signal.load());
+  auto outcome = run_guarded([&] { return run_job(*loaded, options); });
+  return outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
+                 : to_int(ExitStatus::invalid_input);
 }
 
 }  // namespace nonsep::host::cli
