@@ -31,7 +31,7 @@ json optional_number(std::optional<double> value) {
 class StudyExecution {
  public:
   StudyExecution(const LoadedJob& loaded, const RunOptions& options)
-      : loaded_(loaded), job_(loaded.job), study_(*loaded.job.study), options_(options),
+      : loaded_(loaded), job_(loaded.job), study_(loaded.job.study()), options_(options),
         folder_(options.output_directory, "study", loaded.job.file, folder_use(options)),
         energy_available_(loaded.plugin.has_hessians()),
         csv_(options.output_directory / "convergence.csv",
@@ -86,7 +86,7 @@ class StudyExecution {
   StudyRun run_one(const StudyIntegrator& study_integrator, std::uint64_t steps) {
     StudyRun run;
     run.steps = steps;
-    const TimeGrid time = TimeGrid::to_end(job_.time.t_end, job_.time.t_end / static_cast<double>(steps), steps);
+    const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
     run.dt = time.dt;
     run.basic_steps = steps * Integrator(study_integrator.spec).describe().basic_steps_per_step;
     EnsembleDriver driver(loaded_.plugin, loaded_.model,
@@ -157,9 +157,9 @@ class StudyExecution {
                         {"path", loaded_.plugin.path().string()},
                         {"dimension", job_.initial.dimension},
                         {"parameters", json(loaded_.model.parameters())}};
-    summary["hamiltonian"] = job_.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
+    summary["hamiltonian"] = study_.form == HamiltonianForm::TTV ? "TTV" : "VVT";
     json study;
-    study["t_end"] = job_.time.t_end;
+    study["t_end"] = study_.t_end;
     study["initial"] = {{"q", job_.initial.q}, {"p", job_.initial.p}};
     study["reference"] = study_.reference_q.empty()
                              ? json(nullptr)

@@ -101,10 +101,10 @@ TEST_CASE("the schema's defaults are what the reader fills in, and its required 
   const Job job = parse_job(host_testing::quickstart_job(), "/jobs/test.json", issues);
   REQUIRE(issues.empty());
   const json& properties = schema["properties"];
-  CHECK(properties["output"]["properties"]["every"]["default"] == job.every);
-  CHECK(properties["output"]["properties"]["energy_every"]["default"] == job.energy_every);
-  CHECK(properties["checkpoint"]["properties"]["every_steps"]["default"] == job.checkpoint.every_steps);
-  CHECK(properties["checkpoint"]["properties"]["every_seconds"]["default"] == job.checkpoint.every_seconds);
+  CHECK(properties["output"]["properties"]["every"]["default"] == job.run().every);
+  CHECK(properties["output"]["properties"]["energy_every"]["default"] == job.run().energy_every);
+  CHECK(properties["checkpoint"]["properties"]["every_steps"]["default"] == job.run().checkpoint.every_steps);
+  CHECK(properties["checkpoint"]["properties"]["every_seconds"]["default"] == job.run().checkpoint.every_seconds);
   CHECK(properties["hamiltonian"]["default"] == "TTV");
   CHECK(properties["hamiltonian"]["enum"] == json{"TTV", "VVT"});
   for (const std::string form : {"TTV", "VVT"}) {

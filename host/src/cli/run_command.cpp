@@ -150,7 +150,7 @@ int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& ar
   const std::size_t trajectories = outcome.trajectories.size();
   std::string line = std::string(to_string(outcome.status)) + ": " + std::to_string(trajectories) +
                      (trajectories == 1 ? " trajectory (" : " trajectories (") + counts_text(outcome.counts) + "), " +
-                     time_text(job.time);
+                     time_text(job.run().time);
   if (const auto& largest = outcome.largest_energy_error)
     line += "; largest |dH/H0| " + format_number(largest->value) + " (trajectory " +
             std::to_string(largest->trajectory) + ")";
@@ -180,7 +180,7 @@ int command_run(const RunArguments& arguments) {
   } catch (const InvalidJob& error) {
     return report_invalid_job(error);
   }
-  if (arguments.resume && loaded->job.study) {
+  if (arguments.resume && loaded->job.is_study()) {
     std::cerr << "nonsep: cannot resume: " << arguments.job_file
               << " is a convergence study (/study), which is not resumed; run it again without --resume\n";
     return to_int(ExitStatus::invalid_input);
@@ -195,7 +195,7 @@ int command_run(const RunArguments& arguments) {
   options.threads = arguments.threads;
   stop_requested.store(false);
   stop_signal.store(0);
-  if (loaded->job.study) {
+  if (loaded->job.is_study()) {
     auto outcome = run_guarded([&] { return run_study(*loaded, options); });
     return outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
                    : to_int(ExitStatus::invalid_input);

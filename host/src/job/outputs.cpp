@@ -5,6 +5,8 @@
 namespace nonsep::host::job_reader {
 
 void read_output(Checker& check, const json& document, Job& job) {
+  SingleRun study_strides;  // a study's /output/every and /output/energy_every are checked but not used
+  SingleRun& run = job.is_study() ? study_strides : std::get<SingleRun>(job.plan);
   std::filesystem::path output = job.file.stem().string() + ".out";
   if (const json* section = check.member(document, "", "output", false, "");
       section && check.object(*section, "/output", "an object {\"directory\": ..., \"every\": ...}")) {
@@ -17,13 +19,13 @@ void read_output(Checker& check, const json& document, Job& job) {
     if (const json* every = check.member(*section, "/output", "every", false, ""))
       if (auto stride = check.integer(*every, "/output/every", keys["every"].minimum, keys["every"].maximum,
                                       "an integer >= 0: write every n-th step to trajectory.csv (0: no trajectory)"))
-        job.every = static_cast<std::uint64_t>(*stride);
+        run.every = static_cast<std::uint64_t>(*stride);
     if (const json* energy_every = check.member(*section, "/output", "energy_every", false, ""))
       if (auto stride = check.integer(*energy_every, "/output/energy_every", keys["energy_every"].minimum,
                                       keys["energy_every"].maximum,
                                       "an integer >= 0: also evaluate H every n-th step (0: only at the written "
                                       "samples, the start and the end)"))
-        job.energy_every = static_cast<std::uint64_t>(*stride);
+        run.energy_every = static_cast<std::uint64_t>(*stride);
   }
   job.output_directory = output.is_absolute() ? output : job.directory / output;
 }

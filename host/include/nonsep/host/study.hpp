@@ -83,7 +83,7 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
 // fit as summary.json's "fits" entry.
 nlohmann::ordered_json to_json(const StudyFit& fit);
 
-// Runs the study of `job` (job.job.study must be set). Throws OutputError, before anything is computed, when the
+// Runs the study of `job` (job.job.is_study() must hold). Throws OutputError, before anything is computed, when the
 // output folder or convergence.csv cannot be created. A run that diverges or that the plugin fails on is a row
 // with that status, left out of the fits, and makes the exit status run_failed; SIGINT (options.stop_requested)
 // stops after the current step with status "interrupted". summary.json is written in every case.
