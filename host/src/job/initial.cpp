@@ -45,11 +45,11 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
   check.known_keys(value, path, keys.names());
   std::optional<double> from, to;
   std::optional<std::int64_t> count;
-  if (const json* v = check.member(value, path, "from", true, "the first value, a finite number"))
+  if (const json* v = check.member(value, path, "from", keys["from"].required, "the first value, a finite number"))
     from = check.finite_number(*v, child(path, "from"), "the first value, a finite number");
-  if (const json* v = check.member(value, path, "to", true, "the last value, a finite number"))
+  if (const json* v = check.member(value, path, "to", keys["to"].required, "the last value, a finite number"))
     to = check.finite_number(*v, child(path, "to"), "the last value, a finite number");
-  if (const json* v = check.member(value, path, "count", true, "the number of values, an integer >= 1"))
+  if (const json* v = check.member(value, path, "count", keys["count"].required, "the number of values, an integer >= 1"))
     count = check.integer(*v, child(path, "count"), keys["count"].minimum, keys["count"].maximum,
                           "the number of values, an integer from " + std::to_string(keys["count"].minimum) +
                               " to " + std::to_string(keys["count"].maximum));
@@ -92,7 +92,7 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
   bool ok = true;
   for (int which = 0; which < 2; ++which) {
     const std::string name = which == 0 ? "q" : "p";
-    const json* list = check.member(grid, path, name, true, "an array of axes, one per component");
+    const json* list = check.member(grid, path, name, grid_keys()[name].required, "an array of axes, one per component");
     if (!list) {
       ok = false;
       continue;
@@ -138,9 +138,10 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
                 const std::string& first_path) {
   if (!check.object(value, path, "a state {\"q\": [...], \"p\": [...]}")) return;
-  check.known_keys(value, path, state_keys().names());
-  const json* q_value = check.member(value, path, "q", true, "the positions, an array of finite numbers");
-  const json* p_value = check.member(value, path, "p", true, "the momenta, an array of finite numbers");
+  const KeyTable& keys = state_keys();
+  check.known_keys(value, path, keys.names());
+  const json* q_value = check.member(value, path, "q", keys["q"].required, "the positions, an array of finite numbers");
+  const json* p_value = check.member(value, path, "p", keys["p"].required, "the momenta, an array of finite numbers");
   // Sizes first, so that an array over the limit is not copied.
   const std::size_t q_size = q_value && q_value->is_array() ? q_value->size() : 0;
   if (q_size > max_initial_values) {
@@ -177,7 +178,7 @@ InitialStates read_initial(Checker& check, const json& document) {
   InitialStates states;
   const std::string what =
       "one state {\"q\": [...], \"p\": [...]}, an array of such states, or {\"grid\": {\"q\": [axes], \"p\": [axes]}}";
-  const json* initial = check.member(document, "", "initial", true, what);
+  const json* initial = check.member(document, "", "initial", document_keys()["initial"].required, what);
   if (!initial) return states;
   if (initial->is_array()) {
     states.shape = "list";

@@ -11,7 +11,7 @@ namespace nonsep::host::job_reader {
 
 void read_model(Checker& check, const json& document, Job& job) {
   const std::string what = "an object {\"plugin\": name or path, \"parameters\": {...}}";
-  const json* model = check.member(document, "", "model", true, what);
+  const json* model = check.member(document, "", "model", document_keys()["model"].required, what);
   if (!model || !check.object(*model, "/model", what)) return;
   const KeyTable& keys = model_keys();
   check.known_keys(*model, "/model", keys.names());

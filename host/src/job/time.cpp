@@ -19,7 +19,7 @@ std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt,
 TimeGrid read_time(Checker& check, const json& document) {
   TimeGrid grid;
   const std::string what = "an object with \"dt\" and either \"t_end\" or \"steps\"";
-  const json* time = check.member(document, "", "time", true, what);
+  const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
   if (!time || !check.object(*time, "/time", what)) return grid;
   const KeyTable& keys = run_time_keys();
   check.known_keys(*time, "/time", keys.names());
@@ -72,7 +72,7 @@ TimeGrid read_time(Checker& check, const json& document) {
 TimeGrid read_study_time(Checker& check, const json& document) {
   TimeGrid grid;
   const std::string what = "an object {\"t_end\": T}: a study runs every integrator to T with its own step counts";
-  const json* time = check.member(document, "", "time", true, what);
+  const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
   if (!time || !check.object(*time, "/time", what)) return grid;
   const KeyTable& keys = study_time_keys();
   check.known_keys(*time, "/time", keys.names());
