@@ -45,7 +45,8 @@ const KeyTable& document_keys() {
        .description = "TTV: H = T_i(p) V_ij(q) T_j(p); VVT: H = V_i(q) T_ij(p) V_j(q)."},
       {.name = "integrator", .type = ValueType::defined,
        .description = "The scheme and its options (a run; required there, refused in a study).",
-       .definition = "integrator", .run_only = true},
+       .definition = "integrator", .run_only = true, .in_study_found = "an integrator together with /study",
+       .in_study_allowed = "no /integrator in a study: each entry of /study/integrators is one"},
       {.name = "initial", .type = ValueType::defined, .required = true,
        .description = "One state, a non-empty array of states (an ensemble), or a grid of states; a study has one "
                       "state.",
@@ -55,7 +56,8 @@ const KeyTable& document_keys() {
       {.name = "output", .type = ValueType::object, .description = "Where results go.", .keys = output_keys},
       {.name = "analysis", .type = ValueType::object,
        .description = "Per-trajectory analysis of a run (not of a study).", .keys = analysis_keys,
-       .run_only = true},
+       .run_only = true, .in_study_found = "an analysis together with /study",
+       .in_study_allowed = "/analysis in single runs only"},
       {.name = "study", .type = ValueType::object,
        .description = "A convergence study: each integrator runs from the one initial state to time.t_end at each of "
                       "its step counts; outputs convergence.csv and the fitted exponents in summary.json. Step "
@@ -64,7 +66,8 @@ const KeyTable& document_keys() {
       {.name = "checkpoint", .type = ValueType::object,
        .description = "When checkpoint.json is saved in the output folder, for `nonsep run JOB --resume`. Always "
                       "saved when a run is interrupted. Runs only: a study is not resumed.",
-       .keys = checkpoint_keys, .run_only = true},
+       .keys = checkpoint_keys, .run_only = true, .in_study_found = "a checkpoint policy together with /study",
+       .in_study_allowed = "/checkpoint in single runs only (a study is not resumed)"},
   }};
   return table;
 }

@@ -40,7 +40,9 @@ struct KeyRule {
   std::string description = {};  // for the schema
   const KeyTable& (*keys)() = nullptr;      // ValueType::object
   std::string definition = {};   // ValueType::defined
-  bool run_only = false;                    // refused in a study (document keys)
+  // A document key refused in a study: what the issue says was found and what is allowed instead.
+  bool run_only = false;
+  std::string in_study_found = {}, in_study_allowed = {};
 };
 
 // The keys of one kind of object, in the order messages list them ("only the keys ...").

@@ -25,14 +25,9 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
   const HamiltonianForm form = read_hamiltonian(check, document);
   job.initial = read_initial(check, document);
   if (const json* study_value = check.member(document, "", "study", false, "")) {
-    if (document.contains("integrator"))
-      check.issue("/integrator", "an integrator together with /study",
-                  "no /integrator in a study: each entry of /study/integrators is one");
-    if (document.contains("analysis"))
-      check.issue("/analysis", "an analysis together with /study", "/analysis in single runs only");
-    if (document.contains("checkpoint"))
-      check.issue("/checkpoint", "a checkpoint policy together with /study",
-                  "/checkpoint in single runs only (a study is not resumed)");
+    for (const KeyRule& rule : document_keys().rules)
+      if (rule.run_only && document.contains(rule.name))
+        check.issue(child("", rule.name), rule.in_study_found, rule.in_study_allowed);
     const double t_end = read_study_time(check, document).t_end;
     Study& study = job.plan.emplace<Study>(read_study(check, *study_value, form, t_end));
     study.form = form;
