@@ -1,9 +1,11 @@
 #pragma once
 // Internal to the job reader (host/src/job/): the keys of every object of a job file, with their types, integer
-// ranges, defaults and whether they are required. The section readers take their known-key lists, required flags
-// and integer ranges from these tables, and `nonsep schema` (job_schema.cpp) writes schemas/job.schema.json from
-// the same tables and the scheme catalogue, so the schema cannot drift from the reader. Messages (what is
-// allowed) stay with the readers.
+// ranges, defaults and whether they are required. The section readers take their known-key lists, required flags,
+// integer ranges and the keys a study refuses from these tables, and `nonsep schema` (job_schema.cpp) writes
+// schemas/job.schema.json from the same tables and the scheme catalogue, so the schema cannot drift from the
+// reader. The types of numbers are checked by the readers' own calls (each with its own message);
+// tests/host/test_host_job_schema.cpp holds the readers to the types written here. Other messages stay with the
+// readers.
 #include <cstdint>
 #include <string>
 #include <string_view>
