@@ -109,9 +109,9 @@ double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vect
 // trajectory, else all of them through both loops over states (the faster one's time). dt and t2 are taken from the loaded job, not from
 // constants, so that cbrt runs at run time as in the host (a compile-time cbrt may round differently).
 double time_hand_written(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
-  const bench::HandWrittenStep c(job.job.time.dt, job.job.integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
   std::vector<double> q(job.job.initial.q), p(job.job.initial.p), g(q.size());
-  const std::uint64_t steps = job.job.time.steps;
+  const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
   if (q.size() == 1) bench::hand_written_run(c, q[0], p[0], steps);
   else bench::hand_written_run(c, q.data(), p.data(), g.data(), q.size(), steps);
@@ -133,9 +133,9 @@ double time_core(const nonsep::host::LoadedJob& job, std::vector<double>& final_
   nonsep::PhaseSpaceBatch x(1, job.job.initial.count);
   std::copy(job.job.initial.q.begin(), job.job.initial.q.end(), x.q().begin());
   std::copy(job.job.initial.p.begin(), job.job.initial.p.end(), x.p().begin());
-  nonsep::ChinBasicStep stepper(job.job.integrator.form, job.job.integrator.t2);
-  const double step_size = job.job.time.dt;
-  const std::uint64_t steps = job.job.time.steps;
+  nonsep::ChinBasicStep stepper(job.job.run().integrator.form, job.job.run().integrator.t2);
+  const double step_size = job.job.run().time.dt;
+  const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
   for (std::uint64_t k = 0; k < steps; ++k) stepper.step(model, x, step_size);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
@@ -146,11 +146,11 @@ double time_core(const nonsep::host::LoadedJob& job, std::vector<double>& final_
 // Seconds for the hand-written loop cut as the host cuts an ensemble: blocks of nonsep::host::run_block_size
 // states, each stepped to the end on its own, the blocks shared by `threads` std::threads (contiguous parts).
 double time_hand_written_blocks(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
-  const bench::HandWrittenStep c(job.job.time.dt, job.job.integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
   std::vector<double> q(job.job.initial.q), p(job.job.initial.p), g(q.size());
   const std::size_t count = q.size(), block = nonsep::host::run_block_size;
   const std::size_t blocks = (count + block - 1) / block;
-  const std::uint64_t steps = job.job.time.steps;
+  const std::uint64_t steps = job.job.run().time.steps;
   const auto run = [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       const std::size_t first = b * block, size = std::min(block, count - first);

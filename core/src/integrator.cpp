@@ -8,20 +8,16 @@ std::string known_schemes() {
   for (const auto& scheme : scheme_catalogue()) list += (list.empty() ? "" : ", ") + scheme.name;
   return list;
 }
+
+SchemeStepper build(const IntegratorSpec& spec) {
+  ChinBasicStep base(spec.form, spec.t2);
+  const Scheme* scheme = find_scheme(spec.scheme);
+  if (!scheme)
+    throw InvalidArgument("unknown integrator scheme '" + spec.scheme + "'; the schemes are " + known_schemes());
+  return scheme->make(std::move(base), chin_order_index(spec.order, scheme->highest_order_index, scheme->name));
+}
 }  // namespace
 
-Integrator::Integrator(const IntegratorSpec& spec)
-    : spec_(spec), form_(spec.form), stepper_(ChinBasicStep(spec.form, spec.t2)) {
-  ChinBasicStep base(spec.form, spec.t2);
-  if (spec.scheme == "basic") {
-    chin_order_index(spec.order, 1, "basic");
-  } else if (spec.scheme == "triplet") {
-    stepper_ = TripletComposition<>::for_order(base, spec.order);
-  } else if (spec.scheme == "mpe") {
-    stepper_ = MultiProductExpansion<>::for_order(base, spec.order);
-  } else {
-    throw InvalidArgument("unknown integrator scheme '" + spec.scheme + "'; the schemes are " + known_schemes());
-  }
-}
+Integrator::Integrator(const IntegratorSpec& spec) : spec_(spec), form_(spec.form), stepper_(build(spec)) {}
 
 }  // namespace nonsep

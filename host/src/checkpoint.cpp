@@ -108,22 +108,23 @@ constexpr const char* fingerprint_parts[] = {"plugin", "parameters", "integrator
 
 std::string job_fingerprint(const LoadedJob& loaded) {
   const Job& job = loaded.job;
+  const SingleRun& run = job.run();
   std::string parts[7];
   parts[0] = loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + content_hash_hex(file_hash(loaded.plugin.path()));
   parts[1] = loaded.model.parameters().dump();
-  parts[2] = job.integrator.scheme + '\n' + job.integrator.order.to_string() + '\n';
-  append_bits(parts[2], job.integrator.t2);
-  parts[2] += job.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
+  parts[2] = run.integrator.scheme + '\n' + run.integrator.order.to_string() + '\n';
+  append_bits(parts[2], run.integrator.t2);
+  parts[2] += run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
   parts[3] = std::to_string(job.initial.dimension) + ' ' + std::to_string(job.initial.count) + '\n';
   for (double x : job.initial.q) append_bits(parts[3], x);
   for (double x : job.initial.p) append_bits(parts[3], x);
-  append_bits(parts[4], job.time.dt);
-  append_bits(parts[4], job.time.t_end);
-  parts[4] += std::to_string(job.time.steps);
-  parts[5] = std::to_string(job.every) + ' ' + std::to_string(job.energy_every);
-  if (job.analysis.closest_return_after) append_bits(parts[6], *job.analysis.closest_return_after);
+  append_bits(parts[4], run.time.dt);
+  append_bits(parts[4], run.time.t_end);
+  parts[4] += std::to_string(run.time.steps);
+  parts[5] = std::to_string(run.every) + ' ' + std::to_string(run.energy_every);
+  if (run.analysis.closest_return_after) append_bits(parts[6], *run.analysis.closest_return_after);
   parts[6] += '|';
-  if (job.analysis.max_relative_energy_error) append_bits(parts[6], *job.analysis.max_relative_energy_error);
+  if (run.analysis.max_relative_energy_error) append_bits(parts[6], *run.analysis.max_relative_energy_error);
   std::string fingerprint;
   for (std::size_t i = 0; i < 7; ++i)
     fingerprint += (i ? " " : "") + std::string(fingerprint_parts[i]) + ":" + content_hash_hex(content_hash(parts[i]));
@@ -201,7 +202,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;
   state.step = read.unsigned_integer(read.member(document, "step"), "step");
-  if (state.step > job.time.steps) damaged(path, "its step is beyond the job's last step");
+  if (state.step > job.run().time.steps) damaged(path, "its step is beyond the job's last step");
   const json& evaluations = read.member(document, "evaluations");
   state.evaluations.grad_T = read.unsigned_integer(read.member(evaluations, "grad_T"), "evaluations");
   state.evaluations.grad_V = read.unsigned_integer(read.member(evaluations, "grad_V"), "evaluations");

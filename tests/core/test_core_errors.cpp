@@ -1,6 +1,7 @@
 // Bad parameters are rejected with messages that name the problem and what is allowed.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -115,7 +116,28 @@ TEST_CASE("integrators describe themselves") {
     CHECK(std::stod(scheme.parameters[1].default_text) == ChinCoefficients::default_t2());
   }
   CHECK_FALSE(find_scheme("mpe")->symplectic);
-  CHECK_FALSE(find_scheme("rk4").has_value());
+  CHECK(find_scheme("rk4") == nullptr);
+}
+
+TEST_CASE("each catalogue entry builds exactly its orders, with its own flags") {
+  for (const auto& scheme : scheme_catalogue()) {
+    CAPTURE(scheme.name);
+    const auto orders = scheme.orders();
+    REQUIRE(orders.size() == static_cast<std::size_t>(scheme.highest_order_index));
+    for (const Fraction& order : orders) {
+      CAPTURE(order.to_string());
+      const auto description = Integrator(IntegratorSpec{scheme.name, order, -2.0}).describe();
+      CHECK(description.scheme == scheme.name);
+      CHECK(description.order == order);
+      CHECK(description.symplectic == scheme.symplectic);
+      CHECK(description.time_reversible == scheme.time_reversible);
+      CHECK(description.t2 == -2.0);
+    }
+    // The next order of the family is beyond the entry's list, and the entry's default order is one of its orders.
+    const Fraction beyond(2 * (scheme.highest_order_index + 1), 3);
+    CHECK(contains(error_of([&] { Integrator(IntegratorSpec{scheme.name, beyond}); }), "beyond the highest order"));
+    CHECK(std::find(orders.begin(), orders.end(), Fraction::parse(scheme.parameters[0].default_text)) != orders.end());
+  }
 }
 
 namespace {

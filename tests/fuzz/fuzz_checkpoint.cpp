@@ -69,7 +69,7 @@ Fixture& fixture() {
 void check_accepted(const nonsep::host::Checkpoint& checkpoint, const nonsep::host::Job& job) {
   const auto& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;
-  if (state.step > job.time.steps) __builtin_trap();
+  if (state.step > job.run().time.steps) __builtin_trap();
   if (state.records.size() != job.initial.count) __builtin_trap();
   if (state.q.size() != state.active.size() * n || state.p.size() != state.q.size()) __builtin_trap();
   for (std::size_t i = 0; i < state.active.size(); ++i) {
@@ -92,8 +92,8 @@ void try_checkpoint(const std::string& text) {
   try {
     const auto checkpoint = nonsep::host::load_checkpoint(path, *f.loaded);
     check_accepted(checkpoint, job);
-    nonsep::host::EnergyErrorObserver energy(job.initial.count, 0, job.analysis.max_relative_energy_error);
-    nonsep::host::ClosestReturnObserver closest(*job.analysis.closest_return_after, job.initial.dimension,
+    nonsep::host::EnergyErrorObserver energy(job.initial.count, 0, job.run().analysis.max_relative_energy_error);
+    nonsep::host::ClosestReturnObserver closest(*job.run().analysis.closest_return_after, job.initial.dimension,
                                                 job.initial.q, job.initial.p);
     for (nonsep::host::Observer* observer : {static_cast<nonsep::host::Observer*>(&energy),
                                              static_cast<nonsep::host::Observer*>(&closest)})

@@ -45,8 +45,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (job.initial.q.size() > max_initial_values) __builtin_trap();
     if (job.plugin.find('\0') != std::string::npos) __builtin_trap();
     if (job.output_directory.string().find('\0') != std::string::npos) __builtin_trap();
-    const auto bound = job.analysis.max_relative_energy_error;
-    if (bound && !(*bound > 0.0 && std::isfinite(*bound))) __builtin_trap();
+    if (!job.is_study()) {
+      const auto bound = job.run().analysis.max_relative_energy_error;
+      if (bound && !(*bound > 0.0 && std::isfinite(*bound))) __builtin_trap();
+    } else if (job.initial.count != 1) {
+      __builtin_trap();  // a study has one initial state
+    }
   }
   check_model_parameters(job.parameters, fake_parameters(), issues);
   for (std::size_t dimension : {std::size_t{1}, std::size_t{2}}) check_dimension(job.initial, dimension, issues);

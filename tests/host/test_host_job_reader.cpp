@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "host_test_support.hpp"
-#include "nonsep/core/integrator_description.hpp"
+#include "nonsep/core/scheme_catalogue.hpp"
 #include "nonsep/host/job.hpp"
 
 using nlohmann::json;
@@ -59,16 +59,16 @@ TEST_CASE("the quickstart job reads into the values it spells out") {
   const Job& job = parsed.job;
   CHECK(job.plugin == "paper1d");
   CHECK(job.parameters == json::object());
-  CHECK(job.integrator.scheme == "triplet");
-  CHECK(job.integrator.order == Fraction(4, 3));
-  CHECK(job.integrator.t2 == -2.0);
-  CHECK(job.integrator.form == HamiltonianForm::TTV);
+  CHECK(job.run().integrator.scheme == "triplet");
+  CHECK(job.run().integrator.order == Fraction(4, 3));
+  CHECK(job.run().integrator.t2 == -2.0);
+  CHECK(job.run().integrator.form == HamiltonianForm::TTV);
   CHECK(job.initial.shape == "single");
   CHECK(job.initial.count == 1);
   CHECK(job.initial.q == std::vector<double>{2.0});
   CHECK(job.initial.p == std::vector<double>{0.0});
   CHECK(job.output_directory == std::filesystem::path("/jobs/quickstart.out"));
-  CHECK(job.every == 1);
+  CHECK(job.run().every == 1);
 }
 
 TEST_CASE("integrator options left out take the catalogue's defaults") {
@@ -80,21 +80,21 @@ TEST_CASE("integrator options left out take the catalogue's defaults") {
     REQUIRE(parsed.issues.empty());
     for (const auto& parameter : scheme.parameters) {
       REQUIRE_FALSE(parameter.default_text.empty());
-      if (parameter.name == "order") CHECK(parsed.job.integrator.order == Fraction::parse(parameter.default_text));
-      if (parameter.name == "t2") CHECK(parsed.job.integrator.t2 == std::stod(parameter.default_text));
+      if (parameter.name == "order") CHECK(parsed.job.run().integrator.order == Fraction::parse(parameter.default_text));
+      if (parameter.name == "t2") CHECK(parsed.job.run().integrator.t2 == std::stod(parameter.default_text));
     }
   }
-  CHECK(parse(host_testing::quickstart_job()).job.integrator.t2 != ChinCoefficients::default_t2());
+  CHECK(parse(host_testing::quickstart_job()).job.run().integrator.t2 != ChinCoefficients::default_t2());
 }
 
 TEST_CASE("orders are exact fractions or integers and must exist for the scheme") {
   json document = host_testing::quickstart_job();
   document["integrator"] = {{"scheme", "triplet"}, {"order", 2}};
-  CHECK(parse(document).job.integrator.order == Fraction(2));
+  CHECK(parse(document).job.run().integrator.order == Fraction(2));
   document["integrator"]["order"] = " 8 / 3 ";
-  CHECK(parse(document).job.integrator.order == Fraction(8, 3));
+  CHECK(parse(document).job.run().integrator.order == Fraction(8, 3));
   document["integrator"]["order"] = 2.0;
-  CHECK(parse(document).job.integrator.order == Fraction(2));
+  CHECK(parse(document).job.run().integrator.order == Fraction(2));
   for (const json& bad : {json("5/3"), json(1.5), json("4/3x"), json(0), json("-4/3"), json(true)}) {
     CAPTURE(bad.dump());
     document["integrator"]["order"] = bad;
@@ -118,7 +118,7 @@ TEST_CASE("t_end is reached exactly: steps = ceil(t_end/dt) with a relative slac
     CAPTURE(c.t_end);
     const auto parsed = parse(with_time({{"dt", c.dt}, {"t_end", c.t_end}}));
     REQUIRE(parsed.issues.empty());
-    const TimeGrid& time = parsed.job.time;
+    const TimeGrid& time = parsed.job.run().time;
     CHECK(time.steps == c.steps);
     CHECK(time.dt == c.t_end / static_cast<double>(c.steps));
     CHECK(time.dt_requested == c.dt);
@@ -131,11 +131,11 @@ TEST_CASE("t_end is reached exactly: steps = ceil(t_end/dt) with a relative slac
 TEST_CASE("steps instead of t_end: exactly that many steps of dt") {
   const auto parsed = parse(with_time({{"dt", 0.25}, {"steps", 12}}));
   REQUIRE(parsed.issues.empty());
-  CHECK(parsed.job.time.steps == 12);
-  CHECK(parsed.job.time.dt == 0.25);
-  CHECK(parsed.job.time.t_end == 3.0);
-  CHECK(parsed.job.time.time_at(5) == 1.25);
-  CHECK_FALSE(parsed.job.time.from_t_end);
+  CHECK(parsed.job.run().time.steps == 12);
+  CHECK(parsed.job.run().time.dt == 0.25);
+  CHECK(parsed.job.run().time.t_end == 3.0);
+  CHECK(parsed.job.run().time.time_at(5) == 1.25);
+  CHECK_FALSE(parsed.job.run().time.from_t_end);
 }
 
 TEST_CASE("time: the problems of dt, t_end and steps") {
@@ -198,13 +198,13 @@ TEST_CASE("initial states: one, a list, or a grid in row-major order (last axis 
 TEST_CASE("checkpoint: every_steps and every_seconds, with defaults, and each problem with its path") {
   json document = host_testing::quickstart_job();
   auto parsed = parse(document);
-  CHECK(parsed.job.checkpoint.every_steps == 0);
-  CHECK(parsed.job.checkpoint.every_seconds == 60.0);
+  CHECK(parsed.job.run().checkpoint.every_steps == 0);
+  CHECK(parsed.job.run().checkpoint.every_seconds == 60.0);
   document["checkpoint"] = {{"every_steps", 500}, {"every_seconds", 0}};
   parsed = parse(document);
   CHECK(parsed.issues.empty());
-  CHECK(parsed.job.checkpoint.every_steps == 500);
-  CHECK(parsed.job.checkpoint.every_seconds == 0.0);
+  CHECK(parsed.job.run().checkpoint.every_steps == 500);
+  CHECK(parsed.job.run().checkpoint.every_seconds == 0.0);
   document["checkpoint"] = {{"every_steps", 2.5}, {"every_seconds", -1}, {"every_minute", 1}};
   CHECK(paths(parse(document).issues) ==
         std::vector<std::string>{"/checkpoint/every_minute", "/checkpoint/every_steps", "/checkpoint/every_seconds"});
@@ -219,13 +219,13 @@ TEST_CASE("checkpoint: every_steps and every_seconds, with defaults, and each pr
 TEST_CASE("analysis: closest_return_after is a finite time, max_relative_energy_error a finite positive bound") {
   json document = host_testing::quickstart_job();
   auto parsed = parse(document);
-  CHECK_FALSE(parsed.job.analysis.closest_return_after);
-  CHECK_FALSE(parsed.job.analysis.max_relative_energy_error);
+  CHECK_FALSE(parsed.job.run().analysis.closest_return_after);
+  CHECK_FALSE(parsed.job.run().analysis.max_relative_energy_error);
   document["analysis"] = {{"closest_return_after", -1.5}, {"max_relative_energy_error", 1e-6}};
   parsed = parse(document);
   REQUIRE(parsed.issues.empty());
-  CHECK(parsed.job.analysis.closest_return_after == -1.5);
-  CHECK(parsed.job.analysis.max_relative_energy_error == 1e-6);
+  CHECK(parsed.job.run().analysis.closest_return_after == -1.5);
+  CHECK(parsed.job.run().analysis.max_relative_energy_error == 1e-6);
   for (const json& bad :
        {json(0), json(-1e-3), json("1e-6"), json(nullptr), json(std::numeric_limits<double>::infinity())}) {
     CAPTURE(bad.dump());
@@ -299,11 +299,11 @@ TEST_CASE("the output folder is relative to the job file, by default <job>.out b
   document.erase("output");
   auto parsed = parse(document, "/data/runs/orbit.json");
   CHECK(parsed.job.output_directory == std::filesystem::path("/data/runs/orbit.out"));
-  CHECK(parsed.job.every == 1);
+  CHECK(parsed.job.run().every == 1);
   document["output"] = {{"directory", "results/a"}, {"every", 0}};
   parsed = parse(document, "/data/runs/orbit.json");
   CHECK(parsed.job.output_directory == std::filesystem::path("/data/runs/results/a"));
-  CHECK(parsed.job.every == 0);
+  CHECK(parsed.job.run().every == 0);
   document["output"] = {{"directory", "/abs/out"}};
   CHECK(parse(document, "/data/runs/orbit.json").job.output_directory == std::filesystem::path("/abs/out"));
 }

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <regex>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/core.hpp"
+#include "nonsep/host/number_format.hpp"
 #include "nonsep/host/study.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 #include "paper1d/paper1d.hpp"
@@ -36,14 +38,40 @@ struct Finished {
   int status;
   json summary;
   std::vector<std::vector<std::string>> rows;
+  std::string out, err;  // the console report
 };
 
-Finished run_study_job(const TemporaryFolder& folder, const std::string& name, const json& job) {
+Finished run_study_job(const TemporaryFolder& folder, const std::string& name, const json& job, bool quiet = true) {
   const auto file = write_job(folder / (name + ".json"), job);
-  const auto result = run_nonsep({"run", "--quiet", "--output", (folder / name).string(), file.string()}, folder.path());
+  std::vector<std::string> args{"run", "--output", (folder / name).string(), file.string()};
+  if (quiet) args.insert(args.begin() + 1, "--quiet");
+  const auto result = run_nonsep(args, folder.path());
   INFO("stderr: " << result.err);
   REQUIRE(std::filesystem::exists(folder / name / "summary.json"));
-  return {result.status, read_json(folder / name / "summary.json"), read_csv(folder / name / "convergence.csv")};
+  return {result.status, read_json(folder / name / "summary.json"), read_csv(folder / name / "convergence.csv"),
+          result.out, result.err};
+}
+
+// The console report of a study, as it must follow from its summary.json: the status line, one line per fit and
+// one per run that diverged or failed.
+std::string expected_report(const json& summary, const std::filesystem::path& directory) {
+  const json& runs = summary["study"]["runs"];
+  std::string text = summary["status"].get<std::string>() + ": study of " + std::to_string(summary["fits"].size()) +
+                     " integrators, " + std::to_string(runs["completed"].get<std::size_t>()) + " runs completed";
+  for (const char* other : {"diverged", "failed", "interrupted"})
+    if (runs[other].get<std::size_t>() > 0) text += ", " + std::to_string(runs[other].get<std::size_t>()) + " " + other;
+  text += "; results in " + directory.string() + "\n";
+  const auto four_digits = [](double x) {
+    char digits[32];
+    std::snprintf(digits, sizeof digits, "%#.4g", x);
+    return std::string(digits);
+  };
+  for (const auto& fit : summary["fits"])
+    text += "  " + fit["integrator"].get<std::string>() + ": energy error exponent " +
+            (fit["exponent"].is_null() ? std::string("(no fit)") : four_digits(fit["exponent"].get<double>())) +
+            " (nominal " + fit["order"].get<std::string>() + " = " +
+            four_digits(fit["nominal_exponent"].get<double>()) + ")\n";
+  return text;
 }
 
 }  // namespace
@@ -109,6 +137,10 @@ TEST_CASE("a study's rows are the core's runs bit for bit, and its fit is the sl
   CHECK(fits[1]["steps_max"] == 1024);
   CHECK(std::abs(fits[1]["exponent"].get<double>() - 2.0) < 0.3);
   CHECK(std::abs(fits[1]["phase_exponent"].get<double>() - 2.0) < 0.3);
+  // Without --quiet the report on stdout says what summary.json says.
+  const auto loud = run_study_job(folder, "study_loud", study_job(integrators, {128, 256}), false);
+  CHECK(loud.out == expected_report(loud.summary, folder / "study_loud"));
+  CHECK(loud.err.empty());
 }
 
 TEST_CASE("a study run that blows up is a diverged row, left out of the fit, and the exit status is 1") {
@@ -126,6 +158,10 @@ TEST_CASE("a study run that blows up is a diverged row, left out of the fit, and
   CHECK(run.summary["fits"][0]["exponent"].is_null());
   REQUIRE(run.summary["failures"].size() == 1);
   CHECK(run.summary["failures"][0]["steps"] == 16);
+  // The report goes to stderr even with --quiet, and names the run that diverged.
+  CHECK(run.out.empty());
+  CHECK(run.err == "nonsep: " + expected_report(run.summary, folder / "failing") + "nonsep: triplet 8/3 with 16 steps " +
+                       "diverged: " + run.summary["failures"][0]["error"].get<std::string>() + "\n");
 }
 
 TEST_CASE("closest_return is the minimum distance to the start over every step from closest_return_after on") {

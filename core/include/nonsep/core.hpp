@@ -14,6 +14,7 @@
 #include "nonsep/core/model.hpp"
 #include "nonsep/core/multi_product_expansion.hpp"
 #include "nonsep/core/phase_space_batch.hpp"
+#include "nonsep/core/scheme_catalogue.hpp"
 #include "nonsep/core/poincare_crossing.hpp"
 #include "nonsep/core/tangent_basic_step.hpp"
 #include "nonsep/core/tangent_integrator.hpp"

@@ -100,13 +100,19 @@ int run_command_line(int argc, char** argv) {
         ->excludes(example->get_option("--output"));
     example->footer(exit_status_text());
 
+    auto* schema = app.add_subcommand(
+        "schema", "Print the JSON Schema of job files (schemas/job.schema.json), generated from the job reader's "
+                  "tables and the scheme catalogue");
+    schema->footer(exit_status_text());
+
     // CLI11 would call an unknown command a missing subcommand without naming it.
     const auto named = [&](const CLI::App* command) { return command->check_name(argv[1]); };
     if (argc > 1 && argv[1][0] != '-' && app.get_subcommands(named).empty()) {
-      std::string commands;
-      for (const CLI::App* command : app.get_subcommands({}))
-        commands += (commands.empty() ? "" : ", ") + command->get_name();
-      std::cerr << "nonsep: unknown command '" << argv[1] << "'; the commands are " << commands
+      const auto commands = app.get_subcommands([](const CLI::App*) { return true; });
+      std::string names;
+      for (std::size_t i = 0; i < commands.size(); ++i)
+        names += (i == 0 ? "" : i + 1 == commands.size() ? " and " : ", ") + commands[i]->get_name();
+      std::cerr << "nonsep: unknown command '" << argv[1] << "'; the commands are " << names
                 << " (see nonsep --help)\n";
       return to_int(ExitStatus::invalid_input);
     }
@@ -121,6 +127,7 @@ int run_command_line(int argc, char** argv) {
     if (inspect->parsed()) return command_inspect(inspect_arguments);
     if (models->parsed()) return command_models();
     if (example->parsed()) return command_example(example_arguments);
+    if (schema->parsed()) return command_schema();
     return to_int(ExitStatus::invalid_input);
   } catch (const std::exception& error) {
     std::cerr << "nonsep: unexpected error: " << error.what() << "\n";

@@ -39,6 +39,7 @@ struct InspectArguments {
 
 int command_inspect(const InspectArguments& arguments);
 int command_models();
+int command_schema();
 
 // Texts of --help, generated from the scheme catalogue and the exit statuses.
 std::string exit_status_text();

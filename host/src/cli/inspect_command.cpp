@@ -1,3 +1,5 @@
+// `nonsep inspect PLUGIN [--json] [--check ...]`: a plugin's metadata, and with --check its derivatives against
+// finite differences.
 #include <unistd.h>
 
 #include <cmath>
@@ -145,17 +147,6 @@ int command_inspect(const InspectArguments& arguments) {
     std::cerr << "nonsep: derivative check failed: the plugin could not evaluate: " << error.what() << "\n";
     return to_int(ExitStatus::run_failed);
   }
-}
-
-int command_models() {
-  const auto discovered = discover_plugins();
-  for (const auto& entry : discovered) std::cout << describe_discovered(entry) << "\n";
-  if (discovered.empty()) {
-    std::cerr << "nonsep: no plugins found; searched:";
-    for (const auto& directory : plugin_search_path()) std::cerr << " " << directory.string();
-    std::cerr << "\n";
-  }
-  return to_int(ExitStatus::success);
 }
 
 }  // namespace nonsep::host::cli

@@ -5,11 +5,11 @@
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
 #include <cmath>
-#include <cstdio>
 #include <csignal>
+#include <cstdio>
+#include <vector>
 #include <filesystem>
 #include <optional>
-#include <vector>
 
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/output/files.hpp"
@@ -59,7 +59,7 @@ class InterruptGuard {
 // of 1.1e-16: H is a sum of products, and its error accumulates over the steps).
 constexpr double round_off_energy_error = 5e-14;
 // Round-off also shows as errors at the smallest dt this many times above the nominal power law through the
-// largest dt (the fit's energy_error_excess_at_smallest_dt), when they are small enough to be round-off at all.
+// largest dt (StudyFit::energy_error_excess_at_smallest_dt), when they are small enough to be round-off at all.
 constexpr double flattened_excess = 10.0;
 constexpr double round_off_at_most = 1e-8;
 
@@ -71,28 +71,24 @@ std::string four_digits(double x) {
 
 // What makes a study's fit unreliable, with what to do: an energy error that changes sign in the range, one that
 // reaches round-off or flattens at the smallest dt. One sentence each; none for a clean fit.
-std::vector<std::string> fit_warnings(const nlohmann::ordered_json& fit) {
+std::vector<std::string> fit_warnings(const StudyFit& fit) {
   std::vector<std::string> warnings;
-  const auto number = [&](const char* key) {
-    return fit.contains(key) && fit[key].is_number() ? std::optional<double>(fit[key].get<double>()) : std::nullopt;
-  };
-  const auto smallest = number("energy_error_smallest"), excess = number("energy_error_excess_at_smallest_dt"),
-             nominal = number("nominal_exponent"), dt_min = number("dt_min");
+  const auto& smallest = fit.energy_error_smallest;
+  const auto& excess = fit.energy_error_excess_at_smallest_dt;
   std::string round_off;
   if (smallest && *smallest < round_off_energy_error)
     round_off = "its smallest |dH/H0| is " + four_digits(*smallest) + ", at the round-off of double precision";
   else if (excess && smallest && *excess > flattened_excess && *smallest < round_off_at_most)
     round_off = "at the smallest dt it is " + four_digits(*excess) + " times what the nominal exponent " +
-                (nominal ? four_digits(*nominal) : std::string("?")) +
+                four_digits(fit.description.order.value()) +
                 " predicts from the largest dt: the errors flatten, as round-off makes them";
-  const std::string label = fit["integrator"].get<std::string>();
   if (!round_off.empty())
-    warnings.push_back(label + ": the energy error reaches round-off: " + round_off +
-                       (dt_min ? " (dt_min = " + four_digits(*dt_min) + ")" : std::string()) +
+    warnings.push_back(fit.integrator + ": the energy error reaches round-off: " + round_off +
+                       (fit.dt_min ? " (dt_min = " + four_digits(*fit.dt_min) + ")" : std::string()) +
                        "; move its step range to larger dt (fewer steps) so that every point is above it");
-  if (fit.value("energy_error_changes_sign", false))
-    warnings.push_back(label + ": the energy error changes sign within the fitted range, so the fit mixes a zero "
-                       "crossing into the power law; move its step range to where the error keeps one sign (" +
+  if (fit.energy_error_changes_sign)
+    warnings.push_back(fit.integrator + ": the energy error changes sign within the fitted range, so the fit mixes a "
+                       "zero crossing into the power law; move its step range to where the error keeps one sign (" +
                        (round_off.empty() ? std::string("smaller dt, more steps, when the larger dt are not yet "
                                                         "asymptotic")
                                           : std::string("larger dt, fewer steps, away from round-off")) +
@@ -102,33 +98,33 @@ std::vector<std::string> fit_warnings(const nlohmann::ordered_json& fit) {
 
 // The end of a study: one line per integrator with its fitted exponent, or what went wrong; then warnings about
 // fits that round-off or a sign change make unreliable (on stderr, also with --quiet).
-int report_study(const RunOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
-  const auto& summary = outcome.summary;
-  const auto& runs = summary["study"]["runs"];
-  std::string line = summary["status"].get<std::string>() + ": study of " + std::to_string(summary["fits"].size()) +
-                     " integrators, " + std::to_string(runs["completed"].get<std::size_t>()) + " runs completed";
-  for (const char* other : {"diverged", "failed", "interrupted"})
-    if (runs[other].get<std::size_t>() > 0) line += ", " + std::to_string(runs[other].get<std::size_t>()) + " " + other;
+int report_study(const StudyOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
+  const StatusCounts& runs = outcome.run_counts;
+  std::string line = std::string(to_string(outcome.status)) + ": study of " + std::to_string(outcome.fits.size()) +
+                     " integrators, " + std::to_string(runs.completed) + " runs completed";
+  const std::pair<const char*, std::size_t> others[] = {
+      {"diverged", runs.diverged}, {"failed", runs.failed}, {"interrupted", runs.interrupted}};
+  for (const auto& [other, count] : others)
+    if (count > 0) line += ", " + std::to_string(count) + " " + other;
   line += "; results in " + directory.string();
   std::ostream& out = outcome.exit_status == ExitStatus::success ? std::cout : std::cerr;
   if (outcome.exit_status != ExitStatus::success || !quiet) {
     out << (outcome.exit_status == ExitStatus::success ? "" : "nonsep: ") << line << "\n";
-    for (const auto& fit : summary["fits"])
-      out << "  " << fit["integrator"].get<std::string>() << ": energy error exponent "
-          << (fit["exponent"].is_null() ? std::string("(no fit)") : four_digits(fit["exponent"].get<double>()))
-          << " (nominal " << fit["order"].get<std::string>() << " = "
-          << four_digits(fit["nominal_exponent"].get<double>()) << ")" << (fit_warnings(fit).empty() ? "" : " (see warning)")
-          << "\n";
+    for (const auto& fit : outcome.fits)
+      out << "  " << fit.integrator << ": energy error exponent "
+          << (fit.exponent ? four_digits(*fit.exponent) : std::string("(no fit)")) << " (nominal "
+          << fit.description.order.to_string() << " = " << four_digits(fit.description.order.value()) << ")"
+          << (fit_warnings(fit).empty() ? "" : " (see warning)") << "\n";
   }
   out.flush();
-  for (const auto& fit : summary["fits"])
+  for (const auto& fit : outcome.fits)
     for (const auto& warning : fit_warnings(fit)) std::cerr << "nonsep: warning: " << warning << "\n";
-  if (summary.contains("error")) std::cerr << "nonsep: " << summary["error"].get<std::string>() << "\n";
-  if (summary.contains("failures"))
-    for (const auto& failure : summary["failures"])
-      std::cerr << "nonsep: " << failure["integrator"].get<std::string>() << " with " << failure["steps"]
-                << " steps " << failure["status"].get<std::string>() << ": " << failure["error"].get<std::string>()
-                << "\n";
+  if (!outcome.error.empty()) std::cerr << "nonsep: " << outcome.error << "\n";
+  for (std::size_t i = 0; i < outcome.fits.size(); ++i)
+    for (const StudyRun& run : outcome.runs[i])
+      if (run.status == TrajectoryStatus::diverged || run.status == TrajectoryStatus::failed)
+        std::cerr << "nonsep: " << outcome.fits[i].integrator << " with " << run.steps << " steps "
+                  << to_string(run.status) << ": " << run.error << "\n";
   return to_int(outcome.exit_status);
 }
 
@@ -176,12 +172,33 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
                  "(analysis.max_relative_energy_error stops trajectories past a bound)\n";
 }
 
+// Runs `run` (run_job or run_study) with SIGINT and SIGTERM caught. Nothing, after saying why on stderr, when it
+// could not start (the output folder, a checkpoint to resume from); an interrupted outcome becomes "terminated"
+// after SIGTERM.
+template <class Run>
+auto run_guarded(Run run) -> std::optional<decltype(run())> {
+  InterruptGuard guard;
+  try {
+    auto outcome = run();
+    if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() == SIGTERM)
+      outcome.exit_status = ExitStatus::terminated;
+    return outcome;
+  } catch (const OutputError& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+  } catch (const FolderInUse& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+  } catch (const CheckpointError& error) {
+    std::cerr << "nonsep: cannot resume: " << error.what() << "\n";
+  }
+  return std::nullopt;
+}
+
 int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& arguments,
                const std::filesystem::path& directory, int signal) {
   const std::size_t trajectories = outcome.trajectories.size();
   std::string line = std::string(to_string(outcome.status)) + ": " + std::to_string(trajectories) +
                      (trajectories == 1 ? " trajectory (" : " trajectories (") + counts_text(outcome.counts) + "), " +
-                     time_text(job.time);
+                     time_text(job.run().time);
   if (const auto& largest = outcome.largest_energy_error)
     line += "; largest |dH/H0| " + format_number(largest->value) + " (trajectory " +
             std::to_string(largest->trajectory) + ")";
@@ -211,7 +228,7 @@ int command_run(const RunArguments& arguments) {
   } catch (const InvalidJob& error) {
     return report_invalid_job(error);
   }
-  if (arguments.resume && loaded->job.study) {
+  if (arguments.resume && loaded->job.is_study()) {
     std::cerr << "nonsep: cannot resume: " << arguments.job_file
               << " is a convergence study (/study), which is not resumed; run it again without --resume\n";
     return to_int(ExitStatus::invalid_input);
@@ -226,26 +243,14 @@ int command_run(const RunArguments& arguments) {
   options.threads = arguments.threads;
   stop_requested.store(false);
   stop_signal.store(0);
-  RunOutcome outcome;
-  {
-    InterruptGuard guard;
-    try {
-      outcome = loaded->job.study ? run_study(*loaded, options) : run_job(*loaded, options);
-    } catch (const OutputError& error) {
-      std::cerr << "nonsep: " << error.what() << "\n";
-      return to_int(ExitStatus::invalid_input);
-    } catch (const FolderInUse& error) {
-      std::cerr << "nonsep: " << error.what() << "\n";
-      return to_int(ExitStatus::invalid_input);
-    } catch (const CheckpointError& error) {
-      std::cerr << "nonsep: cannot resume: " << error.what() << "\n";
-      return to_int(ExitStatus::invalid_input);
-    }
+  if (loaded->job.is_study()) {
+    auto outcome = run_guarded([&] { return run_study(*loaded, options); });
+    return outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
+                   : to_int(ExitStatus::invalid_input);
   }
-  if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() == SIGTERM)
-    outcome.exit_status = ExitStatus::terminated;
-  if (loaded->job.study) return report_study(outcome, options.output_directory, arguments.quiet);
-  return report_run(outcome, loaded->job, arguments, options.output_directory, stop_signal.load());
+  auto outcome = run_guarded([&] { return run_job(*loaded, options); });
+  return outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
+                 : to_int(ExitStatus::invalid_input);
 }
 
 }  // namespace nonsep::host::cli

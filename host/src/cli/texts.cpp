@@ -4,7 +4,7 @@
 #include "cli/commands.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/core/integrator_description.hpp"
+#include "nonsep/core/scheme_catalogue.hpp"
 
 namespace nonsep::host::cli {
 

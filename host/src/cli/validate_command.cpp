@@ -11,15 +11,15 @@ int command_validate(const std::string& job_file) {
   try {
     const LoadedJob loaded = load_job(job_file);
     const Job& job = loaded.job;
-    const auto& spec = job.integrator;
-    if (job.study) {
+    if (job.is_study()) {
+      const Study& study = job.study();
       std::cout << "valid: " << job_file << "\n"
                 << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
                 << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
-                << "  study:       " << job.study->integrators.size() << " integrators to t_end = "
-                << format_number(job.time.t_end) << (job.study->reference_q.empty() ? "" : ", with a reference")
+                << "  study:       " << study.integrators.size() << " integrators to t_end = "
+                << format_number(study.t_end) << (study.reference_q.empty() ? "" : ", with a reference")
                 << "\n";
-      for (const auto& integrator : job.study->integrators)
+      for (const auto& integrator : study.integrators)
         std::cout << "    " << integrator.label << ": " << integrator.spec.scheme << ", order "
                   << integrator.spec.order.to_string() << ", t2 = " << format_number(integrator.spec.t2) << ", "
                   << integrator.steps.size() << " step counts " << integrator.steps.front() << ".."
@@ -27,6 +27,8 @@ int command_validate(const std::string& job_file) {
       std::cout << "  output:      " << job.output_directory.string() << "\n";
       return to_int(ExitStatus::success);
     }
+    const SingleRun& run = job.run();
+    const IntegratorSpec& spec = run.integrator;
     std::cout << "valid: " << job_file << "\n"
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
@@ -35,9 +37,9 @@ int command_validate(const std::string& job_file) {
               << format_number(spec.t2) << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT") << "\n"
               << "  initial:     " << job.initial.count << " state" << (job.initial.count == 1 ? "" : "s") << " ("
               << job.initial.shape << ")\n"
-              << "  time:        " << time_text(job.time) << "\n"
-              << "  output:      " << job.output_directory.string() << ", trajectory every " << job.every
-              << (job.every == 0 ? " (none)" : " steps") << "\n";
+              << "  time:        " << time_text(run.time) << "\n"
+              << "  output:      " << job.output_directory.string() << ", trajectory every " << run.every
+              << (run.every == 0 ? " (none)" : " steps") << "\n";
     return to_int(ExitStatus::success);
   } catch (const InvalidJob& error) {
     return report_invalid_job(error);

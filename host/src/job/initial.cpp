@@ -32,7 +32,7 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
     return std::nullopt;
   }
   if (value.contains("values")) {
-    check.known_keys(value, path, {"values"});
+    check.known_keys(value, path, values_axis_keys().names());
     const json& values = value["values"];
     if (values.is_array() && values.size() > max_initial_states) {
       check.issue(child(path, "values"), std::to_string(values.size()) + " values",
@@ -41,16 +41,18 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
     }
     return check.vector(values, child(path, "values"));
   }
-  check.known_keys(value, path, {"from", "to", "count"});
+  const KeyTable& keys = range_axis_keys();
+  check.known_keys(value, path, keys.names());
   std::optional<double> from, to;
   std::optional<std::int64_t> count;
-  if (const json* v = check.member(value, path, "from", true, "the first value, a finite number"))
+  if (const json* v = check.member(value, path, "from", keys["from"].required, "the first value, a finite number"))
     from = check.finite_number(*v, child(path, "from"), "the first value, a finite number");
-  if (const json* v = check.member(value, path, "to", true, "the last value, a finite number"))
+  if (const json* v = check.member(value, path, "to", keys["to"].required, "the last value, a finite number"))
     to = check.finite_number(*v, child(path, "to"), "the last value, a finite number");
-  if (const json* v = check.member(value, path, "count", true, "the number of values, an integer >= 1"))
-    count = check.integer(*v, child(path, "count"), 1, static_cast<std::int64_t>(max_initial_states),
-                          "the number of values, an integer from 1 to " + std::to_string(max_initial_states));
+  if (const json* v = check.member(value, path, "count", keys["count"].required, "the number of values, an integer >= 1"))
+    count = check.integer(*v, child(path, "count"), keys["count"].minimum, keys["count"].maximum,
+                          "the number of values, an integer from " + std::to_string(keys["count"].minimum) +
+                              " to " + std::to_string(keys["count"].maximum));
   if (!from || !to || !count) return std::nullopt;
   std::vector<double> values(static_cast<std::size_t>(*count));
   const auto n = values.size();
@@ -83,14 +85,14 @@ void fill_grid(const std::vector<std::vector<double>>& axes, std::size_t n, std:
 void read_grid(Checker& check, const json& grid, InitialStates& states) {
   const std::string path = "/initial/grid";
   if (!check.object(grid, path, "an object {\"q\": [axis, ...], \"p\": [axis, ...]}, one axis per component")) return;
-  check.known_keys(grid, path, {"q", "p"});
+  check.known_keys(grid, path, grid_keys().names());
   std::vector<std::vector<double>> axes;
   std::size_t count = 1;  // states: the product of the axes' sizes
   std::size_t sizes[2] = {0, 0};
   bool ok = true;
   for (int which = 0; which < 2; ++which) {
     const std::string name = which == 0 ? "q" : "p";
-    const json* list = check.member(grid, path, name, true, "an array of axes, one per component");
+    const json* list = check.member(grid, path, name, grid_keys()[name].required, "an array of axes, one per component");
     if (!list) {
       ok = false;
       continue;
@@ -136,9 +138,10 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
                 const std::string& first_path) {
   if (!check.object(value, path, "a state {\"q\": [...], \"p\": [...]}")) return;
-  check.known_keys(value, path, {"q", "p"});
-  const json* q_value = check.member(value, path, "q", true, "the positions, an array of finite numbers");
-  const json* p_value = check.member(value, path, "p", true, "the momenta, an array of finite numbers");
+  const KeyTable& keys = state_keys();
+  check.known_keys(value, path, keys.names());
+  const json* q_value = check.member(value, path, "q", keys["q"].required, "the positions, an array of finite numbers");
+  const json* p_value = check.member(value, path, "p", keys["p"].required, "the momenta, an array of finite numbers");
   // Sizes first, so that an array over the limit is not copied.
   const std::size_t q_size = q_value && q_value->is_array() ? q_value->size() : 0;
   if (q_size > max_initial_values) {
@@ -175,7 +178,7 @@ InitialStates read_initial(Checker& check, const json& document) {
   InitialStates states;
   const std::string what =
       "one state {\"q\": [...], \"p\": [...]}, an array of such states, or {\"grid\": {\"q\": [axes], \"p\": [axes]}}";
-  const json* initial = check.member(document, "", "initial", true, what);
+  const json* initial = check.member(document, "", "initial", document_keys()["initial"].required, what);
   if (!initial) return states;
   if (initial->is_array()) {
     states.shape = "list";
@@ -199,7 +202,7 @@ InitialStates read_initial(Checker& check, const json& document) {
     }
   } else if (initial->is_object() && initial->contains("grid")) {
     states.shape = "grid";
-    check.known_keys(*initial, "/initial", {"grid"});
+    check.known_keys(*initial, "/initial", initial_grid_keys().names());
     read_grid(check, (*initial)["grid"], states);
   } else if (initial->is_object()) {
     states.shape = "single";

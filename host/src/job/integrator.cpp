@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "nonsep/core/error.hpp"
-#include "nonsep/core/integrator_description.hpp"
+#include "nonsep/core/integrator.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -75,7 +75,7 @@ std::optional<OptionValue> read_option(Checker& check, const ParameterDescriptio
 
 // The options of the scheme, or with an unknown scheme the options of every scheme (so that their problems are
 // reported too).
-std::vector<ParameterDescription> options_of(const std::optional<SchemeDescription>& scheme) {
+std::vector<ParameterDescription> options_of(const Scheme* scheme) {
   if (scheme) return scheme->parameters;
   std::vector<ParameterDescription> parameters;
   for (const auto& entry : scheme_catalogue())
@@ -90,8 +90,8 @@ std::vector<ParameterDescription> options_of(const std::optional<SchemeDescripti
 
 HamiltonianForm read_hamiltonian(Checker& check, const json& document) {
   if (const json* form = check.member(document, "", "hamiltonian", false, "")) {
-    if (*form == "TTV") return HamiltonianForm::TTV;
-    if (*form == "VVT") return HamiltonianForm::VVT;
+    for (const auto& [name, value] : hamiltonian_forms())
+      if (*form == name) return value;
     check.issue("/hamiltonian", describe(*form),
                 "\"TTV\" (H = T_i V_ij T_j, the default) or \"VVT\" (H = V_i T_ij V_j)");
   }
@@ -102,7 +102,7 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
                                       HamiltonianForm form, const std::vector<std::string>& extra_keys) {
   IntegratorSpec spec;
   spec.form = form;
-  std::optional<SchemeDescription> scheme;
+  const Scheme* scheme = nullptr;
   if (const json* name = check.member(integrator, path, "scheme", true, "one of " + scheme_names())) {
     if (name->is_string()) scheme = find_scheme(name->get<std::string>());
     if (scheme)

@@ -11,11 +11,12 @@ namespace nonsep::host::job_reader {
 
 void read_model(Checker& check, const json& document, Job& job) {
   const std::string what = "an object {\"plugin\": name or path, \"parameters\": {...}}";
-  const json* model = check.member(document, "", "model", true, what);
+  const json* model = check.member(document, "", "model", document_keys()["model"].required, what);
   if (!model || !check.object(*model, "/model", what)) return;
-  check.known_keys(*model, "/model", {"plugin", "parameters"});
+  const KeyTable& keys = model_keys();
+  check.known_keys(*model, "/model", keys.names());
   const std::string plugin_what = "a plugin name (see `nonsep models`) or a path to a .so file";
-  if (const json* plugin = check.member(*model, "/model", "plugin", true, plugin_what))
+  if (const json* plugin = check.member(*model, "/model", "plugin", keys["plugin"].required, plugin_what))
     if (auto name = check.path_string(*plugin, "/model/plugin", plugin_what)) job.plugin = *name;
   if (const json* parameters = check.member(*model, "/model", "parameters", false, ""))
     if (check.object(*parameters, "/model/parameters", "an object of the plugin's parameters (see `nonsep inspect`)"))

@@ -18,9 +18,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
                     "a JSON object with the keys model, integrator, initial, time (" + manual_location() +
                         ", section Running nonsep)"))
     return job;
-  check.known_keys(document, "",
-                   {"$schema", "description", "model", "hamiltonian", "integrator", "initial", "time", "output",
-                    "analysis", "study", "checkpoint"});
+  check.known_keys(document, "", document_keys().names());
   if (const json* value = check.member(document, "", "$schema", false, ""))
     check.string(*value, "/$schema", "a string (the JSON Schema the file follows; ignored by nonsep)");
   if (const json* value = check.member(document, "", "description", false, ""))
@@ -29,34 +27,32 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
   read_model(check, document, job);
   const HamiltonianForm form = read_hamiltonian(check, document);
   job.initial = read_initial(check, document);
-  if (const json* study = check.member(document, "", "study", false, "")) {
-    if (document.contains("integrator"))
-      check.issue("/integrator", "an integrator together with /study",
-                  "no /integrator in a study: each entry of /study/integrators is one");
-    if (document.contains("analysis"))
-      check.issue("/analysis", "an analysis together with /study", "/analysis in single runs only");
-    if (document.contains("checkpoint"))
-      check.issue("/checkpoint", "a checkpoint policy together with /study",
-                  "/checkpoint in single runs only (a study is not resumed)");
-    job.integrator.form = form;
-    job.time = read_study_time(check, document);
-    job.study = read_study(check, *study, form, job.time.t_end);
+  if (const json* study_value = check.member(document, "", "study", false, "")) {
+    for (const KeyRule& rule : document_keys().rules)
+      if (rule.run_only && document.contains(rule.name))
+        check.issue(child("", rule.name), rule.in_study_found, rule.in_study_allowed);
+    const double t_end = read_study_time(check, document).t_end;
+    Study& study = job.plan.emplace<Study>(read_study(check, *study_value, form, t_end));
+    study.form = form;
+    study.t_end = t_end;
     if (job.initial.count > 1)
       check.issue("/initial", std::to_string(job.initial.count) + " states",
                   "one state: a study runs every integrator from the same initial state");
-    if (!job.study->reference_q.empty() && job.initial.dimension != 0 &&
-        job.study->reference_q.size() != job.initial.dimension)
-      check.issue("/study/reference/q", std::to_string(job.study->reference_q.size()) + " components",
+    if (!study.reference_q.empty() && job.initial.dimension != 0 && study.reference_q.size() != job.initial.dimension)
+      check.issue("/study/reference/q", std::to_string(study.reference_q.size()) + " components",
                   std::to_string(job.initial.dimension) + ", as many as the initial state has");
   } else {
-    job.integrator = read_integrator(check, document, form);
-    job.time = read_time(check, document);
+    SingleRun& run = job.plan.emplace<SingleRun>();
+    run.integrator = read_integrator(check, document, form);
+    run.time = read_time(check, document);
     if (const json* analysis = check.member(document, "", "analysis", false, ""))
-      job.analysis = read_analysis(check, *analysis);
+      run.analysis = read_analysis(check, *analysis);
   }
   read_output(check, document, job);
-  if (const json* checkpoint = check.member(document, "", "checkpoint", false, ""))
-    job.checkpoint = read_checkpoint(check, *checkpoint);
+  if (const json* checkpoint = check.member(document, "", "checkpoint", false, "")) {
+    const CheckpointPolicy policy = read_checkpoint(check, *checkpoint);  // refused above in a study
+    if (!job.is_study()) std::get<SingleRun>(job.plan).checkpoint = policy;
+  }
   return job;
 }
 

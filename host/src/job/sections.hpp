@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "checker.hpp"
+#include "job_keys.hpp"
 
 namespace nonsep::host::job_reader {
 
@@ -40,7 +41,8 @@ void read_state(Checker& check, const json& value, const std::string& path, Init
 // checked, not turned into counts).
 Study read_study(Checker& check, const json& study, HamiltonianForm form, double t_end);
 
-// /output, /analysis and /checkpoint (outputs.cpp). read_output sets job.output_directory, every, energy_every.
+// /output, /analysis and /checkpoint (outputs.cpp). read_output sets job.output_directory and, in a single run,
+// its every and energy_every (job.plan must already say which kind of job it is).
 void read_output(Checker& check, const json& document, Job& job);
 Analysis read_analysis(Checker& check, const json& value);
 CheckpointPolicy read_checkpoint(Checker& check, const json& value);

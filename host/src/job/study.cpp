@@ -92,13 +92,14 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
   const std::string what =
       "an object {\"integrators\": [...], \"steps\": [...] or \"dt\": [...], \"reference\": {\"q\", \"p\"}}";
   if (!check.object(study_value, path, what)) return study;
-  check.known_keys(study_value, path, {"integrators", "steps", "dt", "reference"});
+  const KeyTable& keys = study_keys();
+  check.known_keys(study_value, path, keys.names());
   std::string study_from;
   const std::size_t before = check.issue_count();
   const auto study_steps = read_steps_or_dt(check, study_value, path, t_end, false, study_from, "study.");
   const bool study_steps_invalid = check.issue_count() != before;
 
-  const json* list = check.member(study_value, path, "integrators", true,
+  const json* list = check.member(study_value, path, "integrators", keys["integrators"].required,
                                   "a non-empty array of integrators, each as /integrator of a run");
   if (list && (!list->is_array() || list->empty())) {
     check.issue(child(path, "integrators"), describe(*list),
@@ -111,7 +112,7 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
     if (!check.object(entry, item, "an integrator {\"scheme\": ..., options, \"label\", \"steps\" or \"dt\"}"))
       continue;
     StudyIntegrator integrator;
-    integrator.spec = read_integrator_object(check, entry, item, form, {"label", "steps", "dt"});
+    integrator.spec = read_integrator_object(check, entry, item, form, study_integrator_keys().names());
     integrator.label = default_label(integrator.spec);
     if (const json* label = check.member(entry, item, "label", false, ""))
       if (auto text = check.string(*label, child(item, "label"), "a non-empty string naming the integrator"))

@@ -19,12 +19,13 @@ std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt,
 TimeGrid read_time(Checker& check, const json& document) {
   TimeGrid grid;
   const std::string what = "an object with \"dt\" and either \"t_end\" or \"steps\"";
-  const json* time = check.member(document, "", "time", true, what);
+  const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
   if (!time || !check.object(*time, "/time", what)) return grid;
-  check.known_keys(*time, "/time", {"dt", "t_end", "steps"});
+  const KeyTable& keys = run_time_keys();
+  check.known_keys(*time, "/time", keys.names());
   // NaN marks a value that is missing or invalid (and already reported).
   double dt = std::nan("");
-  if (const json* value = check.member(*time, "/time", "dt", true, "the time step, a finite non-zero number")) {
+  if (const json* value = check.member(*time, "/time", "dt", keys["dt"].required, "the time step, a finite non-zero number")) {
     if (const auto x = check.finite_number(*value, "/time/dt", "the time step, a finite non-zero number")) {
       if (*x == 0.0)
         check.issue("/time/dt", describe(*value), "a finite non-zero number (negative integrates backwards in time)");
@@ -56,8 +57,10 @@ TimeGrid read_time(Checker& check, const json& document) {
       grid = TimeGrid::to_end(*t_end, dt, *steps);
     return grid;
   }
-  const auto steps = check.integer(*steps_value, "/time/steps", 1, static_cast<std::int64_t>(max_steps),
-                                   "an integer from 1 to " + std::to_string(max_steps));
+  const KeyRule& rule = keys["steps"];
+  const auto steps = check.integer(*steps_value, "/time/steps", rule.minimum, rule.maximum,
+                                   "an integer from " + std::to_string(rule.minimum) + " to " +
+                                       std::to_string(rule.maximum));
   if (!steps || std::isnan(dt)) return grid;
   grid = TimeGrid::of_steps(static_cast<std::uint64_t>(*steps), dt);
   if (!std::isfinite(grid.t_end))
@@ -69,10 +72,11 @@ TimeGrid read_time(Checker& check, const json& document) {
 TimeGrid read_study_time(Checker& check, const json& document) {
   TimeGrid grid;
   const std::string what = "an object {\"t_end\": T}: a study runs every integrator to T with its own step counts";
-  const json* time = check.member(document, "", "time", true, what);
+  const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
   if (!time || !check.object(*time, "/time", what)) return grid;
-  check.known_keys(*time, "/time", {"t_end"});
-  if (const json* value = check.member(*time, "/time", "t_end", true, "the end time, a finite non-zero number"))
+  const KeyTable& keys = study_time_keys();
+  check.known_keys(*time, "/time", keys.names());
+  if (const json* value = check.member(*time, "/time", "t_end", keys["t_end"].required, "the end time, a finite non-zero number"))
     if (const auto t_end = check.finite_number(*value, "/time/t_end", "the end time, a finite non-zero number")) {
       if (*t_end == 0.0)
         check.issue("/time/t_end", describe(*value), "a finite non-zero number (negative integrates backwards)");

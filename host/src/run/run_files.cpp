@@ -20,8 +20,8 @@ std::string hamiltonian_text(HamiltonianForm form) {
 }
 
 json energy_facts(const RunFacts& facts) {
-  const Job& job = facts.loaded.job;
-  const std::string hamiltonian = hamiltonian_text(job.integrator.form);
+  const SingleRun& run = facts.loaded.job.run();
+  const std::string hamiltonian = hamiltonian_text(run.integrator.form);
   if (!facts.driver.energy_available())
     return {{"available", false},
             {"hamiltonian", hamiltonian},
@@ -35,18 +35,19 @@ json energy_facts(const RunFacts& facts) {
           {"relative_error_definition", "(H - H0) / H0; unknown when H0 = 0"},
           {"evaluated_at",
            "step 0, every written sample (output.every), " +
-               (job.energy_every > 0 ? "every " + std::to_string(job.energy_every) + "-th step (output.energy_every), "
+               (run.energy_every > 0 ? "every " + std::to_string(run.energy_every) + "-th step (output.energy_every), "
                                      : std::string()) +
                "the last step, and the final state of a trajectory that stopped early"},
           {"largest_relative_error", largest},
-          {"max_relative_error_bound", optional_number(job.analysis.max_relative_energy_error)}};
+          {"max_relative_error_bound", optional_number(run.analysis.max_relative_energy_error)}};
 }
 
 }  // namespace
 
 json run_summary(const RunFacts& facts) {
   const Job& job = facts.loaded.job;
-  const auto description = Integrator(job.integrator).describe();
+  const SingleRun& run = job.run();
+  const auto description = Integrator(run.integrator).describe();
   const RunOutcome& outcome = facts.outcome;
   json summary;
   summary["status"] = to_string(outcome.status);
@@ -57,24 +58,24 @@ json run_summary(const RunFacts& facts) {
                       {"path", facts.loaded.plugin.path().string()},
                       {"dimension", job.initial.dimension},
                       {"parameters", json(facts.loaded.model.parameters())}};
-  summary["hamiltonian"] = job.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
+  summary["hamiltonian"] = run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
   summary["integrator"] = {{"scheme", description.scheme},
                            {"order", description.order.to_string()},
                            {"t2", description.t2},
                            {"symplectic", description.symplectic},
                            {"time_reversible", description.time_reversible},
                            {"basic_steps_per_step", description.basic_steps_per_step}};
-  summary["time"] = {{"dt", job.time.dt},
-                     {"dt_requested", job.time.dt_requested},
-                     {"steps", job.time.steps},
-                     {"t_end", job.time.t_end},
+  summary["time"] = {{"dt", run.time.dt},
+                     {"dt_requested", run.time.dt_requested},
+                     {"steps", run.time.steps},
+                     {"t_end", run.time.t_end},
                      {"steps_completed", outcome.steps_completed}};
   summary["energy"] = energy_facts(facts);
   summary["output"] = {{"directory", facts.directory.string()},
                        {"trajectory", facts.samples_written ? json("trajectory.csv") : json(nullptr)},
                        {"trajectories", trajectories_file_name},
-                       {"every", job.every},
-                       {"energy_every", job.energy_every}};
+                       {"every", run.every},
+                       {"energy_every", run.energy_every}};
   summary["trajectories"] = job.initial.count;
   summary["counts"] = {{"completed", outcome.counts.completed},
                        {"diverged", outcome.counts.diverged},

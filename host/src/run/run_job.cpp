@@ -49,23 +49,24 @@ FolderUse folder_use(const RunOptions& options) {
 RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const Job& job = loaded.job;
+  const SingleRun& run = job.run();
   const std::filesystem::path& directory = options.output_directory;
   const RunFolder folder(directory, "run", job.file, folder_use(options));
   std::optional<Checkpoint> checkpoint;
   if (options.resume) checkpoint = load_checkpoint(directory / checkpoint_file_name, loaded);
 
   EnsembleDriver driver(loaded.plugin, loaded.model,
-                        {job.integrator, job.time, job.initial.dimension, job.initial.q, job.initial.p, options.threads,
+                        {run.integrator, run.time, job.initial.dimension, job.initial.q, job.initial.p, options.threads,
                          options.stop_requested});
   const std::size_t count = job.initial.count;
-  EnergyErrorObserver energy(count, driver.energy_available() ? job.energy_every : 0,
-                             job.analysis.max_relative_energy_error);
+  EnergyErrorObserver energy(count, driver.energy_available() ? run.energy_every : 0,
+                             run.analysis.max_relative_energy_error);
   std::optional<ClosestReturnObserver> closest;
-  if (job.analysis.closest_return_after)
-    closest.emplace(*job.analysis.closest_return_after, job.initial.dimension, job.initial.q, job.initial.p);
+  if (run.analysis.closest_return_after)
+    closest.emplace(*run.analysis.closest_return_after, job.initial.dimension, job.initial.q, job.initial.p);
   std::optional<SampleWriter> samples;
-  if (job.every > 0) {
-    samples.emplace(directory / SampleWriter::file_name, job.initial.dimension, count, job.every, driver.time(),
+  if (run.every > 0) {
+    samples.emplace(directory / SampleWriter::file_name, job.initial.dimension, count, run.every, driver.time(),
                     options.resume);
   } else {
     std::error_code ignored;
@@ -74,7 +75,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   std::vector<Observer*> observers{&energy};
   if (closest) observers.push_back(&*closest);
   if (samples) observers.push_back(&*samples);
-  CheckpointSaver saver(directory / checkpoint_file_name, job_fingerprint(loaded), job.checkpoint, driver, observers);
+  CheckpointSaver saver(directory / checkpoint_file_name, job_fingerprint(loaded), run.checkpoint, driver, observers);
   ProgressObserver progress(options.show_progress, driver, &energy);
   for (Observer* observer : observers) driver.add_observer(*observer);
   driver.add_observer(saver);
@@ -102,7 +103,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   if (!loaded.plugin.thread_safe() && options.threads != 1)
     outcome.notes.push_back("ran on one thread: the plugin '" + loaded.plugin.name() +
                             "' declares \"thread_safe\": false (plugin_abi.h)");
-  const RunFacts facts{loaded, directory, driver, outcome, job.every > 0,
+  const RunFacts facts{loaded, directory, driver, outcome, run.every > 0,
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
   outcome.summary = run_summary(facts);
   const auto fail = [&](const OutputError& error) {

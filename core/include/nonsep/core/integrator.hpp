@@ -1,18 +1,17 @@
 #pragma once
-// A runtime-chosen integrator: one of the schemes of the catalogue (integrator_description.hpp), built from a
-// scheme name, an order, t2 and the Hamiltonian form. This is what the host builds from a job file; code that
-// knows its method at compile time uses ChinBasicStep, TripletComposition or MultiProductExpansion directly.
+// A runtime-chosen integrator: one of the schemes of the catalogue (scheme_catalogue.hpp), built by the entry's
+// factory from a scheme name, an order, t2 and the Hamiltonian form. This is what the host builds from a job file;
+// code that knows its method at compile time uses ChinBasicStep, TripletComposition or MultiProductExpansion
+// directly.
 #include <string>
 #include <variant>
 
-#include "nonsep/core/chin_basic_step.hpp"
-#include "nonsep/core/multi_product_expansion.hpp"
-#include "nonsep/core/triplet_composition.hpp"
+#include "nonsep/core/scheme_catalogue.hpp"
 
 namespace nonsep {
 
 struct IntegratorSpec {
-  std::string scheme = "basic";  // "basic", "triplet", "mpe"
+  std::string scheme = "basic";  // a catalogue entry's name: "basic", "triplet", "mpe"
   Fraction order = Fraction(2, 3);
   double t2 = ChinCoefficients::default_t2();
   HamiltonianForm form = HamiltonianForm::TTV;
@@ -20,8 +19,8 @@ struct IntegratorSpec {
 
 class Integrator {
  public:
-  // Throws InvalidArgument naming the problem: unknown scheme (listing the known ones), an order the scheme
-  // does not have (listing the valid ones), t2 zero or not finite.
+  // Throws InvalidArgument naming the problem: t2 zero or not finite, unknown scheme (listing the known ones), an
+  // order the scheme does not have (listing the valid ones), checked in that order.
   explicit Integrator(const IntegratorSpec& spec);
 
   template <Model M>
@@ -37,11 +36,13 @@ class Integrator {
   }
   HamiltonianForm form() const { return form_; }
   const IntegratorSpec& spec() const { return spec_; }
+  // The stepper the catalogue entry built (TangentIntegrator maps it to its tangent map).
+  const SchemeStepper& stepper() const { return stepper_; }
 
  private:
   IntegratorSpec spec_;
   HamiltonianForm form_;
-  std::variant<ChinBasicStep, TripletComposition<ChinBasicStep>, MultiProductExpansion<ChinBasicStep>> stepper_;
+  SchemeStepper stepper_;
 };
 
 }  // namespace nonsep

@@ -1,10 +1,8 @@
 #pragma once
-// Integrators describe themselves. A SchemeDescription is the static catalogue entry of a method family
-// (what the JSON reader accepts and what `--help` prints); an IntegratorDescription describes one configured
-// instance (what a run reports in its summary).
+// Integrators describe themselves. A SchemeDescription is what the catalogue (scheme_catalogue.hpp) says about a
+// method family: what the JSON reader accepts and what `--help` and `nonsep schema` print; an IntegratorDescription
+// describes one configured instance (what a run reports in its summary).
 #include <cstdint>
-#include <optional>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -19,6 +17,8 @@ struct ParameterDescription {
   // Default as it would be written in a job file ("-1.8171205928321397", "2/3"). Empty: required.
   std::string default_text;
   std::string description;
+  // A Number that must not be 0 (t2). The scheme refuses 0 when it is built; the job schema states it.
+  bool nonzero = false;
 };
 
 struct SchemeDescription {
@@ -29,6 +29,9 @@ struct SchemeDescription {
   bool symplectic = true;
   bool time_reversible = true;
   std::vector<ParameterDescription> parameters;
+  // The orders the scheme has: 2j/3 for j = 1 .. highest_order_index (basic 1, triplet 13, mpe 16).
+  int highest_order_index = 1;
+  std::vector<Fraction> orders() const;
 };
 
 struct IntegratorDescription {
@@ -40,14 +43,11 @@ struct IntegratorDescription {
   double t2 = 0.0;
 };
 
-// Every scheme the core provides, in a fixed order.
-std::span<const SchemeDescription> scheme_catalogue();
-// The catalogue entry named `name`, or nothing.
-std::optional<SchemeDescription> find_scheme(const std::string& name);
-
 // Orders of the paper's family are 2j/3, j = 1, 2, 3, ... (2/3, 4/3, 2, 8/3, 10/3, 4, ...).
 // Returns j for a valid order; throws InvalidArgument naming the order and listing the valid ones otherwise,
 // or if j exceeds `max_j` (the practical limit of a scheme, named in the message as `what`).
 int chin_order_index(const Fraction& order, int max_j, const std::string& what);
+// How messages and descriptions name those orders: "2/3, 4/3, 2, 8/3, 10/3, 4, ... (2j/3 for j = 1, 2, 3, ...)".
+std::string chin_orders_text();
 
 }  // namespace nonsep

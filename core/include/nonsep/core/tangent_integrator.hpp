@@ -1,7 +1,7 @@
 #pragma once
 // A runtime-chosen tangent stepper: the tangent map of the integrator an IntegratorSpec describes (the scheme of
-// a job file), for diagnostics that follow tangent vectors (lyapunov_exponents.hpp, megno.hpp). The states are
-// stepped bit for bit as Integrator(spec) steps them.
+// a job file, built by its catalogue entry), for diagnostics that follow tangent vectors (lyapunov_exponents.hpp,
+// megno.hpp). The states are stepped bit for bit as Integrator(spec) steps them.
 #include <variant>
 
 #include "nonsep/core/integrator.hpp"
@@ -11,9 +11,19 @@
 
 namespace nonsep {
 
+// The tangent map of each stepper type a catalogue entry builds (SchemeStepper): the states stepped bit for bit as
+// the stepper steps them.
+inline TangentBasicStep tangent_map_of(const ChinBasicStep& stepper) { return TangentBasicStep(stepper); }
+inline TangentTripletComposition tangent_map_of(const TripletComposition<ChinBasicStep>& stepper) {
+  return TangentTripletComposition(stepper);
+}
+inline TangentMultiProductExpansion tangent_map_of(const MultiProductExpansion<ChinBasicStep>& stepper) {
+  return TangentMultiProductExpansion(stepper);
+}
+
 class TangentIntegrator {
  public:
-  // Throws InvalidArgument as Integrator(spec) does (unknown scheme, an order the scheme does not have, bad t2).
+  // Throws InvalidArgument as Integrator(spec) does (bad t2, unknown scheme, an order the scheme does not have).
   explicit TangentIntegrator(const IntegratorSpec& spec) : spec_(spec), stepper_(make(spec)) {}
 
   const IntegratorSpec& spec() const { return spec_; }
@@ -33,12 +43,10 @@ class TangentIntegrator {
 
  private:
   using Stepper = std::variant<TangentBasicStep, TangentTripletComposition, TangentMultiProductExpansion>;
+  // Built by the catalogue, through Integrator, and mapped to its tangent map.
   static Stepper make(const IntegratorSpec& spec) {
-    const Integrator validated(spec);
-    const ChinBasicStep base(spec.form, spec.t2);
-    if (spec.scheme == "triplet") return TangentTripletComposition(TripletComposition<>::for_order(base, spec.order));
-    if (spec.scheme == "mpe") return TangentMultiProductExpansion(MultiProductExpansion<>::for_order(base, spec.order));
-    return TangentBasicStep(base);
+    return std::visit([](const auto& stepper) -> Stepper { return tangent_map_of(stepper); },
+                      Integrator(spec).stepper());
   }
 
   IntegratorSpec spec_;

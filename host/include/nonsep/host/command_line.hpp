@@ -1,5 +1,5 @@
 #pragma once
-// The `nonsep` command line: run, validate, inspect, models, --version (CLI11). main() is a call to this.
+// The `nonsep` command line: run, validate, inspect, models, schema, --version (CLI11). main() is a call to this.
 namespace nonsep::host {
 
 // Parses argv, runs the command and returns the process exit status (exit_status.hpp): 0, 1, 2, 130 or 143.

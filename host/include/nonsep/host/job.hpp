@@ -6,7 +6,7 @@
 //   1. parse_job_text  strict JSON: syntax (with line and column), duplicate keys, at most max_nesting_depth levels.
 //   2. parse_job       structure and values that need no plugin: unknown keys, types, required keys, ranges,
 //                      integrator options against nonsep::scheme_catalogue(), the time grid, initial states.
-//                      The result, Job, is plain data.
+//                      The result, Job, is plain data: a std::variant of a single run and a study.
 //   3. load_model      the plugin: it must load (/model/plugin), the parameters must match its metadata
 //                      (/model/parameters/<name>), and the states must have the model's dimension (/initial/...).
 // read_job is passes 1 and 2 on a file (at most max_job_file_bytes); load_job is all three, reporting the
@@ -18,6 +18,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -58,7 +59,7 @@ struct InitialStates {
   std::vector<double> q, p;
 };
 
-// A convergence study (/study): the job's model and initial state are run to time.t_end by each integrator at
+// A convergence study (/study): the job's model and initial state are run to /time/t_end by each integrator at
 // each of its step counts, and the errors at t_end are compared (study.hpp). Step counts are per integrator: the
 // study's list (/study/steps, or /study/dt turned into counts as TimeGrid does) unless the integrator gives its own.
 struct StudyIntegrator {
@@ -68,6 +69,8 @@ struct StudyIntegrator {
   std::string steps_from;      // where the counts came from: "study.steps", "study.dt", "integrator.steps", ...
 };
 struct Study {
+  HamiltonianForm form = HamiltonianForm::TTV;  // /hamiltonian, shared by every integrator
+  double t_end = 0.0;                           // /time/t_end
   std::vector<StudyIntegrator> integrators;
   // /study/reference: the exact state at t_end, for the phase-space error; empty when not given.
   std::vector<double> reference_q, reference_p;
@@ -91,22 +94,31 @@ struct CheckpointPolicy {
   double every_seconds = 60.0;
 };
 
+// A single run (a job without /study): one integrator over one time grid for every initial state.
+struct SingleRun {
+  IntegratorSpec integrator;  // /hamiltonian and /integrator, defaults filled in from the catalogue
+  TimeGrid time;
+  std::uint64_t every = 1;                 // /output/every; 0: no trajectory file
+  std::uint64_t energy_every = 0;          // /output/energy_every; 0: H only at samples, start and end
+  Analysis analysis;                       // /analysis
+  CheckpointPolicy checkpoint;             // /checkpoint
+};
+
 struct Job {
   std::filesystem::path file;       // the job file as given
   std::filesystem::path directory;  // its folder: relative paths in the job resolve against it
   std::string plugin;               // /model/plugin: a name or a path
   nlohmann::json parameters = nlohmann::json::object();  // /model/parameters as written
-  IntegratorSpec integrator;        // /hamiltonian and /integrator, defaults filled in from the catalogue
-  InitialStates initial;
-  TimeGrid time;
+  InitialStates initial;            // a study has exactly one state
   std::filesystem::path output_directory;  // /output/directory resolved against `directory`
-  std::uint64_t every = 1;                 // /output/every; 0: no trajectory file
-  std::uint64_t energy_every = 0;          // /output/energy_every; 0: H only at samples, start and end
-  Analysis analysis;                       // /analysis (single runs only)
-  // /study: present for a convergence study, which has no /integrator, no /time/dt and exactly one initial state;
-  // `integrator` and `time.dt` are then unused and time.t_end is the study's end time.
-  std::optional<Study> study;
-  CheckpointPolicy checkpoint;             // /checkpoint
+  // What the job does: a single run, or a convergence study (/study, which has no /integrator, /analysis or
+  // /checkpoint and a /time of its own).
+  std::variant<SingleRun, Study> plan;
+
+  bool is_study() const { return std::holds_alternative<Study>(plan); }
+  // The plan as the kind the caller has checked it is (std::bad_variant_access otherwise: a programming error).
+  const SingleRun& run() const { return std::get<SingleRun>(plan); }
+  const Study& study() const { return std::get<Study>(plan); }
 };
 
 // Largest accepted number of initial states and of steps; larger values are reported as out of range.

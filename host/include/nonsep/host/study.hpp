@@ -13,9 +13,16 @@
 //     at the nominal order); the same for the phase error when a
 //     reference is given; the range of dt and steps fitted and whether the energy error changed sign in it.
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
+#include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "nonsep/core/integrator_description.hpp"
+#include "nonsep/core/model.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/run/run_job.hpp"
 
@@ -32,10 +39,58 @@ struct PowerLawFit {
 // such pairs or when all their dt are equal. `dt` and `error` have the same length.
 std::optional<PowerLawFit> fit_power_law(std::span<const double> dt, std::span<const double> error);
 
-// Runs the study of `job` (job.job.study must be set). Throws OutputError, before anything is computed, when the
+// One run of a study: one integrator at one step count.
+struct StudyRun {
+  std::uint64_t steps = 0;
+  double dt = 0.0;
+  TrajectoryStatus status = TrajectoryStatus::completed;  // completed, diverged, failed or interrupted
+  std::string error;  // why it diverged or failed; "" otherwise
+  std::uint64_t basic_steps = 0;
+  EvaluationCounts evaluations;
+  std::optional<double> relative_energy_error, phase_error;  // at t_end; completed runs only
+};
+
+// The fits of one integrator over its completed runs (summary.json "fits"). Values that cannot be fitted (fewer
+// than two usable points) are empty; the phase fit exists only with /study/reference.
+struct StudyFit {
+  std::string integrator;            // the label
+  IntegratorDescription description;  // scheme, order (the nominal exponent), t2, symplectic
+  std::string steps_from;
+  std::size_t points = 0;  // runs with a finite, non-zero energy error
+  std::optional<double> exponent, constant, constant_at_nominal_exponent;
+  bool energy_error_changes_sign = false;
+  // Where round-off shows: the smallest |energy error| fitted, and how many times the |error| at the smallest dt
+  // exceeds the nominal power law through the largest dt (about 1 in the asymptotic range; round-off, which
+  // flattens the errors, makes it large).
+  std::optional<double> energy_error_smallest, energy_error_excess_at_smallest_dt;
+  std::optional<double> dt_min, dt_max;  // by |dt|, over the completed runs
+  std::optional<std::uint64_t> steps_min, steps_max;
+  bool with_reference = false;
+  std::optional<double> phase_exponent, phase_constant;
+};
+
+// What a study ended with: its status, its runs per integrator (in the order of /study/integrators, each in step
+// order) and their fits. summary.json is written from these.
+struct StudyOutcome {
+  ExitStatus exit_status = ExitStatus::success;  // success, run_failed or interrupted
+  TrajectoryStatus status = TrajectoryStatus::completed;  // interrupted, failed, diverged or completed
+  std::string error;  // why the study as a whole failed (the plugin, an output); "" otherwise
+  StatusCounts run_counts;
+  std::vector<StudyFit> fits;                 // one per integrator
+  std::vector<std::vector<StudyRun>> runs;    // per integrator, as fits
+  nlohmann::ordered_json summary;             // what summary.json holds
+};
+
+// The fits of `runs`, the runs of `integrator` (described by `description`); `with_reference` adds the phase fit.
+StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescription& description,
+                   const std::vector<StudyRun>& runs, bool with_reference);
+// fit as summary.json's "fits" entry.
+nlohmann::ordered_json to_json(const StudyFit& fit);
+
+// Runs the study of `job` (job.job.is_study() must hold). Throws OutputError, before anything is computed, when the
 // output folder or convergence.csv cannot be created. A run that diverges or that the plugin fails on is a row
 // with that status, left out of the fits, and makes the exit status run_failed; SIGINT (options.stop_requested)
 // stops after the current step with status "interrupted". summary.json is written in every case.
-RunOutcome run_study(const LoadedJob& job, const RunOptions& options);
+StudyOutcome run_study(const LoadedJob& job, const RunOptions& options);
 
 }  // namespace nonsep::host

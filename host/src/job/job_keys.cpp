@@ -1,0 +1,231 @@
+// The key tables of job files (job_keys.hpp). Descriptions are the schema's; the limits are the reader's own
+// constants (job.hpp, time_grid.hpp).
+#include "job_keys.hpp"
+
+#include <limits>
+#include <stdexcept>
+
+#include "nonsep/host/job.hpp"
+
+namespace nonsep::host::job_reader {
+
+namespace {
+constexpr std::int64_t steps_limit = static_cast<std::int64_t>(max_steps);
+constexpr std::int64_t int64_limit = std::numeric_limits<std::int64_t>::max();
+constexpr std::int64_t states_limit = static_cast<std::int64_t>(max_initial_states);
+}  // namespace
+
+std::vector<std::string> KeyTable::names() const {
+  std::vector<std::string> names;
+  for (const auto& rule : rules) names.push_back(rule.name);
+  return names;
+}
+
+std::vector<std::string> KeyTable::required() const {
+  std::vector<std::string> names;
+  for (const auto& rule : rules)
+    if (rule.required) names.push_back(rule.name);
+  return names;
+}
+
+const KeyRule& KeyTable::operator[](std::string_view name) const {
+  for (const auto& rule : rules)
+    if (rule.name == name) return rule;
+  throw std::logic_error("the job reader has no rule for the key \"" + std::string(name) + "\"");
+}
+
+const KeyTable& document_keys() {
+  static const KeyTable table{{
+      {.name = "$schema", .type = ValueType::string,
+       .description = "The schema the file follows (for editors); ignored by nonsep."},
+      {.name = "description", .type = ValueType::text, .description = "Free text; ignored by nonsep."},
+      {.name = "model", .type = ValueType::object, .required = true, .description = "The model plugin.",
+       .keys = model_keys},
+      {.name = "hamiltonian", .type = ValueType::form, .default_value = "TTV",
+       .description = "TTV: H = T_i(p) V_ij(q) T_j(p); VVT: H = V_i(q) T_ij(p) V_j(q)."},
+      {.name = "integrator", .type = ValueType::defined,
+       .description = "The scheme and its options (a run; required there, refused in a study).",
+       .definition = "integrator", .run_only = true, .in_study_found = "an integrator together with /study",
+       .in_study_allowed = "no /integrator in a study: each entry of /study/integrators is one"},
+      {.name = "initial", .type = ValueType::defined, .required = true,
+       .description = "One state, a non-empty array of states (an ensemble), or a grid of states; a study has one "
+                      "state.",
+       .definition = "initial"},
+      {.name = "time", .type = ValueType::object, .required = true,
+       .description = "The time grid: {dt, t_end or steps} for a run, {t_end} for a study."},
+      {.name = "output", .type = ValueType::object, .description = "Where results go.", .keys = output_keys},
+      {.name = "analysis", .type = ValueType::object,
+       .description = "Per-trajectory analysis of a run (not of a study).", .keys = analysis_keys,
+       .run_only = true, .in_study_found = "an analysis together with /study",
+       .in_study_allowed = "/analysis in single runs only"},
+      {.name = "study", .type = ValueType::object,
+       .description = "A convergence study: each integrator runs from the one initial state to time.t_end at each of "
+                      "its step counts; outputs convergence.csv and the fitted exponents in summary.json. Step "
+                      "counts come from the integrator's own steps or dt, else from the study's.",
+       .keys = study_keys},
+      {.name = "checkpoint", .type = ValueType::object,
+       .description = "When checkpoint.json is saved in the output folder, for `nonsep run JOB --resume`. Always "
+                      "saved when a run is interrupted. Runs only: a study is not resumed.",
+       .keys = checkpoint_keys, .run_only = true, .in_study_found = "a checkpoint policy together with /study",
+       .in_study_allowed = "/checkpoint in single runs only (a study is not resumed)"},
+  }};
+  return table;
+}
+
+const KeyTable& model_keys() {
+  static const KeyTable table{{
+      {.name = "plugin", .type = ValueType::path, .required = true,
+       .description = "A plugin name (looked up as <name>.so on the search path, see `nonsep models`) or a path to a "
+                      ".so file (contains '/' or ends in .so; relative to the job file's folder)."},
+      {.name = "parameters", .type = ValueType::defined, .default_value = nlohmann::ordered_json::object(),
+       .description = "The plugin's parameters by name (see `nonsep inspect PLUGIN`); missing ones take the "
+                      "plugin's defaults.",
+       .definition = "parameters"},
+  }};
+  return table;
+}
+
+const KeyTable& run_time_keys() {
+  static const KeyTable table{{
+      {.name = "dt", .type = ValueType::nonzero, .required = true,
+       .description = "Time step; negative integrates backwards (t_end must then be negative too)."},
+      {.name = "t_end", .type = ValueType::nonzero,
+       .description = "End time, same sign as dt. steps = ceil((t_end/dt)(1 - 1e-9)), and the step actually used "
+                      "is t_end/steps, so the run ends exactly at t_end."},
+      {.name = "steps", .type = ValueType::integer, .minimum = 1, .maximum = steps_limit,
+       .description = "Number of steps of exactly dt."},
+  }};
+  return table;
+}
+
+const KeyTable& study_time_keys() {
+  static const KeyTable table{{
+      {.name = "t_end", .type = ValueType::nonzero, .required = true,
+       .description = "The end time of every run of the study."},
+  }};
+  return table;
+}
+
+const KeyTable& output_keys() {
+  static const KeyTable table{{
+      {.name = "directory", .type = ValueType::path,
+       .description = "Output folder, relative to the job file's folder; default <job file name without .json>.out "
+                      "beside the job file. `nonsep run --output DIR` overrides it."},
+      {.name = "every", .type = ValueType::integer, .minimum = 0, .maximum = int64_limit, .default_value = 1,
+       .description = "trajectory.csv gets steps 0, every, 2 every, ... and the final step; 0 writes no "
+                      "trajectory.csv."},
+      {.name = "energy_every", .type = ValueType::integer, .minimum = 0, .maximum = int64_limit,
+       .default_value = 0,
+       .description = "H is evaluated at step 0, at every written sample and at the end; energy_every > 0 also "
+                      "evaluates it every energy_every-th step. Costs about a step's work per evaluation."},
+  }};
+  return table;
+}
+
+const KeyTable& analysis_keys() {
+  static const KeyTable table{{
+      {.name = "closest_return_after", .type = ValueType::finite,
+       .description = "From |t| >= this time on, the smallest Euclidean phase-space distance |(q, p) - (q0, p0)| "
+                      "of each trajectory to its initial state is tracked at every step (trajectories.csv: "
+                      "closest_return_distance, _t, _step)."},
+      {.name = "max_relative_energy_error", .type = ValueType::positive,
+       .description = "A bound on the relative energy error |H(t) - H0| / |H0|: a trajectory that exceeds it is "
+                      "retired with status \"inaccurate\". Absent: no bound."},
+  }};
+  return table;
+}
+
+const KeyTable& checkpoint_keys() {
+  static const KeyTable table{{
+      {.name = "every_steps", .type = ValueType::integer, .minimum = 0, .maximum = steps_limit, .default_value = 0,
+       .description = "Save a checkpoint every n steps; 0: not by steps."},
+      {.name = "every_seconds", .type = ValueType::nonnegative, .default_value = 60,
+       .description = "Save a checkpoint when this many seconds of wall time have passed since the last one; 0: "
+                      "not by time."},
+  }};
+  return table;
+}
+
+const KeyTable& study_keys() {
+  static const KeyTable table{{
+      {.name = "integrators", .type = ValueType::defined, .required = true,
+       .description = "The integrators, each as /integrator of a run with an optional label and its own steps or "
+                      "dt.",
+       .definition = "study_integrators"},
+      {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
+      {.name = "dt", .type = ValueType::defined, .definition = "step_sizes"},
+      {.name = "reference", .type = ValueType::defined,
+       .description = "The exact state at t_end: convergence.csv then has each run's phase-space error "
+                      "|(q, p) - (q_ref, p_ref)|, and the fits its exponent.",
+       .definition = "state"},
+  }};
+  return table;
+}
+
+const KeyTable& study_integrator_keys() {
+  static const KeyTable table{{
+      {.name = "label", .type = ValueType::string,
+       .description = "The integrator's name in convergence.csv and the fits; default \"<scheme> <order>\" "
+                      "(\"basic\" for the basic step); distinct per integrator."},
+      {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
+      {.name = "dt", .type = ValueType::defined, .definition = "step_sizes"},
+  }};
+  return table;
+}
+
+const KeyTable& state_keys() {
+  static const KeyTable table{{
+      {.name = "q", .type = ValueType::defined, .required = true,
+       .description = "Positions, one per degree of freedom.", .definition = "vector"},
+      {.name = "p", .type = ValueType::defined, .required = true, .description = "Momenta, as many as q.",
+       .definition = "vector"},
+  }};
+  return table;
+}
+
+const KeyTable& initial_grid_keys() {
+  static const KeyTable table{{
+      {.name = "grid", .type = ValueType::object, .required = true,
+       .description = "One axis per component of q and of p; the states are every combination, in row-major order "
+                      "over q0, q1, ..., p0, p1, ... (the last axis varies fastest). At most " +
+                          std::to_string(max_initial_states) + " states, and at most " +
+                          std::to_string(max_initial_values) + " numbers in q (states times dimension).",
+       .keys = grid_keys},
+  }};
+  return table;
+}
+
+const KeyTable& grid_keys() {
+  static const KeyTable table{{
+      {.name = "q", .type = ValueType::defined, .required = true, .description = "The axes of q0, q1, ...",
+       .definition = "axes"},
+      {.name = "p", .type = ValueType::defined, .required = true, .description = "The axes of p0, p1, ...",
+       .definition = "axes"},
+  }};
+  return table;
+}
+
+const KeyTable& range_axis_keys() {
+  static const KeyTable table{{
+      {.name = "from", .type = ValueType::finite, .required = true, .description = "The first value."},
+      {.name = "to", .type = ValueType::finite, .required = true, .description = "The last value."},
+      {.name = "count", .type = ValueType::integer, .required = true, .minimum = 1, .maximum = states_limit,
+       .description = "The number of values."},
+  }};
+  return table;
+}
+
+const KeyTable& values_axis_keys() {
+  static const KeyTable table{{
+      {.name = "values", .type = ValueType::defined, .required = true, .description = "The values listed.",
+       .definition = "vector"},
+  }};
+  return table;
+}
+
+const std::vector<FormName>& hamiltonian_forms() {
+  static const std::vector<FormName> forms{{"TTV", HamiltonianForm::TTV}, {"VVT", HamiltonianForm::VVT}};
+  return forms;
+}
+
+}  // namespace nonsep::host::job_reader

@@ -1,0 +1,84 @@
+#pragma once
+// Internal to the job reader (host/src/job/): the keys of every object of a job file, with their types, integer
+// ranges, defaults and whether they are required. The section readers take their known-key lists, required flags,
+// integer ranges and the keys a study refuses from these tables, and `nonsep schema` (job_schema.cpp) writes
+// schemas/job.schema.json from the same tables and the scheme catalogue, so the schema cannot drift from the
+// reader. The types of numbers are checked by the readers' own calls (each with its own message);
+// tests/host/test_host_job_schema.cpp holds the readers to the types written here. Other messages stay with the
+// readers.
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nonsep/core/chin_basic_step.hpp"
+
+namespace nonsep::host::job_reader {
+
+enum class ValueType {
+  object,       // an object whose keys are `keys` (or, without `keys`, any object: /time, checked per kind of job)
+  text,         // any string (/description)
+  string,       // a non-empty string
+  path,         // a non-empty string without NUL (U+0000)
+  finite,       // a finite number
+  nonzero,      // a finite non-zero number
+  positive,     // a finite number > 0
+  nonnegative,  // a finite number >= 0
+  integer,      // an integral number (10.0 counts) within [minimum, maximum]
+  form,         // one of hamiltonian_forms()
+  defined,      // a shape of its own, $defs/<definition> of the schema (states, axes, integrators, step lists)
+};
+
+struct KeyTable;
+
+struct KeyRule {
+  std::string name = {};
+  ValueType type = ValueType::finite;
+  bool required = false;
+  std::int64_t minimum = 0, maximum = 0;   // ValueType::integer
+  nlohmann::ordered_json default_value = nullptr;  // as a job file would write it; null: no default
+  std::string description = {};  // for the schema
+  const KeyTable& (*keys)() = nullptr;      // ValueType::object
+  std::string definition = {};   // ValueType::defined
+  // A document key refused in a study: what the issue says was found and what is allowed instead.
+  bool run_only = false;
+  std::string in_study_found = {}, in_study_allowed = {};
+};
+
+// The keys of one kind of object, in the order messages list them ("only the keys ...").
+struct KeyTable {
+  std::vector<KeyRule> rules;
+  std::vector<std::string> names() const;
+  std::vector<std::string> required() const;
+  // The rule named `name`; a name without a rule is a programming error (std::logic_error).
+  const KeyRule& operator[](std::string_view name) const;
+};
+
+// The document and its sections.
+const KeyTable& document_keys();
+const KeyTable& model_keys();
+const KeyTable& run_time_keys();      // a run's /time: "dt" and exactly one of "t_end", "steps"
+const KeyTable& study_time_keys();    // a study's /time
+const KeyTable& output_keys();
+const KeyTable& analysis_keys();
+const KeyTable& checkpoint_keys();
+const KeyTable& study_keys();         // at most one of "steps", "dt"
+// The keys a study's integrator has besides the scheme's options (at most one of "steps", "dt").
+const KeyTable& study_integrator_keys();
+// /initial and the states of /study/reference.
+const KeyTable& state_keys();
+const KeyTable& initial_grid_keys();  // {"grid": ...}
+const KeyTable& grid_keys();          // {"q": axes, "p": axes}
+const KeyTable& range_axis_keys();    // {"from", "to", "count"}
+const KeyTable& values_axis_keys();   // {"values"}
+
+// The names of /hamiltonian, the default first.
+struct FormName {
+  const char* name;
+  HamiltonianForm form;
+};
+const std::vector<FormName>& hamiltonian_forms();
+
+}  // namespace nonsep::host::job_reader

@@ -1,0 +1,157 @@
+// The generated job schema against the reader: the schema is generated from the reader's key tables, and these
+// tests check that the reader really applies what the schema states (ranges, signs, defaults, required keys), so
+// that a table entry the reader ignored would fail here. schemas/job.schema.json being exactly this output is
+// checked by the host.schema test.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "host_test_support.hpp"
+#include "nonsep/core/scheme_catalogue.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/job_schema.hpp"
+
+using nlohmann::json;
+using namespace nonsep;
+using namespace nonsep::host;
+
+namespace {
+
+std::vector<JobIssue> issues_of(const json& document) {
+  std::vector<JobIssue> issues;
+  parse_job(document, "/jobs/test.json", issues);
+  return issues;
+}
+
+bool names(const std::vector<JobIssue>& issues, const std::string& path) {
+  return std::any_of(issues.begin(), issues.end(), [&](const JobIssue& issue) { return issue.path == path; });
+}
+
+// A valid run with every optional section present, so that each value can be varied alone.
+json full_run() {
+  json job = host_testing::quickstart_job();
+  job["time"] = {{"dt", 0.005}, {"steps", 10}};
+  job["output"] = {{"every", 1}, {"energy_every", 0}};
+  job["checkpoint"] = {{"every_steps", 0}, {"every_seconds", 60}};
+  job["analysis"] = {{"closest_return_after", 0.1}, {"max_relative_energy_error", 0.5}};
+  return job;
+}
+
+// The schema of the value at `pointer` of a run (following $ref into $defs once, as the generator writes them).
+json property_schema(const json& schema, const std::string& section, const std::string& key) {
+  json object = schema["properties"][section];
+  if (section == "time") object = schema["$defs"]["run_time"];
+  return object["properties"][key];
+}
+
+}  // namespace
+
+TEST_CASE("the schema's ranges of numbers and integers are the reader's") {
+  const json schema = job_schema();
+  const json finite = schema["$defs"]["finite"];
+  int checked = 0;
+  for (const auto& [section, key] : std::vector<std::pair<std::string, std::string>>{
+           {"time", "dt"}, {"time", "steps"}, {"output", "every"}, {"output", "energy_every"},
+           {"checkpoint", "every_steps"}, {"checkpoint", "every_seconds"}, {"analysis", "closest_return_after"},
+           {"analysis", "max_relative_energy_error"}}) {
+    const std::string path = "/" + section + "/" + key;
+    CAPTURE(path);
+    const json rule = property_schema(schema, section, key);
+    REQUIRE(rule.is_object());
+    const auto accepted = [&](const json& value) {
+      json job = full_run();
+      job[section][key] = value;
+      return !names(issues_of(job), path);
+    };
+    CHECK(accepted(full_run()[section][key]));
+    if (rule.contains("minimum") && rule["type"] == "integer") {
+      const auto minimum = rule["minimum"].get<std::int64_t>(), maximum = rule["maximum"].get<std::int64_t>();
+      CHECK(accepted(minimum));
+      CHECK_FALSE(accepted(minimum - 1));
+      CHECK(accepted(maximum));
+      CHECK_FALSE(accepted(json(static_cast<std::uint64_t>(maximum) + 1)));
+      CHECK_FALSE(accepted(static_cast<double>(minimum) + 0.5));
+      ++checked;
+      continue;
+    }
+    REQUIRE(rule.contains("$ref"));
+    CHECK_FALSE(accepted("1"));
+    CHECK(accepted(finite["maximum"]));
+    if (rule["$ref"] == "#/$defs/nonzero") CHECK_FALSE(accepted(0.0));
+    if (rule.contains("exclusiveMinimum")) {
+      CHECK_FALSE(accepted(rule["exclusiveMinimum"]));
+      CHECK(accepted(rule["exclusiveMinimum"].get<double>() + 1e-9));
+    }
+    if (rule.contains("minimum")) {
+      CHECK(accepted(rule["minimum"]));
+      CHECK_FALSE(accepted(rule["minimum"].get<double>() - 1e-9));
+    }
+    if (!rule.contains("minimum") && !rule.contains("exclusiveMinimum") && rule["$ref"] == "#/$defs/finite")
+      CHECK(accepted(finite["minimum"]));
+    ++checked;
+  }
+  CHECK(checked == 8);
+}
+
+TEST_CASE("the schema's defaults are what the reader fills in, and its required keys are required") {
+  const json schema = job_schema();
+  std::vector<JobIssue> issues;
+  const Job job = parse_job(host_testing::quickstart_job(), "/jobs/test.json", issues);
+  REQUIRE(issues.empty());
+  const json& properties = schema["properties"];
+  CHECK(properties["output"]["properties"]["every"]["default"] == job.run().every);
+  CHECK(properties["output"]["properties"]["energy_every"]["default"] == job.run().energy_every);
+  CHECK(properties["checkpoint"]["properties"]["every_steps"]["default"] == job.run().checkpoint.every_steps);
+  CHECK(properties["checkpoint"]["properties"]["every_seconds"]["default"] == job.run().checkpoint.every_seconds);
+  CHECK(properties["hamiltonian"]["default"] == "TTV");
+  CHECK(properties["hamiltonian"]["enum"] == json{"TTV", "VVT"});
+  for (const std::string form : {"TTV", "VVT"}) {
+    json document = host_testing::quickstart_job();
+    document["hamiltonian"] = form;
+    CHECK(issues_of(document).empty());
+  }
+  for (const auto& key : schema["required"]) {
+    json document = host_testing::quickstart_job();
+    document.erase(key.get<std::string>());
+    CHECK(names(issues_of(document), "/" + key.get<std::string>()));
+  }
+  // Every key the schema allows at the top level is known to the reader, and an unknown one is refused by both.
+  for (const auto& [key, value] : properties.items()) {
+    json document = full_run();
+    if (!document.contains(key)) document[key] = nullptr;
+    const auto problems = issues_of(document);
+    CHECK_FALSE(std::any_of(problems.begin(), problems.end(), [&](const JobIssue& issue) {
+      return issue.path == "/" + key && issue.found.find("unknown key") != std::string::npos;
+    }));
+  }
+  CHECK(schema["additionalProperties"] == false);
+}
+
+TEST_CASE("the schema's integrator options are the catalogue's, with its defaults") {
+  const json schema = job_schema();
+  const json& integrator = schema["$defs"]["integrator"];
+  std::vector<std::string> names_in_schema = integrator["properties"]["scheme"]["enum"];
+  REQUIRE(names_in_schema.size() == scheme_catalogue().size());
+  for (std::size_t i = 0; i < scheme_catalogue().size(); ++i) {
+    const Scheme& scheme = scheme_catalogue()[i];
+    CAPTURE(scheme.name);
+    CHECK(names_in_schema[i] == scheme.name);
+    const json& branch = integrator["allOf"][i];
+    CHECK(branch["if"]["properties"]["scheme"]["const"] == scheme.name);
+    const json& options = branch["then"]["properties"];
+    CHECK(options.size() == scheme.parameters.size() + 1);
+    for (const auto& parameter : scheme.parameters) {
+      CAPTURE(parameter.name);
+      REQUIRE(options.contains(parameter.name));
+      const json& option = options[parameter.name];
+      if (parameter.kind == ParameterDescription::Kind::Order) {
+        CHECK(option["default"] == parameter.default_text);
+        CHECK(option["examples"].size() == static_cast<std::size_t>(scheme.highest_order_index));
+      } else {
+        CHECK(option["default"].get<double>() == std::stod(parameter.default_text));
+      }
+    }
+  }
+}
