@@ -199,8 +199,9 @@ InitialStates read_initial(Checker& check, const json& document) {
     }
   } else if (initial->is_object() && initial->contains("grid")) {
     states.shape = "grid";
-    check.known_keys(*initial, "/initial", {"grid"});
+    check.known_keys(*initial, "/initial", {"grid", "energy", "solve_for"});
     read_grid(check, (*initial)["grid"], states);
+    read_energy_shell(check, *initial, states);
   } else if (initial->is_object()) {
     states.shape = "single";
     read_state(check, *initial, "/initial", states, "/initial");

@@ -101,10 +101,16 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
     return std::nullopt;
   }
   check_dimension(checked.initial, loaded.model.dimension(), issues);
+  if (issues.size() == before) place_on_energy_shell(loaded, issues);
   if (const std::size_t n = loaded.model.dimension(); loaded.plugin.has_hessians() && n > max_hessian_values / n)
     issues.push_back({"/model", "a model of dimension " + std::to_string(n) + ", whose Hessian (for H) would take " +
                                     gibibytes(n * n * sizeof(double)) + " GiB",
                       "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians"});
+  if (const std::size_t k = checked.analysis.tangent_vectors(); k > 0 && !loaded.plugin.has_hessians())
+    issues.push_back({checked.analysis.lyapunov ? "/analysis/lyapunov" : "/analysis/megno",
+                      "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
+                      "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them by "
+                      "automatic differentiation)"});
   if (issues.size() != before) return std::nullopt;
   return loaded;
 }

@@ -49,7 +49,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     job.integrator = read_integrator(check, document, form);
     job.time = read_time(check, document);
     if (const json* analysis = check.member(document, "", "analysis", false, ""))
-      job.analysis = read_analysis(check, *analysis);
+      job.analysis = read_analysis(check, *analysis, job.initial.dimension);
   }
   read_output(check, document, job);
   if (const json* checkpoint = check.member(document, "", "checkpoint", false, ""))
