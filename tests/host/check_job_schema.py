@@ -77,6 +77,30 @@ def main():
                 if default is None or (default != default_text and not (isinstance(default, float) and default == float(default_text))):
                     failures.append(f"{where}: schema default of {name}.{option} is {default!r}, the catalogue's is {default_text}")
 
+    # The keys of /analysis and of its objects: the reader's (as `nonsep validate` lists them for an unknown key)
+    # against the schema's properties.
+    base = {"model": {"plugin": "paper2d"}, "integrator": {"scheme": "basic"},
+            "initial": {"q": [0.25, 0.3], "p": [-1.5, 0.2]}, "time": {"dt": 0.01, "steps": 1}}
+    analysis_schema = schema["properties"]["analysis"]
+    for where, analysis, properties in (
+            ("/analysis", {"unknown_key": 1}, analysis_schema["properties"]),
+            ("/analysis/poincare", {"poincare": {"component": "q0", "unknown_key": 1}},
+             analysis_schema["properties"]["poincare"]["properties"]),
+            ("/analysis/lyapunov", {"lyapunov": {"unknown_key": 1}},
+             analysis_schema["properties"]["lyapunov"]["properties"])):
+        job_path = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"nonsep_schema_keys_{os.getpid()}.json")
+        with open(job_path, "w") as file:
+            json.dump(dict(base, analysis=analysis), file)
+        result = subprocess.run([args.nonsep, "validate", job_path], capture_output=True, text=True, timeout=60)
+        os.remove(job_path)
+        match = re.search(re.escape(where) + r"/unknown_key: .*allowed: only the keys? (.*)", result.stderr)
+        if not match:
+            failures.append(f"{where}: `nonsep validate` did not list the allowed keys:\n{result.stderr}")
+            continue
+        reader_keys = sorted(key.strip() for key in match.group(1).split(","))
+        if reader_keys != sorted(properties):
+            failures.append(f"{where}: the reader accepts {reader_keys}, the schema {sorted(properties)}")
+
     for failure in failures:
         print(f"FAIL {failure}", file=sys.stderr)
     print(f"{len(examples)} examples, {len(on_disk)} bad jobs listed, {len(catalogue)} schemes checked")
