@@ -297,3 +297,25 @@ TEST_CASE("Lyapunov exponents and MEGNO are refused, naming /analysis, for a plu
     CHECK(result.err.find("no Hessians") != std::string::npos);
   }
 }
+
+TEST_CASE("an energy shell: \"p1\" takes the root p1 >= 0, \"-p1\" the root p1 <= 0, both on H = E to round-off") {
+  TemporaryFolder folder;
+  for (const char* solve_for : {"p1", "-p1"}) {
+    CAPTURE(solve_for);
+    json job = paper2d_job({{"grid", {{"q", {0.25, 0.3}}, {"p", {{{"values", {-1.5, 0.5, 3.0}}}, 99.0}}}},
+                            {"energy", 7.0},
+                            {"solve_for", solve_for}},
+                           {{"dt", 0.005}, {"steps", 1}}, json::object());
+    const auto result = run_named(folder, solve_for, job);
+    INFO("stderr: " << result.err);
+    REQUIRE(result.status == 0);
+    const auto rows = table(folder / solve_for / "trajectories.csv");
+    // p0 = 3 is off the shell: H > 7 at p1 = 0 already.
+    REQUIRE(rows.size() == 2);
+    CHECK(read_json(folder / solve_for / "summary.json")["energy_shell"]["left_out"] == 1);
+    for (const auto& row : rows) {
+      CHECK(cell(row, "H0") == doctest::Approx(7.0).epsilon(2e-16 * 4));
+      CHECK(cell(row, "p1") * (std::string(solve_for) == "p1" ? 1.0 : -1.0) > 0.0);
+    }
+  }
+}

@@ -5,6 +5,7 @@
 #include <numeric>
 #include <tuple>
 
+#include "nonsep/core/error.hpp"
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/plugin_loader.hpp"
@@ -55,13 +56,27 @@ void PoincareSectionObserver::on_step(std::uint64_t step, double, const BlockVie
         p_before(previous_p_.data() + trajectory * n, n), q = block.q.subspan(slot * n, n),
         p = block.p.subspan(slot * n, n);
     if (!crosses(plane_.distance(q_before, p_before), plane_.distance(q, p))) continue;
-    state.locator.locate(*block.model, q_before, p_before, time_.time_at(step - 1), time_.dt, plane_, state.crossing);
-    Found found{step, trajectory, counts_[trajectory]++, state.crossing.time, state.crossing.q, state.crossing.p, {}};
-    if (energy_) {
-      double h = 0.0;
-      state.energy.evaluate(*block.model, PhaseSpaceBatch::single(found.q, found.p), std::span<double>(&h, 1));
-      if (std::isfinite(h)) found.energy = h;
+    Found found{step, trajectory, counts_[trajectory], 0.0, {}, {}, {}};
+    try {
+      state.locator.locate(*block.model, q_before, p_before, time_.time_at(step - 1), time_.dt, plane_,
+                           state.crossing);
+      if (energy_) {
+        double h = 0.0;
+        state.energy.evaluate(*block.model, PhaseSpaceBatch::single(state.crossing.q, state.crossing.p),
+                              std::span<double>(&h, 1));
+        if (std::isfinite(h)) found.energy = h;
+      }
+    } catch (const ModelError& error) {
+      if (block.retire)
+        block.retire->push_back({trajectory, TrajectoryStatus::failed,
+                                 "the model failed while locating a Poincare crossing in step " +
+                                     std::to_string(step) + ": " + error.what()});
+      continue;
     }
+    ++counts_[trajectory];
+    found.t = state.crossing.time;
+    found.q = state.crossing.q;
+    found.p = state.crossing.p;
     state.found.push_back(std::move(found));
     if (max_crossings_ && counts_[trajectory] == *max_crossings_ && block.retire)
       block.retire->push_back({trajectory, TrajectoryStatus::completed,
