@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <csignal>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -213,16 +214,16 @@ TEST_CASE("tangent vectors do not change the states: trajectory.csv is the same 
 
 namespace {
 
-// 300 states (two blocks of 256) on a grid, put on the shell H = 7, with every diagnostic; the basic step with
-// t2 = -3 (cheap; accuracy does not matter here).
-json ensemble_job(std::uint64_t steps) {
+// 300 states (two blocks of 256) on a grid, put on the shell H = 7, with every diagnostic; trajectories stop inside
+// chunks at their max_crossings-th crossing. The basic step with t2 = -3 (cheap; accuracy does not matter here).
+json ensemble_job(std::uint64_t steps, std::uint64_t max_crossings) {
   json job = paper2d_job({{"grid",
                            {{"q", {{{"from", -0.8}, {"to", 0.8}, {"count", 20}}, 0.0}},
                             {"p", {{{"from", -1.5}, {"to", 1.5}, {"count", 15}}, 0.0}}}},
                           {"energy", 7.0},
                           {"solve_for", "p1"}},
                          {{"dt", 0.002}, {"steps", steps}},
-                         {{"poincare", {{"component", "q1"}, {"direction", "+"}}},
+                         {{"poincare", {{"component", "q1"}, {"direction", "+"}, {"max_crossings", max_crossings}}},
                           {"lyapunov", {{"vectors", 2}, {"renormalize_every", 5}, {"every", 500}}},
                           {"megno", true}});
   job["output"]["every"] = 250;
@@ -234,7 +235,7 @@ json ensemble_job(std::uint64_t steps) {
 
 TEST_CASE("--threads 1 and 2 write the same poincare.csv, lyapunov.csv and trajectories.csv, byte for byte") {
   TemporaryFolder folder;
-  const json job = ensemble_job(2000);
+  const json job = ensemble_job(2000, 2);
   REQUIRE(run_named(folder, "one", job, {"--threads", "1"}).status == 0);
   REQUIRE(run_named(folder, "two", job, {"--threads", "2"}).status == 0);
   for (const char* file : {"poincare.csv", "lyapunov.csv", "trajectories.csv", "trajectory.csv"}) {
@@ -245,13 +246,19 @@ TEST_CASE("--threads 1 and 2 write the same poincare.csv, lyapunov.csv and traje
   CHECK(summary["trajectories"].get<int>() > 256);  // two blocks at least
   CHECK(summary["energy_shell"]["left_out"].get<int>() > 0);
   CHECK(summary["energy_shell"]["left_out"].get<int>() + summary["trajectories"].get<int>() == 300);
-  // Every state starts on the shell H = 7.
-  for (const auto& row : table(folder / "one/trajectories.csv")) CHECK(cell(row, "H0") == doctest::Approx(7.0).epsilon(1e-14));
+  // Every state starts on the shell H = 7; some stopped at their second crossing, some ran to the end.
+  std::map<std::string, int> statuses;
+  for (const auto& row : table(folder / "one/trajectories.csv")) {
+    CHECK(cell(row, "H0") == doctest::Approx(7.0).epsilon(1e-14));
+    ++statuses[row.at("status") + (row.at("message").empty() ? "" : " (max_crossings)")];
+  }
+  CHECK(statuses["completed (max_crossings)"] > 0);
+  CHECK(statuses["completed"] > 0);
 }
 
 TEST_CASE("killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv bit for bit") {
   TemporaryFolder reference;
-  json job = ensemble_job(60000);
+  json job = ensemble_job(60000, 25);
   job["checkpoint"] = {{"every_steps", 1000}, {"every_seconds", 0}};
   REQUIRE(run_named(reference, "out", job).status == 0);
 
@@ -261,7 +268,7 @@ TEST_CASE("killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv b
                                     folder.path());
   REQUIRE(wait_until([&] {
     try {
-      return read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>() >= 3000;
+      return read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>() >= 20000;
     } catch (const std::exception&) {
       return false;
     }
@@ -279,6 +286,13 @@ TEST_CASE("killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv b
     CAPTURE(name);
     CHECK(read_text(folder / "out" / name) == read_text(reference / "out" / name));
   }
+  // Trajectories stopped by max_crossings both before and after the checkpoint.
+  std::vector<double> stops;
+  for (const auto& row : table(reference / "out/trajectories.csv"))
+    if (!row.at("message").empty()) stops.push_back(cell(row, "step"));
+  REQUIRE(!stops.empty());
+  CHECK(*std::min_element(stops.begin(), stops.end()) < double(step));
+  CHECK(*std::max_element(stops.begin(), stops.end()) > double(step));
 }
 
 TEST_CASE("Lyapunov exponents and MEGNO are refused, naming /analysis, for a plugin without Hessians") {
