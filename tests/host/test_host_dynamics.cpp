@@ -333,3 +333,24 @@ TEST_CASE("an energy shell: \"p1\" takes the root p1 >= 0, \"-p1\" the root p1 <
     }
   }
 }
+
+TEST_CASE("a chunk redone step by step after a divergence keeps the crossings and max_crossings stops of the others") {
+  TemporaryFolder folder;
+  const json analysis = {{"poincare", {{"component", "q0"}, {"max_crossings", 3}}}, {"megno", true}};
+  // Alone, and in one block with a state that overflows at once: that block's chunk is redone step by step, after
+  // the regular orbit already left it at its third crossing in the unchecked pass.
+  const json alone = paper2d_job(json::array({state2(regular_q, regular_p)}), {{"dt", 0.005}, {"steps", 6000}}, analysis);
+  json together = alone;
+  together["initial"].push_back(state2({1e103, 0.0}, {0.0, 0.0}));
+  REQUIRE(run_named(folder, "alone", alone).status == 0);
+  REQUIRE(run_named(folder, "together", together).status == 1);  // diverged
+  const auto rows = table(folder / "together/trajectories.csv");
+  CHECK(rows[1].at("status") == "diverged");
+  CHECK(rows[0].at("message").find("3-th Poincare crossing") != std::string::npos);
+  CHECK(read_text(folder / "together/poincare.csv") == read_text(folder / "alone/poincare.csv"));
+  const auto single = table(folder / "alone/trajectories.csv");
+  for (const char* column : {"step", "q0", "q1", "p0", "p1", "mean_megno", "poincare_crossings"}) {
+    CAPTURE(column);
+    CHECK(rows[0].at(column) == single[0].at(column));
+  }
+}
