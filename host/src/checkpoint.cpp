@@ -17,7 +17,7 @@ using json = nlohmann::json;
 
 namespace {
 
-constexpr const char* format_tag = "nonsep checkpoint 2";
+constexpr const char* format_tag = "nonsep checkpoint 3";
 
 json encode(double value) { return format_number(value); }
 
@@ -28,6 +28,15 @@ json encode(const std::vector<double>& values) {
 }
 
 json encode(const std::optional<double>& value) { return value ? encode(*value) : json(nullptr); }
+
+// A LyapunovRecord as numbers: steps, steps since renormalisation, time, time since, ln |v_1|, then the k sums.
+json encode(const LyapunovRecord& record, std::size_t k) {
+  std::vector<double> numbers{static_cast<double>(record.steps), static_cast<double>(record.steps_since_renormalization),
+                              record.time, record.time_since_renormalization, record.log_norm_first};
+  numbers.insert(numbers.end(), record.log_stretch.begin(), record.log_stretch.begin() + static_cast<std::ptrdiff_t>(k));
+  return encode(numbers);
+}
+json encode(const MegnoRecord& record) { return encode(std::vector<double>{record.time, record.weighted_growth, record.integrated_y}); }
 
 // Every read of a malformed file ends here, with what was wrong.
 [[noreturn]] void damaged(const std::filesystem::path& path, const std::string& what) {
@@ -125,6 +134,17 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   if (run.analysis.closest_return_after) append_bits(parts[6], *run.analysis.closest_return_after);
   parts[6] += '|';
   if (run.analysis.max_relative_energy_error) append_bits(parts[6], *run.analysis.max_relative_energy_error);
+  if (const auto& section = run.analysis.poincare) {
+    parts[6] += "|poincare ";
+    for (double x : section->normal) append_bits(parts[6], x);
+    append_bits(parts[6], section->offset);
+    parts[6] += std::to_string(static_cast<int>(section->direction)) + ' ' +
+                (section->max_crossings ? std::to_string(*section->max_crossings) : "none");
+  }
+  if (const auto& lyapunov = run.analysis.lyapunov)
+    parts[6] += "|lyapunov " + std::to_string(lyapunov->vectors) + ' ' + std::to_string(lyapunov->renormalize_every) +
+                ' ' + std::to_string(lyapunov->every);
+  if (run.analysis.megno) parts[6] += "|megno";
   std::string fingerprint;
   for (std::size_t i = 0; i < 7; ++i)
     fingerprint += (i ? " " : "") + std::string(fingerprint_parts[i]) + ":" + content_hash_hex(content_hash(parts[i]));
@@ -153,7 +173,14 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
                        {"stop_step", record.stop_step},
                        {"stop_t", encode(record.stop_t)},
                        {"stop_variable", record.stop_variable},
-                       {"message", record.message}});
+                       {"message", record.message},
+                       {"lyapunov", encode(record.lyapunov)},
+                       {"megno", encode(record.megno)},
+                       {"mean_megno", encode(record.mean_megno)}});
+  json lyapunov = json::array(), megno = json::array();
+  const std::size_t k = state.active.empty() ? 0 : state.tangent_q.size() / std::max<std::size_t>(1, state.q.size());
+  for (const LyapunovRecord& record : state.lyapunov) lyapunov.push_back(encode(record, k));
+  for (const MegnoRecord& record : state.megno) megno.push_back(encode(record));
   const json document = {
       {"format", format_tag},
       {"job_fingerprint", fingerprint},
@@ -161,7 +188,11 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
       {"evaluations", {{"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}}},
       {"active",
        {{"trajectories", state.active}, {"q", encode(state.q)}, {"p", encode(state.p)},
-        {"energies", encode(state.energies)}}},
+        {"energies", encode(state.energies)},
+        {"tangent_q", encode(state.tangent_q)},
+        {"tangent_p", encode(state.tangent_p)},
+        {"lyapunov", std::move(lyapunov)},
+        {"megno", std::move(megno)}}},
       {"records", std::move(records)},
       {"observers", checkpoint.observers}};
   // The checksum covers everything else, as dumped (keys sorted, numbers as strings): an edited or damaged
@@ -220,6 +251,27 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   state.q = read.numbers(read.member(active, "q"), state.active.size() * n, "active.q");
   state.p = read.numbers(read.member(active, "p"), state.active.size() * n, "active.p");
   state.energies = read.numbers(read.member(active, "energies"), state.active.size(), "active.energies");
+  const std::size_t k = job.run().analysis.tangent_vectors(), tangent_size = state.active.size() * k * n;
+  state.tangent_q = read.numbers(read.member(active, "tangent_q"), tangent_size, "active.tangent_q");
+  state.tangent_p = read.numbers(read.member(active, "tangent_p"), tangent_size, "active.tangent_p");
+  const json& lyapunov = read.member(active, "lyapunov");
+  const json& megno = read.member(active, "megno");
+  if (!lyapunov.is_array() || !megno.is_array() || lyapunov.size() != (k > 0 ? state.active.size() : 0) ||
+      megno.size() != lyapunov.size())
+    damaged(path, "active.lyapunov and active.megno do not have one entry per active trajectory");
+  for (std::size_t i = 0; i < lyapunov.size(); ++i) {
+    const auto l = read.numbers(lyapunov[i], 5 + k, "active.lyapunov");
+    const auto m = read.numbers(megno[i], 3, "active.megno");
+    LyapunovRecord record;
+    record.steps = static_cast<std::uint64_t>(l[0]);
+    record.steps_since_renormalization = static_cast<std::uint64_t>(l[1]);
+    record.time = l[2];
+    record.time_since_renormalization = l[3];
+    record.log_norm_first = l[4];
+    std::copy(l.begin() + 5, l.end(), record.log_stretch.begin());
+    state.lyapunov.push_back(record);
+    state.megno.push_back(MegnoRecord{m[0], m[1], m[2]});
+  }
   const json& records = read.member(document, "records");
   if (!records.is_array() || records.size() != job.initial.count)
     damaged(path, "it does not have one record per trajectory");
@@ -240,6 +292,10 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     record.stop_t = read.number(read.member(entry, "stop_t"), "stop_t");
     record.stop_variable = read.string(read.member(entry, "stop_variable"), "stop_variable");
     record.message = read.string(read.member(entry, "message"), "message");
+    const json& exponents = read.member(entry, "lyapunov");
+    record.lyapunov = read.numbers(exponents, exponents.is_array() && exponents.empty() ? 0 : k, "lyapunov");
+    record.megno = read.optional_number(read.member(entry, "megno"), "megno");
+    record.mean_megno = read.optional_number(read.member(entry, "mean_megno"), "mean_megno");
     state.records.push_back(std::move(record));
   }
   check_consistency(path, state, n);

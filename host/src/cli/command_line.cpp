@@ -36,7 +36,8 @@ int run_command_line(int argc, char** argv) {
     InspectArguments inspect_arguments;
 
     auto* run = app.add_subcommand("run",
-                                   "Run a job: trajectory.csv (streamed), trajectories.csv and summary.json in the output folder; a "
+                                   "Run a job: trajectory.csv (streamed), trajectories.csv and summary.json in the output folder "
+                                   "(with /analysis/poincare also poincare.csv, with /analysis/lyapunov/every lyapunov.csv); a "
                                    "study (/study): convergence.csv, and summary.json with the fitted exponents");
     run->add_option("JOB.json", arguments.job_file, "the job file")->required();
     run->add_option("--output,-o", arguments.output,

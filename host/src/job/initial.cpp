@@ -204,6 +204,7 @@ InitialStates read_initial(Checker& check, const json& document) {
     states.shape = "grid";
     check.known_keys(*initial, "/initial", initial_grid_keys().names());
     read_grid(check, (*initial)["grid"], states);
+    read_energy_shell(check, *initial, states);
   } else if (initial->is_object()) {
     states.shape = "single";
     read_state(check, *initial, "/initial", states, "/initial");

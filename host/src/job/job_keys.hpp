@@ -28,6 +28,8 @@ enum class ValueType {
   nonnegative,  // a finite number >= 0
   integer,      // an integral number (10.0 counts) within [minimum, maximum]
   form,         // one of hamiltonian_forms()
+  boolean,      // true or false
+  choice,       // one of the strings `choices`
   defined,      // a shape of its own, $defs/<definition> of the schema (states, axes, integrators, step lists)
 };
 
@@ -42,6 +44,8 @@ struct KeyRule {
   std::string description = {};  // for the schema
   const KeyTable& (*keys)() = nullptr;      // ValueType::object
   std::string definition = {};   // ValueType::defined
+  std::vector<std::string> choices = {};  // ValueType::choice
+  std::string pattern = {};      // ValueType::string: a regular expression the string matches (in the schema)
   // A document key refused in a study: what the issue says was found and what is allowed instead.
   bool run_only = false;
   std::string in_study_found = {}, in_study_allowed = {};
@@ -50,6 +54,9 @@ struct KeyRule {
 // The keys of one kind of object, in the order messages list them ("only the keys ...").
 struct KeyTable {
   std::vector<KeyRule> rules;
+  // What the table cannot say key by key (exactly one of two keys, two keys that go together), as JSON Schema
+  // keywords added to the object's schema; the reader checks the same with its own messages.
+  nlohmann::ordered_json constraints = nlohmann::ordered_json::object();
   std::vector<std::string> names() const;
   std::vector<std::string> required() const;
   // The rule named `name`; a name without a rule is a programming error (std::logic_error).
@@ -63,6 +70,8 @@ const KeyTable& run_time_keys();      // a run's /time: "dt" and exactly one of 
 const KeyTable& study_time_keys();    // a study's /time
 const KeyTable& output_keys();
 const KeyTable& analysis_keys();
+const KeyTable& poincare_keys();      // /analysis/poincare
+const KeyTable& lyapunov_keys();      // /analysis/lyapunov
 const KeyTable& checkpoint_keys();
 const KeyTable& study_keys();         // at most one of "steps", "dt"
 // The keys a study's integrator has besides the scheme's options (at most one of "steps", "dt").

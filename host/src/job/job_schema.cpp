@@ -37,7 +37,12 @@ schema_json value_schema(const KeyRule& rule) {
       schema = {{"type", "object"}};
       break;
     case ValueType::text: schema = {{"type", "string"}}; break;
-    case ValueType::string: schema = {{"type", "string"}, {"minLength", 1}}; break;
+    case ValueType::string:
+      schema = {{"type", "string"}, {"minLength", 1}};
+      if (!rule.pattern.empty()) schema["pattern"] = rule.pattern;
+      break;
+    case ValueType::boolean: schema = {{"type", "boolean"}}; break;
+    case ValueType::choice: schema = {{"enum", rule.choices}}; break;
     case ValueType::path: schema = {{"type", "string"}, {"minLength", 1}, {"pattern", "^[^\\u0000]*$"}}; break;
     case ValueType::finite: schema = ref("finite"); break;
     case ValueType::nonzero: schema = ref("nonzero"); break;
@@ -68,6 +73,7 @@ schema_json object_schema(const KeyTable& table, const std::string& description)
   schema_json properties = schema_json::object();
   for (const auto& rule : table.rules) properties[rule.name] = value_schema(rule);
   schema["properties"] = std::move(properties);
+  for (const auto& [keyword, value] : table.constraints.items()) schema[keyword] = value;
   return schema;
 }
 

@@ -105,6 +105,13 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
     issues.push_back({"/model", "a model of dimension " + std::to_string(n) + ", whose Hessian (for H) would take " +
                                     gibibytes(n * n * sizeof(double)) + " GiB",
                       "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians"});
+  if (issues.size() == before) place_on_energy_shell(loaded, issues);
+  if (!checked.is_study())
+    if (const Analysis& analysis = checked.run().analysis; analysis.tangent_vectors() > 0 && !loaded.plugin.has_hessians())
+      issues.push_back({analysis.lyapunov ? "/analysis/lyapunov" : "/analysis/megno",
+                        "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
+                        "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them "
+                        "by automatic differentiation)"});
   if (issues.size() != before) return std::nullopt;
   return loaded;
 }

@@ -30,12 +30,15 @@ void read_output(Checker& check, const json& document, Job& job) {
   job.output_directory = output.is_absolute() ? output : job.directory / output;
 }
 
-Analysis read_analysis(Checker& check, const json& value) {
+Analysis read_analysis(Checker& check, const json& value, std::size_t dimension) {
   Analysis analysis;
   const std::string path = "/analysis";
-  if (!check.object(value, path, "an object {\"closest_return_after\": t, \"max_relative_energy_error\": e}"))
+  if (!check.object(value, path,
+                    "an object {\"closest_return_after\": t, \"max_relative_energy_error\": e, \"poincare\": {...}, "
+                    "\"lyapunov\": {...}, \"megno\": true}"))
     return analysis;
   check.known_keys(value, path, analysis_keys().names());
+  read_dynamics(check, value, dimension, analysis);
   if (const json* after = check.member(value, path, "closest_return_after", false, ""))
     analysis.closest_return_after = check.finite_number(
         *after, child(path, "closest_return_after"),

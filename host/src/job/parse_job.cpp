@@ -46,7 +46,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     run.integrator = read_integrator(check, document, form);
     run.time = read_time(check, document);
     if (const json* analysis = check.member(document, "", "analysis", false, ""))
-      run.analysis = read_analysis(check, *analysis);
+      run.analysis = read_analysis(check, *analysis, job.initial.dimension);
   }
   read_output(check, document, job);
   if (const json* checkpoint = check.member(document, "", "checkpoint", false, "")) {

@@ -34,6 +34,8 @@ std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt,
 // /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
 // `first_path` names the state whose dimension the others must have.
 InitialStates read_initial(Checker& check, const json& document);
+// /initial/energy and /initial/solve_for of a grid (energy_shell.cpp), into states.shell.
+void read_energy_shell(Checker& check, const json& initial, InitialStates& states);
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
                 const std::string& first_path);
 
@@ -44,7 +46,10 @@ Study read_study(Checker& check, const json& study, HamiltonianForm form, double
 // /output, /analysis and /checkpoint (outputs.cpp). read_output sets job.output_directory and, in a single run,
 // its every and energy_every (job.plan must already say which kind of job it is).
 void read_output(Checker& check, const json& document, Job& job);
-Analysis read_analysis(Checker& check, const json& value);
+// read_analysis needs the dimension of the initial states (0 when unknown) for /analysis/poincare and /lyapunov.
+Analysis read_analysis(Checker& check, const json& value, std::size_t dimension);
+// /analysis/poincare, /lyapunov and /megno (dynamics.cpp), into `analysis`.
+void read_dynamics(Checker& check, const json& value, std::size_t dimension, Analysis& analysis);
 CheckpointPolicy read_checkpoint(Checker& check, const json& value);
 
 }  // namespace nonsep::host::job_reader

@@ -75,8 +75,9 @@ void check_outputs_placeable(const std::filesystem::path& directory) {
 }  // namespace
 
 const std::vector<std::string>& RunFolder::output_files() {
-  static const std::vector<std::string> names{"summary.json",  "trajectory.csv", "trajectories.csv",
-                                              "checkpoint.json", "convergence.csv", manifest_name};
+  static const std::vector<std::string> names{"summary.json",    "trajectory.csv",  "trajectories.csv",
+                                              "poincare.csv",    "lyapunov.csv",    "checkpoint.json",
+                                              "convergence.csv", manifest_name};
   return names;
 }
 

@@ -14,7 +14,9 @@
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/core/phase_space_batch.hpp"
+#include "nonsep/host/run/observer.hpp"
 #include "nonsep/host/run/trajectory.hpp"
+#include "run/tangent_block.hpp"
 
 namespace nonsep::host {
 
@@ -30,6 +32,8 @@ struct Departure {
   std::string message;
   std::vector<double> q, p;      // the final state
   std::optional<double> energy;  // H of the final state, when known
+  std::vector<double> lyapunov;  // the final estimates, when the block follows tangent vectors
+  std::optional<double> megno, mean_megno;
 };
 
 // The first non-finite variable of state `slot` ("q[0]", "p[2]"), or "".
@@ -93,6 +97,11 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
   std::vector<Departure> departures;       // found in the current chunk
   PhaseSpaceBatch chunk_start;             // the block at the start of the current chunk
   std::optional<Integrator> chunk_start_integrator;
+  std::optional<BlockTangents> tangents;   // when the run follows tangent vectors; then it steps the block
+  std::optional<BlockTangents> chunk_start_tangents;
+  std::vector<std::size_t> chunk_start_trajectories;
+  std::vector<double> chunk_start_energies;
+  std::size_t chunk_start_departures = 0;
   std::exception_ptr error;                // anything but a ModelError, thrown in the current chunk
 
   Block(const IntegratorSpec& spec, std::size_t dimension, std::span<const std::size_t> members,
@@ -104,6 +113,28 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
   }
 
   bool empty() const { return trajectories.empty(); }
+
+  // One step of the whole block (the driver's unchecked path).
+  template <class M>
+  void step(const M& model, double dt) {
+    if (tangents)
+      tangents->step(model, batch, dt);
+    else
+      integrator.step(model, batch, dt);
+  }
+  EvaluationCounts evaluations() const {
+    return tangents ? tangents->integrator.evaluations() : integrator.evaluations();
+  }
+
+  // The final Lyapunov and MEGNO estimates of `slot` into `departure` (nothing without tangents).
+  template <class Record>
+  void final_estimates(std::size_t slot, Record& departure) const {
+    if (!tangents) return;
+    departure.lyapunov.clear();
+    for (std::size_t j = 0; j < tangents->k; ++j) departure.lyapunov.push_back(tangents->lyapunov[slot].exponent(j));
+    departure.megno = tangents->megno[slot].y();
+    departure.mean_megno = tangents->megno[slot].mean_y();
+  }
   void clear() { trajectories.clear(); }
 
   // H of `slot` at energy_step when it is finite.
@@ -118,20 +149,55 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
     return finite;
   }
 
+  // Trajectories may leave the block inside a chunk (an every-step observer asks), so its members are saved too.
   void begin_chunk() {
     chunk_start = batch;
     chunk_start_integrator = integrator;
+    chunk_start_tangents = tangents;
+    chunk_start_trajectories = trajectories;
+    chunk_start_energies = energies;
+    chunk_start_departures = departures.size();
   }
   // Back to the chunk's start, to redo it step by step.
   void rollback_chunk() {
     batch = chunk_start;
     integrator = *chunk_start_integrator;
+    tangents = chunk_start_tangents;
+    trajectories = chunk_start_trajectories;
+    energies = chunk_start_energies;
+    departures.resize(chunk_start_departures);
   }
   // Back to the chunk's start for good: the run ends there.
   void abandon_chunk() {
     if (!chunk_start_integrator) return;
     rollback_chunk();
     departures.clear();
+  }
+
+  // Retires the trajectories of `requests` (sorted by trajectory; those not in this block are ignored) at `step`,
+  // phase 2, with their state there and H from `energy(slot)`.
+  template <class Energy>
+  void retire_requested(std::span<const RetirementRequest> requests, std::uint64_t step, Energy&& energy) {
+    std::vector<bool> retire(trajectories.size(), false);
+    for (std::size_t slot = 0; slot < trajectories.size(); ++slot) {
+      const auto found =
+          std::lower_bound(requests.begin(), requests.end(), trajectories[slot],
+                           [](const RetirementRequest& r, std::size_t trajectory) { return r.trajectory < trajectory; });
+      if (found == requests.end() || found->trajectory != trajectories[slot]) continue;
+      retire[slot] = true;
+      Departure departure;
+      departure.trajectory = found->trajectory;
+      departure.step = departure.final_step = step;
+      departure.phase = 2;
+      departure.status = found->status;
+      departure.message = found->message;
+      departure.q.assign(batch.q(slot).begin(), batch.q(slot).end());
+      departure.p.assign(batch.p(slot).begin(), batch.p(slot).end());
+      departure.energy = energy(slot);
+      final_estimates(slot, departure);
+      departures.push_back(std::move(departure));
+    }
+    compact(retire);
   }
 
   // Removes the slots marked in `retire`, keeping the others in order.
@@ -149,6 +215,7 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
       next_energies.push_back(energies[slot]);
     }
     batch = std::move(next);
+    if (tangents) tangents->compact(retire);
     trajectories = std::move(next_trajectories);
     energies = std::move(next_energies);
   }

@@ -47,6 +47,10 @@ struct EnsembleDriver::Impl {
       std::iota(members.begin(), members.end(), first);
       blocks.emplace_back(setup.integrator, n, members, setup.q.subspan(first * n, size * n),
                           setup.p.subspan(first * n, size * n));
+      if (setup.tangent_vectors > 0) {
+        blocks.back().tangents.emplace(setup.integrator, setup.tangent_vectors, setup.renormalize_every, n, size);
+        blocks.back().tangents->start();
+      }
     }
     // A plugin that is not thread-safe ("thread_safe": false, plugin_abi.h) gets one instance on one thread.
     const unsigned requested = !plugin.thread_safe() ? 1u
@@ -101,46 +105,62 @@ struct EnsembleDriver::Impl {
     return std::min(to, from + longest);
   }
 
-  BlockView view(const Block& block, std::size_t index) const {
-    return {index, setup.dimension, block.trajectories, block.batch.q(), block.batch.p()};
+  BlockView view(const Block& block, const Worker& worker) const {
+    return {static_cast<std::size_t>(&block - blocks.data()), setup.dimension, block.trajectories, block.batch.q(),
+            block.batch.p(), &worker.model};
   }
 
-  void watch_step(const Block& block, std::uint64_t step) {
+  static void sort_requests(std::vector<RetirementRequest>& requests) {
+    std::sort(requests.begin(), requests.end(),
+              [](const RetirementRequest& a, const RetirementRequest& b) { return a.trajectory < b.trajectory; });
+  }
+
+  // The every-step observers see the block at `step`; the trajectories they ask to stop leave it there.
+  void watch_step(Block& block, Worker& worker, std::uint64_t step) {
     if (step_watchers.empty()) return;
-    const std::size_t index = static_cast<std::size_t>(&block - blocks.data());
-    const auto v = view(block, index);
+    std::vector<RetirementRequest> requests;
+    auto v = view(block, worker);
+    v.retire = &requests;
     for (Observer* watcher : step_watchers) watcher->on_step(step, setup.time.time_at(step), v);
+    if (requests.empty()) return;
+    sort_requests(requests);
+    block.retire_requested(requests, step, [&](std::size_t slot) { return energy_of(worker, block.batch, slot); });
   }
 
   void advance_block(Block& block, Worker& worker, std::uint64_t from, std::uint64_t to) {
-    const std::size_t index = static_cast<std::size_t>(&block - blocks.data());
     block.begin_chunk();
-    for (Observer* watcher : step_watchers) watcher->save_block(view(block, index));
+    for (Observer* watcher : step_watchers) watcher->save_block(view(block, worker));
     const double dt = setup.time.dt;
     bool clean = true;
     try {
-      for (std::uint64_t step = from; step < to; ++step) {
-        block.integrator.step(worker.model, block.batch, dt);
-        watch_step(block, step + 1);
+      for (std::uint64_t step = from; step < to && !block.empty(); ++step) {
+        block.step(worker.model, dt);
+        watch_step(block, worker, step + 1);
       }
     } catch (const ModelError&) {
       clean = false;
     }
     if (clean && block.all_finite()) return;
     block.rollback_chunk();
-    for (Observer* watcher : step_watchers) watcher->restore_block(view(block, index));
+    for (Observer* watcher : step_watchers) watcher->restore_block(view(block, worker));
     for (std::uint64_t step = from + 1; step <= to && !block.empty(); ++step) {
       checked_step(block, worker, step);
-      watch_step(block, step);
+      if (!block.empty()) watch_step(block, worker, step);
     }
   }
 
   // One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge.
   void checked_step(Block& block, Worker& worker, std::uint64_t step) {
     const PhaseSpaceBatch before = block.batch;
-    const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t) {
-      block.integrator.step(worker.model, x, setup.time.dt);
+    const std::optional<PhaseSpaceBatch> tangents_before =
+        block.tangents ? std::optional<PhaseSpaceBatch>(block.tangents->vectors) : std::nullopt;
+    const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
+      if (block.tangents)
+        block.tangents->step_part(worker.model, x, *tangents_before, first, setup.time.dt);
+      else
+        block.integrator.step(worker.model, x, setup.time.dt);
     });
+    if (block.tangents) block.tangents->after_step(setup.time.dt);
     std::vector<bool> retire(block.trajectories.size(), false);
     for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
       Departure departure;
@@ -242,6 +262,9 @@ struct EnsembleDriver::Impl {
       record.stop_step = departure.step;
       record.stop_t = setup.time.time_at(departure.step);
       record.stop_variable = departure.variable;
+      record.lyapunov = departure.lyapunov;
+      record.megno = departure.megno;
+      record.mean_megno = departure.mean_megno;
       retire(departure.trajectory, departure.final_step, departure.q, departure.p, departure.energy);
     }
   }
@@ -254,34 +277,18 @@ struct EnsembleDriver::Impl {
       for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
         states.push_back({block.trajectories[slot], block.batch.q(slot), block.batch.p(slot),
                           block.energy_step == step ? block.energy(slot) : std::nullopt,
-                          &records[block.trajectories[slot]]});
+                          &records[block.trajectories[slot]],
+                          block.tangents ? &block.tangents->lyapunov[slot] : nullptr,
+                          block.tangents ? &block.tangents->megno[slot] : nullptr});
     std::vector<RetirementRequest> requests;
     const Event event{step, setup.time.time_at(step), states, energy_evaluated, &requests};
     for (Observer* observer : observers) observer->on_event(event);
     if (requests.empty()) return;
-    std::sort(requests.begin(), requests.end(),
-              [](const RetirementRequest& a, const RetirementRequest& b) { return a.trajectory < b.trajectory; });
-    for (Block& block : blocks) {
-      std::vector<bool> retire(block.trajectories.size(), false);
-      for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
-        const auto found = std::lower_bound(
-            requests.begin(), requests.end(), block.trajectories[slot],
-            [](const RetirementRequest& r, std::size_t trajectory) { return r.trajectory < trajectory; });
-        if (found == requests.end() || found->trajectory != block.trajectories[slot]) continue;
-        retire[slot] = true;
-        Departure departure;
-        departure.trajectory = found->trajectory;
-        departure.step = departure.final_step = step;
-        departure.phase = 2;
-        departure.status = found->status;
-        departure.message = found->message;
-        departure.q.assign(block.batch.q(slot).begin(), block.batch.q(slot).end());
-        departure.p.assign(block.batch.p(slot).begin(), block.batch.p(slot).end());
-        departure.energy = block.energy_step == step ? block.energy(slot) : std::nullopt;
-        block.departures.push_back(std::move(departure));
-      }
-      block.compact(retire);
-    }
+    sort_requests(requests);
+    for (Block& block : blocks)
+      block.retire_requested(requests, step, [&](std::size_t slot) {
+        return block.energy_step == step ? block.energy(slot) : std::nullopt;
+      });
     apply_departures();
   }
 
@@ -327,6 +334,7 @@ struct EnsembleDriver::Impl {
         TrajectoryRecord& record = records[block.trajectories[slot]];
         record.status = status;
         if (!error.empty()) record.message = error;
+        block.final_estimates(slot, record);
         try {
           retire(block.trajectories[slot], completed, block.batch.q(slot), block.batch.p(slot),
                  block.energy_step == completed ? block.energy(slot) : std::nullopt);
@@ -398,6 +406,10 @@ void EnsembleDriver::restore(DriverState state) {
       energies.push_back(state.energies[k]);
     }
     d.blocks[b] = Block(d.setup.integrator, n, trajectories, q, p);
+    if (const std::size_t k = d.setup.tangent_vectors; k > 0)
+      d.blocks[b]
+          .tangents.emplace(d.setup.integrator, k, d.setup.renormalize_every, n, trajectories.size())
+          .restore(members[b], state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
     d.blocks[b].energies = std::move(energies);
     d.blocks[b].energy_step = state.step;
   }
@@ -417,6 +429,7 @@ DriverState EnsembleDriver::state() const {
     state.p.insert(state.p.end(), block.batch.p().begin(), block.batch.p().end());
     for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
       state.energies.push_back(block.energy_step == d.completed ? block.energies[slot] : std::nan(""));
+    if (block.tangents) block.tangents->save(state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
   }
   state.records = d.records;
   state.evaluations = evaluations();
@@ -426,7 +439,7 @@ DriverState EnsembleDriver::state() const {
 const std::vector<TrajectoryRecord>& EnsembleDriver::records() const { return impl_->records; }
 EvaluationCounts EnsembleDriver::evaluations() const {
   EvaluationCounts counts = impl_->evaluations_before;
-  for (const Block& block : impl_->blocks) counts += block.integrator.evaluations();
+  for (const Block& block : impl_->blocks) counts += block.evaluations();
   return counts;
 }
 std::uint64_t EnsembleDriver::steps_completed() const { return impl_->completed; }

@@ -6,6 +6,8 @@
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/observers/checkpoint_saver.hpp"
 #include "nonsep/host/observers/closest_return.hpp"
+#include "nonsep/host/observers/lyapunov_megno.hpp"
+#include "nonsep/host/observers/poincare_section.hpp"
 #include "nonsep/host/observers/progress.hpp"
 #include "nonsep/host/observers/sample_writer.hpp"
 #include "nonsep/host/output/files.hpp"
@@ -40,6 +42,44 @@ ExitStatus exit_status_of(TrajectoryStatus status) {
   return ExitStatus::run_failed;
 }
 
+// An earlier run's file that this run does not write would mislead.
+void remove_stale(const std::filesystem::path& path) {
+  std::error_code ignored;
+  std::filesystem::remove(path, ignored);
+}
+
+nlohmann::ordered_json poincare_facts(const PoincareSection& section, const PoincareSectionObserver& observer) {
+  const char* direction = section.direction == CrossingDirection::up     ? "+"
+                          : section.direction == CrossingDirection::down ? "-"
+                                                                         : "both";
+  return {{"file", PoincareSectionObserver::file_name},
+          {"plane", "normal . (q, p) = value"},
+          {"normal", section.normal},
+          {"value", section.offset},
+          {"direction", direction},
+          {"max_crossings", section.max_crossings ? nlohmann::ordered_json(*section.max_crossings) : nullptr},
+          {"crossings", observer.total_crossings()},
+          {"located_by", "a fractional step of the run's integrator from the state before the step, its length "
+                         "found by TOMS 748 (core/poincare_crossing.hpp)"}};
+}
+
+nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
+  nlohmann::ordered_json facts = {
+      {"vectors", analysis.tangent_vectors()},
+      {"first_vector", "(1, 1/2, ..., 1/(2n)) over (dq, dp), normalised; vector j >= 1 starts as the unit vector of "
+                       "component j (run/tangent_block.hpp)"},
+      {"method", "the exact tangent map of the run's integrator (core/tangent_integrator.hpp)"}};
+  if (const auto& l = analysis.lyapunov)
+    facts["lyapunov"] = {{"exponents", l->vectors},
+                         {"renormalize_every", l->renormalize_every},
+                         {"columns", "trajectories.csv lyapunov0 .. lyapunov" + std::to_string(l->vectors - 1)},
+                         {"series", l->every > 0 ? nlohmann::ordered_json(LyapunovMegnoObserver::file_name) : nullptr},
+                         {"every", l->every}};
+  if (analysis.megno)
+    facts["megno"] = {{"columns", "trajectories.csv megno (Y), mean_megno (<Y>, -> 2 on quasi-periodic orbits)"}};
+  return facts;
+}
+
 }  // namespace
 
 FolderUse folder_use(const RunOptions& options) {
@@ -57,7 +97,8 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
 
   EnsembleDriver driver(loaded.plugin, loaded.model,
                         {run.integrator, run.time, job.initial.dimension, job.initial.q, job.initial.p, options.threads,
-                         options.stop_requested});
+                         options.stop_requested, run.analysis.tangent_vectors(),
+                        run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1});
   const std::size_t count = job.initial.count;
   EnergyErrorObserver energy(count, driver.energy_available() ? run.energy_every : 0,
                              run.analysis.max_relative_energy_error);
@@ -69,12 +110,27 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
     samples.emplace(directory / SampleWriter::file_name, job.initial.dimension, count, run.every, driver.time(),
                     options.resume);
   } else {
-    std::error_code ignored;
-    std::filesystem::remove(directory / SampleWriter::file_name, ignored);  // an earlier run's would mislead
+    remove_stale(directory / SampleWriter::file_name);
   }
+  std::optional<PoincareSectionObserver> poincare;
+  if (run.analysis.poincare)
+    poincare.emplace(directory / PoincareSectionObserver::file_name, *run.analysis.poincare, run.integrator,
+                     driver.time(), job.initial.dimension, count, driver.energy_available(), options.resume);
+  else
+    remove_stale(directory / PoincareSectionObserver::file_name);
+  std::optional<LyapunovMegnoObserver> chaos;
+  if (run.analysis.tangent_vectors() > 0)
+    chaos.emplace(directory / LyapunovMegnoObserver::file_name,
+                  run.analysis.lyapunov ? run.analysis.lyapunov->vectors : 0, run.analysis.megno,
+                  run.analysis.lyapunov ? run.analysis.lyapunov->every : 0, driver.time(), driver.records(),
+                  options.resume);
+  if (!chaos || !run.analysis.lyapunov || run.analysis.lyapunov->every == 0)
+    remove_stale(directory / LyapunovMegnoObserver::file_name);
   std::vector<Observer*> observers{&energy};
+  if (chaos) observers.push_back(&*chaos);
   if (closest) observers.push_back(&*closest);
   if (samples) observers.push_back(&*samples);
+  if (poincare) observers.push_back(&*poincare);
   CheckpointSaver saver(directory / checkpoint_file_name, job_fingerprint(loaded), run.checkpoint, driver, observers);
   ProgressObserver progress(options.show_progress, driver, &energy);
   for (Observer* observer : observers) driver.add_observer(*observer);
@@ -106,6 +162,13 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   const RunFacts facts{loaded, directory, driver, outcome, run.every > 0,
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
   outcome.summary = run_summary(facts);
+  if (poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *poincare);
+  if (chaos) outcome.summary["analysis"]["tangent_map"] = tangent_facts(run.analysis);
+  if (const auto& shell = job.initial.shell)
+    outcome.summary["energy_shell"] = {{"energy", shell->energy},
+                                       {"solve_for", shell->solve_for},
+                                       {"states", job.initial.count},
+                                       {"left_out", shell->left_out}};
   const auto fail = [&](const OutputError& error) {
     outcome.error = (outcome.error.empty() ? "" : outcome.error + "; ") + error.what();
     outcome.summary["error"] = outcome.error;
@@ -116,6 +179,8 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   try {
     std::vector<const Observer*> columns{&energy};
     if (closest) columns.push_back(&*closest);
+    if (poincare) columns.push_back(&*poincare);
+    if (chaos) columns.push_back(&*chaos);
     write_trajectories_csv(directory / trajectories_file_name, facts, columns);
   } catch (const OutputError& error) {
     fail(error);

@@ -52,11 +52,24 @@ class InvalidJob : public std::runtime_error {
 
 // The initial states, state-major as in nonsep::PhaseSpaceBatch: component i of state b at b*dimension + i.
 // `shape` says how the job wrote them: "single" (one object), "list" (an array of objects) or "grid".
+// /initial/energy and /initial/solve_for (a grid only): every state of the grid is put on the energy shell H = energy
+// by solving for one momentum component (energy_shell.cpp). "p1" takes the root p1 >= 0 nearest to 0, "-p1" the
+// root p1 <= 0; the grid's value of that component is ignored. States for which H already exceeds `energy` at
+// p_i = 0 (or that have no root within |p_i| <= 2^40) are left out of the run; `left_out` counts them.
+struct EnergyShell {
+  double energy = 0.0;
+  std::size_t component = 0;  // i of p_i
+  bool negative = false;      // "-p<i>": the root p_i <= 0
+  std::string solve_for;      // as written
+  std::size_t left_out = 0;
+};
+
 struct InitialStates {
   std::string shape;
   std::size_t dimension = 0;
   std::size_t count = 0;
   std::vector<double> q, p;
+  std::optional<EnergyShell> shell;  // set by the reader; the states are solved when the model is loaded
 };
 
 // A convergence study (/study): the job's model and initial state are run to /time/t_end by each integrator at
@@ -76,8 +89,30 @@ struct Study {
   std::vector<double> reference_q, reference_p;
 };
 
+// /analysis/poincare: the crossings of every trajectory with the hyperplane normal . (q, p) = offset of phase space
+// (poincare.csv; observers/poincare_section.hpp).
+enum class CrossingDirection { up, down, both };  // "+": s = normal . (q, p) - offset goes from < 0 to >= 0
+struct PoincareSection {
+  std::vector<double> normal;   // 2n numbers, n for q then n for p ("component": "q1" is the unit vector of q1)
+  double offset = 0.0;          // /analysis/poincare/value (or offset)
+  CrossingDirection direction = CrossingDirection::up;
+  std::optional<std::uint64_t> max_crossings;  // a trajectory stops ("completed", with a message) after this many
+};
+
+// /analysis/lyapunov: Benettin's finite-time Lyapunov exponents through the tangent map of the run's integrator.
+struct LyapunovAnalysis {
+  std::size_t vectors = 1;                 // k: the k largest exponents
+  std::uint64_t renormalize_every = 1;     // steps between re-orthonormalisations
+  std::uint64_t every = 0;                 // lyapunov.csv every this many steps; 0: no time series
+};
+
 // Per-trajectory analysis of a single run (/analysis).
 struct Analysis {
+  std::optional<PoincareSection> poincare;  // /analysis/poincare
+  std::optional<LyapunovAnalysis> lyapunov;  // /analysis/lyapunov
+  bool megno = false;                        // /analysis/megno: MEGNO of the first tangent vector
+  // Tangent vectors per trajectory the run must follow: lyapunov's k, or 1 for MEGNO alone; 0 for none.
+  std::size_t tangent_vectors() const { return lyapunov ? lyapunov->vectors : megno ? 1 : 0; }
   // /analysis/closest_return_after: from this time on, the smallest Euclidean phase-space distance
   // |(q, p) - (q0, p0)| to the trajectory's initial state is tracked at every step (summary: closest_return).
   std::optional<double> closest_return_after;
@@ -161,6 +196,10 @@ struct LoadedJob {
   Plugin plugin;
   PluginModel model;
 };
+
+// Puts loaded.job.initial on its energy shell (when /initial/energy is given; see EnergyShell), with the model's H.
+// Adds an issue at /initial/energy when the plugin has no Hessians, or no state of the grid reaches the shell.
+void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues);
 
 // Passes 1 and 2 on the file at `job_file`. Nothing when the file cannot be read (missing, a directory, larger than
 // max_job_file_bytes: an issue at "") or is not strict JSON; otherwise the Job, meaningful only if no issue was added.

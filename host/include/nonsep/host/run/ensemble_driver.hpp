@@ -19,7 +19,8 @@
 //     "p[0]"); its final state is its last finite one;
 //   - when the plugin fails on the block (nonsep::ModelError), the step is redone state by state from the previous
 //     step's copy, and only the states the plugin fails on retire, as "failed" with the plugin's message.
-// Removing a state from a block does not change the others' numbers.
+// Removing a state from a block does not change the others' numbers. An every-step observer may also ask for a
+// trajectory to stop at a step (BlockView::retire; e.g. at its last Poincare crossing).
 //
 // Energy: H (nonsep::EnergyEvaluator, needs the plugin's Hessians) is evaluated at step 0, at every event step an
 // observer asks for (needs_energy), at the last step, and for the final state of a trajectory that stops early.
@@ -35,6 +36,8 @@
 #include <nlohmann/json.hpp>
 
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/core/lyapunov_exponents.hpp"
+#include "nonsep/core/megno.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/observer.hpp"
 #include "nonsep/host/run/trajectory.hpp"
@@ -53,6 +56,10 @@ struct EnsembleSetup {
   std::span<const double> q, p;  // initial states, state-major (count * dimension each)
   unsigned threads = 0;  // worker threads; 0: all cores (omp_get_max_threads); 1 for a plugin that is not thread-safe
   const std::atomic<bool>* stop_requested = nullptr;  // checked between chunks
+  // Tangent vectors per trajectory (/analysis/lyapunov, /megno; run/tangent_block.hpp), 0 for none; the plugin
+  // must then have Hessians. The states are stepped bit for bit as without them.
+  std::size_t tangent_vectors = 0;
+  std::uint64_t renormalize_every = 1;
 };
 
 // The driver's state between two steps, for checkpoints.
@@ -63,6 +70,11 @@ struct DriverState {
   std::vector<double> energies;           // their H at `step` (NaN when not evaluated there)
   std::vector<TrajectoryRecord> records;  // every trajectory, by index
   EvaluationCounts evaluations;
+  // With tangent vectors (k per trajectory): the active trajectories' vectors (k * dimension numbers each, in
+  // tangent_basic_step.hpp's layout) and their Lyapunov and MEGNO sums; empty without.
+  std::vector<double> tangent_q, tangent_p;
+  std::vector<LyapunovRecord> lyapunov;
+  std::vector<MegnoRecord> megno;
 };
 
 // How the stepping ended.

@@ -21,7 +21,11 @@
 // Observers that watch every step (watches_every_step() true) are called inside chunks, on the worker thread of
 // each block, with that block's states only (on_step); they must touch nothing but their state for those
 // trajectories. Before a chunk the driver calls save_block; when a chunk is redone step by step (a state stopped
-// being finite, or the plugin failed, somewhere in it) restore_block puts the block's trajectories back.
+// being finite, or the plugin failed, somewhere in it) restore_block puts the block's trajectories back. The view
+// carries the worker thread's plugin instance (BlockView::model), for observers that must evaluate or step a state
+// themselves (a Poincare section re-steps from the state before the step), and in on_step a list where the
+// observer may ask for trajectories to stop at this step (BlockView::retire: the driver removes them from the block
+// after every watcher saw the step; their final state is the state at this step).
 //
 // Checkpoints: save() returns the observer's state as JSON (numbers as shortest round-trip strings: see
 // checkpoint.hpp), restore() takes it back after a resume; a resumed run must end bit for bit as an uninterrupted
@@ -36,9 +40,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "nonsep/core/lyapunov_exponents.hpp"
+#include "nonsep/core/megno.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 namespace nonsep::host {
+
+class PluginModel;
 
 inline constexpr std::uint64_t no_event = std::numeric_limits<std::uint64_t>::max();
 
@@ -48,6 +56,9 @@ struct StateView {
   std::span<const double> q, p;
   std::optional<double> energy;          // H at this step, when it was evaluated and finite
   const TrajectoryRecord* record = nullptr;  // energy_initial etc.
+  // The running Lyapunov and MEGNO sums, when the run follows tangent vectors (EnsembleSetup::tangent_vectors).
+  const LyapunovRecord* lyapunov = nullptr;
+  const MegnoRecord* megno = nullptr;
 };
 
 // A retirement an observer asks for at an event: the trajectory stops there with `status` and `message`.
@@ -72,6 +83,8 @@ struct BlockView {
   std::size_t dimension = 0;
   std::span<const std::size_t> trajectories;
   std::span<const double> q, p;
+  const PluginModel* model = nullptr;  // the worker thread's plugin instance; use it on this thread only
+  std::vector<RetirementRequest>* retire = nullptr;  // on_step only: stop these trajectories at this step
 };
 
 class Observer {

@@ -42,6 +42,10 @@ struct TrajectoryRecord {
   double stop_t = 0.0;
   std::string stop_variable;
   std::string message;
+  // The final estimates of /analysis/lyapunov (k exponents) and /analysis/megno (Y and <Y>), set when a run that
+  // follows tangent vectors retires the trajectory; empty for one that diverged or failed, and when not computed.
+  std::vector<double> lyapunov;
+  std::optional<double> megno, mean_megno;
 };
 
 // (H - H0) / H0, unknown when either is unknown or H0 = 0: trajectory.csv's and trajectories.csv's

@@ -1,0 +1,56 @@
+#pragma once
+// The results of /analysis/lyapunov and /analysis/megno, which the ensemble driver computes with the tangent
+// vectors it follows (run/tangent_block.hpp, EnsembleSetup::tangent_vectors):
+//   trajectories.csv  columns lyapunov0 .. lyapunov<k-1> (Benettin's finite-time exponents at the last
+//                     re-orthonormalisation) and/or megno, mean_megno (Y and <Y> of the first tangent vector:
+//                     <Y> -> 2 on a quasi-periodic orbit, ~ lambda t / 2 on a chaotic one, 0 on a stable periodic
+//                     one); empty for a trajectory that diverged or failed.
+//   lyapunov.csv      with /analysis/lyapunov/every = s > 0, the running estimates every s-th step:
+//                     trajectory,step,t,lyapunov0,...[,megno,mean_megno], in (step, trajectory) order.
+// Checkpoints: lyapunov.csv's size and content hash, like trajectory.csv; the estimates themselves are the driver's.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "nonsep/host/output/csv.hpp"
+#include "nonsep/host/run/observer.hpp"
+#include "nonsep/host/time_grid.hpp"
+
+namespace nonsep::host {
+
+class LyapunovMegnoObserver : public Observer {
+ public:
+  static constexpr const char* file_name = "lyapunov.csv";
+
+  // `exponents`: k columns of exponents (0 without /analysis/lyapunov); `megno`: the MEGNO columns; `every`: the
+  // series' stride (0: no lyapunov.csv). `records` (the driver's) and `time` must outlive the observer. Creates the
+  // series file unless `resuming` (then restore() opens it). Throws OutputError.
+  LyapunovMegnoObserver(const std::filesystem::path& path, std::size_t exponents, bool megno, std::uint64_t every,
+                        const TimeGrid& time, const std::vector<TrajectoryRecord>& records, bool resuming);
+
+  std::uint64_t next_event(std::uint64_t step) const override;
+  void on_event(const Event& event) override;
+  void on_end() override {
+    if (file_) file_->flush();
+  }
+
+  std::string name() const override { return every_ > 0 ? "lyapunov_csv" : ""; }
+  nlohmann::json save() override;
+  void restore(const nlohmann::json& state) override;
+
+  void columns(std::vector<std::string>& names) const override;
+  void cells(std::size_t trajectory, std::string& row) const override;
+
+ private:
+  std::filesystem::path path_;
+  std::size_t exponents_;
+  bool megno_;
+  std::uint64_t every_;
+  const TimeGrid& time_;
+  const std::vector<TrajectoryRecord>& records_;
+  std::optional<CsvAppender> file_;
+};
+
+}  // namespace nonsep::host

@@ -1,0 +1,132 @@
+// /analysis/poincare, /analysis/lyapunov and /analysis/megno: the dynamics diagnostics of a run (README.md,
+// "Dynamics: Poincare sections, Lyapunov exponents, MEGNO"). Whether the plugin has the Hessians the tangent map
+// needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
+#include <limits>
+
+#include "nonsep/core/lyapunov_exponents.hpp"
+#include "job_keys.hpp"
+#include "sections.hpp"
+
+namespace nonsep::host::job_reader {
+
+namespace {
+
+// "q0", "p12": the index into (q, p) of n + n numbers, or nothing.
+std::optional<std::size_t> component_index(const std::string& name, std::size_t dimension) {
+  if (name.size() < 2 || (name[0] != 'q' && name[0] != 'p')) return std::nullopt;
+  std::size_t index = 0;
+  for (std::size_t i = 1; i < name.size(); ++i) {
+    if (name[i] < '0' || name[i] > '9' || (i == 1 && name[i] == '0' && name.size() > 2) || index > 1000000)
+      return std::nullopt;
+    index = index * 10 + static_cast<std::size_t>(name[i] - '0');
+  }
+  if (index >= dimension) return std::nullopt;
+  return (name[0] == 'q' ? 0 : dimension) + index;
+}
+
+std::optional<PoincareSection> read_poincare(Checker& check, const json& value, std::size_t dimension) {
+  const std::string path = "/analysis/poincare";
+  if (!check.object(value, path,
+                    "an object {\"component\": \"q0\" (or \"normal\": [2n numbers]), \"value\": c, \"direction\": "
+                    "\"+\", \"max_crossings\": N}"))
+    return std::nullopt;
+  check.known_keys(value, path, poincare_keys().names());
+  const std::size_t issues = check.issue_count();
+  PoincareSection section;
+  const bool has_component = value.contains("component"), has_normal = value.contains("normal");
+  const std::string components = dimension > 0 ? "\"q0\" .. \"q" + std::to_string(dimension - 1) + "\" or \"p0\" .. \"p" +
+                                                     std::to_string(dimension - 1) + "\""
+                                               : "\"q<i>\" or \"p<i>\"";
+  if (has_component == has_normal) {
+    check.issue(path, has_component ? "both \"component\" and \"normal\"" : "neither \"component\" nor \"normal\"",
+                "exactly one of \"component\" (" + components + ") and \"normal\" (2n numbers, n for q then n for p)");
+  } else if (has_component) {
+    const json& component = value["component"];
+    const auto index = component.is_string() ? component_index(component.get<std::string>(), dimension) : std::nullopt;
+    if (!index) {
+      check.issue(child(path, "component"), describe(component), components + ", a component of the state");
+    } else {
+      section.normal.assign(2 * dimension, 0.0);
+      section.normal[*index] = 1.0;
+    }
+  } else if (auto normal = check.vector(value["normal"], child(path, "normal"))) {
+    double squared = 0.0;
+    for (double x : *normal) squared += x * x;
+    if (normal->size() != 2 * dimension && dimension > 0)
+      check.issue(child(path, "normal"), std::to_string(normal->size()) + " numbers",
+                  std::to_string(2 * dimension) + " numbers (2n: n for q, then n for p)");
+    else if (!(squared > 0.0) || !std::isfinite(squared))
+      check.issue(child(path, "normal"), describe(value["normal"]), "a normal vector that is not zero");
+    else
+      section.normal = std::move(*normal);
+  }
+  if (value.contains("value") && value.contains("offset"))
+    check.issue(path, "both \"value\" and \"offset\"", "one of them: the plane is normal . (q, p) = value");
+  for (const char* key : {"value", "offset"})
+    if (const json* c = check.member(value, path, key, false, ""))
+      if (auto number = check.finite_number(*c, child(path, key), "a finite number: the plane is normal . (q, p) = "
+                                                                   "value (default 0)"))
+        section.offset = *number;
+  if (const json* direction = check.member(value, path, "direction", false, "")) {
+    const std::string text = direction->is_string() ? direction->get<std::string>() : "";
+    if (text == "+") section.direction = CrossingDirection::up;
+    else if (text == "-") section.direction = CrossingDirection::down;
+    else if (text == "both") section.direction = CrossingDirection::both;
+    else
+      check.issue(child(path, "direction"), describe(*direction),
+                  "\"+\" (normal . (q, p) - value goes from < 0 to >= 0; the default), \"-\" or \"both\"");
+  }
+  if (const json* cap = check.member(value, path, "max_crossings", false, ""))
+    if (auto n = check.integer(*cap, child(path, "max_crossings"), 1, std::numeric_limits<std::int64_t>::max(),
+                               "an integer >= 1: a trajectory stops (status \"completed\", with a message) at the "
+                               "step of its N-th crossing"))
+      section.max_crossings = static_cast<std::uint64_t>(*n);
+  if (check.issue_count() != issues) return std::nullopt;
+  return section;
+}
+
+std::optional<LyapunovAnalysis> read_lyapunov(Checker& check, const json& value, std::size_t dimension) {
+  const std::string path = "/analysis/lyapunov";
+  if (!check.object(value, path, "an object {\"vectors\": k, \"renormalize_every\": m, \"every\": s}"))
+    return std::nullopt;
+  check.known_keys(value, path, lyapunov_keys().names());
+  const std::size_t issues = check.issue_count();
+  LyapunovAnalysis lyapunov;
+  const std::size_t most = std::min<std::size_t>(LyapunovRecord::max_exponents, dimension > 0 ? 2 * dimension : 2);
+  if (const json* k = check.member(value, path, "vectors", false, ""))
+    if (auto n = check.integer(*k, child(path, "vectors"), 1, static_cast<std::int64_t>(most),
+                               "an integer from 1 to " + std::to_string(most) +
+                                   " (2n, at most 32): the number of largest exponents (default 1)"))
+      lyapunov.vectors = static_cast<std::size_t>(*n);
+  if (const json* m = check.member(value, path, "renormalize_every", false, ""))
+    if (auto n = check.integer(*m, child(path, "renormalize_every"), 1, static_cast<std::int64_t>(max_steps),
+                               "an integer >= 1: steps between re-orthonormalisations of the tangent vectors "
+                               "(default 1)"))
+      lyapunov.renormalize_every = static_cast<std::uint64_t>(*n);
+  if (const json* every = check.member(value, path, "every", false, ""))
+    if (auto n = check.integer(*every, child(path, "every"), 0, static_cast<std::int64_t>(max_steps),
+                               "an integer >= 0: write lyapunov.csv every n-th step (0: no time series; the "
+                               "default)"))
+      lyapunov.every = static_cast<std::uint64_t>(*n);
+  if (check.issue_count() != issues) return std::nullopt;
+  return lyapunov;
+}
+
+}  // namespace
+
+void read_dynamics(Checker& check, const json& value, std::size_t dimension, Analysis& analysis) {
+  const std::string path = "/analysis";
+  if (const json* poincare = check.member(value, path, "poincare", false, ""))
+    analysis.poincare = read_poincare(check, *poincare, dimension);
+  if (const json* lyapunov = check.member(value, path, "lyapunov", false, ""))
+    analysis.lyapunov = read_lyapunov(check, *lyapunov, dimension);
+  if (const json* megno = check.member(value, path, "megno", false, "")) {
+    if (megno->is_boolean())
+      analysis.megno = megno->get<bool>();
+    else
+      check.issue(child(path, "megno"), describe(*megno),
+                  "true or false: MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)");
+  }
+}
+
+}  // namespace nonsep::host::job_reader

@@ -1,0 +1,116 @@
+// /initial/energy and /initial/solve_for: a grid of initial states put on one energy shell H(q, p) = E by solving for
+// one momentum component, the helper behind Poincare phase portraits (examples/dynamics). The root is bracketed
+// from p_i = 0 outwards (doubling) and refined by Boost.Math's TOMS 748 to the last bits; the state keeps the
+// evaluated p_i with the smallest |H - E|.
+#include <boost/math/tools/toms748_solve.hpp>
+
+#include <cmath>
+
+#include "nonsep/core/energy.hpp"
+#include "nonsep/core/error.hpp"
+#include "nonsep/host/number_format.hpp"
+#include "sections.hpp"
+
+namespace nonsep::host {
+
+namespace job_reader {
+
+void read_energy_shell(Checker& check, const json& initial, InitialStates& states) {
+  const bool has_energy = initial.contains("energy"), has_solve = initial.contains("solve_for");
+  if (!has_energy && !has_solve) return;
+  if (has_energy != has_solve) {
+    check.issue(has_energy ? "/initial/solve_for" : "/initial/energy", "nothing",
+                "\"energy\" and \"solve_for\" together: the component p_i solved for so that H = energy");
+    return;
+  }
+  EnergyShell shell;
+  const auto energy =
+      check.finite_number(initial["energy"], "/initial/energy", "a finite number: the energy H of every state");
+  const json& solve = initial["solve_for"];
+  std::string text = solve.is_string() ? solve.get<std::string>() : "";
+  shell.solve_for = text;
+  shell.negative = !text.empty() && text[0] == '-';
+  if (shell.negative) text.erase(0, 1);
+  bool valid = text.size() >= 2 && text[0] == 'p' && text.size() < 8;
+  for (std::size_t i = 1; valid && i < text.size(); ++i) valid = text[i] >= '0' && text[i] <= '9';
+  if (valid) shell.component = static_cast<std::size_t>(std::stoul(text.substr(1)));
+  if (!valid || (states.dimension > 0 && shell.component >= states.dimension)) {
+    check.issue("/initial/solve_for", describe(solve),
+                "\"p<i>\" (the root p_i >= 0) or \"-p<i>\" (the root p_i <= 0), i from 0 to " +
+                    std::to_string(states.dimension > 0 ? states.dimension - 1 : 0));
+    return;
+  }
+  if (!energy) return;
+  shell.energy = *energy;
+  states.shell = shell;
+}
+
+}  // namespace job_reader
+
+void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues) {
+  InitialStates& initial = loaded.job.initial;
+  if (!initial.shell) return;
+  EnergyShell& shell = *initial.shell;
+  if (!loaded.plugin.has_hessians()) {
+    issues.push_back({"/initial/energy", "the plugin '" + loaded.plugin.name() + "', which has no Hessians",
+                      "a plugin with Hessians (hessian_T and hessian_V): H needs them"});
+    return;
+  }
+  const std::size_t n = initial.dimension, c = shell.component;
+  EnergyEvaluator evaluator(loaded.job.is_study() ? loaded.job.study().form : loaded.job.run().integrator.form);
+  std::vector<double> q, p, kept_q, kept_p;
+  // H - E at p_c = x for the state being solved.
+  auto excess = [&](double x) {
+    p[c] = shell.negative ? -x : x;
+    double h = 0.0;
+    try {
+      evaluator.evaluate(loaded.model, PhaseSpaceBatch::single(q, p), std::span<double>(&h, 1));
+    } catch (const ModelError&) {
+      return std::nan("");  // not bracketed: the state is left out
+    }
+    return h - shell.energy;
+  };
+  for (std::size_t b = 0; b < initial.count; ++b) {
+    q.assign(initial.q.begin() + static_cast<std::ptrdiff_t>(b * n), initial.q.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
+    p.assign(initial.p.begin() + static_cast<std::ptrdiff_t>(b * n), initial.p.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
+    double lower = 0.0, g_lower = excess(0.0), upper = 1.0, g_upper = 0.0;
+    bool bracketed = false;
+    if (std::isfinite(g_lower) && g_lower <= 0.0) {
+      for (; upper <= 0x1p40; upper *= 2.0) {
+        g_upper = excess(upper);
+        if (!std::isfinite(g_upper)) break;
+        if (g_upper >= 0.0) {
+          bracketed = true;
+          break;
+        }
+        lower = upper;
+        g_lower = g_upper;
+      }
+    }
+    if (!bracketed) {
+      ++shell.left_out;
+      continue;
+    }
+    double root = g_lower == 0.0 ? lower : upper;
+    if (g_lower != 0.0 && g_upper != 0.0) {
+      std::uintmax_t iterations = 200;
+      const auto range = boost::math::tools::toms748_solve(excess, lower, upper, g_lower, g_upper,
+                                                           boost::math::tools::eps_tolerance<double>(), iterations);
+      root = std::abs(excess(range.first)) <= std::abs(excess(range.second)) ? range.first : range.second;
+    }
+    p[c] = shell.negative ? -root : root;
+    kept_q.insert(kept_q.end(), q.begin(), q.end());
+    kept_p.insert(kept_p.end(), p.begin(), p.end());
+  }
+  if (kept_q.empty()) {
+    issues.push_back({"/initial/energy", format_number(shell.energy) + ", which no state of the grid reaches",
+                      "an energy that some states of the grid reach by solving for " + shell.solve_for +
+                          " (H at " + shell.solve_for.substr(shell.negative ? 1 : 0) + " = 0 must not exceed it)"});
+    return;
+  }
+  initial.q = std::move(kept_q);
+  initial.p = std::move(kept_p);
+  initial.count = initial.q.size() / n;
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,135 @@
+#pragma once
+// Internal to the ensemble driver: the tangent vectors of one block's trajectories, for /analysis/lyapunov and
+// /analysis/megno. When a run asks for them, the block steps with nonsep::TangentIntegrator instead of
+// nonsep::Integrator: the states get the same numbers bit for bit (tangent_integrator.hpp), and k vectors per
+// state follow the exact tangent map of each step. After every step LyapunovExponents::after_step takes the
+// growth of the first vector (for MEGNO) and re-orthonormalises every `renormalize_every` steps
+// (lyapunov_exponents.hpp); MegnoRecord::add_step sums Y and <Y> (megno.hpp).
+//
+// Initial vectors (the same for every trajectory, fixed so that results are reproducible): vector 0 is
+// w = (1, 1/2, 1/3, ..., 1/(2n)) over (dq_0 .. dq_(n-1), dp_0 .. dp_(n-1)), a generic direction (not along the flow
+// or a torus of the shipped models), normalised; vector j >= 1 is the unit vector of component j, independent of
+// w and of each other. LyapunovExponents::start orthonormalises them, keeping w's direction.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "nonsep/core/lyapunov_exponents.hpp"
+#include "nonsep/core/megno.hpp"
+#include "nonsep/core/tangent_integrator.hpp"
+
+namespace nonsep::host {
+
+// The initial tangent vectors above, k for one state of dimension n, in the tangent layout (vector j at entry j).
+inline PhaseSpaceBatch initial_tangent_vectors(std::size_t n, std::size_t k) {
+  PhaseSpaceBatch v(n, k);
+  for (std::size_t i = 0; i < 2 * n; ++i) (i < n ? v.q()[i] : v.p()[i - n]) = 1.0 / static_cast<double>(i + 1);
+  for (std::size_t j = 1; j < k; ++j) (j < n ? v.q()[j * n + j] : v.p()[j * n + j - n]) = 1.0;
+  return v;
+}
+
+struct BlockTangents {
+  TangentIntegrator integrator;
+  LyapunovExponents exponents;
+  std::size_t k;
+  PhaseSpaceBatch vectors;               // k per slot: vector j of slot s at entry s*k + j
+  std::vector<LyapunovRecord> lyapunov;  // per slot
+  std::vector<MegnoRecord> megno;        // per slot
+  std::vector<double> growth;            // scratch: ln-growth of vector 0 over the last step, per slot
+
+  BlockTangents(const IntegratorSpec& spec, std::size_t vectors_per_state, std::uint64_t renormalize_every,
+                std::size_t n, std::size_t slots)
+      : integrator(spec), exponents(vectors_per_state, renormalize_every), k(vectors_per_state),
+        vectors(n, slots * vectors_per_state), lyapunov(slots), megno(slots), growth(slots) {}
+
+  // Every slot at time 0: the initial vectors, orthonormalised, and zeroed sums.
+  void start() {
+    const std::size_t n = vectors.dimension();
+    const PhaseSpaceBatch one = initial_tangent_vectors(n, k);
+    for (std::size_t s = 0; s < lyapunov.size(); ++s) {
+      std::copy(one.q().begin(), one.q().end(), vectors.q().begin() + static_cast<std::ptrdiff_t>(s * k * n));
+      std::copy(one.p().begin(), one.p().end(), vectors.p().begin() + static_cast<std::ptrdiff_t>(s * k * n));
+    }
+    exponents.start(vectors, lyapunov);
+    std::fill(megno.begin(), megno.end(), MegnoRecord{});
+  }
+
+  // Steps the states of `x`, which are slots first .. first + x.count() - 1 of the block, with their vectors as
+  // they were in `before` (the block's vectors before this step); writes the mapped vectors into `vectors`.
+  template <class M>
+  void step_part(const M& model, PhaseSpaceBatch& x, const PhaseSpaceBatch& before, std::size_t first, double dt) {
+    const std::size_t n = vectors.dimension(), size = x.count() * k * n;
+    const auto offset = static_cast<std::ptrdiff_t>(first * k * n);
+    PhaseSpaceBatch part(n, x.count() * k);
+    std::copy_n(before.q().begin() + offset, size, part.q().begin());
+    std::copy_n(before.p().begin() + offset, size, part.p().begin());
+    integrator.step(model, x, part, dt);
+    std::copy(part.q().begin(), part.q().end(), vectors.q().begin() + offset);
+    std::copy(part.p().begin(), part.p().end(), vectors.p().begin() + offset);
+  }
+
+  // A step of every slot at once.
+  template <class M>
+  void step(const M& model, PhaseSpaceBatch& x, double dt) {
+    integrator.step(model, x, vectors, dt);
+    after_step(dt);
+  }
+
+  // The Lyapunov and MEGNO sums after a step of dt of every slot.
+  void after_step(double dt) {
+    exponents.after_step(vectors, lyapunov, dt, growth);
+    add_megno_step(megno, growth, dt);
+  }
+
+  // Checkpoints (DriverState): appends every slot's vectors and sums; restore() takes slot s from entry
+  // entries[s] of such lists (the block's members among the active trajectories of a checkpoint).
+  void save(std::vector<double>& q, std::vector<double>& p, std::vector<LyapunovRecord>& l,
+            std::vector<MegnoRecord>& m) const {
+    q.insert(q.end(), vectors.q().begin(), vectors.q().end());
+    p.insert(p.end(), vectors.p().begin(), vectors.p().end());
+    l.insert(l.end(), lyapunov.begin(), lyapunov.end());
+    m.insert(m.end(), megno.begin(), megno.end());
+  }
+  void restore(std::span<const std::size_t> entries, std::span<const double> q, std::span<const double> p,
+               std::span<const LyapunovRecord> l, std::span<const MegnoRecord> m) {
+    const std::size_t size = k * vectors.dimension();
+    for (std::size_t slot = 0; slot < entries.size(); ++slot) {
+      std::copy_n(q.begin() + static_cast<std::ptrdiff_t>(entries[slot] * size), size,
+                  vectors.q().begin() + static_cast<std::ptrdiff_t>(slot * size));
+      std::copy_n(p.begin() + static_cast<std::ptrdiff_t>(entries[slot] * size), size,
+                  vectors.p().begin() + static_cast<std::ptrdiff_t>(slot * size));
+      lyapunov[slot] = l[entries[slot]];
+      megno[slot] = m[entries[slot]];
+    }
+  }
+
+  // Removes the slots marked in `retire`, keeping the others in order.
+  void compact(const std::vector<bool>& retire) {
+    const std::size_t n = vectors.dimension();
+    std::size_t kept = 0;
+    for (std::size_t s = 0; s < retire.size(); ++s) {
+      if (retire[s]) continue;
+      if (kept != s) {
+        std::copy_n(vectors.q().begin() + static_cast<std::ptrdiff_t>(s * k * n), k * n,
+                    vectors.q().begin() + static_cast<std::ptrdiff_t>(kept * k * n));
+        std::copy_n(vectors.p().begin() + static_cast<std::ptrdiff_t>(s * k * n), k * n,
+                    vectors.p().begin() + static_cast<std::ptrdiff_t>(kept * k * n));
+        lyapunov[kept] = lyapunov[s];
+        megno[kept] = megno[s];
+      }
+      ++kept;
+    }
+    if (kept == retire.size()) return;
+    PhaseSpaceBatch next(n, kept * k);
+    std::copy_n(vectors.q().begin(), kept * k * n, next.q().begin());
+    std::copy_n(vectors.p().begin(), kept * k * n, next.p().begin());
+    vectors = std::move(next);
+    lyapunov.resize(kept);
+    megno.resize(kept);
+    growth.resize(kept);
+  }
+};
+
+}  // namespace nonsep::host

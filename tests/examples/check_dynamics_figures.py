@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Checks what examples/dynamics/run_dynamics.sh produced in OUT_DIR (the examples test runs it with --small):
+
+  - dynamics_poincare and dynamics_chaos_map exist as PNG files of at least 150 dpi (their pHYs chunk) and 800
+    pixels wide, and as PDF files;
+  - the portrait's crossings lie on the section q1 = 0 (to 1e-12 relative) with H on the shell H = 7;
+  - every starting point was put on the shell (H0 = 7), some were left out, and the chaos map has both regular
+    (<Y> within 10% of 2) and chaotic (<Y> > 4) orbits, as the picture claims.
+
+    /usr/bin/python3 tests/examples/check_dynamics_figures.py OUT_DIR
+"""
+import csv
+import json
+import math
+import sys
+from pathlib import Path
+
+failures = []
+
+
+def check(condition, message):
+    if not condition:
+        failures.append(message)
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def png_chunks(data):
+    at = 8
+    while at + 8 <= len(data):
+        length = int.from_bytes(data[at:at + 4], "big")
+        yield data[at + 4:at + 8], data[at + 8:at + 8 + length]
+        at += 12 + length
+
+
+def check_pictures(out):
+    for name in ("dynamics_poincare", "dynamics_chaos_map"):
+        path = out / f"{name}.png"
+        check(path.exists(), f"{path} was not produced")
+        if path.exists():
+            data = path.read_bytes()
+            check(data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG file")
+            chunks = dict(png_chunks(data))
+            width = int.from_bytes(chunks.get(b"IHDR", bytes(4))[:4], "big")
+            check(width >= 800, f"{path} is {width} pixels wide")
+            phys = chunks.get(b"pHYs")
+            dpi = int.from_bytes(phys[:4], "big") * 0.0254 if phys and phys[8] == 1 else None
+            check(dpi is not None and dpi >= 149.5, f"{path}: {dpi} dpi, expected at least 150")
+        pdf = out / f"{name}.pdf"
+        check(pdf.exists() and pdf.read_bytes()[:5] == b"%PDF-", f"{pdf} is not a PDF file")
+
+
+def check_numbers(out):
+    crossings = rows(out / "poincare_portrait/poincare.csv")
+    check(len(crossings) > 100, f"the portrait has only {len(crossings)} crossings")
+    for r in crossings:
+        v = [float(r[k]) for k in ("q0", "q1", "p0", "p1")]
+        check(abs(v[1]) <= 1e-12 * math.hypot(*v), f"crossing {r['trajectory']}/{r['crossing']} is off q1 = 0: {v[1]}")
+        check(abs(float(r["H"]) / 7.0 - 1.0) < 1e-3, f"crossing {r['trajectory']}/{r['crossing']} has H = {r['H']}")
+    for folder in ("poincare_portrait", "chaos_map"):
+        summary = json.loads((out / folder / "summary.json").read_text())
+        check(summary["status"] == "completed", f"{folder}: status {summary['status']}")
+        check(summary["energy_shell"]["left_out"] > 0, f"{folder}: no starting point was left out")
+        for r in rows(out / folder / "trajectories.csv"):
+            check(abs(float(r["H0"]) - 7.0) <= 1e-13, f"{folder}: trajectory {r['trajectory']} starts at H = {r['H0']}")
+    megno = [float(r["mean_megno"]) for r in rows(out / "chaos_map/trajectories.csv")]
+    check(any(abs(y - 2.0) < 0.2 for y in megno), "the chaos map has no regular orbit (<Y> near 2)")
+    check(any(y > 4.0 for y in megno), "the chaos map has no chaotic orbit (<Y> > 4)")
+
+
+def main():
+    out = Path(sys.argv[1])
+    check_pictures(out)
+    check_numbers(out)
+    for failure in failures[:20]:
+        print(f"FAIL {failure}", file=sys.stderr)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,356 @@
+// The dynamics diagnostics end to end through the `nonsep` executable on paper2d (plugins/paper2d): Poincare
+// sections (poincare.csv, crossings on the plane to round-off, max_crossings), Lyapunov exponents and MEGNO
+// (trajectories.csv columns and lyapunov.csv), the same for any --threads, resumed bit for bit, and the refusals.
+#include <doctest/doctest.h>
+
+#include <csignal>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "host_run_support.hpp"
+#include "paper2d/paper2d.hpp"
+
+using namespace nonsep::host_testing;
+
+namespace {
+
+using PluginPaper2D = nonsep::sdk::ModelAdapter<::Paper2D>;
+
+const std::vector<double> regular_q{0.25, 0.3}, regular_p{-1.5, 0.2};  // quasi-periodic (plugins/paper2d)
+const std::vector<double> chaotic_q{-0.75, 0.3}, chaotic_p{-1.5, 0.2};
+
+// MPE of order 4 at dt = 0.005 keeps |H/H0 - 1| below 1e-4 on these orbits for t = 400 (the symplectic triplet 4/3
+// with the default t2 diverges on the chaotic orbit at dt = 0.002: its error constant is large in 2D).
+json paper2d_job(json initial, json time, json analysis) {
+  return {{"model", {{"plugin", "paper2d"}}},
+          {"integrator", {{"scheme", "mpe"}, {"order", 4}}},
+          {"initial", std::move(initial)},
+          {"time", std::move(time)},
+          {"output", {{"every", 0}}},
+          {"analysis", std::move(analysis)}};
+}
+
+json state2(const std::vector<double>& q, const std::vector<double>& p) { return {{"q", q}, {"p", p}}; }
+
+// A CSV file as rows of named cells.
+std::vector<std::map<std::string, std::string>> table(const std::filesystem::path& path) {
+  const auto rows = read_csv(path);
+  REQUIRE(!rows.empty());
+  std::vector<std::map<std::string, std::string>> result;
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    std::map<std::string, std::string> row;
+    for (std::size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = c < rows[r].size() ? rows[r][c] : "";
+    result.push_back(std::move(row));
+  }
+  return result;
+}
+
+double cell(const std::map<std::string, std::string>& row, const std::string& name) {
+  REQUIRE(row.count(name) == 1);
+  return std::strtod(row.at(name).c_str(), nullptr);
+}
+
+// Runs `job` as folder/name and returns the process result (no status check).
+Result run_named(const TemporaryFolder& folder, const std::string& name, const json& job,
+                 const std::vector<std::string>& extra = {}) {
+  const auto file = write_job(folder / (name + ".json"), job);
+  std::vector<std::string> args{"run", "--quiet", "--output", (folder / name).string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  args.push_back(file.string());
+  return run_nonsep(args, folder.path());
+}
+
+}  // namespace
+
+TEST_CASE("poincare.csv: every crossing of q0 = 0 upwards lies on the plane to 1e-12, between its step's samples") {
+  TemporaryFolder folder;
+  json job = paper2d_job(json::array({state2(regular_q, regular_p), state2(chaotic_q, chaotic_p)}),
+                         {{"dt", 0.005}, {"steps", 6000}}, {{"poincare", {{"component", "q0"}, {"value", 0.0}}}});
+  job["output"]["every"] = 1;
+  const auto result = run_named(folder, "run", job);
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  const auto crossings = table(folder / "run/poincare.csv");
+  const auto samples = table(folder / "run/trajectory.csv");
+  std::map<std::pair<int, int>, const std::map<std::string, std::string>*> by_step;
+  for (const auto& row : samples) by_step[{int(cell(row, "trajectory")), int(cell(row, "step"))}] = &row;
+  std::map<int, int> next_index;
+  for (const auto& row : crossings) {
+    const int trajectory = int(cell(row, "trajectory")), step = int(cell(row, "step"));
+    CHECK(cell(row, "crossing") == next_index[trajectory]++);
+    const double scale = std::hypot(cell(row, "q0"), cell(row, "q1"), std::hypot(cell(row, "p0"), cell(row, "p1")));
+    CHECK(std::abs(cell(row, "q0")) <= 1e-12 * scale);
+    // On the step where the sign changed: q0 < 0 before, >= 0 after; t between the two.
+    const auto& before = *by_step.at({trajectory, step - 1});
+    const auto& after = *by_step.at({trajectory, step});
+    CHECK(cell(before, "q0") < 0.0);
+    CHECK(cell(after, "q0") >= 0.0);
+    CHECK(cell(row, "t") >= cell(before, "t"));
+    CHECK(cell(row, "t") <= cell(after, "t"));
+    // H on the numerical trajectory: as conserved as at the samples.
+    CHECK(cell(row, "H") == doctest::Approx(cell(before, "H")).epsilon(1e-6));
+  }
+  CHECK(next_index[0] >= 3);  // t = 30: several turns
+  CHECK(next_index[1] >= 3);
+  const json summary = read_json(folder / "run/summary.json");
+  CHECK(summary["analysis"]["poincare"]["crossings"] == next_index[0] + next_index[1]);
+  const auto rows = table(folder / "run/trajectories.csv");
+  CHECK(cell(rows[0], "poincare_crossings") == next_index[0]);
+}
+
+TEST_CASE("a general normal, direction both, and max_crossings stopping a trajectory as completed at that step") {
+  TemporaryFolder folder;
+  // The plane q0 + p1 = 0.1, both directions; two crossings each, then the trajectory stops.
+  const json analysis = {{"poincare",
+                          {{"normal", {1.0, 0.0, 0.0, 1.0}}, {"offset", 0.1}, {"direction", "both"},
+                           {"max_crossings", 2}}}};
+  const auto result = run_named(folder, "run",
+                                paper2d_job(json::array({state2(regular_q, regular_p), state2(chaotic_q, chaotic_p)}),
+                                            {{"dt", 0.005}, {"steps", 5000}}, analysis));
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  const auto crossings = table(folder / "run/poincare.csv");
+  REQUIRE(crossings.size() == 4);
+  const auto rows = table(folder / "run/trajectories.csv");
+  for (std::size_t t = 0; t < 2; ++t) {
+    CHECK(rows[t].at("status") == "completed");
+    CHECK(rows[t].at("message").find("2-th Poincare crossing (max_crossings)") != std::string::npos);
+    CHECK(cell(rows[t], "step") < 5000);
+    double last_step = 0.0;
+    for (const auto& row : crossings) {
+      if (cell(row, "trajectory") != double(t)) continue;
+      const double s = cell(row, "q0") + cell(row, "p1") - 0.1;
+      CHECK(std::abs(s) <= 1e-12 * (std::sqrt(2.0) * 3.0 + 0.1));
+      last_step = cell(row, "step");
+    }
+    CHECK(cell(rows[t], "step") == last_step);  // it stopped at the step of its second crossing
+  }
+}
+
+TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaotic one, and lyapunov.csv") {
+  TemporaryFolder folder;
+  const json analysis = {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 10000}}}, {"megno", true}};
+  const auto result = run_named(folder, "run",
+                                paper2d_job(json::array({state2(regular_q, regular_p), state2(chaotic_q, chaotic_p)}),
+                                            {{"dt", 0.005}, {"steps", 80000}}, analysis));
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  const auto rows = table(folder / "run/trajectories.csv");
+  MESSAGE("t = 400: regular <Y> " << rows[0].at("mean_megno") << " lambda " << rows[0].at("lyapunov0")
+                                  << "; chaotic <Y> " << rows[1].at("mean_megno") << " lambda "
+                                  << rows[1].at("lyapunov0"));
+  CHECK(cell(rows[0], "mean_megno") == doctest::Approx(2.0).epsilon(0.05));
+  CHECK(cell(rows[0], "lyapunov0") < 0.05);
+  CHECK(cell(rows[1], "lyapunov0") > 0.1);
+  // The series: the chaotic <Y> grows (like lambda t / 2), the regular one stays near 2.
+  const auto series = table(folder / "run/lyapunov.csv");
+  REQUIRE(series.size() == 16);  // 2 trajectories at steps 10000, 20000, ..., 80000
+  std::vector<double> chaotic;
+  for (const auto& row : series)
+    if (cell(row, "trajectory") == 1.0) chaotic.push_back(cell(row, "mean_megno"));
+  CHECK(chaotic.back() > 4.0 * chaotic.front());
+  CHECK(chaotic.back() > 0.25 * cell(rows[1], "lyapunov0") * 400.0 / 2.0);
+  CHECK(series.back().at("mean_megno") == rows[1].at("mean_megno"));  // the last row is the final estimate
+  const json summary = read_json(folder / "run/summary.json");
+  CHECK(summary["analysis"]["tangent_map"]["vectors"] == 1);
+  CHECK(summary["analysis"]["tangent_map"]["lyapunov"]["series"] == "lyapunov.csv");
+}
+
+TEST_CASE("the host's largest exponent and states are the core's, bit for bit, with the documented first vector") {
+  TemporaryFolder folder;
+  const std::uint64_t steps = 3000;
+  const json analysis = {{"lyapunov", {{"vectors", 2}, {"renormalize_every", 7}}}, {"megno", true}};
+  const auto result = run_named(folder, "run",
+                                paper2d_job(state2(chaotic_q, chaotic_p), {{"dt", 0.005}, {"steps", steps}}, analysis));
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  const auto rows = table(folder / "run/trajectories.csv");
+
+  volatile double opaque_dt = 0.005;
+  const double dt = opaque_dt;
+  const PluginPaper2D model;
+  nonsep::TangentIntegrator integrator({"mpe", nonsep::Fraction(4)});
+  nonsep::PhaseSpaceBatch x = nonsep::PhaseSpaceBatch::single(chaotic_q, chaotic_p);
+  // The first vector (1, 1/2, 1/3, 1/4) over (dq0, dq1, dp0, dp1); the second the unit vector of dq1.
+  nonsep::PhaseSpaceBatch tangents(2, 2);
+  tangents.q()[0] = 1.0, tangents.q()[1] = 0.5, tangents.p()[0] = 1.0 / 3.0, tangents.p()[1] = 0.25;
+  tangents.q()[3] = 1.0;
+  nonsep::LyapunovExponents exponents(2, 7);
+  std::array<nonsep::LyapunovRecord, 1> record{};
+  std::array<nonsep::MegnoRecord, 1> megno{};
+  std::array<double, 1> growth{};
+  exponents.start(tangents, record);
+  for (std::uint64_t k = 0; k < steps; ++k) {
+    integrator.step(model, x, tangents, dt);
+    exponents.after_step(tangents, record, dt, growth);
+    nonsep::add_megno_step(megno, growth, dt);
+  }
+  CHECK(cell(rows[0], "q0") == x.q()[0]);
+  CHECK(cell(rows[0], "p1") == x.p()[1]);
+  CHECK(cell(rows[0], "lyapunov0") == record[0].exponent(0));
+  CHECK(cell(rows[0], "lyapunov1") == record[0].exponent(1));
+  CHECK(cell(rows[0], "mean_megno") == megno[0].mean_y());
+  CHECK(cell(rows[0], "megno") == megno[0].y());
+  CHECK(record[0].exponent(0) > 0.05);
+}
+
+TEST_CASE("tangent vectors do not change the states: trajectory.csv is the same with and without /analysis") {
+  TemporaryFolder folder;
+  json plain = paper2d_job(json::array({state2(regular_q, regular_p), state2(chaotic_q, chaotic_p)}),
+                           {{"dt", 0.005}, {"steps", 2000}}, json::object());
+  plain["output"]["every"] = 100;
+  json with = plain;
+  with["analysis"] = {{"lyapunov", {{"vectors", 4}}}, {"megno", true}};
+  REQUIRE(run_named(folder, "plain", plain).status == 0);
+  REQUIRE(run_named(folder, "with", with).status == 0);
+  CHECK(read_text(folder / "plain/trajectory.csv") == read_text(folder / "with/trajectory.csv"));
+  // The same drifts; the tangent stepper re-evaluates grad V where the plain step reuses its last one.
+  CHECK(read_json(folder / "plain/summary.json")["evaluations"]["grad_T"] ==
+        read_json(folder / "with/summary.json")["evaluations"]["grad_T"]);
+}
+
+namespace {
+
+// 300 states (two blocks of 256) on a grid, put on the shell H = 7, with every diagnostic; trajectories stop inside
+// chunks at their max_crossings-th crossing. The basic step with t2 = -3 (cheap; accuracy does not matter here).
+json ensemble_job(std::uint64_t steps, std::uint64_t max_crossings) {
+  json job = paper2d_job({{"grid",
+                           {{"q", {{{"from", -0.8}, {"to", 0.8}, {"count", 20}}, 0.0}},
+                            {"p", {{{"from", -1.5}, {"to", 1.5}, {"count", 15}}, 0.0}}}},
+                          {"energy", 7.0},
+                          {"solve_for", "p1"}},
+                         {{"dt", 0.002}, {"steps", steps}},
+                         {{"poincare", {{"component", "q1"}, {"direction", "+"}, {"max_crossings", max_crossings}}},
+                          {"lyapunov", {{"vectors", 2}, {"renormalize_every", 5}, {"every", 500}}},
+                          {"megno", true}});
+  job["output"]["every"] = 250;
+  job["integrator"] = {{"scheme", "basic"}, {"t2", -3.0}};
+  return job;
+}
+
+}  // namespace
+
+TEST_CASE("--threads 1 and 2 write the same poincare.csv, lyapunov.csv and trajectories.csv, byte for byte") {
+  TemporaryFolder folder;
+  const json job = ensemble_job(2000, 2);
+  REQUIRE(run_named(folder, "one", job, {"--threads", "1"}).status == 0);
+  REQUIRE(run_named(folder, "two", job, {"--threads", "2"}).status == 0);
+  for (const char* file : {"poincare.csv", "lyapunov.csv", "trajectories.csv", "trajectory.csv"}) {
+    CAPTURE(file);
+    CHECK(read_text(folder / "one" / file) == read_text(folder / "two" / file));
+  }
+  const json summary = read_json(folder / "one/summary.json");
+  CHECK(summary["trajectories"].get<int>() > 256);  // two blocks at least
+  CHECK(summary["energy_shell"]["left_out"].get<int>() > 0);
+  CHECK(summary["energy_shell"]["left_out"].get<int>() + summary["trajectories"].get<int>() == 300);
+  // Every state starts on the shell H = 7; some stopped at their second crossing, some ran to the end.
+  std::map<std::string, int> statuses;
+  for (const auto& row : table(folder / "one/trajectories.csv")) {
+    CHECK(cell(row, "H0") == doctest::Approx(7.0).epsilon(1e-14));
+    ++statuses[row.at("status") + (row.at("message").empty() ? "" : " (max_crossings)")];
+  }
+  CHECK(statuses["completed (max_crossings)"] > 0);
+  CHECK(statuses["completed"] > 0);
+}
+
+TEST_CASE("killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv bit for bit") {
+  TemporaryFolder reference;
+  json job = ensemble_job(60000, 25);
+  job["checkpoint"] = {{"every_steps", 1000}, {"every_seconds", 0}};
+  REQUIRE(run_named(reference, "out", job).status == 0);
+
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", job);
+  const auto process = start_nonsep({"run", "--quiet", "--output", (folder / "out").string(), file.string()},
+                                    folder.path());
+  REQUIRE(wait_until([&] {
+    try {
+      return read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>() >= 20000;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }));
+  REQUIRE(::kill(process.pid, SIGKILL) == 0);
+  finish(process, std::chrono::seconds(30));
+  const auto step = read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>();
+  INFO("killed after the checkpoint at step " << step);
+  CHECK(step < 60000);
+  const auto resumed =
+      run_nonsep({"run", "--quiet", "--resume", "--output", (folder / "out").string(), file.string()}, folder.path());
+  INFO("stderr: " << resumed.err);
+  REQUIRE(resumed.status == 0);
+  for (const char* name : {"poincare.csv", "lyapunov.csv", "trajectories.csv", "trajectory.csv"}) {
+    CAPTURE(name);
+    CHECK(read_text(folder / "out" / name) == read_text(reference / "out" / name));
+  }
+  // Trajectories stopped by max_crossings both before and after the checkpoint.
+  std::vector<double> stops;
+  for (const auto& row : table(reference / "out/trajectories.csv"))
+    if (!row.at("message").empty()) stops.push_back(cell(row, "step"));
+  REQUIRE(!stops.empty());
+  CHECK(*std::min_element(stops.begin(), stops.end()) < double(step));
+  CHECK(*std::max_element(stops.begin(), stops.end()) > double(step));
+}
+
+TEST_CASE("Lyapunov exponents and MEGNO are refused, naming /analysis, for a plugin without Hessians") {
+  use_test_plugins();
+  TemporaryFolder folder;
+  for (const char* key : {"lyapunov", "megno"}) {
+    CAPTURE(key);
+    json job = {{"model", {{"plugin", "blowup_gradients_only"}}},
+                {"integrator", {{"scheme", "basic"}}},
+                {"initial", {{"q", {0.5}}, {"p", {0.1}}}},
+                {"time", {{"dt", 0.005}, {"steps", 10}}},
+                {"analysis", {{key, std::string(key) == "megno" ? json(true) : json::object()}}}};
+    const auto result = run_named(folder, key, job);
+    CHECK(result.status == 2);
+    CHECK(result.err.find(std::string("/analysis/") + key) != std::string::npos);
+    CHECK(result.err.find("no Hessians") != std::string::npos);
+  }
+}
+
+TEST_CASE("an energy shell: \"p1\" takes the root p1 >= 0, \"-p1\" the root p1 <= 0, both on H = E to round-off") {
+  TemporaryFolder folder;
+  for (const char* solve_for : {"p1", "-p1"}) {
+    CAPTURE(solve_for);
+    json job = paper2d_job({{"grid", {{"q", {0.25, 0.3}}, {"p", {{{"values", {-1.5, 0.5, 3.0}}}, 99.0}}}},
+                            {"energy", 7.0},
+                            {"solve_for", solve_for}},
+                           {{"dt", 0.005}, {"steps", 1}}, json::object());
+    const auto result = run_named(folder, solve_for, job);
+    INFO("stderr: " << result.err);
+    REQUIRE(result.status == 0);
+    const auto rows = table(folder / solve_for / "trajectories.csv");
+    // p0 = 3 is off the shell: H > 7 at p1 = 0 already.
+    REQUIRE(rows.size() == 2);
+    CHECK(read_json(folder / solve_for / "summary.json")["energy_shell"]["left_out"] == 1);
+    for (const auto& row : rows) {
+      CHECK(cell(row, "H0") == doctest::Approx(7.0).epsilon(2e-16 * 4));
+      CHECK(cell(row, "p1") * (std::string(solve_for) == "p1" ? 1.0 : -1.0) > 0.0);
+    }
+  }
+}
+
+TEST_CASE("a chunk redone step by step after a divergence keeps the crossings and max_crossings stops of the others") {
+  TemporaryFolder folder;
+  const json analysis = {{"poincare", {{"component", "q0"}, {"max_crossings", 3}}}, {"megno", true}};
+  // Alone, and in one block with a state that overflows at once: that block's chunk is redone step by step, after
+  // the regular orbit already left it at its third crossing in the unchecked pass.
+  const json alone = paper2d_job(json::array({state2(regular_q, regular_p)}), {{"dt", 0.005}, {"steps", 6000}}, analysis);
+  json together = alone;
+  together["initial"].push_back(state2({1e103, 0.0}, {0.0, 0.0}));
+  REQUIRE(run_named(folder, "alone", alone).status == 0);
+  REQUIRE(run_named(folder, "together", together).status == 1);  // diverged
+  const auto rows = table(folder / "together/trajectories.csv");
+  CHECK(rows[1].at("status") == "diverged");
+  CHECK(rows[0].at("message").find("3-th Poincare crossing") != std::string::npos);
+  CHECK(read_text(folder / "together/poincare.csv") == read_text(folder / "alone/poincare.csv"));
+  const auto single = table(folder / "alone/trajectories.csv");
+  for (const char* column : {"step", "q0", "q1", "p0", "p1", "mean_megno", "poincare_crossings"}) {
+    CAPTURE(column);
+    CHECK(rows[0].at(column) == single[0].at(column));
+  }
+}
