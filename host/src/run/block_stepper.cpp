@@ -1,0 +1,133 @@
+#include "run/block_stepper.hpp"
+
+#include <cmath>
+
+#include "nonsep/core/error.hpp"
+
+namespace nonsep::host {
+
+BlockView BlockStepper::view(const Block& block, const Worker& worker) const {
+  return {static_cast<std::size_t>(&block - blocks.data()), setup.dimension, block.trajectories, block.batch.q(),
+          block.batch.p(), &worker.model};
+}
+
+// The every-step observers see the block at `step`; the trajectories they ask to stop leave it there.
+void BlockStepper::watch_step(Block& block, Worker& worker, std::uint64_t step) {
+  if (step_watchers.empty()) return;
+  std::vector<RetirementRequest> requests;
+  auto v = view(block, worker);
+  v.retire = &requests;
+  for (Observer* watcher : step_watchers) watcher->on_step(step, setup.time.time_at(step), v);
+  if (requests.empty()) return;
+  sort_requests(requests);
+  block.retire_requested(requests, step, [&](std::size_t slot) { return energy_of(worker, block.batch, slot); });
+}
+
+void BlockStepper::advance_block(Block& block, Worker& worker, std::uint64_t from, std::uint64_t to) {
+  block.begin_chunk();
+  for (Observer* watcher : step_watchers) watcher->save_block(view(block, worker));
+  const double dt = setup.time.dt;
+  bool clean = true;
+  try {
+    for (std::uint64_t step = from; step < to && !block.empty(); ++step) {
+      block.step(worker.model, dt);
+      watch_step(block, worker, step + 1);
+    }
+  } catch (const ModelError&) {
+    clean = false;
+  }
+  if (clean && block.all_finite()) return;
+  block.rollback_chunk();
+  for (Observer* watcher : step_watchers) watcher->restore_block(view(block, worker));
+  for (std::uint64_t step = from + 1; step <= to && !block.empty(); ++step) {
+    checked_step(block, worker, step);
+    if (!block.empty()) watch_step(block, worker, step);
+  }
+}
+
+// One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge.
+void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step) {
+  const PhaseSpaceBatch before = block.batch;
+  const std::optional<PhaseSpaceBatch> tangents_before =
+      block.tangents ? std::optional<PhaseSpaceBatch>(block.tangents->vectors) : std::nullopt;
+  const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
+    if (block.tangents)
+      block.tangents->step_part(worker.model, x, *tangents_before, first, setup.time.dt);
+    else
+      block.integrator.step(worker.model, x, setup.time.dt);
+  });
+  if (block.tangents) block.tangents->after_step(setup.time.dt);
+  std::vector<bool> retire(block.trajectories.size(), false);
+  for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
+    Departure departure;
+    if (!errors[slot].empty()) {
+      departure.status = TrajectoryStatus::failed;
+      departure.message = "the model failed at step " + std::to_string(step) + ": " + errors[slot];
+    } else if (auto variable = first_non_finite(block.batch, slot); !variable.empty()) {
+      departure.status = TrajectoryStatus::diverged;
+      departure.variable = variable;
+    } else {
+      continue;
+    }
+    retire[slot] = true;
+    departure.trajectory = block.trajectories[slot];
+    departure.step = step;
+    departure.final_step = step - 1;
+    departure.q.assign(before.q(slot).begin(), before.q(slot).end());
+    departure.p.assign(before.p(slot).begin(), before.p(slot).end());
+    departure.energy = energy_of(worker, before, slot);
+    block.departures.push_back(std::move(departure));
+  }
+  block.compact(retire);
+}
+
+// H of state `slot` of x alone, or nothing when unknown.
+std::optional<double> BlockStepper::energy_of(Worker& worker, const PhaseSpaceBatch& x, std::size_t slot) const {
+  if (!energy_available) return std::nullopt;
+  try {
+    const double energy = worker.energy.evaluate_one(worker.model, single_state(x, slot));
+    if (std::isfinite(energy)) return energy;
+  } catch (const ModelError&) {
+  }
+  return std::nullopt;
+}
+
+// H of the block's states at `step`; the states the model fails on retire as "failed". Sets H0 at step 0 (each
+// trajectory belongs to one block: no two threads touch the same record).
+void BlockStepper::evaluate_energies(Block& block, Worker& worker, std::uint64_t step) {
+  const auto errors = compute_energies(block, worker, step);
+  std::vector<bool> retire(block.trajectories.size(), false);
+  for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
+    if (errors[slot].empty()) {
+      if (step == 0) records[block.trajectories[slot]].energy_initial = block.energy(slot);
+      continue;
+    }
+    retire[slot] = true;
+    Departure departure;
+    departure.trajectory = block.trajectories[slot];
+    departure.step = departure.final_step = step;
+    departure.phase = 1;
+    departure.status = TrajectoryStatus::failed;
+    departure.message = "the energy could not be evaluated at step " + std::to_string(step) + ": " + errors[slot];
+    departure.q.assign(block.batch.q(slot).begin(), block.batch.q(slot).end());
+    departure.p.assign(block.batch.p(slot).begin(), block.batch.p(slot).end());
+    block.departures.push_back(std::move(departure));
+  }
+  block.compact(retire);
+}
+
+// Fills block.energies at `step` (NaN where the model fails); returns the model's message per slot.
+std::vector<std::string> BlockStepper::compute_energies(Block& block, Worker& worker, std::uint64_t step) {
+  block.energies.assign(block.trajectories.size(), std::nan(""));
+  block.energy_step = step;
+  PhaseSpaceBatch x = block.batch;
+  auto errors = isolate_failures(x, block.batch, [&](PhaseSpaceBatch& part, std::size_t first) {
+    worker.energy.evaluate(worker.model, part, std::span<double>(block.energies).subspan(first, part.count()));
+  });
+  for (std::size_t slot = 0; slot < errors.size(); ++slot)
+    if (!errors[slot].empty()) block.energies[slot] = std::nan("");
+  return errors;
+}
+
+
+}  // namespace nonsep::host
