@@ -15,6 +15,7 @@
 #include <boost/shared_ptr.hpp>
 
 #include "nonsep/plugin_abi.h"
+#include "plugin_internals.hpp"
 #include "nonsep/sdk/parameters.hpp"
 
 namespace nonsep::host {
@@ -22,118 +23,8 @@ namespace nonsep::host {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Plugin::Loaded {
-  boost::shared_ptr<const nonsep_plugin_api> table;  // from import_alias: owns the loaded library
-  fs::path path;
-  const nonsep_plugin_api* api = nullptr;            // table.get()
-  json metadata;
-};
-
-struct PluginModel::Instance {
-  Plugin plugin;  // keeps the library loaded while the instance lives
-  const nonsep_plugin_api* api = nullptr;
-  nonsep_instance* handle = nullptr;
-  std::size_t dimension = 0;
-  json parameters;
-
-  Instance() = default;
-  Instance(const Instance&) = delete;
-  Instance& operator=(const Instance&) = delete;
-  ~Instance() {
-    if (handle != nullptr) api->destroy(handle);
-  }
-};
-
 namespace {
 
-const char* status_name(nonsep_status status) {
-  switch (status) {
-    case NONSEP_OK: return "ok";
-    case NONSEP_INVALID_PARAMETERS: return "invalid parameters";
-    case NONSEP_EVALUATION_FAILED: return "evaluation failed";
-    case NONSEP_INTERNAL_ERROR: return "internal error";
-    case NONSEP_UNSUPPORTED: return "unsupported";
-  }
-  return "unknown status";
-}
-
-std::string quoted(const fs::path& path) { return std::string("'").append(path.string()).append("'"); }
-
-// The metadata checks of plugin_abi.h, after the JSON has parsed. Throws PluginError naming the field.
-void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path& path) {
-  const std::string where = "the metadata of plugin " + quoted(path);
-  auto fail = [&](const std::string& problem) { throw PluginError(where + " " + problem); };
-  if (!m.is_object()) fail("must be a JSON object (found " + std::string(m.type_name()) + ")");
-  for (const char* key : {"name", "version", "description", "hamiltonian"})
-    if (!m.contains(key) || !m[key].is_string()) fail("lacks the string \"" + std::string(key) + "\"");
-  const std::string name = m["name"].get<std::string>();
-  if (name != path.stem().string())
-    fail("declares the name '" + name + "' but the file is named " + path.filename().string() +
-         "; a plugin's file must be <name>.so (expected '" + path.stem().string() + "', found '" + name + "')");
-
-  if (!m.contains("parameters") || !m["parameters"].is_array()) fail("lacks the array \"parameters\"");
-  std::set<std::string> parameter_names;
-  for (const json& p : m["parameters"]) {
-    if (!p.is_object() || !p.contains("name") || !p["name"].is_string())
-      fail("has a parameter without a string \"name\"");
-    const std::string parameter = p["name"].get<std::string>();
-    if (!parameter_names.insert(parameter).second) fail("declares parameter '" + parameter + "' twice");
-    const std::string type = p.value("type", json()).is_string() ? p["type"].get<std::string>() : "";
-    if (type != "integer" && type != "number" && type != "boolean")
-      fail("gives parameter '" + parameter + "' the type " + p.value("type", json()).dump() +
-           " (expected \"integer\", \"number\" or \"boolean\")");
-    if (!p.contains("default")) fail("gives parameter '" + parameter + "' no default");
-    for (const char* bound : {"minimum", "maximum"})
-      if (p.contains(bound) && !p[bound].is_number())
-        fail("gives parameter '" + parameter + "' a non-numeric " + bound);
-    for (const char* text : {"unit", "description"})
-      if (p.contains(text) && !p[text].is_string()) fail("gives parameter '" + parameter + "' a non-string " + text);
-    const auto bound = [&](const char* key) {
-      return p.contains(key) ? std::optional<double>(p[key].get<double>()) : std::nullopt;
-    };
-    const std::string problem =
-        sdk::check_parameter_value(parameter, type, bound("minimum"), bound("maximum"), p["default"]);
-    if (!problem.empty()) fail("has an invalid default: " + problem);
-  }
-
-  if (!m.contains("dimension") || !m["dimension"].is_object()) fail("lacks the object \"dimension\"");
-  const json& dimension = m["dimension"];
-  if (dimension.contains("fixed")) {
-    if (!dimension["fixed"].is_number_unsigned() || dimension["fixed"].get<std::uint64_t>() == 0)
-      fail("gives \"dimension\": {\"fixed\": ...} a value that is not a positive integer (found " +
-           dimension["fixed"].dump() + ")");
-  } else if (dimension.contains("parameter")) {
-    const json& parameter = dimension["parameter"];
-    const auto& parameters = m["parameters"];
-    const bool declared = parameter.is_string() && std::any_of(parameters.begin(), parameters.end(), [&](const json& p) {
-                            return p["name"] == parameter && p["type"] == "integer";
-                          });
-    if (!declared)
-      fail("sets the dimension by parameter " + parameter.dump() + ", which is not a declared integer parameter");
-  } else {
-    fail("gives \"dimension\" neither \"fixed\" nor \"parameter\"");
-  }
-
-  if (!m.contains("thread_safe") || !m["thread_safe"].is_boolean())
-    fail("lacks the boolean \"thread_safe\" (required since plugin ABI version 3; true when distinct instances "
-         "share no mutable state, false to be run as one instance on one thread" +
-         (m.contains("thread_safe") ? "; found " + m["thread_safe"].dump() : std::string()) + ")");
-
-  if (!m.contains("capabilities") || !m["capabilities"].is_object()) fail("lacks the object \"capabilities\"");
-  const std::pair<const char*, bool> present[] = {{"value_T", api.value_T != nullptr},
-                                                  {"value_V", api.value_V != nullptr},
-                                                  {"hessian_T", api.hessian_T != nullptr},
-                                                  {"hessian_V", api.hessian_V != nullptr},
-                                                  {"d3T", api.d3T != nullptr},
-                                                  {"d3V", api.d3V != nullptr}};
-  for (const auto& [capability, in_table] : present) {
-    const json claimed = m["capabilities"].value(capability, json(false));
-    if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
-    if (claimed.get<bool>() != in_table)
-      fail("says capability \"" + std::string(capability) + "\" is " + (claimed.get<bool>() ? "true" : "false") +
-           " but the table's " + capability + " pointer is " + (in_table ? "set" : "null"));
-  }
-}
 
 // The remedy for a plugin of another ABI version, named in both version refusals.
 const std::string rebuild_hint =
@@ -366,71 +257,5 @@ std::vector<DiscoveredPlugin> discover_plugins() {
   }
   return found;
 }
-
-std::size_t PluginModel::dimension() const { return instance_->dimension; }
-const Plugin& PluginModel::plugin() const { return instance_->plugin; }
-const json& PluginModel::parameters() const { return instance_->parameters; }
-
-
-namespace {
-
-// Checks the spans, then makes one batched call of the table, `call(handle, in, out, count)` (absent when
-// `present` is false), and turns a failure into ModelError with the plugin's message.
-template <class Call>
-void evaluate(const PluginModel& model, nonsep_instance* handle, const nonsep_plugin_api& api, bool present,
-              const char* function_name, std::span<const double> in, std::span<double> out, std::size_t count,
-              std::size_t out_per_state, const Call& call) {
-  const std::size_t n = model.dimension();
-  if (in.size() < count * n || out.size() < count * out_per_state)
-    throw nonsep::InvalidArgument(std::string(function_name) + ": a batch of " + std::to_string(count) +
-                                  " states of dimension " + std::to_string(n) + " needs " +
-                                  std::to_string(count * n) + " inputs and " + std::to_string(count * out_per_state) +
-                                  " outputs (found " + std::to_string(in.size()) + " and " +
-                                  std::to_string(out.size()) + ")");
-  if (!present)
-    throw nonsep::ModelError("plugin '" + model.plugin().name() + "' does not provide " + function_name +
-                             " (its capability is false)");
-  const nonsep_status status = call(handle, in.data(), out.data(), count);
-  if (status != NONSEP_OK) {
-    const char* message = api.last_error(handle);
-    throw nonsep::ModelError("plugin '" + model.plugin().name() + "' failed in " + function_name + " (" +
-                             status_name(status) + "): " + (message != nullptr && *message ? message : "no message"));
-  }
-}
-
-}  // namespace
-
-#define NONSEP_PLUGIN_MODEL_FUNCTION(function, out_per_state)                                                     \
-  void PluginModel::function(std::span<const double> x, std::span<double> out, std::size_t count) const {         \
-    const std::size_t n = instance_->dimension;                                                                   \
-    const nonsep_plugin_api& api = *instance_->api;                                                               \
-    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, x, out, count, out_per_state,     \
-             api.function);                                                                                       \
-  }
-NONSEP_PLUGIN_MODEL_FUNCTION(grad_T, n)
-NONSEP_PLUGIN_MODEL_FUNCTION(grad_V, n)
-NONSEP_PLUGIN_MODEL_FUNCTION(hessian_T, n * n)
-NONSEP_PLUGIN_MODEL_FUNCTION(hessian_V, n * n)
-NONSEP_PLUGIN_MODEL_FUNCTION(value_T, (static_cast<void>(n), 1))
-NONSEP_PLUGIN_MODEL_FUNCTION(value_V, (static_cast<void>(n), 1))
-#undef NONSEP_PLUGIN_MODEL_FUNCTION
-
-#define NONSEP_PLUGIN_MODEL_DIRECTIONAL(function)                                                                \
-  void PluginModel::function(std::span<const double> x, std::span<const double> u, std::span<double> out,        \
-                             std::size_t count) const {                                                          \
-    const std::size_t n = instance_->dimension;                                                                  \
-    if (u.size() < count * n)                                                                                    \
-      throw nonsep::InvalidArgument(#function ": a batch of " + std::to_string(count) + " states of dimension " + \
-                                    std::to_string(n) + " needs " + std::to_string(count * n) +                  \
-                                    " direction components (found " + std::to_string(u.size()) + ")");          \
-    const nonsep_plugin_api& api = *instance_->api;                                                             \
-    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, x, out, count, n,               \
-             [&](nonsep_instance* handle, const double* in, double* result, std::size_t size) {                 \
-               return api.function(handle, in, u.data(), result, size);                                         \
-             });                                                                                                 \
-  }
-NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3T)
-NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3V)
-#undef NONSEP_PLUGIN_MODEL_DIRECTIONAL
 
 }  // namespace nonsep::host

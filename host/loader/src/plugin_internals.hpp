@@ -1,0 +1,50 @@
+#pragma once
+// Internal to nonsep::loader (host/loader/src/): what a Plugin and a PluginModel hold, shared by the loader
+// (plugin_loader.cpp), the metadata checks (plugin_metadata.cpp) and the evaluations (plugin_model.cpp).
+#include <cstddef>
+#include <filesystem>
+#include <string>
+
+#include <boost/shared_ptr.hpp>
+#include <nlohmann/json.hpp>
+
+#include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/plugin_abi.h"
+
+namespace nonsep::host {
+
+struct Plugin::Loaded {
+  boost::shared_ptr<const nonsep_plugin_api> table;  // from import_alias: owns the loaded library
+  std::filesystem::path path;
+  const nonsep_plugin_api* api = nullptr;            // table.get()
+  nlohmann::json metadata;
+};
+
+struct PluginModel::Instance {
+  Plugin plugin;  // keeps the library loaded while the instance lives
+  const nonsep_plugin_api* api = nullptr;
+  nonsep_instance* handle = nullptr;
+  std::size_t dimension = 0;
+  nlohmann::json parameters;
+
+  Instance() = default;
+  Instance(const Instance&) = delete;
+  Instance& operator=(const Instance&) = delete;
+  ~Instance() {
+    if (handle != nullptr) api->destroy(handle);
+  }
+};
+
+// A path in quotes, as the loader's messages name files.
+inline std::string quoted(const std::filesystem::path& path) {
+  return std::string("'").append(path.string()).append("'");
+}
+
+// "ok", "invalid parameters", ...: a status of plugin_abi.h as words.
+const char* status_name(nonsep_status status);
+
+// The metadata checks of plugin_abi.h on the parsed metadata `m` of the plugin at `path` whose table is `api`.
+// Throws PluginError naming the field.
+void check_metadata(const nlohmann::json& m, const nonsep_plugin_api& api, const std::filesystem::path& path);
+
+}  // namespace nonsep::host

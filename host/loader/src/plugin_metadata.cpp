@@ -1,0 +1,88 @@
+// The metadata checks of plugin_abi.h (plugin_internals.hpp), after the JSON has parsed.
+#include <set>
+#include <string>
+
+#include "nonsep/sdk/parameters.hpp"
+#include "plugin_internals.hpp"
+
+namespace nonsep::host {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path& path) {
+  const std::string where = "the metadata of plugin " + quoted(path);
+  auto fail = [&](const std::string& problem) { throw PluginError(where + " " + problem); };
+  if (!m.is_object()) fail("must be a JSON object (found " + std::string(m.type_name()) + ")");
+  for (const char* key : {"name", "version", "description", "hamiltonian"})
+    if (!m.contains(key) || !m[key].is_string()) fail("lacks the string \"" + std::string(key) + "\"");
+  const std::string name = m["name"].get<std::string>();
+  if (name != path.stem().string())
+    fail("declares the name '" + name + "' but the file is named " + path.filename().string() +
+         "; a plugin's file must be <name>.so (expected '" + path.stem().string() + "', found '" + name + "')");
+
+  if (!m.contains("parameters") || !m["parameters"].is_array()) fail("lacks the array \"parameters\"");
+  std::set<std::string> parameter_names;
+  for (const json& p : m["parameters"]) {
+    if (!p.is_object() || !p.contains("name") || !p["name"].is_string())
+      fail("has a parameter without a string \"name\"");
+    const std::string parameter = p["name"].get<std::string>();
+    if (!parameter_names.insert(parameter).second) fail("declares parameter '" + parameter + "' twice");
+    const std::string type = p.value("type", json()).is_string() ? p["type"].get<std::string>() : "";
+    if (type != "integer" && type != "number" && type != "boolean")
+      fail("gives parameter '" + parameter + "' the type " + p.value("type", json()).dump() +
+           " (expected \"integer\", \"number\" or \"boolean\")");
+    if (!p.contains("default")) fail("gives parameter '" + parameter + "' no default");
+    for (const char* bound : {"minimum", "maximum"})
+      if (p.contains(bound) && !p[bound].is_number())
+        fail("gives parameter '" + parameter + "' a non-numeric " + bound);
+    for (const char* text : {"unit", "description"})
+      if (p.contains(text) && !p[text].is_string()) fail("gives parameter '" + parameter + "' a non-string " + text);
+    const auto bound = [&](const char* key) {
+      return p.contains(key) ? std::optional<double>(p[key].get<double>()) : std::nullopt;
+    };
+    const std::string problem =
+        sdk::check_parameter_value(parameter, type, bound("minimum"), bound("maximum"), p["default"]);
+    if (!problem.empty()) fail("has an invalid default: " + problem);
+  }
+
+  if (!m.contains("dimension") || !m["dimension"].is_object()) fail("lacks the object \"dimension\"");
+  const json& dimension = m["dimension"];
+  if (dimension.contains("fixed")) {
+    if (!dimension["fixed"].is_number_unsigned() || dimension["fixed"].get<std::uint64_t>() == 0)
+      fail("gives \"dimension\": {\"fixed\": ...} a value that is not a positive integer (found " +
+           dimension["fixed"].dump() + ")");
+  } else if (dimension.contains("parameter")) {
+    const json& parameter = dimension["parameter"];
+    const auto& parameters = m["parameters"];
+    const bool declared = parameter.is_string() && std::any_of(parameters.begin(), parameters.end(), [&](const json& p) {
+                            return p["name"] == parameter && p["type"] == "integer";
+                          });
+    if (!declared)
+      fail("sets the dimension by parameter " + parameter.dump() + ", which is not a declared integer parameter");
+  } else {
+    fail("gives \"dimension\" neither \"fixed\" nor \"parameter\"");
+  }
+
+  if (!m.contains("thread_safe") || !m["thread_safe"].is_boolean())
+    fail("lacks the boolean \"thread_safe\" (required since plugin ABI version 3; true when distinct instances "
+         "share no mutable state, false to be run as one instance on one thread" +
+         (m.contains("thread_safe") ? "; found " + m["thread_safe"].dump() : std::string()) + ")");
+
+  if (!m.contains("capabilities") || !m["capabilities"].is_object()) fail("lacks the object \"capabilities\"");
+  const std::pair<const char*, bool> present[] = {{"value_T", api.value_T != nullptr},
+                                                  {"value_V", api.value_V != nullptr},
+                                                  {"hessian_T", api.hessian_T != nullptr},
+                                                  {"hessian_V", api.hessian_V != nullptr},
+                                                  {"d3T", api.d3T != nullptr},
+                                                  {"d3V", api.d3V != nullptr}};
+  for (const auto& [capability, in_table] : present) {
+    const json claimed = m["capabilities"].value(capability, json(false));
+    if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
+    if (claimed.get<bool>() != in_table)
+      fail("says capability \"" + std::string(capability) + "\" is " + (claimed.get<bool>() ? "true" : "false") +
+           " but the table's " + capability + " pointer is " + (in_table ? "set" : "null"));
+  }
+}
+
+}  // namespace nonsep::host
