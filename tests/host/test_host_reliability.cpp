@@ -425,8 +425,8 @@ TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3),
   // The trust model (README): a plugin runs inside nonsep, so its crash is nonsep's: the status is the signal's
   // 128 + n (SIGABRT 134, SIGSEGV 139) or the plugin's own exit code, and what was flushed before stays readable.
 #if defined(__SANITIZE_ADDRESS__)
-  // The sanitized suite: ASan catches the fault itself and aborts (abort_on_error=1, tests/ci), and LeakSanitizer
-  // would turn exit(3) into its own status by reporting what the interrupted run still held.
+  // The sanitized suite: ASan's handler catches SIGSEGV itself and aborts (abort_on_error=1, tests/ci), and
+  // LeakSanitizer would turn exit(3) into its own status by reporting what the interrupted run still held.
   const std::pair<int, int> cases[] = {{0, 134}, {1, 134}, {2, 3}};
   const std::string sanitizer_options = std::getenv("ASAN_OPTIONS") ? std::getenv("ASAN_OPTIONS") : "";
   ::setenv("ASAN_OPTIONS", (sanitizer_options + ":detect_leaks=0").c_str(), 1);

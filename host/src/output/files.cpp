@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "nonsep/host/output/content_hash.hpp"
@@ -16,8 +17,11 @@
 namespace nonsep::host {
 
 std::optional<std::uint64_t> descriptor_content_hash(int descriptor, std::optional<std::uint64_t> size) {
+  // The bound as a plain number (all of the file: the largest), so that nothing below depends on an empty
+  // optional's unset value.
+  const bool exact = size.has_value();
+  const std::uint64_t end = exact ? *size : std::numeric_limits<std::uint64_t>::max();
   std::uint64_t hash = content_hash_start, offset = 0;
-  const std::uint64_t end = size.value_or(UINT64_MAX);
   std::string buffer(1 << 16, '\0');
   while (offset < end) {
     const auto want = static_cast<std::size_t>(std::min<std::uint64_t>(end - offset, buffer.size()));
@@ -28,7 +32,7 @@ std::optional<std::uint64_t> descriptor_content_hash(int descriptor, std::option
     hash = content_hash(std::string_view(buffer.data(), static_cast<std::size_t>(got)), hash);
     offset += static_cast<std::uint64_t>(got);
   }
-  if (size && offset < *size) return std::nullopt;
+  if (exact && offset < end) return std::nullopt;
   return hash;
 }
 

@@ -4,6 +4,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -18,12 +19,16 @@ namespace {
 constexpr const char* lock_name = ".nonsep.lock";
 constexpr const char* manifest_name = ".nonsep-run.json";
 
-// At most the first `limit` bytes of a file ("" when it cannot be read).
+// At most the first `limit` bytes of a file ("" when it cannot be read), read in pieces: a limit meant for a large
+// summary.json is not allocated (and cleared) for a small one.
 std::string read_head(const std::filesystem::path& path, std::size_t limit) {
   std::ifstream in(path, std::ios::binary);
-  std::string text(limit, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(limit));
-  text.resize(static_cast<std::size_t>(in.gcount()));
+  std::string text;
+  char buffer[1 << 14];
+  while (in && text.size() < limit) {
+    in.read(buffer, static_cast<std::streamsize>(std::min(sizeof buffer, limit - text.size())));
+    text.append(buffer, static_cast<std::size_t>(in.gcount()));
+  }
   return text;
 }
 
