@@ -12,7 +12,7 @@ import numpy as np  # noqa: E402
 
 import nonsep  # noqa: E402
 import nonsep.plot  # noqa: E402
-from support import FolderTestCase, read_csv  # noqa: E402
+from support import FolderTestCase, blowup_job, read_csv  # noqa: E402
 
 MAX_CROSSINGS = 4
 
@@ -188,6 +188,29 @@ class DynamicsPlotTest(SharedRun):
             nonsep.plot.poincare(result)
         with self.assertRaises(FileNotFoundError):
             result.crossings(0)
+
+
+
+class FailedRunTest(FolderTestCase):
+    def test_a_run_error_carries_the_crossings_of_the_trajectories_that_went_on(self):
+        # tests/host/plugins/blowup.cpp in 2D: the first state's crossing of q0 = 0.5 cannot be located (grad V
+        # refuses one state with |q1| = 0.8 > fail_single_above), the second's can (test_host_dynamics.cpp).
+        job = blowup_job([{"q": [0.3, 0.8], "p": [1.0, 0.0]}, {"q": [0.2, 0.1], "p": [0.5, 0.0]}], steps=1600,
+                         dimension=2, fail_single_above=0.6)
+        job["time"]["dt"] = 0.001
+        job["analysis"] = {"poincare": {"component": "q0", "value": 0.5}}
+        with self.assertRaises(nonsep.RunError) as caught:
+            nonsep.run(job, output="out")
+        self.assertEqual(caught.exception.status, 1)
+        result = caught.exception.result
+        self.assertEqual(result.status, "failed")
+        self.assertEqual(list(result.trajectories["status"]), ["failed", "completed"])
+        self.assertIn("while locating a Poincare crossing", result.trajectories["message"][0])
+        self.assertEqual(len(result.crossings(0).t), 0)
+        crossing = result.crossings(1)
+        self.assertEqual(list(crossing.crossing), [0])
+        self.assertAlmostEqual(crossing.q[0, 0], 0.5, delta=1e-12)  # on the plane
+        self.assertEqual(list(result.trajectories["poincare_crossings"]), [0, 1])
 
 
 if __name__ == "__main__":
