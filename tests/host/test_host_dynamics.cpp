@@ -356,7 +356,7 @@ TEST_CASE("a chunk redone step by step after a divergence keeps the crossings an
   }
 }
 
-TEST_CASE("a plugin failing while a crossing is located stops that trajectory as failed; the others go on") {
+TEST_CASE("a plugin failing while a crossing is located stops that trajectory as failed, and the others go on") {
   TemporaryFolder folder;
   // tests/host/plugins/blowup.cpp in 2D: H_TTV = 3 sum q_i^2 p_i^2, so each q_i p_i is conserved and
   // q_i = q_i(0) exp(6 q_i(0) p_i(0) t): q0 grows through the plane q0 = 0.5 once, q1 stays put (p1 = 0).
