@@ -1,5 +1,5 @@
-#!/usr/bin/env python3
-"""Render the dynamics pictures of paper2d from the CSV files the nonsep runs wrote, and nothing else.
+"""Render the dynamics pictures of paper2d from the outputs the nonsep runs wrote, with nonsep.load and
+nonsep.plot.poincare / nonsep.plot.chaos_map (python/nonsep, found from this file when not on PYTHONPATH).
 
     /usr/bin/python3 examples/dynamics/plot_dynamics.py OUT_DIR
 
@@ -11,9 +11,6 @@ OUT_DIR is the folder `examples/dynamics/run_dynamics.sh` fills:
     */summary.json                       the energy shell, the integrator and the time, for the titles
 Writes dynamics_poincare and dynamics_chaos_map into OUT_DIR, each as a PNG at DPI dots per inch and as a PDF.
 """
-import csv
-import json
-import math
 import sys
 from pathlib import Path
 
@@ -23,16 +20,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.colors import LinearSegmentedColormap  # noqa: E402
 
+try:
+    import nonsep.plot
+except ImportError:  # run from the source tree without PYTHONPATH=python
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+    import nonsep.plot
+
 DPI = 200
 PALETTE = 64
 MEGNO_TOP = 8.0  # <Y> at or above this is drawn as the most chaotic colour
 # <Y> = 2 (quasi-periodic) blue, rising to red for chaotic orbits.
 CHAOS = LinearSegmentedColormap.from_list("chaos", ["#2166ac", "#67a9cf", "#fddbc7", "#ef8a62", "#b2182b"])
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def save(fig, out, name):
@@ -58,62 +56,32 @@ def subtitle(summary):
             f"dt = {summary['time']['dt']:g}, t = {summary['time']['t_end']:g}")
 
 
+# <Y> from just below 2 to MEGNO_TOP; larger values take the top colour.
+COLOURS = {"cmap": CHAOS, "vmin": 2.0 - (MEGNO_TOP - 2.0) / 8, "vmax": MEGNO_TOP}
+BAR = f"(2: regular; >= {MEGNO_TOP:g} shown alike)"
+
+
 def portrait(out):
-    folder = out / "poincare_portrait"
-    summary = json.loads((folder / "summary.json").read_text())
-    megno = {int(r["trajectory"]): float(r["mean_megno"]) if r["mean_megno"] else math.nan
-             for r in read_rows(folder / "trajectories.csv")}
-    crossings = read_rows(folder / "poincare.csv")
-    if not crossings:
-        raise SystemExit(f"{folder / 'poincare.csv'} has no crossings")
-    q0 = [float(r["q0"]) for r in crossings]
-    p0 = [float(r["p0"]) for r in crossings]
-    colour = [min(megno[int(r["trajectory"])], MEGNO_TOP) for r in crossings]
+    result = nonsep.load(out / "poincare_portrait")
+    if result.poincare is None or len(result.poincare) == 0:
+        raise SystemExit(f"{result.directory / 'poincare.csv'} has no crossings")
     fig, ax = plt.subplots(figsize=(6.4, 5.6))
-    points = ax.scatter(q0, p0, c=colour, cmap=CHAOS, vmin=2.0 - (MEGNO_TOP - 2.0) / 8, vmax=MEGNO_TOP, s=0.4,
-                        linewidths=0, rasterized=True)
-    ax.set_xlabel("q0")
-    ax.set_ylabel("p0")
-    ax.set_title(f"Poincaré section q1 = 0 (upwards), {len(megno)} orbits\n{subtitle(summary)}", fontsize=10)
-    bar = fig.colorbar(points, ax=ax)
-    bar.set_label(f"orbit's MEGNO <Y> (2: regular; >= {MEGNO_TOP:g} shown alike)")
+    nonsep.plot.poincare(result, ax=ax, color_by="mean_megno", colorbar=False, s=0.4, **COLOURS)
+    ax.set_title(f"Poincaré section q1 = 0 (upwards), {len(result.trajectories)} orbits\n"
+                 f"{subtitle(result.summary)}", fontsize=10)
+    fig.colorbar(ax.collections[0], ax=ax).set_label(f"orbit's MEGNO <Y> {BAR}")
     save(fig, out, "dynamics_poincare")
 
 
 def chaos_map(out):
-    folder = out / "chaos_map"
-    summary = json.loads((folder / "summary.json").read_text())
-    job = json.loads(Path(summary["job"]).read_text())
-    axes = job["initial"]["grid"]
-    q_axis, p_axis = axes["q"][0], axes["p"][0]
-
-    def index(value, axis):
-        step = (axis["to"] - axis["from"]) / (axis["count"] - 1)
-        return round((value - axis["from"]) / step)
-
-    start = {}
-    for r in read_rows(folder / "trajectory.csv"):
-        if r["step"] == "0":
-            start[int(r["trajectory"])] = (float(r["q0"]), float(r["p0"]))
-    grid = [[math.nan] * q_axis["count"] for _ in range(p_axis["count"])]
-    for r in read_rows(folder / "trajectories.csv"):
-        q, p = start[int(r["trajectory"])]
-        grid[index(p, p_axis)][index(q, q_axis)] = float(r["mean_megno"]) if r["mean_megno"] else math.nan
-    half_q = (q_axis["to"] - q_axis["from"]) / (q_axis["count"] - 1) / 2
-    half_p = (p_axis["to"] - p_axis["from"]) / (p_axis["count"] - 1) / 2
+    result = nonsep.load(out / "chaos_map")
     fig, ax = plt.subplots(figsize=(6.4, 5.6))
-    cmap = CHAOS.copy()
-    cmap.set_bad("#d9d9d9")  # off the shell: H > E already at p1 = 0
-    image = ax.imshow([[min(v, MEGNO_TOP) for v in row] for row in grid], origin="lower", cmap=cmap,
-                      vmin=2.0 - (MEGNO_TOP - 2.0) / 8, vmax=MEGNO_TOP, interpolation="nearest", aspect="auto",
-                      extent=(q_axis["from"] - half_q, q_axis["to"] + half_q, p_axis["from"] - half_p,
-                              p_axis["to"] + half_p))
+    nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q0", y="p0", colorbar=False, **COLOURS)
     ax.set_xlabel("q0 (initial; q1 = 0)")
     ax.set_ylabel("p0 (initial; p1 >= 0 on the shell)")
-    ax.set_title(f"Chaos map: MEGNO <Y> of {len(start)} orbits (grey: off the shell)\n{subtitle(summary)}",
-                 fontsize=10)
-    bar = fig.colorbar(image, ax=ax)
-    bar.set_label(f"<Y> (2: regular; >= {MEGNO_TOP:g} shown alike)")
+    ax.set_title(f"Chaos map: MEGNO <Y> of {len(result.trajectories)} orbits (grey: off the shell)\n"
+                 f"{subtitle(result.summary)}", fontsize=10)
+    fig.colorbar(ax.images[0], ax=ax).set_label(f"<Y> {BAR}")
     save(fig, out, "dynamics_chaos_map")
 
 

@@ -1,7 +1,9 @@
-"""Figures of a Result with matplotlib (imported here, not by `import nonsep`). Each function draws into `ax` (a new
-figure's axes when None) and returns the axes, labelled with the quantities and with a legend when it shows more
-than one series (and at most MAX_LEGEND; an ensemble's hundred lines get none). Choose the backend before importing
-pyplot, e.g. matplotlib.use("Agg") for files only.
+"""Figures of a Result with matplotlib (imported here, not by `import nonsep`): orbit, energy_error, convergence,
+and for the dynamics outputs poincare (the crossings of poincare.csv) and chaos_map (MEGNO or a Lyapunov exponent
+over the grid of initial conditions). Each function draws into `ax` (a new figure's axes when None) and returns
+the axes, labelled with the quantities and with a legend when it shows more than one series (and at most
+MAX_LEGEND; an ensemble's hundred lines get none). Choose the backend before importing pyplot, e.g.
+matplotlib.use("Agg") for files only.
 """
 import numpy as np
 
@@ -91,3 +93,177 @@ def convergence(result, ax=None):
     ax.set_ylabel("|relative energy error| at $t_\\mathrm{end}$")
     ax.legend(fontsize="small")
     return ax
+
+
+def _math(name):
+    """A column name of the files (components numbered from 0) as mathtext: q0 -> $q_0$, p12 -> $p_{12}$."""
+    letter, index = name[0], name[1:]
+    if not index.isdigit():
+        return name
+    return f"${letter}_{index}$" if len(index) == 1 else f"${letter}_{{{index}}}$"
+
+
+def _component_names(dimension):
+    return [f"q{k}" for k in range(dimension)] + [f"p{k}" for k in range(dimension)]
+
+
+def _section_axes(section, dimension):
+    """The default (x, y) of a section plot: q and p of the first degree of freedom the plane's normal leaves out
+    (for the plane q1 = 0 of a 2D model: q0 and p0), else q0 and p0."""
+    normal = (section or {}).get("normal")
+    if normal is not None and len(normal) == 2 * dimension:
+        for k in range(dimension):
+            if normal[k] == 0 and normal[dimension + k] == 0:
+                return f"q{k}", f"p{k}"
+    return "q0", "p0"
+
+
+def _section_title(section, dimension):
+    if not section:
+        return "Poincaré section"
+    names = _component_names(dimension)
+    normal, value = section.get("normal") or [], section.get("value", 0.0)
+    nonzero = [k for k, c in enumerate(normal) if c != 0]
+    if len(nonzero) == 1 and len(normal) == len(names):
+        plane = f"{_math(names[nonzero[0]])} = {value / normal[nonzero[0]]:g}"
+    else:
+        plane = f"$n \\cdot (q, p) = {value:g}$"
+    direction = {"+": ", upward crossings", "-": ", downward crossings"}.get(section.get("direction"), "")
+    return f"Poincaré section {plane}{direction}"
+
+
+def poincare(result, ax=None, x=None, y=None, i=None, color_by=None, cmap=None, colorbar=True, **style):
+    """The crossings of poincare.csv as points, x against y (column names such as "q0", "p0"; default: q and p of
+    the first degree of freedom the section's plane leaves out, e.g. q0 and p0 for the plane q1 = 0 of a 2D model).
+    `i`: a trajectory index, a list, or None for all. Points are coloured per trajectory (a qualitative colour map
+    over trajectory indices, `cmap` default "tab20"), or with `color_by` a column of trajectories.csv such as
+    "mean_megno" by that trajectory's value (`cmap` default "viridis", with a labelled colour bar when `colorbar`).
+    One scatter call whatever the number of points; `style` goes to ax.scatter (default: dots of size 2, rasterized).
+    The title names the plane. Raises ValueError when the run wrote no poincare.csv."""
+    table = result.poincare
+    if table is None:
+        raise ValueError(f"{result.directory} holds no poincare.csv: the job had no analysis.poincare")
+    dimension = sum(1 for name in table.dtype.names if name[0] == "q" and name[1:].isdigit())
+    section = result.section
+    default_x, default_y = _section_axes(section, dimension)
+    x, y = x or default_x, y or default_y
+    for name in (x, y):
+        if name not in table.dtype.names:
+            raise ValueError(f"poincare.csv has no column {name!r}; it has {', '.join(table.dtype.names)}")
+    if i is not None:
+        table = table[np.isin(table["trajectory"], [int(i)] if np.isscalar(i) else [int(k) for k in i])]
+    ax = _axes(ax)
+    style = {"s": 2.0, "linewidths": 0, "rasterized": True, **style}
+    trajectory = table["trajectory"]
+    if color_by is None:
+        colours = _colour_map(cmap, "tab20")
+        points = ax.scatter(table[x], table[y], c=colours(trajectory % colours.N), **style)
+    else:
+        values = _per_trajectory(result, color_by)[trajectory]
+        points = ax.scatter(table[x], table[y], c=values, cmap=cmap or "viridis", **style)
+        if colorbar:
+            ax.figure.colorbar(points, ax=ax).set_label(_value_label(color_by))
+    ax.set_xlabel(_math(x))
+    ax.set_ylabel(_math(y))
+    ax.set_title(_section_title(section, dimension), fontsize="medium")
+    return ax
+
+
+def _per_trajectory(result, column):
+    table = result.trajectories
+    if table is None or column not in table.dtype.names:
+        names = ", ".join(table.dtype.names) if table is not None else "none"
+        raise ValueError(f"trajectories.csv has no column {column!r} (its columns: {names})")
+    if not np.array_equal(table["trajectory"], np.arange(len(table))):
+        raise ValueError("trajectories.csv does not list the trajectories 0, 1, ... in order")
+    return np.asarray(table[column], dtype=float)
+
+
+def _value_label(column):
+    if column == "mean_megno":
+        return "MEGNO $\\langle Y \\rangle$ (2: quasi-periodic)"
+    if column == "megno":
+        return "MEGNO $Y$"
+    if column.startswith("lyapunov") and column[8:].isdigit():
+        return f"finite-time Lyapunov exponent $\\lambda_{{{column[8:]}}}$ ({column})"
+    return column
+
+
+def _grid_axes(columns, count):
+    """The two columns of the initial states that index them as a 2D grid: of the columns that vary, the pair whose
+    values tell every state apart with the fewest distinct values (on an energy shell the solved momentum varies
+    too, with as many values as states)."""
+    distinct = {name: len(np.unique(values)) for name, values in columns.items()}
+    varying = [name for name in columns if distinct[name] > 1]
+    best = None
+    for a_index, a in enumerate(varying):
+        for b in varying[a_index + 1:]:
+            cells = distinct[a] * distinct[b]
+            if best is not None and cells >= best[0]:
+                continue
+            pairs = np.unique(np.column_stack([columns[a], columns[b]]), axis=0)
+            if len(pairs) == count:
+                best = (cells, a, b)
+    if best is None:
+        raise ValueError("the initial states are not a grid over two of their components; give x and y")
+    return best[1], best[2]
+
+
+def chaos_map(result, ax=None, value="mean_megno", x=None, y=None, cmap=None, colorbar=True, **style):
+    """An image of `value` (a column of trajectories.csv: "mean_megno", the default, "lyapunov0", ...) over the
+    grid of initial conditions, one cell per trajectory at its initial (x, y) (column names such as "q0", "p0").
+    The initial states come from trajectory.csv's step-0 rows; x and y default to the two components that tell the
+    states apart as a grid (see _grid_axes): for a grid over q0 and p0 on an energy shell, q0 and p0. Cells without
+    a trajectory (states left off the shell) or without a value (diverged or failed) are grey. A uniform grid is
+    drawn with ax.imshow, another with ax.pcolormesh; `style` goes there (e.g. vmin, vmax). Returns the axes, with a
+    colour bar labelled with the quantity when `colorbar`."""
+    values = _per_trajectory(result, value)
+    q, p = result.initial_states()
+    names = _component_names(q.shape[1])
+    columns = dict(zip(names, np.column_stack([q, p]).T))
+    if x is None or y is None:
+        x, y = _grid_axes(columns, len(values))
+    xs, column_of = np.unique(columns[x], return_inverse=True)
+    ys, row_of = np.unique(columns[y], return_inverse=True)
+    grid = np.full((len(ys), len(xs)), np.nan)
+    grid[row_of, column_of] = values
+    counts = np.zeros(grid.shape, dtype=int)
+    np.add.at(counts, (row_of, column_of), 1)
+    if counts.max() > 1:
+        raise ValueError(f"several trajectories start at the same ({x}, {y}): not a grid over them")
+    colours = _colour_map(cmap, "viridis").copy()
+    colours.set_bad("#d9d9d9")
+    ax = _axes(ax)
+    if _uniform(xs) and _uniform(ys):
+        half_x = (xs[-1] - xs[0]) / (len(xs) - 1) / 2 if len(xs) > 1 else 0.5
+        half_y = (ys[-1] - ys[0]) / (len(ys) - 1) / 2 if len(ys) > 1 else 0.5
+        style = {"interpolation": "nearest", "aspect": "auto", **style}
+        image = ax.imshow(np.ma.masked_invalid(grid), origin="lower", cmap=colours,
+                          extent=(xs[0] - half_x, xs[-1] + half_x, ys[0] - half_y, ys[-1] + half_y), **style)
+    else:
+        image = ax.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(grid), cmap=colours, **style)
+    ax.set_xlabel(f"{_math(x)} (initial)")
+    ax.set_ylabel(f"{_math(y)} (initial)")
+    if colorbar:
+        ax.figure.colorbar(image, ax=ax).set_label(_value_label(value))
+    return ax
+
+
+def _colour_map(cmap, default):
+    """A Colormap from a name, a Colormap, or None (the default's name)."""
+    import matplotlib
+    return matplotlib.colormaps[cmap or default] if cmap is None or isinstance(cmap, str) else cmap
+
+
+def _uniform(values):
+    if len(values) < 3:
+        return True
+    steps = np.diff(values)
+    return bool(np.allclose(steps, steps[0], rtol=1e-6, atol=0.0))
+
+
+def _edges(values):
+    if len(values) == 1:
+        return np.array([values[0] - 0.5, values[0] + 0.5])
+    middle = (values[1:] + values[:-1]) / 2
+    return np.concatenate([[2 * values[0] - middle[0]], middle, [2 * values[-1] - middle[-1]]])

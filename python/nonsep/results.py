@@ -5,8 +5,12 @@ Files read (README.md, "What a run leaves behind"); each is optional except summ
   trajectories.csv   Result.trajectories, one row per trajectory (None for a study)
   trajectory.csv     Result.samples() and Result.orbit(i): read on first use and kept
   convergence.csv    Result.convergence (a study); Result.fits and Result.exponents come from summary.json's "fits"
-  other *.csv        Result.dynamics[name] (poincare.csv -> "poincare", lyapunov.csv, megno.csv, ...): read by
-                     header on first use, as tables.read_table types columns
+  poincare.csv       Result.poincare (every crossing, rows in (step, trajectory) order; None without the file) and
+                     Result.crossings(i) (trajectory i's crossings in order): read on first use and kept
+  lyapunov.csv       Result.lyapunov (the running Lyapunov and MEGNO estimates; None without the file) and
+                     Result.lyapunov_series(i): read on first use and kept
+  other *.csv        Result.dynamics[name] (poincare.csv and lyapunov.csv too, the same arrays): read by header on
+                     first use, as tables.read_table types columns
   results.h5         Result.dynamics["results.h5/<dataset path>"]: every dataset, read with h5py on first use
 """
 import json
@@ -34,6 +38,28 @@ class Orbit(NamedTuple):
     relative_energy_error: np.ndarray
 
 
+class Crossings(NamedTuple):
+    """The Poincare crossings of one trajectory (poincare.csv), in order: crossing counts them from 0, step is the
+    step within which each crossed, q and p are [crossings, dimension], H the energy there (NaN when unknown)."""
+    crossing: np.ndarray
+    step: np.ndarray
+    t: np.ndarray
+    q: np.ndarray
+    p: np.ndarray
+    H: np.ndarray
+
+
+class LyapunovSeries(NamedTuple):
+    """The running estimates of one trajectory (lyapunov.csv), in step order: exponents is [rows, k] (columns
+    lyapunov0 .. lyapunov<k-1>, k = 0 when only MEGNO was asked for); megno (Y) and mean_megno (<Y>) are None when
+    the run did not compute MEGNO."""
+    step: np.ndarray
+    t: np.ndarray
+    exponents: np.ndarray
+    megno: object
+    mean_megno: object
+
+
 class Result:
     """The outputs of one run or study in `directory`. See the module's documentation for which file is what."""
 
@@ -49,6 +75,7 @@ class Result:
         self.dynamics = _Dynamics(self.directory)
         self._samples = None
         self._order = self._sorted = None
+        self._groups = {}
 
     @property
     def status(self):
@@ -72,10 +99,71 @@ class Result:
         rows = samples[self._order[begin:end]]
         if len(rows) == 0:
             raise KeyError(f"trajectory.csv in {self.directory} has no rows of trajectory {index}")
-        d = sum(1 for name in samples.dtype.names if re.fullmatch(r"q\d+", name))
-        q = np.column_stack([rows[f"q{k}"] for k in range(d)])
-        p = np.column_stack([rows[f"p{k}"] for k in range(d)])
+        q, p = _components(rows)
         return Orbit(rows["step"], rows["t"], q, p, rows["H"], rows["relative_energy_error"])
+
+    @property
+    def poincare(self):
+        """Every row of poincare.csv as a structured array (trajectory, crossing, step, t, q0, ..., p0, ..., H), in
+        the file's (step, trajectory) order; None when the run wrote none (no analysis.poincare)."""
+        return self.dynamics.get("poincare")
+
+    @property
+    def lyapunov(self):
+        """Every row of lyapunov.csv as a structured array (trajectory, step, t, lyapunov0, ..., and megno,
+        mean_megno when computed), in the file's order; None when the run wrote none (analysis.lyapunov.every 0)."""
+        return self.dynamics.get("lyapunov")
+
+    @property
+    def section(self):
+        """The Poincare section of the run, summary.json's analysis.poincare (normal, value, direction,
+        max_crossings, crossings, ...), or None."""
+        return (self.summary.get("analysis") or {}).get("poincare")
+
+    def crossings(self, index):
+        """The crossings of trajectory `index` as Crossings (empty arrays when it crossed no time). Raises
+        FileNotFoundError when the run wrote no poincare.csv, KeyError for an index that is not a trajectory."""
+        rows = self._rows_of("poincare", index)
+        q, p = _components(rows)
+        return Crossings(rows["crossing"], rows["step"], rows["t"], q, p, rows["H"])
+
+    def lyapunov_series(self, index):
+        """The running Lyapunov / MEGNO estimates of trajectory `index` as a LyapunovSeries. Raises
+        FileNotFoundError when the run wrote no lyapunov.csv, KeyError for an index that is not a trajectory."""
+        rows = self._rows_of("lyapunov", index)
+        names = rows.dtype.names
+        k = sum(1 for name in names if re.fullmatch(r"lyapunov\d+", name))
+        exponents = np.column_stack([rows[f"lyapunov{j}"] for j in range(k)]) if k else np.empty((len(rows), 0))
+        megno = rows["megno"] if "megno" in names else None
+        mean_megno = rows["mean_megno"] if "mean_megno" in names else None
+        return LyapunovSeries(rows["step"], rows["t"], exponents, megno, mean_megno)
+
+    def initial_states(self):
+        """(q, p), each [trajectories, dimension]: every trajectory's state at step 0, from trajectory.csv (the host
+        writes step 0 whatever output.every). Raises FileNotFoundError when the run wrote no trajectory.csv, and
+        ValueError when it has no step-0 row of some trajectory."""
+        samples = self.samples()
+        first = samples[samples["step"] == 0]
+        first = first[np.argsort(first["trajectory"], kind="stable")]
+        count = len(self.trajectories) if self.trajectories is not None else len(first)
+        if not np.array_equal(first["trajectory"], np.arange(count)):
+            raise ValueError(f"trajectory.csv in {self.directory} does not have one step-0 row per trajectory")
+        return _components(first)
+
+    def _rows_of(self, name, index):
+        """The rows of trajectory `index` in file `name`.csv, in file order: grouped once by a stable sort."""
+        table = self.dynamics.get(name)
+        if table is None:
+            raise FileNotFoundError(f"{self.directory} holds no {name}.csv")
+        if name not in self._groups:
+            order = np.argsort(table["trajectory"], kind="stable")
+            self._groups[name] = (order, table["trajectory"][order])
+        count = len(self.trajectories) if self.trajectories is not None else None
+        if index < 0 or (count is not None and index >= count):
+            raise KeyError(f"{self.directory} has no trajectory {index}")
+        order, sorted_indices = self._groups[name]
+        begin, end = np.searchsorted(sorted_indices, [index, index + 1])
+        return table[order[begin:end]]
 
     def __repr__(self):
         return f"nonsep.Result({str(self.directory)!r}, status={self.status!r})"
@@ -85,6 +173,14 @@ def load(output_dir):
     """The Result of the run or study whose outputs are in `output_dir`. Raises FileNotFoundError without
     summary.json there."""
     return Result(output_dir)
+
+
+def _components(rows):
+    """(q, p) of `rows`, each [rows, dimension], from the columns q0.. and p0.. ."""
+    d = sum(1 for name in rows.dtype.names if re.fullmatch(r"q\d+", name))
+    q = np.column_stack([rows[f"q{k}"] for k in range(d)]) if d else np.empty((len(rows), 0))
+    p = np.column_stack([rows[f"p{k}"] for k in range(d)]) if d else np.empty((len(rows), 0))
+    return q, p
 
 
 def _number(value):

@@ -1,6 +1,7 @@
 // The dynamics diagnostics end to end through the `nonsep` executable on paper2d (plugins/paper2d): Poincare
 // sections (poincare.csv, crossings on the plane to round-off, max_crossings), Lyapunov exponents and MEGNO
-// (trajectories.csv columns and lyapunov.csv), the same for any --threads, resumed bit for bit, and the refusals.
+// (trajectories.csv columns and lyapunov.csv), the same for any --threads, resumed bit for bit, the refusals, and a
+// plugin failing while a crossing is located.
 #include <doctest/doctest.h>
 
 #include <csignal>
@@ -353,4 +354,55 @@ TEST_CASE("a chunk redone step by step after a divergence keeps the crossings an
     CAPTURE(column);
     CHECK(rows[0].at(column) == single[0].at(column));
   }
+}
+
+TEST_CASE("a plugin failing while a crossing is located stops that trajectory as failed, and the others go on") {
+  TemporaryFolder folder;
+  // tests/host/plugins/blowup.cpp in 2D: H_TTV = 3 sum q_i^2 p_i^2, so each q_i p_i is conserved and
+  // q_i = q_i(0) exp(6 q_i(0) p_i(0) t): q0 grows through the plane q0 = 0.5 once, q1 stays put (p1 = 0).
+  // fail_single_above = 0.6 makes grad V fail in a call for one state with some |q_i| > 0.6: only the location
+  // of a crossing makes such calls while both states are stepped together. The first state (q1 = 0.8) crosses
+  // at t = ln(5/3)/1.8 = 0.284, and its location fails; the second (q1 = 0.1) crosses at t = ln(2.5)/0.6 = 1.53
+  // and keeps |q| < 0.6 up to t_end = 1.6 (q0 = 0.52), so it is never refused, alone in its block or not.
+  const json failing = {{"q", {0.3, 0.8}}, {"p", {1.0, 0.0}}}, fine = {{"q", {0.2, 0.1}}, {"p", {0.5, 0.0}}};
+  json together = blowup_job(json::array({failing, fine}), {{"dimension", 2}, {"fail_single_above", 0.6}});
+  together["time"] = {{"dt", 0.001}, {"steps", 1600}};
+  together["analysis"] = {{"poincare", {{"component", "q0"}, {"value", 0.5}, {"direction", "+"}}}};
+  json alone = together;
+  alone["initial"] = json::array({fine});
+  const auto result = run_named(folder, "together", together);
+  INFO("stderr: " << result.err);
+  CHECK(result.status == 1);  // a trajectory failed
+  REQUIRE(run_named(folder, "alone", alone).status == 0);
+
+  const auto rows = table(folder / "together/trajectories.csv");
+  REQUIRE(rows.size() == 2);
+  CHECK(rows[0].at("status") == "failed");
+  CHECK(rows[0].at("message").find("the model failed while locating a Poincare crossing in step") != std::string::npos);
+  CHECK(rows[0].at("message").find("beyond fail_single_above (one state)") != std::string::npos);
+  CHECK(cell(rows[0], "poincare_crossings") == 0);
+  CHECK(cell(rows[0], "stop_step") == doctest::Approx(284).epsilon(0.02));  // the step of its crossing
+  CHECK(rows[1].at("status") == "completed");
+  CHECK(cell(rows[1], "step") == 1600);
+  CHECK(cell(rows[1], "poincare_crossings") == 1);
+
+  // The other trajectory's crossings and final state are those of a run without the failing one.
+  const auto crossings = table(folder / "together/poincare.csv"), single = table(folder / "alone/poincare.csv");
+  REQUIRE(crossings.size() == single.size());
+  for (std::size_t i = 0; i < crossings.size(); ++i) {
+    CHECK(crossings[i].at("trajectory") == "1");
+    for (const char* column : {"crossing", "step", "t", "q0", "q1", "p0", "p1", "H"}) {
+      CAPTURE(column);
+      CHECK(crossings[i].at(column) == single[i].at(column));
+    }
+  }
+  const auto single_rows = table(folder / "alone/trajectories.csv");
+  for (const char* column : {"step", "t", "q0", "q1", "p0", "p1", "H", "poincare_crossings"}) {
+    CAPTURE(column);
+    CHECK(rows[1].at(column) == single_rows[0].at(column));
+  }
+  const json summary = read_json(folder / "together/summary.json");
+  CHECK(summary["status"] == "failed");
+  CHECK(summary["counts"]["failed"] == 1);
+  CHECK(summary["counts"]["completed"] == 1);
 }

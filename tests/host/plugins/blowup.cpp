@@ -7,7 +7,9 @@
 //
 // grad V overflows to inf for |q| > ~5.6e102 (no finiteness check), so a state that starts there turns
 // non-finite in its first step. Parameter fail_above: grad V reports NONSEP_EVALUATION_FAILED at any finite |q_i|
-// above it. Parameters nan_after and inf_after: grad V returns NaN (or +inf) in every component from its
+// above it. Parameter fail_single_above: the same, but only in a call for one state (count 1), as when the host
+// locates a Poincare crossing (it steps that one state again with fractional steps), never in a block's steps of
+// two or more states. Parameters nan_after and inf_after: grad V returns NaN (or +inf) in every component from its
 // (n+1)-th call on (0: never). Parameter sleep_ms: every call of grad V sleeps that long first (a very slow model,
 // to test that the host stays interruptible). Parameters crash_after and crash_how: from its (n+1)-th call on
 // (0: never), grad V crashes the process as a faulty plugin would: crash_how 0 abort() (SIGABRT), 1 SIGSEGV,
@@ -39,7 +41,7 @@
 
 struct nonsep_instance {
   std::size_t dimension = 1;
-  double fail_above = 1e300;
+  double fail_above = 1e300, fail_single_above = 1e300;
   std::uint64_t nan_after = 0, inf_after = 0, sleep_ms = 0, crash_after = 0, crash_how = 0;
   std::uint64_t grad_V_calls = 0;
   std::string last_error;
@@ -65,6 +67,8 @@ const char* metadata() {
          {"description", "number of degrees of freedom (0 and huge values test the host's refusals)"}},
         {{"name", "fail_above"}, {"type", "number"}, {"default", 1e300}, {"minimum", 0}, {"unit", "length"},
          {"description", "grad V fails for any |q_i| above this"}},
+        {{"name", "fail_single_above"}, {"type", "number"}, {"default", 1e300}, {"minimum", 0}, {"unit", "length"},
+         {"description", "grad V fails for any |q_i| above this in a call for one state (count 1) only"}},
         {{"name", "nan_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
          {"description", "grad V returns NaN from its (n+1)-th call on; 0: never"}},
         {{"name", "inf_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
@@ -89,6 +93,7 @@ nonsep_status create(const char* parameters_json, nonsep_instance** out, char* m
     auto instance = new nonsep_instance;
     instance->dimension = parameters.value("dimension", std::size_t{1});
     instance->fail_above = parameters.value("fail_above", 1e300);
+    instance->fail_single_above = parameters.value("fail_single_above", 1e300);
     instance->nan_after = parameters.value("nan_after", std::uint64_t{0});
     instance->inf_after = parameters.value("inf_after", std::uint64_t{0});
     instance->sleep_ms = parameters.value("sleep_ms", std::uint64_t{0});
@@ -123,6 +128,10 @@ nonsep_status grad_V(nonsep_instance* instance, const double* q, double* out, st
   for (std::size_t i = 0; i < count * instance->dimension; ++i) {
     if (std::isfinite(q[i]) && std::abs(q[i]) > instance->fail_above) {
       instance->last_error = "q = " + std::to_string(q[i]) + " is beyond fail_above";
+      return NONSEP_EVALUATION_FAILED;
+    }
+    if (count == 1 && std::isfinite(q[i]) && std::abs(q[i]) > instance->fail_single_above) {
+      instance->last_error = "q = " + std::to_string(q[i]) + " is beyond fail_single_above (one state)";
       return NONSEP_EVALUATION_FAILED;
     }
     out[i] = q[i] * q[i] * q[i];
