@@ -36,7 +36,10 @@ class StudyExecution {
         energy_available_(loaded.plugin.has_hessians()),
         csv_(options.output_directory / "convergence.csv",
              "integrator,scheme,order,t2,symplectic,dt,steps,basic_steps,grad_T,grad_V,relative_energy_error,"
-             "phase_error,status") {}
+             "phase_error,status,family,grad_H"),
+        work_precision_csv_(options.output_directory / "work_precision.csv",
+                            "integrator,scheme,family,options,order,symplectic,dt,steps,evaluations,grad_T,grad_V,"
+                            "grad_H,wall_seconds,repeats,relative_energy_error,phase_error,status") {}
   StudyExecution(const StudyExecution&) = delete;
   StudyExecution& operator=(const StudyExecution&) = delete;
 
@@ -56,6 +59,7 @@ class StudyExecution {
     }
     try {
       csv_.flush();
+      work_precision_csv_.flush();
     } catch (const OutputError& error) {
       if (run_error_.empty()) run_error_ = error.what();
     }
@@ -89,10 +93,26 @@ class StudyExecution {
     const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
     run.dt = time.dt;
     run.basic_steps = steps * Integrator(study_integrator.spec).describe().basic_steps_per_step;
+    // Each repeat is a fresh driver doing the same work; the first one's results are kept, the others only timed.
+    std::vector<double> seconds;
+    for (int r = 1; r < study_.repeats && !interrupted_; ++r) {
+      EnsembleDriver repeat(loaded_.plugin, loaded_.model,
+                            {study_integrator.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
+                             options_.stop_requested});
+      const auto start = Clock::now();
+      if (repeat.run() != DriverEnd::completed) break;
+      seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    }
     EnsembleDriver driver(loaded_.plugin, loaded_.model,
                           {study_integrator.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
                            options_.stop_requested});
+    const auto start = Clock::now();
     const DriverEnd end = driver.run();
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    std::sort(seconds.begin(), seconds.end());
+    const std::size_t middle = seconds.size() / 2;
+    run.wall_seconds = seconds.size() % 2 ? seconds[middle] : (seconds[middle - 1] + seconds[middle]) / 2.0;
+    run.repeats = static_cast<int>(seconds.size());
     run.evaluations = driver.evaluations();
     const TrajectoryRecord& record = driver.records().front();
     if (!energy_initial_) energy_initial_ = record.energy_initial;
@@ -131,7 +151,53 @@ class StudyExecution {
     if (run.phase_error) append_number(row, *run.phase_error);
     row += ",";
     row += to_string(run.status);
+    row += "," + description.family + "," + std::to_string(run.evaluations.grad_H);
     csv_.end_row();
+    write_work_precision_row(integrator, description, run);
+  }
+
+  // work_precision.csv: the cost (evaluations = grad_T + grad_V + grad_H, each counted once per state; a grad_H
+  // costs the model a gradient, two Hessians and a third-derivative contraction) and the median wall time against
+  // the errors.
+  void write_work_precision_row(const StudyIntegrator& integrator, const IntegratorDescription& description,
+                                const StudyRun& run) {
+    const EvaluationCounts& e = run.evaluations;
+    std::string& row = work_precision_csv_.row();
+    append_csv_text(row, integrator.label);
+    row += "," + description.scheme + "," + description.family + ",";
+    append_csv_text(row, options_text(integrator.spec));
+    row += "," + description.order.to_string() + (description.symplectic ? ",true," : ",false,");
+    append_number(row, run.dt);
+    row += "," + std::to_string(run.steps) + "," + std::to_string(e.grad_T + e.grad_V + e.grad_H) + "," +
+           std::to_string(e.grad_T) + "," + std::to_string(e.grad_V) + "," + std::to_string(e.grad_H) + ",";
+    append_number(row, run.wall_seconds);
+    row += "," + std::to_string(run.repeats) + ",";
+    if (run.relative_energy_error) append_number(row, *run.relative_energy_error);
+    row += ",";
+    if (run.phase_error) append_number(row, *run.phase_error);
+    row += ",";
+    row += to_string(run.status);
+    work_precision_csv_.end_row();
+  }
+
+  // The scheme's catalogue options with their values: "order=4/3 t2=-1.81712059283214", "omega=20".
+  static std::string options_text(const IntegratorSpec& spec) {
+    std::string text;
+    const Scheme* scheme = find_scheme(spec.scheme);
+    for (const auto& parameter : scheme ? scheme->parameters : std::vector<ParameterDescription>{}) {
+      std::string value;
+      if (parameter.name == "order") {
+        value = spec.order.to_string();
+      } else {
+        const double number = parameter.name == "t2"      ? spec.t2
+                              : parameter.name == "omega" ? spec.omega
+                              : parameter.name == "stages" ? spec.stages
+                                                           : spec.max_iterations;
+        append_number(value, number);
+      }
+      text += (text.empty() ? "" : " ") + parameter.name + "=" + value;
+    }
+    return text;
   }
 
   TrajectoryStatus status() const {
@@ -185,7 +251,9 @@ class StudyExecution {
     }
     summary["fits"] = std::move(fits);
     if (!failures.empty()) summary["failures"] = std::move(failures);
-    summary["output"] = {{"directory", options_.output_directory.string()}, {"convergence", "convergence.csv"}};
+    summary["output"] = {{"directory", options_.output_directory.string()}, {"convergence", "convergence.csv"},
+                         {"work_precision", "work_precision.csv"}};
+    summary["study"]["repeats"] = study_.repeats;
     summary["wall_seconds"] = wall_seconds;
     return summary;
   }
@@ -198,6 +266,7 @@ class StudyExecution {
   bool energy_available_;
   std::optional<double> energy_initial_;
   CsvAppender csv_;
+  CsvAppender work_precision_csv_;
   std::vector<std::vector<StudyRun>> runs_;  // per integrator, in step order
   bool interrupted_ = false;
   std::string run_error_;

@@ -215,6 +215,10 @@ const KeyTable& study_keys() {
        .description = "The exact state at t_end: convergence.csv then has each run's phase-space error "
                       "|(q, p) - (q_ref, p_ref)|, and the fits its exponent.",
        .definition = "state"},
+      {.name = "repeats", .type = ValueType::integer, .minimum = 1, .maximum = 1000, .default_value = 1,
+       .description = "How many times each run is repeated for its wall time: work_precision.csv gives the median "
+                      "over the repeats and their count (the errors and evaluation counts are those of the first: "
+                      "every repeat computes the same numbers)."},
   }};
   return table;
 }

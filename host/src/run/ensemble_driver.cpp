@@ -154,11 +154,14 @@ struct EnsembleDriver::Impl {
     const PhaseSpaceBatch before = block.batch;
     const std::optional<PhaseSpaceBatch> tangents_before =
         block.tangents ? std::optional<PhaseSpaceBatch>(block.tangents->vectors) : std::nullopt;
+    const Integrator integrator_before = block.integrator;  // Tao's copies, for a redo state by state
     const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
       if (block.tangents)
         block.tangents->step_part(worker.model, x, *tangents_before, first, setup.time.dt);
-      else
+      else if (x.count() == before.count())
         block.integrator.step(worker.model, x, setup.time.dt);
+      else
+        block.integrator.step_part(worker.model, x, integrator_before, first, before.count(), setup.time.dt);
     });
     if (block.tangents) block.tangents->after_step(setup.time.dt);
     std::vector<bool> retire(block.trajectories.size(), false);
@@ -441,6 +444,11 @@ EvaluationCounts EnsembleDriver::evaluations() const {
   EvaluationCounts counts = impl_->evaluations_before;
   for (const Block& block : impl_->blocks) counts += block.evaluations();
   return counts;
+}
+double EnsembleDriver::max_copy_distance() const {
+  double distance = 0.0;
+  for (const Block& block : impl_->blocks) distance = std::max(distance, block.integrator.max_copy_distance());
+  return distance;
 }
 std::uint64_t EnsembleDriver::steps_completed() const { return impl_->completed; }
 std::size_t EnsembleDriver::active_count() const { return impl_->active_count(); }
