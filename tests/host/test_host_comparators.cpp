@@ -97,6 +97,28 @@ TEST_CASE("gauss: a trajectory whose fixed-point iteration fails retires as fail
   CHECK(number(summary["trajectories"][2]["final"]["q"][0]) == alone.state.q()[0]);
 }
 
+TEST_CASE("tao: a trajectory that diverges leaves the block with its copy; the others keep theirs, bit for bit") {
+  TemporaryFolder folder;
+  // (3, 6) diverges at step 2, after the block has stepped all three once: the driver redoes the chunk step by
+  // step and compacts the block and Tao's copies; the survivors must still be the core's single runs.
+  json job = paper1d_job(ensemble({{2.0, 0.0}, {3.0, 6.0}, {1.5, 0.1}}), {{"dt", 0.02}, {"steps", 50}},
+                         {{"scheme", "tao"}, {"order", 2}});
+  job["output"]["every"] = 10;
+  const json summary = run_job(folder, "tao-diverges", job, 1);
+  CHECK(summary["counts"]["diverged"] == 1);
+  CHECK(summary["trajectories"][1]["status"] == "diverged");
+  CHECK(summary["trajectories"][1]["final"]["step"] == 1);
+  const nonsep::IntegratorSpec spec{"tao", nonsep::Fraction(2)};
+  for (const std::size_t k : {0u, 2u}) {
+    CAPTURE(k);
+    const double q0 = k == 0 ? 2.0 : 1.5, p0 = k == 0 ? 0.0 : 0.1;
+    const CoreRun core = core_run(spec, q0, p0, 0.02, 50);
+    CHECK(summary["trajectories"][k]["status"] == "completed");
+    CHECK(number(summary["trajectories"][k]["final"]["q"][0]) == core.state.q()[0]);
+    CHECK(number(summary["trajectories"][k]["final"]["p"][0]) == core.state.p()[0]);
+  }
+}
+
 TEST_CASE("comparators need Hessians and third derivatives: refused at the scheme's path, with the reason") {
   TemporaryFolder folder;
   use_test_plugins();
