@@ -46,6 +46,7 @@ class StudyExecution {
   StudyOutcome execute() {
     const auto start = Clock::now();
     try {
+      if (study_.reference_run) compute_reference(*study_.reference_run);
       for (const auto& integrator : study_.integrators) {
         runs_.emplace_back();
         for (const std::uint64_t steps : integrator.steps) {
@@ -73,7 +74,7 @@ class StudyExecution {
       for (const auto& run : list) ++outcome.run_counts[run.status];
     for (std::size_t i = 0; i < runs_.size(); ++i)
       outcome.fits.push_back(fit_study(study_.integrators[i], Integrator(study_.integrators[i].spec).describe(),
-                                       runs_[i], !study_.reference_q.empty()));
+                                       runs_[i], !reference_q_.empty()));
     outcome.runs = std::move(runs_);
     outcome.summary = summary(outcome, std::chrono::duration<double>(Clock::now() - start).count());
     try {
@@ -87,6 +88,21 @@ class StudyExecution {
   }
 
  private:
+  // Runs /study/reference_run; its end state becomes the reference (throws when it does not complete).
+  void compute_reference(const StudyIntegrator& reference) {
+    const std::uint64_t steps = reference.steps.front();
+    const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
+    EnsembleDriver driver(loaded_.plugin, loaded_.model,
+                          {reference.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
+                           options_.stop_requested});
+    if (driver.run() != DriverEnd::completed || driver.records().front().status != TrajectoryStatus::completed)
+      throw std::runtime_error("the reference run (/study/reference_run, " + reference.spec.scheme + " with " +
+                               std::to_string(steps) + " steps) did not complete: " +
+                               (driver.error().empty() ? driver.records().front().message : driver.error()));
+    reference_q_ = driver.records().front().final_q;
+    reference_p_ = driver.records().front().final_p;
+  }
+
   StudyRun run_one(const StudyIntegrator& study_integrator, std::uint64_t steps) {
     StudyRun run;
     run.steps = steps;
@@ -125,10 +141,10 @@ class StudyExecution {
       run.error = record.message;
     if (record.status != TrajectoryStatus::completed) return run;
     run.relative_energy_error = relative_energy_error(record.energy_final, record.energy_initial);
-    if (!study_.reference_q.empty()) {
+    if (!reference_q_.empty()) {
       double sum = 0.0;
       for (std::size_t i = 0; i < record.final_q.size(); ++i) {
-        const double dq = record.final_q[i] - study_.reference_q[i], dp = record.final_p[i] - study_.reference_p[i];
+        const double dq = record.final_q[i] - reference_q_[i], dp = record.final_p[i] - reference_p_[i];
         sum += dq * dq + dp * dp;
       }
       run.phase_error = std::sqrt(sum);
@@ -227,9 +243,11 @@ class StudyExecution {
     json study;
     study["t_end"] = study_.t_end;
     study["initial"] = {{"q", job_.initial.q}, {"p", job_.initial.p}};
-    study["reference"] = study_.reference_q.empty()
-                             ? json(nullptr)
-                             : json{{"q", study_.reference_q}, {"p", study_.reference_p}};
+    study["reference"] = reference_q_.empty() ? json(nullptr) : json{{"q", reference_q_}, {"p", reference_p_}};
+    if (study_.reference_run)
+      study["reference_from"] = {{"scheme", study_.reference_run->spec.scheme},
+                                 {"options", options_text(study_.reference_run->spec)},
+                                 {"steps", study_.reference_run->steps.front()}};
     study["energy_initial"] = optional_number(energy_initial_);
     study["energy_available"] = energy_available_;
     const StatusCounts& counts = outcome.run_counts;
@@ -267,6 +285,7 @@ class StudyExecution {
   std::optional<double> energy_initial_;
   CsvAppender csv_;
   CsvAppender work_precision_csv_;
+  std::vector<double> reference_q_ = study_.reference_q, reference_p_ = study_.reference_p;
   std::vector<std::vector<StudyRun>> runs_;  // per integrator, in step order
   bool interrupted_ = false;
   std::string run_error_;

@@ -187,3 +187,42 @@ TEST_CASE("a study of Chin's schemes and comparators writes work_precision.csv w
   CHECK(ratio > 12.0);
   CHECK(ratio < 20.0);
 }
+
+TEST_CASE("a study's reference_run: its end state is the reference of the phase errors, as a given reference") {
+  TemporaryFolder folder;
+  const nonsep::IntegratorSpec reference_spec = [] {
+    nonsep::IntegratorSpec spec{"gauss"};
+    spec.stages = 3;
+    return spec;
+  }();
+  const CoreRun reference = core_run(reference_spec, 2.0, 0.0, quarter_period / 256, 256);
+  json job = {{"model", {{"plugin", "paper1d"}}},
+              {"initial", state(2.0, 0.0)},
+              {"time", {{"t_end", quarter_period}}},
+              {"study",
+               {{"reference_run", {{"scheme", "gauss"}, {"stages", 3}, {"steps", {256}}}},
+                {"integrators", {{{"scheme", "tao"}, {"order", 2}, {"steps", {32, 64}}}}}}}};
+  const auto run_study = [&](const std::string& name) {
+    const auto file = write_job(folder / (name + ".json"), job);
+    const auto result =
+        run_nonsep({"run", "--quiet", "--output", (folder / name).string(), file.string()}, folder.path());
+    INFO("stderr: " << result.err);
+    REQUIRE(result.status == 0);
+  };
+  run_study("with-run");
+  const json summary = read_json(folder / "with-run" / "summary.json");
+  CHECK(summary["study"]["reference"]["p"][0].get<double>() == reference.state.p()[0]);
+  CHECK(summary["study"]["reference_from"]["scheme"] == "gauss");
+  CHECK(summary["study"]["reference_from"]["steps"] == 256);
+  // The same study with that end state written as /study/reference gives the same phase errors, bit for bit.
+  job["study"].erase("reference_run");
+  job["study"]["reference"] = {{"q", {reference.state.q()[0]}}, {"p", {reference.state.p()[0]}}};
+  run_study("given");
+  const auto a = read_csv(folder / "with-run" / "work_precision.csv"), b = read_csv(folder / "given" / "work_precision.csv");
+  REQUIRE(a.size() == 3);
+  REQUIRE(b.size() == 3);
+  const std::size_t phase = column(a[0], "phase_error");
+  CHECK(a[1][phase] == b[1][phase]);
+  CHECK(a[2][phase] == b[2][phase]);
+  CHECK(std::stod(a[1][phase]) > 1e-6);
+}

@@ -127,6 +127,8 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
     const auto& integrators = checked.study().integrators;
     for (std::size_t i = 0; i < integrators.size(); ++i)
       check_comparator(integrators[i].spec, "/study/integrators/" + std::to_string(i) + "/scheme");
+    if (const auto& reference = checked.study().reference_run)
+      check_comparator(reference->spec, "/study/reference_run/scheme");
   } else {
     check_comparator(checked.run().integrator, "/integrator/scheme");
     if (checked.run().analysis.tangent_vectors() > 0 && Integrator(checked.run().integrator).is_comparator())
