@@ -97,7 +97,7 @@ TEST_CASE("gauss: a trajectory whose fixed-point iteration fails retires as fail
   CHECK(number(summary["trajectories"][2]["final"]["q"][0]) == alone.state.q()[0]);
 }
 
-TEST_CASE("tao: a trajectory that diverges leaves the block with its copy; the others keep theirs, bit for bit") {
+TEST_CASE("tao: a trajectory that diverges leaves the block with its copy, the others keep theirs bit for bit") {
   TemporaryFolder folder;
   // (3, 6) diverges at step 2, after the block has stepped all three once: the driver redoes the chunk step by
   // step and compacts the block and Tao's copies; the survivors must still be the core's single runs.
