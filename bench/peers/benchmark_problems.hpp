@@ -26,9 +26,11 @@ struct Paper1D {
   template <class Real> static Real T(Real p) { return p + p * p * p / 6; }
   template <class Real> static Real grad_T(Real p) { return 1 + p * p / 2; }
   template <class Real> static Real hessian_T(Real p) { return p; }
+  template <class Real> static Real third_T(Real) { return 1; }
   template <class Real> static Real V(Real q) { return q * q / 2 + q * q * q * q / 12; }
   template <class Real> static Real grad_V(Real q) { return q + q * q * q / 3; }
   template <class Real> static Real hessian_V(Real q) { return 1 + q * q; }
+  template <class Real> static Real third_V(Real q) { return 2 * q; }
 
   template <class Real> static Real H(Real q, Real p) {
     const Real u = 1 + p * p / 2;
@@ -56,9 +58,14 @@ struct TaoProduct {
   }
   template <class Real> static Real grad_T(Real p) { return std::sqrt((1 + p * p) / 2); }
   template <class Real> static Real hessian_T(Real p) { return p / (2 * grad_T(p)); }
+  template <class Real> static Real third_T(Real p) {
+    const Real g = grad_T(p);
+    return 1 / (2 * g) - p * p / (4 * g * g * g);
+  }
   template <class Real> static Real V(Real q) { return q * q / 2 + q * q * q * q / 12; }
   template <class Real> static Real grad_V(Real q) { return q + q * q * q / 3; }
   template <class Real> static Real hessian_V(Real q) { return 1 + q * q; }
+  template <class Real> static Real third_V(Real q) { return 2 * q; }
 
   template <class Real> static Real H(Real q, Real p) { return (q * q + 1) * (p * p + 1) / 2; }
   template <class Real> static Real dH_dq(Real q, Real p) { return q * (1 + p * p); }
@@ -69,7 +76,8 @@ struct TaoProduct {
   }
 };
 
-// Problem P as a nonsep::ModelWithHessians of dimension 1 (a batch is `count` independent 1D states).
+// Problem P as a nonsep::ModelWithThirdDerivatives of dimension 1 (a batch is `count` independent 1D states); the
+// third derivatives serve the comparator schemes (grad H).
 template <class P>
 struct BatchedModel {
   std::size_t dimension() const { return 1; }
@@ -84,6 +92,12 @@ struct BatchedModel {
   }
   void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
     for (std::size_t b = 0; b < count; ++b) out[b] = P::hessian_V(q[b]);
+  }
+  void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = P::third_T(p[b]) * u[b] * u[b];
+  }
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = P::third_V(q[b]) * u[b] * u[b];
   }
 };
 
@@ -107,6 +121,8 @@ std::vector<std::string> check_derivatives() {
       compare("hessian_T" + at, p, P::hessian_T(p), [](double x) { return P::grad_T(x); });
       compare("grad_V" + at, q, P::grad_V(q), [](double x) { return P::V(x); });
       compare("hessian_V" + at, q, P::hessian_V(q), [](double x) { return P::grad_V(x); });
+      compare("third_T" + at, p, P::third_T(p), [](double x) { return P::hessian_T(x); });
+      compare("third_V" + at, q, P::third_V(q), [](double x) { return P::hessian_V(x); });
       const double ttv = P::grad_T(p) * P::hessian_V(q) * P::grad_T(p);
       if (!(std::abs(P::H(q, p) - ttv) <= 1e-13 * std::abs(ttv)))
         failures.push_back(std::string(P::name) + ": H" + at + " = " + std::to_string(P::H(q, p)) +

@@ -10,14 +10,35 @@ std::string known_schemes() {
 }
 
 SchemeStepper build(const IntegratorSpec& spec) {
-  ChinBasicStep base(spec.form, spec.t2);
   const Scheme* scheme = find_scheme(spec.scheme);
+  // t2 first, as before the comparators joined: it is the one option every Chin scheme has.
+  if (!scheme || scheme->family == "chin") ChinBasicStep(spec.form, spec.t2);
   if (!scheme)
     throw InvalidArgument("unknown integrator scheme '" + spec.scheme + "'; the schemes are " + known_schemes());
-  return scheme->make(std::move(base), chin_order_index(spec.order, scheme->highest_order_index, scheme->name));
+  return scheme->make(spec);
+}
+
+template <class S>
+IntegratorDescription description_of(const S& stepper) {
+  if constexpr (is_comparator_stepper<S>)
+    return stepper.describe().integrator_description();
+  else
+    return stepper.describe();
 }
 }  // namespace
 
 Integrator::Integrator(const IntegratorSpec& spec) : spec_(spec), form_(spec.form), stepper_(build(spec)) {}
+
+IntegratorDescription Integrator::describe() const {
+  IntegratorDescription d = std::visit([](const auto& stepper) { return description_of(stepper); }, stepper_);
+  d.scheme = spec_.scheme == "implicit_midpoint" ? spec_.scheme : d.scheme;
+  return d;
+}
+
+std::string Integrator::needs_third_derivatives() const {
+  return "the comparator scheme '" + spec_.scheme +
+         "' integrates H from its gradient and needs a model with Hessians (hessian_T, hessian_V) and third "
+         "derivatives (d3T, d3V); use a Chin scheme (basic, triplet, mpe) with this model";
+}
 
 }  // namespace nonsep

@@ -7,6 +7,7 @@ namespace nonsep {
 std::string chin_orders_text() { return "2/3, 4/3, 2, 8/3, 10/3, 4, ... (2j/3 for j = 1, 2, 3, ...)"; }
 
 std::vector<Fraction> SchemeDescription::orders() const {
+  if (!comparator_orders.empty()) return comparator_orders;
   std::vector<Fraction> orders;
   for (int j = 1; j <= highest_order_index; ++j) orders.push_back(Fraction(2 * j, 3));
   return orders;

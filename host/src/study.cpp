@@ -36,13 +36,17 @@ class StudyExecution {
         energy_available_(loaded.plugin.has_hessians()),
         csv_(options.output_directory / "convergence.csv",
              "integrator,scheme,order,t2,symplectic,dt,steps,basic_steps,grad_T,grad_V,relative_energy_error,"
-             "phase_error,status") {}
+             "phase_error,status,family,grad_H"),
+        work_precision_csv_(options.output_directory / "work_precision.csv",
+                            "integrator,scheme,family,options,order,symplectic,dt,steps,evaluations,grad_T,grad_V,"
+                            "grad_H,wall_seconds,repeats,relative_energy_error,phase_error,status") {}
   StudyExecution(const StudyExecution&) = delete;
   StudyExecution& operator=(const StudyExecution&) = delete;
 
   StudyOutcome execute() {
     const auto start = Clock::now();
     try {
+      if (study_.reference_run) compute_reference(*study_.reference_run);
       for (const auto& integrator : study_.integrators) {
         runs_.emplace_back();
         for (const std::uint64_t steps : integrator.steps) {
@@ -56,6 +60,7 @@ class StudyExecution {
     }
     try {
       csv_.flush();
+      work_precision_csv_.flush();
     } catch (const OutputError& error) {
       if (run_error_.empty()) run_error_ = error.what();
     }
@@ -69,7 +74,7 @@ class StudyExecution {
       for (const auto& run : list) ++outcome.run_counts[run.status];
     for (std::size_t i = 0; i < runs_.size(); ++i)
       outcome.fits.push_back(fit_study(study_.integrators[i], Integrator(study_.integrators[i].spec).describe(),
-                                       runs_[i], !study_.reference_q.empty()));
+                                       runs_[i], !reference_q_.empty()));
     outcome.runs = std::move(runs_);
     outcome.summary = summary(outcome, std::chrono::duration<double>(Clock::now() - start).count());
     try {
@@ -83,16 +88,47 @@ class StudyExecution {
   }
 
  private:
+  // Runs /study/reference_run; its end state becomes the reference (throws when it does not complete).
+  void compute_reference(const StudyIntegrator& reference) {
+    const std::uint64_t steps = reference.steps.front();
+    const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
+    EnsembleDriver driver(loaded_.plugin, loaded_.model,
+                          {reference.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
+                           options_.stop_requested});
+    if (driver.run() != DriverEnd::completed || driver.records().front().status != TrajectoryStatus::completed)
+      throw std::runtime_error("the reference run (/study/reference_run, " + reference.spec.scheme + " with " +
+                               std::to_string(steps) + " steps) did not complete: " +
+                               (driver.error().empty() ? driver.records().front().message : driver.error()));
+    reference_q_ = driver.records().front().final_q;
+    reference_p_ = driver.records().front().final_p;
+  }
+
   StudyRun run_one(const StudyIntegrator& study_integrator, std::uint64_t steps) {
     StudyRun run;
     run.steps = steps;
     const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
     run.dt = time.dt;
     run.basic_steps = steps * Integrator(study_integrator.spec).describe().basic_steps_per_step;
+    // Each repeat is a fresh driver doing the same work; the first one's results are kept, the others only timed.
+    std::vector<double> seconds;
+    for (int r = 1; r < study_.repeats && !interrupted_; ++r) {
+      EnsembleDriver repeat(loaded_.plugin, loaded_.model,
+                            {study_integrator.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
+                             options_.stop_requested});
+      const auto start = Clock::now();
+      if (repeat.run() != DriverEnd::completed) break;
+      seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    }
     EnsembleDriver driver(loaded_.plugin, loaded_.model,
                           {study_integrator.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
                            options_.stop_requested});
+    const auto start = Clock::now();
     const DriverEnd end = driver.run();
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    std::sort(seconds.begin(), seconds.end());
+    const std::size_t middle = seconds.size() / 2;
+    run.wall_seconds = seconds.size() % 2 ? seconds[middle] : (seconds[middle - 1] + seconds[middle]) / 2.0;
+    run.repeats = static_cast<int>(seconds.size());
     run.evaluations = driver.evaluations();
     const TrajectoryRecord& record = driver.records().front();
     if (!energy_initial_) energy_initial_ = record.energy_initial;
@@ -105,10 +141,10 @@ class StudyExecution {
       run.error = record.message;
     if (record.status != TrajectoryStatus::completed) return run;
     run.relative_energy_error = relative_energy_error(record.energy_final, record.energy_initial);
-    if (!study_.reference_q.empty()) {
+    if (!reference_q_.empty()) {
       double sum = 0.0;
       for (std::size_t i = 0; i < record.final_q.size(); ++i) {
-        const double dq = record.final_q[i] - study_.reference_q[i], dp = record.final_p[i] - study_.reference_p[i];
+        const double dq = record.final_q[i] - reference_q_[i], dp = record.final_p[i] - reference_p_[i];
         sum += dq * dq + dp * dp;
       }
       run.phase_error = std::sqrt(sum);
@@ -131,7 +167,53 @@ class StudyExecution {
     if (run.phase_error) append_number(row, *run.phase_error);
     row += ",";
     row += to_string(run.status);
+    row += "," + description.family + "," + std::to_string(run.evaluations.grad_H);
     csv_.end_row();
+    write_work_precision_row(integrator, description, run);
+  }
+
+  // work_precision.csv: the cost (evaluations = grad_T + grad_V + grad_H, each counted once per state; a grad_H
+  // costs the model a gradient, two Hessians and a third-derivative contraction) and the median wall time against
+  // the errors.
+  void write_work_precision_row(const StudyIntegrator& integrator, const IntegratorDescription& description,
+                                const StudyRun& run) {
+    const EvaluationCounts& e = run.evaluations;
+    std::string& row = work_precision_csv_.row();
+    append_csv_text(row, integrator.label);
+    row += "," + description.scheme + "," + description.family + ",";
+    append_csv_text(row, options_text(integrator.spec));
+    row += "," + description.order.to_string() + (description.symplectic ? ",true," : ",false,");
+    append_number(row, run.dt);
+    row += "," + std::to_string(run.steps) + "," + std::to_string(e.grad_T + e.grad_V + e.grad_H) + "," +
+           std::to_string(e.grad_T) + "," + std::to_string(e.grad_V) + "," + std::to_string(e.grad_H) + ",";
+    append_number(row, run.wall_seconds);
+    row += "," + std::to_string(run.repeats) + ",";
+    if (run.relative_energy_error) append_number(row, *run.relative_energy_error);
+    row += ",";
+    if (run.phase_error) append_number(row, *run.phase_error);
+    row += ",";
+    row += to_string(run.status);
+    work_precision_csv_.end_row();
+  }
+
+  // The scheme's catalogue options with their values: "order=4/3 t2=-1.81712059283214", "omega=20".
+  static std::string options_text(const IntegratorSpec& spec) {
+    std::string text;
+    const Scheme* scheme = find_scheme(spec.scheme);
+    for (const auto& parameter : scheme ? scheme->parameters : std::vector<ParameterDescription>{}) {
+      std::string value;
+      if (parameter.name == "order") {
+        value = spec.order.to_string();
+      } else {
+        const double number = parameter.name == "t2"      ? spec.t2
+                              : parameter.name == "omega" ? spec.omega
+                              : parameter.name == "stages" ? spec.stages
+                                                           : spec.max_iterations;
+        append_number(value, number);
+      }
+      text += (text.empty() ? "" : " ") + parameter.name + "=" + value;
+    }
+    return text;
   }
 
   TrajectoryStatus status() const {
@@ -161,9 +243,11 @@ class StudyExecution {
     json study;
     study["t_end"] = study_.t_end;
     study["initial"] = {{"q", job_.initial.q}, {"p", job_.initial.p}};
-    study["reference"] = study_.reference_q.empty()
-                             ? json(nullptr)
-                             : json{{"q", study_.reference_q}, {"p", study_.reference_p}};
+    study["reference"] = reference_q_.empty() ? json(nullptr) : json{{"q", reference_q_}, {"p", reference_p_}};
+    if (study_.reference_run)
+      study["reference_from"] = {{"scheme", study_.reference_run->spec.scheme},
+                                 {"options", options_text(study_.reference_run->spec)},
+                                 {"steps", study_.reference_run->steps.front()}};
     study["energy_initial"] = optional_number(energy_initial_);
     study["energy_available"] = energy_available_;
     const StatusCounts& counts = outcome.run_counts;
@@ -185,7 +269,9 @@ class StudyExecution {
     }
     summary["fits"] = std::move(fits);
     if (!failures.empty()) summary["failures"] = std::move(failures);
-    summary["output"] = {{"directory", options_.output_directory.string()}, {"convergence", "convergence.csv"}};
+    summary["output"] = {{"directory", options_.output_directory.string()}, {"convergence", "convergence.csv"},
+                         {"work_precision", "work_precision.csv"}};
+    summary["study"]["repeats"] = study_.repeats;
     summary["wall_seconds"] = wall_seconds;
     return summary;
   }
@@ -198,6 +284,8 @@ class StudyExecution {
   bool energy_available_;
   std::optional<double> energy_initial_;
   CsvAppender csv_;
+  CsvAppender work_precision_csv_;
+  std::vector<double> reference_q_ = study_.reference_q, reference_p_ = study_.reference_p;
   std::vector<std::vector<StudyRun>> runs_;  // per integrator, in step order
   bool interrupted_ = false;
   std::string run_error_;

@@ -57,11 +57,6 @@ double measured_order(const std::string& name, const Run& run, double q0, double
   return n;
 }
 
-// Paper1D's quarter period from (2, 0): ends exactly at (0, p_final).
-double quarter_period_order(const std::string& name, const Run& run, int first_steps, int halvings) {
-  const auto exact = nonsep::reference::paper1d_quarter(2.0);
-  return measured_order(name, run, 2.0, 0.0, exact.period, 0.0, exact.p_final, first_steps, halvings);
-}
 
 }  // namespace
 
@@ -101,29 +96,8 @@ TEST_CASE("the gradient of H is the derivative of the energy, both forms") {
   CHECK_THROWS_AS(ttv.evaluate(Paper1D{}, std::vector<double>{q}, std::vector<double>{p}, dq, dp, 2), InvalidArgument);
 }
 
-TEST_CASE("Tao's extended phase-space integrator converges with orders 2, 4 and 6 (omega = 20)") {
-  auto tao = [](int order) {
-    return run_with<TaoExtendedPhaseSpace>([order] { return TaoExtendedPhaseSpace(HamiltonianForm::TTV, order); });
-  };
-  // Slopes from T/8 down: order 2: 2.24, 2.05, 2.01, 2.003, 2.0007, 2.0002, 2.00004 (T/64 .. T/1024 used);
-  // order 4: 3.05, 3.48, 3.88, 3.97, 3.99, 3.998, 3.9996, 3.997 (T/64 .. T/1024 used);
-  // order 6: 3.2, 5.5, 5.88, 5.97, 5.99, 6.001, 6.03, then round-off at 3e-14 (T/32 .. T/256 used).
-  CHECK(std::abs(quarter_period_order("tao 2", tao(2), 64, 4) - 2.0) < 0.1);
-  CHECK(std::abs(quarter_period_order("tao 4", tao(4), 64, 4) - 4.0) < 0.1);
-  CHECK(std::abs(quarter_period_order("tao 6", tao(6), 32, 3) - 6.0) < 0.1);
-}
-
-TEST_CASE("Gauss-Legendre collocation converges with orders 2, 4 and 6") {
-  auto gauss = [](int order) {
-    return run_with<GaussLegendre>([order] { return GaussLegendre(HamiltonianForm::TTV, order); });
-  };
-  // Slopes from T/8 down: order 2: 1.96, 1.99, 1.997, 1.9993, 1.9998, ... (T/32 .. T/512 used);
-  // order 4: 4.08, 4.02, 4.005, 4.001, 4.0004, 4.00, then round-off at 1e-14 (T/16 .. T/256 used);
-  // order 6: 6.12, 6.02, 6.007, 6.03, then round-off at 1e-14 (T/8 .. T/64 used).
-  CHECK(std::abs(quarter_period_order("gauss 2", gauss(2), 32, 4) - 2.0) < 0.1);
-  CHECK(std::abs(quarter_period_order("gauss 4", gauss(4), 16, 4) - 4.0) < 0.1);
-  CHECK(std::abs(quarter_period_order("gauss 6", gauss(6), 8, 3) - 6.0) < 0.1);
-}
+// The orders on the exact quarter period of paper1d (tao 2, 4, 6; implicit midpoint; gauss 1, 2, 3 stages) are
+// measured with every other scheme of the catalogue in test_core_convergence.cpp.
 
 TEST_CASE("the VVT form: both comparators converge to the flow of H_VVT = (q + q^3/3)^2 p") {
   // The reference of test_core_properties.cpp: Hamilton's equations by Runge-Kutta-Fehlberg 7(8).

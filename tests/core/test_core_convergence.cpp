@@ -1,11 +1,15 @@
-// Measured orders of convergence on the paper's 1D test (eq. h1d) against its exact solution.
+// Measured orders of convergence on the paper's 1D test (eq. h1d) against its exact solution, for every scheme of
+// the catalogue (Chin's and the comparators), each built through Integrator from an IntegratorSpec as the host
+// builds it. The cases are one table (order_cases); the last test fails for a catalogue entry without a case.
 // The reference point is exact: from (q0, 0) the orbit reaches (0, p_quarter) after the quarter period and
 // returns to (q0, 0) after four, both computed by quadrature of the conserved energy (nonsep/reference/paper1d_exact.hpp).
 // Each case halves dt over a range chosen inside the asymptotic regime (found by printing the local slopes
 // log2(e(dt)/e(dt/2)) from dt = T/4 down to round-off) and fits the slope of log(phase error) vs log(dt).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "nonsep/core.hpp"
@@ -20,9 +24,8 @@ using nonsep::testing::Paper1D;
 namespace {
 
 struct Study {
-  const char* scheme;
-  Fraction order;
-  double t2;
+  IntegratorSpec spec;
+  double nominal;   // the order the fit must find within 0.1
   double q0;
   int quarters;     // integrate to quarters * (quarter period); 1 or 4
   int first_steps;  // steps over that time at the largest dt; each further dt halves the step
@@ -36,7 +39,7 @@ double measured_order(const Study& study) {
   const double p_exact = study.quarters == 4 ? 0.0 : exact.p_final;
   std::vector<double> dts, errors;
   for (int h = 0, steps = study.first_steps; h <= study.halvings; ++h, steps *= 2) {
-    Integrator integrator(IntegratorSpec{study.scheme, study.order, study.t2});
+    Integrator integrator(study.spec);
     const double q[] = {study.q0}, p[] = {0.0};
     auto x = PhaseSpaceBatch::single(q, p);
     const double dt = t_end / steps;
@@ -45,10 +48,71 @@ double measured_order(const Study& study) {
     errors.push_back(std::hypot(x.q()[0] - q_exact, x.p()[0] - p_exact));
   }
   const double n = nonsep::testing::fitted_exponent(dts, errors);
-  MESSAGE(std::string(study.scheme) << " " << study.order.to_string() << ": fitted exponent " << n << " for dt from "
-                       << dts.front() << " to " << dts.back() << ", errors " << errors.front() << " to "
-                       << errors.back());
+  MESSAGE(study.spec.scheme << " " << Integrator(study.spec).describe().order.to_string() << ": fitted exponent " << n
+                            << " for dt from " << dts.front() << " to " << dts.back() << ", errors " << errors.front()
+                            << " to " << errors.back());
   return n;
+}
+
+IntegratorSpec chin(const char* scheme, Fraction order, double t2 = ChinCoefficients::default_t2()) {
+  return {scheme, order, t2};
+}
+IntegratorSpec tao(int order) { return {"tao", Fraction(order)}; }
+IntegratorSpec gauss(int stages) {
+  IntegratorSpec spec{"gauss"};
+  spec.stages = stages;
+  return spec;
+}
+
+// Each dt range lies inside the asymptotic regime, found by printing the local slopes log2(e(dt)/e(dt/2)) from
+// dt = T/4 (or T/8) down to round-off; the slopes are quoted at each case.
+const std::vector<Study>& order_cases() {
+  static const std::vector<Study> cases = {
+      // basic: slopes 0.660 .. 0.666 for dt = T/1024 .. T/16384.
+      {chin("basic", Fraction(2, 3)), 2.0 / 3, 2.0, 1, 1024, 4},
+      // triplet 4/3: slopes 1.333 for dt = T/1024 .. T/8192.
+      {chin("triplet", Fraction(4, 3)), 4.0 / 3, 2.0, 1, 1024, 3},
+      // triplet 2: an error cancellation near dt = T/256 (the error changes sign); asymptotic from T/8192
+      // (slopes 1.89 .. 1.98).
+      {chin("triplet", Fraction(2)), 2.0, 2.0, 1, 8192, 3},
+      // triplet 8/3: slopes 2.64 .. 2.66 for dt = T/2048 .. T/16384.
+      {chin("triplet", Fraction(8, 3)), 8.0 / 3, 2.0, 1, 2048, 3},
+      // mpe 4/3: slopes 1.333 for dt = T/1024 .. T/8192.
+      {chin("mpe", Fraction(4, 3)), 4.0 / 3, 2.0, 1, 1024, 3},
+      // mpe 2: slopes 1.96 .. 1.99 for dt = T/4096 .. T/32768.
+      {chin("mpe", Fraction(2)), 2.0, 2.0, 1, 4096, 3},
+      // mpe 8/3: slopes 2.65 .. 2.67 for dt = T/256 .. T/2048 (round-off takes over below 1e-11).
+      {chin("mpe", Fraction(8, 3)), 8.0 / 3, 2.0, 1, 256, 3},
+      // mpe 4 (six terms): the next error term is only dt^(2/3) smaller, so the slope approaches 4 from above
+      // slowly and the weights (|c_i| up to 645) bring round-off to ~1e-11 early. With t2 = -1.2 that next term is
+      // small: over one full period from q0 = 2 the slopes are 4.11, 4.05, 4.00 for dt = 4T/512 .. 4T/2048.
+      {chin("mpe", Fraction(4), -1.2), 4.0, 2.0, 4, 512, 2},
+      // tao 2 (omega = 20): slopes 2.05, 2.01, 2.003, 2.0007 for T/64 .. T/1024.
+      {tao(2), 2.0, 2.0, 1, 64, 4},
+      // tao 4: slopes 3.88, 3.97, 3.99, 3.998 for T/64 .. T/1024.
+      {tao(4), 4.0, 2.0, 1, 64, 4},
+      // tao 6: slopes 5.88, 5.97, 5.99 for T/32 .. T/256, then round-off near 3e-14.
+      {tao(6), 6.0, 2.0, 1, 32, 3},
+      // implicit midpoint (= gauss with 1 stage): slopes 1.99, 1.997, 1.9993, 1.9998 for T/32 .. T/512.
+      {IntegratorSpec{"implicit_midpoint"}, 2.0, 2.0, 1, 32, 4},
+      {gauss(1), 2.0, 2.0, 1, 32, 4},
+      // gauss 2 stages: slopes 4.02, 4.005, 4.001, 4.0004 for T/16 .. T/256, then round-off near 1e-14.
+      {gauss(2), 4.0, 2.0, 1, 16, 4},
+      // gauss 3 stages: slopes 6.12, 6.02, 6.007 for T/8 .. T/64, then round-off near 1e-14.
+      {gauss(3), 6.0, 2.0, 1, 8, 3},
+  };
+  return cases;
+}
+
+void check_cases_of(const std::string& scheme) {
+  int cases = 0;
+  for (const Study& study : order_cases())
+    if (study.spec.scheme == scheme) {
+      ++cases;
+      CAPTURE(Integrator(study.spec).describe().order.to_string());
+      CHECK(std::abs(measured_order(study) - study.nominal) < 0.1);
+    }
+  CHECK(cases > 0);
 }
 
 const double default_t2 = ChinCoefficients::default_t2();
@@ -74,29 +138,30 @@ TEST_CASE("exact quarter period of the paper's 1D test by quadrature") {
   CHECK(std::abs(end[1] - exact.p_final) < 1e-11);
 }
 
-TEST_CASE("basic step converges with order 2/3") {
-  // Local slopes are 0.660 .. 0.666 for dt = T/1024 .. T/16384.
-  CHECK(std::abs(measured_order({"basic", Fraction(2, 3), default_t2, 2.0, 1, 1024, 4}) - 2.0 / 3) < 0.1);
+TEST_CASE("basic step converges with order 2/3") { check_cases_of("basic"); }
+
+TEST_CASE("triplet composition converges with orders 4/3, 2 and 8/3") { check_cases_of("triplet"); }
+
+TEST_CASE("multi-product expansion converges with orders 4/3, 2, 8/3 and 4") { check_cases_of("mpe"); }
+
+TEST_CASE("comparators from the catalogue: tao 2, 4, 6, implicit midpoint, gauss with 1, 2, 3 stages") {
+  for (const char* scheme : {"tao", "implicit_midpoint", "gauss"}) {
+    CAPTURE(scheme);
+    check_cases_of(scheme);
+  }
 }
 
-TEST_CASE("triplet composition converges with orders 4/3, 2 and 8/3") {
-  // 4/3: slopes 1.333 for dt = T/1024 .. T/8192.
-  CHECK(std::abs(measured_order({"triplet", Fraction(4, 3), default_t2, 2.0, 1, 1024, 3}) - 4.0 / 3) < 0.1);
-  // 2: an error cancellation near dt = T/256 (the error changes sign); asymptotic from T/8192 (slopes 1.89 .. 1.98).
-  CHECK(std::abs(measured_order({"triplet", Fraction(2), default_t2, 2.0, 1, 8192, 3}) - 2.0) < 0.1);
-  // 8/3: slopes 2.64 .. 2.66 for dt = T/2048 .. T/16384.
-  CHECK(std::abs(measured_order({"triplet", Fraction(8, 3), default_t2, 2.0, 1, 2048, 3}) - 8.0 / 3) < 0.1);
-}
-
-TEST_CASE("multi-product expansion converges with orders 4/3, 2, 8/3 and 4") {
-  // 4/3: slopes 1.333 for dt = T/1024 .. T/8192.
-  CHECK(std::abs(measured_order({"mpe", Fraction(4, 3), default_t2, 2.0, 1, 1024, 3}) - 4.0 / 3) < 0.1);
-  // 2: slopes 1.96 .. 1.99 for dt = T/4096 .. T/32768.
-  CHECK(std::abs(measured_order({"mpe", Fraction(2), default_t2, 2.0, 1, 4096, 3}) - 2.0) < 0.1);
-  // 8/3: slopes 2.65 .. 2.67 for dt = T/256 .. T/2048 (round-off takes over below 1e-11).
-  CHECK(std::abs(measured_order({"mpe", Fraction(8, 3), default_t2, 2.0, 1, 256, 3}) - 8.0 / 3) < 0.1);
-  // 4 (six terms): the next error term is only dt^(2/3) smaller, so the slope approaches 4 from above slowly and
-  // the weights (|c_i| up to 645) bring round-off to ~1e-11 early. With t2 = -1.2 that next term is small: over
-  // one full period from q0 = 2 the slopes are 4.11, 4.05, 4.00 for dt = 4T/512 .. 4T/2048.
-  CHECK(std::abs(measured_order({"mpe", Fraction(4), -1.2, 2.0, 4, 512, 2}) - 4.0) < 0.1);
+TEST_CASE("every scheme of the catalogue, every order of a comparator, has an order case") {
+  for (const auto& scheme : scheme_catalogue()) {
+    CAPTURE(scheme.name);
+    std::vector<Fraction> covered;
+    for (const Study& study : order_cases())
+      if (study.spec.scheme == scheme.name) covered.push_back(Integrator(study.spec).describe().order);
+    CHECK_MESSAGE(!covered.empty(), "no order case for the catalogue scheme " << scheme.name);
+    if (scheme.family == "comparator")
+      for (const Fraction& order : scheme.orders()) {
+        CAPTURE(order.to_string());
+        CHECK(std::find(covered.begin(), covered.end(), order) != covered.end());
+      }
+  }
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 
 #include "nonsep/core.hpp"
@@ -106,9 +107,19 @@ TEST_CASE("integrators describe themselves") {
   CHECK_FALSE(mpe.time_reversible);
   CHECK(mpe.basic_steps_per_step == 21);
   // The catalogue lists every scheme with its parameters and defaults, for the host's reader and help text.
-  REQUIRE(scheme_catalogue().size() == 3);
-  for (const auto& scheme : scheme_catalogue()) {
+  // Chin's three first, then the three comparators.
+  REQUIRE(scheme_catalogue().size() == 6);
+  const char* comparators[] = {"tao", "implicit_midpoint", "gauss"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    CAPTURE(comparators[i]);
+    CHECK(scheme_catalogue()[3 + i].name == comparators[i]);
+    CHECK(scheme_catalogue()[3 + i].family == "comparator");
+    CHECK(scheme_catalogue()[3 + i].summary.find("Needs the plugin's Hessians and third derivatives") !=
+          std::string::npos);
+  }
+  for (const auto& scheme : scheme_catalogue().first(3)) {
     CAPTURE(scheme.name);
+    CHECK(scheme.family == "chin");
     CHECK(!scheme.summary.empty());
     CHECK(!scheme.equations.empty());
     REQUIRE(scheme.parameters.size() == 2);
@@ -122,22 +133,70 @@ TEST_CASE("integrators describe themselves") {
 TEST_CASE("each catalogue entry builds exactly its orders, with its own flags") {
   for (const auto& scheme : scheme_catalogue()) {
     CAPTURE(scheme.name);
+    const bool chin = scheme.family == "chin";
+    CHECK((chin || scheme.family == "comparator"));
     const auto orders = scheme.orders();
-    REQUIRE(orders.size() == static_cast<std::size_t>(scheme.highest_order_index));
+    REQUIRE(orders.size() == (chin ? static_cast<std::size_t>(scheme.highest_order_index) : scheme.comparator_orders.size()));
+    // A comparator's order is its "order" option (tao) or twice its stages (gauss); implicit_midpoint has only 2.
+    const auto spec_of = [&](const Fraction& order) {
+      IntegratorSpec spec{scheme.name, order, -2.0};
+      spec.stages = static_cast<double>(order.numerator()) / 2.0;
+      return spec;
+    };
     for (const Fraction& order : orders) {
       CAPTURE(order.to_string());
-      const auto description = Integrator(IntegratorSpec{scheme.name, order, -2.0}).describe();
+      const auto description = Integrator(spec_of(order)).describe();
       CHECK(description.scheme == scheme.name);
+      CHECK(description.family == scheme.family);
       CHECK(description.order == order);
       CHECK(description.symplectic == scheme.symplectic);
       CHECK(description.time_reversible == scheme.time_reversible);
-      CHECK(description.t2 == -2.0);
+      CHECK(description.t2 == (chin ? -2.0 : 0.0));
     }
-    // The next order of the family is beyond the entry's list, and the entry's default order is one of its orders.
-    const Fraction beyond(2 * (scheme.highest_order_index + 1), 3);
-    CHECK(contains(error_of([&] { Integrator(IntegratorSpec{scheme.name, beyond}); }), "beyond the highest order"));
-    CHECK(std::find(orders.begin(), orders.end(), Fraction::parse(scheme.parameters[0].default_text)) != orders.end());
+    if (chin) {
+      // The next order of the family is beyond the entry's list, and the default order is one of its orders.
+      const Fraction beyond(2 * (scheme.highest_order_index + 1), 3);
+      CHECK(contains(error_of([&] { Integrator(IntegratorSpec{scheme.name, beyond}); }), "beyond the highest order"));
+      CHECK(std::find(orders.begin(), orders.end(), Fraction::parse(scheme.parameters[0].default_text)) !=
+            orders.end());
+    } else if (scheme.name != "implicit_midpoint") {
+      // Order 8 (tao) or 4 stages (gauss) does not exist: the message names the valid ones.
+      CHECK(contains(error_of([&] { Integrator(spec_of(Fraction(8))); }), "2, 4"));
+    }
   }
+}
+
+TEST_CASE("comparator options: each bad value has its own message") {
+  IntegratorSpec tao{"tao", Fraction(4, 3)};
+  CHECK(contains(error_of([&] { Integrator{tao}; }), "orders 2, 4 and 6 (found 4/3)"));
+  tao.order = Fraction(2);
+  tao.omega = 0.0;
+  CHECK(contains(error_of([&] { Integrator{tao}; }), "omega must be finite and positive"));
+  IntegratorSpec gauss{"gauss"};
+  gauss.stages = 1.5;
+  CHECK(contains(error_of([&] { Integrator{gauss}; }), "stages must be a whole number"));
+  gauss.stages = 0;
+  CHECK(contains(error_of([&] { Integrator{gauss}; }), "1, 2 or 3 stages"));
+  gauss.stages = 2;
+  gauss.max_iterations = 0;
+  CHECK(contains(error_of([&] { Integrator{gauss}; }), "max_iterations >= 1"));
+  // A comparator ignores t2 (0 is not refused), a Chin scheme refuses it first.
+  IntegratorSpec midpoint{"implicit_midpoint", Fraction(2), 0.0};
+  CHECK_NOTHROW(Integrator{midpoint});
+  // A model type without Hessians and third derivatives: the comparator refuses to step, a Chin scheme steps.
+  struct GradientsOnly {
+    std::size_t dimension() const { return 1; }
+    void grad_T(std::span<const double> p, std::span<double> out, std::size_t) const { out[0] = p[0]; }
+    void grad_V(std::span<const double> q, std::span<double> out, std::size_t) const { out[0] = q[0]; }
+  };
+  const double q[] = {1.0}, p[] = {0.5};
+  auto x = PhaseSpaceBatch::single(q, p);
+  Integrator comparator(IntegratorSpec{"tao", Fraction(2)});
+  CHECK(contains(error_of([&] { comparator.step(GradientsOnly{}, x, 0.1); }), "needs a model with Hessians"));
+  Integrator basic(IntegratorSpec{"basic"});
+  CHECK_NOTHROW(basic.step(GradientsOnly{}, x, 0.1));
+  // No tangent map for a comparator.
+  CHECK(contains(error_of([&] { TangentIntegrator{IntegratorSpec{"tao", Fraction(2)}}; }), "has no tangent map"));
 }
 
 namespace {

@@ -65,7 +65,8 @@ TEST_CASE("usage: --version, --help with the schemes, options and exit statuses,
     result = run_nonsep(args, folder.path());
     CHECK(result.status == 0);
     for (const auto& scheme : nonsep::scheme_catalogue()) {
-      CHECK(result.out.find("  " + scheme.name + ": " + scheme.method) != std::string::npos);
+      CHECK(result.out.find("  " + scheme.name + " [family " + scheme.family + "]: " + scheme.method) !=
+            std::string::npos);
       for (const auto& parameter : scheme.parameters)
         CHECK(result.out.find(parameter.name + " (default " + parameter.default_text + ")") != std::string::npos);
     }

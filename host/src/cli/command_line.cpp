@@ -38,7 +38,7 @@ int run_command_line(int argc, char** argv) {
     auto* run = app.add_subcommand("run",
                                    "Run a job: trajectory.csv (streamed), trajectories.csv and summary.json in the output folder "
                                    "(with /analysis/poincare also poincare.csv, with /analysis/lyapunov/every lyapunov.csv); a "
-                                   "study (/study): convergence.csv, and summary.json with the fitted exponents");
+                                   "study (/study): convergence.csv, work_precision.csv, and summary.json with the fitted exponents");
     run->add_option("JOB.json", arguments.job_file, "the job file")->required();
     run->add_option("--output,-o", arguments.output,
                     "output folder, relative to the current directory (overrides the job's output.directory)");

@@ -25,7 +25,7 @@ std::string exit_status_text() {
 std::string schemes_text() {
   std::string text = "Integrator schemes (job file: \"integrator\": {\"scheme\": name, option: value, ...}):\n";
   for (const auto& scheme : scheme_catalogue()) {
-    text += "  " + scheme.name + ": " + scheme.method + ", " + scheme.equations + "; " +
+    text += "  " + scheme.name + " [family " + scheme.family + "]: " + scheme.method + ", " + scheme.equations + "; " +
             (scheme.symplectic ? "symplectic" : "not symplectic") + ", " +
             (scheme.time_reversible ? "time-reversible" : "not time-reversible") + "\n";
     text += "      " + scheme.summary + "\n";

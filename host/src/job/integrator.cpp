@@ -31,6 +31,12 @@ void set_option(IntegratorSpec& spec, const ParameterDescription& parameter, con
     spec.order = value.order;
   else if (parameter.name == "t2" && parameter.kind == ParameterDescription::Kind::Number)
     spec.t2 = value.number;
+  else if (parameter.name == "omega" && parameter.kind == ParameterDescription::Kind::Number)
+    spec.omega = value.number;
+  else if (parameter.name == "stages" && parameter.kind == ParameterDescription::Kind::Number)
+    spec.stages = value.number;
+  else if (parameter.name == "max_iterations" && parameter.kind == ParameterDescription::Kind::Number)
+    spec.max_iterations = value.number;
   else
     throw std::logic_error("the host does not know the integrator parameter '" + parameter.name + "'");
 }
@@ -116,6 +122,11 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
   keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
   check.known_keys(integrator, path, keys);
 
+  // Every option starts at the scheme's default, so that a refused value leaves a spec the scheme can build (a
+  // comparator refuses IntegratorSpec's own default order 2/3).
+  if (scheme)
+    for (const auto& parameter : parameters)
+      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option(parameter));
   for (const auto& parameter : parameters) {
     const std::string option_path = child(path, parameter.name);
     const json* given = check.member(integrator, path, parameter.name, parameter.default_text.empty(),

@@ -215,7 +215,17 @@ const KeyTable& study_keys() {
        .description = "The exact state at t_end: convergence.csv then has each run's phase-space error "
                       "|(q, p) - (q_ref, p_ref)|, and the fits its exponent.",
        .definition = "state"},
-  }};
+      {.name = "reference_run", .type = ValueType::defined,
+       .description = "Instead of reference: an integrator with exactly one step count (\"steps\": [N]) or size, "
+                      "run first from the initial state to t_end; its end state is the reference of the phase-space "
+                      "errors (summary.json study.reference says which).",
+       .definition = "study_integrator"},
+      {.name = "repeats", .type = ValueType::integer, .minimum = 1, .maximum = 1000, .default_value = 1,
+       .description = "How many times each run is repeated for its wall time: work_precision.csv gives the median "
+                      "over the repeats and their count (the errors and evaluation counts are those of the first: "
+                      "every repeat computes the same numbers)."},
+  },
+  {{"dependentSchemas", {{"reference_run", {{"not", {{"required", {"reference"}}}}}}}}}};
   return table;
 }
 

@@ -116,7 +116,8 @@ schema_json integrator_schema(const KeyTable* extra, const std::string& descript
     schema_json required = schema_json::array();
     for (const auto& parameter : scheme.parameters)
       if (parameter.default_text.empty()) required.push_back(parameter.name);
-    schema_json then = {{"description", scheme.method + ", " + scheme.equations + ". " + scheme.summary},
+    schema_json then = {{"description", "[family " + scheme.family + "] " + scheme.method + ", " + scheme.equations +
+                                            ". " + scheme.summary},
                         {"properties", std::move(properties)},
                         {"additionalProperties", false}};
     if (!required.empty()) then["required"] = std::move(required);

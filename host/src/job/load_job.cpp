@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "checker.hpp"
+#include "nonsep/core/integrator.hpp"
 
 namespace nonsep::host {
 
@@ -112,6 +113,29 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
                         "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
                         "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them "
                         "by automatic differentiation)"});
+  // Comparators integrate H from its gradient: Hessians and third derivatives of the plugin (ABI 3).
+  const bool has_gradient_of_h = loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives();
+  const auto check_comparator = [&](const IntegratorSpec& spec, const std::string& path) {
+    if (!Integrator(spec).is_comparator() || has_gradient_of_h) return;
+    issues.push_back({path, "\"" + spec.scheme + "\" with the plugin '" + loaded.plugin.name() + "', which has " +
+                                (loaded.plugin.has_hessians() ? "no third derivatives (d3T, d3V)"
+                                                              : "no Hessians (hessian_T, hessian_V)"),
+                      "a plugin with Hessians and third derivatives (the gradient of H needs both; the SDK provides "
+                      "them by automatic differentiation), or a Chin scheme (basic, triplet, mpe)"});
+  };
+  if (checked.is_study()) {
+    const auto& integrators = checked.study().integrators;
+    for (std::size_t i = 0; i < integrators.size(); ++i)
+      check_comparator(integrators[i].spec, "/study/integrators/" + std::to_string(i) + "/scheme");
+    if (const auto& reference = checked.study().reference_run)
+      check_comparator(reference->spec, "/study/reference_run/scheme");
+  } else {
+    check_comparator(checked.run().integrator, "/integrator/scheme");
+    if (checked.run().analysis.tangent_vectors() > 0 && Integrator(checked.run().integrator).is_comparator())
+      issues.push_back({checked.run().analysis.lyapunov ? "/analysis/lyapunov" : "/analysis/megno",
+                        "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme + "\"",
+                        "a Chin scheme (basic, triplet, mpe): the comparators have no tangent map"});
+  }
   if (issues.size() != before) return std::nullopt;
   return loaded;
 }

@@ -137,6 +137,32 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
     study.integrators.push_back(std::move(integrator));
   }
 
+  if (const json* run = check.member(study_value, path, "reference_run", false, "")) {
+    const std::string run_path = child(path, "reference_run");
+    if (study_value.contains("reference"))
+      check.issue(run_path, "a reference run together with " + child(path, "reference"),
+                  "either \"reference\" (the state at t_end) or \"reference_run\" (an integrator that computes it)");
+    else if (check.object(*run, run_path, "an integrator {\"scheme\": ..., options, \"steps\": [N]}")) {
+      StudyIntegrator reference;
+      reference.spec = read_integrator_object(check, *run, run_path, form, study_integrator_keys().names());
+      reference.label = "reference run";
+      std::string from;
+      if (auto steps = read_steps_or_dt(check, *run, run_path, t_end, true, from, "reference_run.")) {
+        if (steps->size() == 1) {
+          reference.steps = std::move(*steps);
+          reference.steps_from = from;
+          study.reference_run = std::move(reference);
+        } else {
+          check.issue(child(run_path, run->contains("steps") ? "steps" : "dt"),
+                      std::to_string(steps->size()) + " step counts", "exactly one step count (or size)");
+        }
+      }
+    }
+  }
+  if (const json* repeats = check.member(study_value, path, "repeats", false, ""))
+    if (const auto n = check.integer(*repeats, child(path, "repeats"), keys["repeats"].minimum,
+                                     keys["repeats"].maximum, "a whole number of repeats from 1 to 1000"))
+      study.repeats = static_cast<int>(*n);
   if (const json* reference = check.member(study_value, path, "reference", false, "")) {
     const std::string reference_path = child(path, "reference");
     if (check.object(*reference, reference_path, "the exact state at t_end {\"q\": [...], \"p\": [...]}")) {

@@ -215,6 +215,7 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
       next_energies.push_back(energies[slot]);
     }
     batch = std::move(next);
+    integrator.compact(retire);
     if (tangents) tangents->compact(retire);
     trajectories = std::move(next_trajectories);
     energies = std::move(next_energies);

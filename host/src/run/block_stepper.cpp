@@ -50,11 +50,14 @@ void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step
   const PhaseSpaceBatch before = block.batch;
   const std::optional<PhaseSpaceBatch> tangents_before =
       block.tangents ? std::optional<PhaseSpaceBatch>(block.tangents->vectors) : std::nullopt;
+  const Integrator integrator_before = block.integrator;  // Tao's copies, for a redo state by state
   const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
     if (block.tangents)
       block.tangents->step_part(worker.model, x, *tangents_before, first, setup.time.dt);
-    else
+    else if (x.count() == before.count())
       block.integrator.step(worker.model, x, setup.time.dt);
+    else
+      block.integrator.step_part(worker.model, x, integrator_before, first, before.count(), setup.time.dt);
   });
   if (block.tangents) block.tangents->after_step(setup.time.dt);
   std::vector<bool> retire(block.trajectories.size(), false);

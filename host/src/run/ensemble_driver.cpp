@@ -310,6 +310,11 @@ EvaluationCounts EnsembleDriver::evaluations() const {
   for (const Block& block : impl_->blocks) counts += block.evaluations();
   return counts;
 }
+double EnsembleDriver::max_copy_distance() const {
+  double distance = 0.0;
+  for (const Block& block : impl_->blocks) distance = std::max(distance, block.integrator.max_copy_distance());
+  return distance;
+}
 std::uint64_t EnsembleDriver::steps_completed() const { return impl_->completed; }
 std::size_t EnsembleDriver::active_count() const { return impl_->active_count(); }
 const std::string& EnsembleDriver::error() const { return impl_->error; }

@@ -30,7 +30,7 @@ struct ComparatorDescription {
 
   // The common part, as IntegratorDescription has it (t2 = 0, basic_steps_per_step = 1: neither applies).
   IntegratorDescription integrator_description() const {
-    return {scheme, Fraction(order), symplectic, time_reversible, 1, 0.0};
+    return {scheme, Fraction(order), symplectic, time_reversible, 1, 0.0, "comparator"};
   }
 };
 

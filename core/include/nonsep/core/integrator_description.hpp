@@ -26,11 +26,16 @@ struct SchemeDescription {
   std::string method;      // human name: "Chin basic 9-stage splitting"
   std::string equations;   // where in the paper: "eq. (expalg)"
   std::string summary;     // one paragraph
+  // "chin" (the paper's schemes) or "comparator" (Tao, Gauss-Legendre: need the gradient of H, i.e. the plugin's
+  // Hessians and third derivatives; no tangent map).
+  std::string family = "chin";
   bool symplectic = true;
   bool time_reversible = true;
   std::vector<ParameterDescription> parameters;
   // The orders the scheme has: 2j/3 for j = 1 .. highest_order_index (basic 1, triplet 13, mpe 16).
   int highest_order_index = 1;
+  // A comparator's orders (2, 4, 6) when they are not of the form 2j/3; empty for Chin's schemes.
+  std::vector<Fraction> comparator_orders;
   std::vector<Fraction> orders() const;
 };
 
@@ -41,6 +46,7 @@ struct IntegratorDescription {
   bool time_reversible = true;
   std::uint64_t basic_steps_per_step = 1;
   double t2 = 0.0;
+  std::string family = "chin";
 };
 
 // Orders of the paper's family are 2j/3, j = 1, 2, 3, ... (2/3, 4/3, 2, 8/3, 10/3, 4, ...).

@@ -4,29 +4,44 @@
 // what `nonsep --help` and `nonsep schema` print) and the factory that builds its stepper over a basic step.
 // Integrator (integrator.hpp) builds from it, TangentIntegrator (tangent_integrator.hpp) from an Integrator.
 // Adding a scheme is one entry in scheme_catalogue.cpp; a new stepper type also joins SchemeStepper, and gets a
-// tangent_map_of overload in tangent_integrator.hpp (without one the tangent integrator does not compile).
+// tangent_map_of overload in tangent_integrator.hpp or is listed there as having none (a comparator: refused).
+//
+// Two families (SchemeDescription::family): "chin", the paper's splittings of T(p) + V(q), and "comparator",
+// Tao's extended phase space (tao_extended_phase_space.hpp) and Gauss-Legendre collocation (gauss_legendre.hpp),
+// which integrate H itself from its gradient (hamiltonian_gradient.hpp): they need a model with Hessians and third
+// derivatives, and have no tangent map.
 #include <span>
 #include <string>
+#include <type_traits>
 #include <variant>
 
 #include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/gauss_legendre.hpp"
 #include "nonsep/core/integrator_description.hpp"
 #include "nonsep/core/multi_product_expansion.hpp"
+#include "nonsep/core/tao_extended_phase_space.hpp"
 #include "nonsep/core/triplet_composition.hpp"
 
 namespace nonsep {
 
 // Every stepper type a catalogue entry can build.
-using SchemeStepper =
-    std::variant<ChinBasicStep, TripletComposition<ChinBasicStep>, MultiProductExpansion<ChinBasicStep>>;
+using SchemeStepper = std::variant<ChinBasicStep, TripletComposition<ChinBasicStep>, MultiProductExpansion<ChinBasicStep>,
+                                   TaoExtendedPhaseSpace, GaussLegendre>;
+
+// The comparator stepper types: they need ModelWithThirdDerivatives and have no tangent map.
+template <class S>
+inline constexpr bool is_comparator_stepper =
+    std::is_same_v<S, TaoExtendedPhaseSpace> || std::is_same_v<S, GaussLegendre>;
+
+struct IntegratorSpec;  // integrator.hpp
 
 struct Scheme : SchemeDescription {
-  // Builds the stepper of order 2j/3 over `base`, j = order_index in [1, highest_order_index] (checked by the
-  // caller, Integrator, with chin_order_index).
-  SchemeStepper (*make)(ChinBasicStep base, int order_index) = nullptr;
+  // Builds the stepper the spec describes (its order, t2, omega, stages, ... and form). Throws InvalidArgument
+  // naming the option that the scheme refuses (an order it does not have, t2 = 0, omega <= 0, stages 4).
+  SchemeStepper (*make)(const IntegratorSpec& spec) = nullptr;
 };
 
-// Every scheme the core provides, in a fixed order (basic, triplet, mpe).
+// Every scheme the core provides, in a fixed order (basic, triplet, mpe, tao, implicit_midpoint, gauss).
 std::span<const Scheme> scheme_catalogue();
 // The catalogue entry named `name`, or nullptr.
 const Scheme* find_scheme(const std::string& name);

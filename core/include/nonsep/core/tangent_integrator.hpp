@@ -2,6 +2,8 @@
 // A runtime-chosen tangent stepper: the tangent map of the integrator an IntegratorSpec describes (the scheme of
 // a job file, built by its catalogue entry), for diagnostics that follow tangent vectors (lyapunov_exponents.hpp,
 // megno.hpp). The states are stepped bit for bit as Integrator(spec) steps them.
+#include <string>
+#include <type_traits>
 #include <variant>
 
 #include "nonsep/core/integrator.hpp"
@@ -23,7 +25,8 @@ inline TangentMultiProductExpansion tangent_map_of(const MultiProductExpansion<C
 
 class TangentIntegrator {
  public:
-  // Throws InvalidArgument as Integrator(spec) does (bad t2, unknown scheme, an order the scheme does not have).
+  // Throws InvalidArgument as Integrator(spec) does (bad t2, unknown scheme, an order the scheme does not have),
+  // and for a comparator scheme (tao, implicit_midpoint, gauss), which has no tangent map.
   explicit TangentIntegrator(const IntegratorSpec& spec) : spec_(spec), stepper_(make(spec)) {}
 
   const IntegratorSpec& spec() const { return spec_; }
@@ -45,8 +48,16 @@ class TangentIntegrator {
   using Stepper = std::variant<TangentBasicStep, TangentTripletComposition, TangentMultiProductExpansion>;
   // Built by the catalogue, through Integrator, and mapped to its tangent map.
   static Stepper make(const IntegratorSpec& spec) {
-    return std::visit([](const auto& stepper) -> Stepper { return tangent_map_of(stepper); },
-                      Integrator(spec).stepper());
+    return std::visit(
+        [&](const auto& stepper) -> Stepper {
+          if constexpr (is_comparator_stepper<std::decay_t<decltype(stepper)>>)
+            throw InvalidArgument("the comparator scheme '" + spec.scheme +
+                                  "' has no tangent map: Lyapunov exponents and MEGNO need a Chin scheme "
+                                  "(basic, triplet, mpe)");
+          else
+            return tangent_map_of(stepper);
+        },
+        Integrator(spec).stepper());
   }
 
   IntegratorSpec spec_;

@@ -87,6 +87,11 @@ struct Study {
   std::vector<StudyIntegrator> integrators;
   // /study/reference: the exact state at t_end, for the phase-space error; empty when not given.
   std::vector<double> reference_q, reference_p;
+  // /study/reference_run (instead of /study/reference): run first, with its one step count; its end state is the
+  // reference.
+  std::optional<StudyIntegrator> reference_run;
+  // /study/repeats: each run is repeated this many times for its wall time (work_precision.csv: the median).
+  int repeats = 1;
 };
 
 // /analysis/poincare: the crossings of every trajectory with the hyperplane normal . (q, p) = offset of phase space

@@ -48,6 +48,8 @@ struct StudyRun {
   std::uint64_t basic_steps = 0;
   EvaluationCounts evaluations;
   std::optional<double> relative_energy_error, phase_error;  // at t_end; completed runs only
+  double wall_seconds = 0.0;  // the median over the repeats (/study/repeats) of the driver's run
+  int repeats = 0;            // how many runs the median is over
 };
 
 // The fits of one integrator over its completed runs (summary.json "fits"). Values that cannot be fitted (fewer

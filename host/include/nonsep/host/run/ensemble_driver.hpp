@@ -106,6 +106,9 @@ class EnsembleDriver {
 
   const std::vector<TrajectoryRecord>& records() const;
   EvaluationCounts evaluations() const;
+  // Tao's scheme: the largest distance between a state and its extended copy over every block and step of this
+  // process (a resumed run restarts the copies from the states and counts from there); 0 for the other schemes.
+  double max_copy_distance() const;
   std::uint64_t steps_completed() const;
   std::size_t active_count() const;
   const std::string& error() const;  // why the run failed (DriverEnd::failed)

@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""Plots the work_precision.csv of a nonsep study (README, "Work-precision studies").
+
+Usage: /usr/bin/python3 scripts/plot_work_precision.py STUDY_DIR --out FILE.png [--title TEXT]
+           [--peers PEERS_CSV --problem NAME] [--error phase|energy] [--dpi N]
+
+Two panels: the error at t_end against the median wall time, and against the evaluations (grad_T + grad_V +
+grad_H per trajectory), log-log. Each curve is one integrator's Pareto front over its step counts: the smallest
+error reached at that cost or less. Failed or diverged runs are left out. With --peers, the rows of
+bench/peers' work_precision.csv for --problem (GSL rk2imp/rk4imp, Odeint dopri5/rk4; columns method, problem,
+wall_seconds_median, evaluations, energy_error, phase_error, status) join both panels as dashed fronts.
+Needs matplotlib (Debian's python3-matplotlib: /usr/bin/python3).
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def pareto_front(points):
+    """(cost, error) pairs sorted by cost, keeping only those that improve on every cheaper one."""
+    front, best = [], math.inf
+    for cost, error in sorted(points):
+        if error < best:
+            front.append((cost, error))
+            best = error
+    return front
+
+
+def number(text):
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        return None
+    return abs(value) if math.isfinite(value) and value != 0.0 else None
+
+
+def study_curves(path, error_column):
+    """{label: (family, [(wall, evaluations, error)])} from a study's work_precision.csv."""
+    curves = {}
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            if row["status"] != "completed":
+                continue
+            error = number(row[error_column])
+            if error is None:
+                continue
+            family = row["family"]
+            curves.setdefault(row["integrator"], (family, []))[1].append(
+                (float(row["wall_seconds"]), float(row["evaluations"]), error))
+    return curves
+
+
+def peer_curves(path, problem, error_column):
+    curves = {}
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            if row["problem"] != problem or row["status"] not in ("ok", "completed"):
+                continue
+            if not row["method"].startswith(("gsl", "odeint")):
+                continue
+            error = number(row[error_column])
+            if error is None:
+                continue
+            curves.setdefault(row["method"], ("peer", []))[1].append(
+                (float(row["wall_seconds_median"]), float(row["evaluations"]), error))
+    return curves
+
+
+STYLE = {"chin": "-", "comparator": "-.", "peer": "--"}
+MARKER = {"chin": "o", "comparator": "s", "peer": "^"}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("study_dir")
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--title", default="")
+    parser.add_argument("--peers")
+    parser.add_argument("--problem")
+    parser.add_argument("--error", choices=["phase", "energy"], default="phase")
+    parser.add_argument("--dpi", type=int, default=150)
+    args = parser.parse_args()
+    column = "phase_error" if args.error == "phase" else "relative_energy_error"
+    curves = study_curves(os.path.join(args.study_dir, "work_precision.csv"), column)
+    if args.peers:
+        if not args.problem:
+            sys.exit("plot_work_precision.py: --peers needs --problem (paper1d, tao_product, ...)")
+        peer_column = "phase_error" if args.error == "phase" else "energy_error"
+        curves.update(peer_curves(args.peers, args.problem, peer_column))
+    if not curves:
+        sys.exit("plot_work_precision.py: no completed run with a finite non-zero " + column)
+    figure, axes = plt.subplots(1, 2, figsize=(12, 5))
+    colors = plt.get_cmap("tab20").colors
+    for index_curve, (label, (family, points)) in enumerate(sorted(curves.items())):
+        for axis, index, name in ((axes[0], 0, "median wall seconds per run"), (axes[1], 1, "evaluations")):
+            front = pareto_front([(p[index], p[2]) for p in points])
+            axis.loglog([c for c, _ in front], [e for _, e in front], STYLE.get(family, ":"),
+                        marker=MARKER.get(family, "x"), markersize=3, label=label,
+                        color=colors[index_curve % len(colors)])
+            axis.set_xlabel(name)
+    ylabel = "phase-space error at t_end" if args.error == "phase" else "relative energy error at t_end"
+    for axis in axes:
+        axis.set_ylabel(ylabel)
+        axis.grid(True, which="major", alpha=0.3)
+    axes[1].legend(fontsize=7, ncol=2)
+    figure.suptitle(args.title + " (solid: Chin, dash-dot: comparators, dashed: peers)")
+    figure.tight_layout()
+    figure.savefig(args.out, dpi=args.dpi)
+    print("wrote " + args.out)
+
+
+if __name__ == "__main__":
+    main()
