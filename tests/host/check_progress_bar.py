@@ -78,7 +78,7 @@ def check(nonsep, job):
     with open(job, "w") as file:
         json.dump({"model": {"plugin": "paper1d"}, "integrator": {"scheme": "basic"},
                    "initial": {"q": [1.0], "p": [0.0]}, "time": {"dt": 1e-6, "steps": 1000000000},
-                   "output": {"every": 0}, "checkpoint": {"every_steps": 0, "every_seconds": 2}}, file)
+                   "output": {"every": 0, "energy_every": 100000}, "checkpoint": {"every_steps": 0, "every_seconds": 2}}, file)
     failures = []
 
     status, shown = run(nonsep, job, quiet=False, terminal=True, wait_for_bar=True)
@@ -89,7 +89,7 @@ def check(nonsep, job):
         failures.append("terminal: no progress bar drawn")
     else:
         bar = bars[0]
-        for part in ("%", "step ", "/1000000000", "t = ", "1 active", "s left"):
+        for part in ("%", "step ", "/1000000000", "t = ", "1 active", "max |dH/H0| ", "s left"):
             if part not in bar:
                 failures.append(f"terminal: the bar {bar[:120]!r} lacks {part!r}")
         if "\r\x1b[K" not in shown.split("\r[")[-1]:
