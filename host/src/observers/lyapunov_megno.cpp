@@ -1,9 +1,7 @@
 #include "nonsep/host/observers/lyapunov_megno.hpp"
 
-#include <charconv>
 
 #include "nonsep/host/checkpoint.hpp"
-#include "nonsep/host/output/content_hash.hpp"
 
 namespace nonsep::host {
 
@@ -48,24 +46,15 @@ void LyapunovMegnoObserver::on_event(const Event& event) {
 }
 
 nlohmann::json LyapunovMegnoObserver::save() {
-  file_->flush();
-  return {{"bytes", file_->flushed_size()}, {"content_hash", content_hash_hex(file_->flushed_hash())}};
+  return csv_checkpoint_state(*file_);
 }
 
 void LyapunovMegnoObserver::restore(const nlohmann::json& state) {
   const auto damaged = [](const std::string& what) {
     throw CheckpointError("its lyapunov_csv state is damaged (" + what + ")");
   };
-  if (!state.is_object() || !state.contains("bytes") || !state["bytes"].is_number_unsigned())
-    damaged("no byte count");
-  const nlohmann::json& hash = state.contains("content_hash") ? state["content_hash"] : nlohmann::json();
-  std::uint64_t prefix_hash = 0;
-  if (!hash.is_string() || hash.get_ref<const std::string&>().size() != 16 ||
-      std::from_chars(hash.get_ref<const std::string&>().data(), hash.get_ref<const std::string&>().data() + 16,
-                      prefix_hash, 16).ec != std::errc())
-    damaged("no content hash of lyapunov.csv");
-  file_.reset();
-  file_.emplace(path_, state["bytes"].get<std::uint64_t>(), prefix_hash);
+  if (!state.is_object()) damaged("not an object");
+  resume_csv(file_, path_, state, damaged);
 }
 
 void LyapunovMegnoObserver::columns(std::vector<std::string>& names) const {

@@ -1,13 +1,11 @@
 #include "nonsep/host/observers/poincare_section.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <numeric>
 #include <tuple>
 
 #include "nonsep/core/error.hpp"
 #include "nonsep/host/checkpoint.hpp"
-#include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 
 namespace nonsep::host {
@@ -137,32 +135,23 @@ std::uint64_t PoincareSectionObserver::total_crossings() const {
 }
 
 nlohmann::json PoincareSectionObserver::save() {
-  file_->flush();
-  return {{"bytes", file_->flushed_size()},
-          {"content_hash", content_hash_hex(file_->flushed_hash())},
-          {"crossings", counts_}};
+  nlohmann::json state = csv_checkpoint_state(*file_);
+  state["crossings"] = counts_;
+  return state;
 }
 
 void PoincareSectionObserver::restore(const nlohmann::json& state) {
   const auto damaged = [](const std::string& what) {
     throw CheckpointError("its poincare_csv state is damaged (" + what + ")");
   };
-  if (!state.is_object() || !state.contains("bytes") || !state["bytes"].is_number_unsigned())
-    damaged("no byte count");
+  if (!state.is_object()) damaged("not an object");
   const nlohmann::json& counts = state.contains("crossings") ? state["crossings"] : nlohmann::json();
   if (!counts.is_array() || counts.size() != counts_.size()) damaged("not one crossing count per trajectory");
   for (std::size_t i = 0; i < counts.size(); ++i) {
     if (!counts[i].is_number_unsigned()) damaged("a crossing count is not a count");
     counts_[i] = counts[i].get<std::uint64_t>();
   }
-  const nlohmann::json& hash = state.contains("content_hash") ? state["content_hash"] : nlohmann::json();
-  std::uint64_t prefix_hash = 0;
-  if (!hash.is_string() || hash.get_ref<const std::string&>().size() != 16 ||
-      std::from_chars(hash.get_ref<const std::string&>().data(), hash.get_ref<const std::string&>().data() + 16,
-                      prefix_hash, 16).ec != std::errc())
-    damaged("no content hash of poincare.csv");
-  file_.reset();
-  file_.emplace(path_, state["bytes"].get<std::uint64_t>(), prefix_hash);
+  resume_csv(file_, path_, state, damaged);
 }
 
 void PoincareSectionObserver::cells(std::size_t trajectory, std::string& row) const {

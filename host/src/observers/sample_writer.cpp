@@ -1,9 +1,7 @@
 #include "nonsep/host/observers/sample_writer.hpp"
 
-#include <charconv>
 
 #include "nonsep/host/checkpoint.hpp"
-#include "nonsep/host/output/content_hash.hpp"
 
 namespace nonsep::host {
 
@@ -67,20 +65,18 @@ void SampleWriter::after_chunk(std::uint64_t) {
 }
 
 nlohmann::json SampleWriter::save() {
-  file_->flush();
   nlohmann::json last = nlohmann::json::array();
   for (std::uint64_t step : last_written_) last.push_back(step == none ? nlohmann::json(nullptr) : nlohmann::json(step));
-  return {{"bytes", file_->flushed_size()},
-          {"content_hash", content_hash_hex(file_->flushed_hash())},
-          {"last_written_step", std::move(last)}};
+  nlohmann::json state = csv_checkpoint_state(*file_);
+  state["last_written_step"] = std::move(last);
+  return state;
 }
 
 void SampleWriter::restore(const nlohmann::json& state) {
   const auto damaged = [](const std::string& what) {
     throw CheckpointError("its trajectory_csv state is damaged (" + what + ")");
   };
-  if (!state.is_object() || !state.contains("bytes") || !state["bytes"].is_number_unsigned())
-    damaged("no byte count");
+  if (!state.is_object()) damaged("not an object");
   const nlohmann::json& last = state.contains("last_written_step") ? state["last_written_step"] : nlohmann::json();
   if (!last.is_array() || last.size() != last_written_.size()) damaged("not one last row per trajectory");
   for (std::size_t i = 0; i < last.size(); ++i) {
@@ -92,14 +88,7 @@ void SampleWriter::restore(const nlohmann::json& state) {
       damaged("a last row's step is not a step of the run");
     }
   }
-  const nlohmann::json& hash = state.contains("content_hash") ? state["content_hash"] : nlohmann::json();
-  std::uint64_t prefix_hash = 0;
-  if (!hash.is_string() || hash.get_ref<const std::string&>().size() != 16 ||
-      std::from_chars(hash.get_ref<const std::string&>().data(), hash.get_ref<const std::string&>().data() + 16,
-                      prefix_hash, 16).ec != std::errc())
-    damaged("no content hash of trajectory.csv");
-  file_.reset();
-  file_.emplace(path_, state["bytes"].get<std::uint64_t>(), prefix_hash);
+  resume_csv(file_, path_, state, damaged);
 }
 
 }  // namespace nonsep::host

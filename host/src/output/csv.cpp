@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 
 #include "nonsep/host/output/content_hash.hpp"
@@ -110,5 +111,29 @@ void CsvAppender::flush() {
   flushed_hash_ = content_hash(buffer_, flushed_hash_);
   buffer_.clear();
 }
+
+nlohmann::json csv_checkpoint_state(CsvAppender& file) {
+  file.flush();
+  return {{"bytes", file.flushed_size()}, {"content_hash", content_hash_hex(file.flushed_hash())}};
+}
+
+namespace detail {
+
+CsvResumePoint csv_resume_point(const nlohmann::json& state, const std::filesystem::path& path) {
+  CsvResumePoint point;
+  if (!state.is_object() || !state.contains("bytes") || !state["bytes"].is_number_unsigned()) {
+    point.problem = "no byte count";
+    return point;
+  }
+  point.bytes = state["bytes"].get<std::uint64_t>();
+  const nlohmann::json& hash = state.contains("content_hash") ? state["content_hash"] : nlohmann::json();
+  const std::string* digits = hash.is_string() ? &hash.get_ref<const std::string&>() : nullptr;
+  if (!digits || digits->size() != 16 ||
+      std::from_chars(digits->data(), digits->data() + 16, point.content_hash, 16).ec != std::errc())
+    point.problem = "no content hash of " + path.filename().string();
+  return point;
+}
+
+}  // namespace detail
 
 }  // namespace nonsep::host

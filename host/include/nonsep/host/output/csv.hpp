@@ -14,6 +14,8 @@
 #include <string>
 #include <string_view>
 
+#include <nlohmann/json.hpp>
+
 #include "nonsep/host/number_format.hpp"
 
 namespace nonsep::host {
@@ -59,5 +61,32 @@ class CsvAppender {
   std::uint64_t flushed_hash_;
   std::string buffer_;
 };
+
+// A streamed file's part of an observer's checkpoint state: after flushing `file`, {"bytes": its size, "content_hash":
+// 16 hexadecimal digits of those bytes} (content_hash.hpp).
+nlohmann::json csv_checkpoint_state(CsvAppender& file);
+// Reopens the file at `path` from such a state (CsvAppender's resuming constructor). A state without a valid
+// "bytes" and "content_hash" is reported through `damaged(what)`, which must throw.
+template <class Damaged>
+void resume_csv(std::optional<CsvAppender>& file, const std::filesystem::path& path, const nlohmann::json& state,
+                Damaged&& damaged);
+
+namespace detail {
+// The byte count and content hash of a state, or the reason it has none.
+struct CsvResumePoint {
+  std::uint64_t bytes = 0, content_hash = 0;
+  std::string problem;  // empty when the state is valid
+};
+CsvResumePoint csv_resume_point(const nlohmann::json& state, const std::filesystem::path& path);
+}  // namespace detail
+
+template <class Damaged>
+void resume_csv(std::optional<CsvAppender>& file, const std::filesystem::path& path, const nlohmann::json& state,
+                Damaged&& damaged) {
+  const detail::CsvResumePoint point = detail::csv_resume_point(state, path);
+  if (!point.problem.empty()) damaged(point.problem);
+  file.reset();
+  file.emplace(path, point.bytes, point.content_hash);
+}
 
 }  // namespace nonsep::host
