@@ -16,3 +16,27 @@ if(NOT DEFINED Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
   set(Python3_EXECUTABLE /usr/bin/python3 CACHE FILEPATH "Python interpreter with the Debian python3-* modules")
 endif()
 find_package(Python3 COMPONENTS Interpreter)
+
+# Ensembles beyond one machine (docs/cluster.md): MPI ranks (libopenmpi-dev) and HDF5 output (libhdf5-dev; under MPI
+# the parallel build libhdf5-openmpi-dev, so that the ranks write results.h5 through MPI-IO). Both on by default;
+# a build without them still runs everything else and says so in `nonsep --version`.
+option(NONSEP_WITH_MPI "Distribute `nonsep run` ensembles over MPI ranks (OpenMPI)" ON)
+option(NONSEP_WITH_HDF5 "output.format \"hdf5\": results.h5 (HDF5 C library)" ON)
+if(NONSEP_WITH_MPI OR NONSEP_WITH_HDF5)
+  enable_language(C)  # FindMPI and FindHDF5 probe the C libraries with the C compiler
+endif()
+if(NONSEP_WITH_MPI)
+  find_package(MPI 3.1 REQUIRED COMPONENTS C)         # libopenmpi-dev
+endif()
+if(NONSEP_WITH_HDF5)
+  set(HDF5_PREFER_PARALLEL ${NONSEP_WITH_MPI})
+  find_package(HDF5 1.10 REQUIRED COMPONENTS C)       # libhdf5-openmpi-dev (with MPI) or libhdf5-dev
+  if(NONSEP_WITH_MPI AND NOT HDF5_IS_PARALLEL)
+    message(FATAL_ERROR "NONSEP_WITH_MPI needs the parallel HDF5 build (Debian: libhdf5-openmpi-dev); found a "
+                        "serial one at ${HDF5_INCLUDE_DIRS}. Install it, or configure with -DNONSEP_WITH_HDF5=OFF.")
+  endif()
+  if(NOT NONSEP_WITH_MPI AND HDF5_IS_PARALLEL)
+    message(FATAL_ERROR "HDF5 at ${HDF5_INCLUDE_DIRS} is the parallel build but NONSEP_WITH_MPI is OFF; install "
+                        "the serial build (Debian: libhdf5-dev) or turn MPI on.")
+  endif()
+endif()

@@ -9,6 +9,7 @@ packages=(
   ca-certificates cmake g++ make pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev doctest-dev libcli11-dev
   python3 python3-jsonschema python3-matplotlib python3-numpy python3-h5py
+  libopenmpi-dev openmpi-bin libhdf5-openmpi-dev hdf5-tools  # MPI ranks, parallel HDF5 output (docs/cluster.md)
   clang libclang-rt-14-dev valgrind  # CI: fuzzing (tests/fuzz) and memcheck (tests/ci)
   libgsl-dev  # benchmark-only (GPL): the peer integrators of bench/peers; nothing in the product links it
 )

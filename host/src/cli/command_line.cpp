@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.hpp"
+#include "nonsep/host/build_features.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/installation.hpp"
 
@@ -25,7 +26,7 @@ int run_command_line(int argc, char** argv) {
                  "(S. A. Chin). Models are plugins; runs are described by JSON job files. The manual (section\n"
                  "Running nonsep): " + manual_location(),
                  "nonsep"};
-    app.set_version_flag("--version", "nonsep " NONSEP_VERSION);
+    app.set_version_flag("--version", [] { return build_features_text(); });
     app.require_subcommand(1);
     app.footer(schemes_text() + "\n" + exit_status_text() +
                "\nPlugins are searched in $NONSEP_PLUGIN_PATH (':'-separated), then the installed and the build "
