@@ -9,9 +9,13 @@
 #include <cstdio>
 #include <vector>
 #include <filesystem>
+#include <memory>
+#include <streambuf>
 #include <optional>
 
 #include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/cluster/distributed_run.hpp"
+#include "nonsep/host/cluster/ranks.hpp"
 #include "nonsep/host/output/files.hpp"
 #include "nonsep/host/progress_bar.hpp"
 #include "nonsep/host/run/run_job.hpp"
@@ -31,7 +35,7 @@ extern "C" void request_stop(int signal) {
   stop_requested.store(true);
 }
 
-// Catches the first SIGINT or SIGTERM (the run finishes its step, flushes trajectory.csv and writes its checkpoint
+// Catches the first SIGINT, SIGTERM or SIGUSR1 (the run finishes its step, flushes trajectory.csv and writes its checkpoint
 // and summary); SA_RESETHAND restores the default action, so a second signal of the same kind ends the process at
 // once. No SA_RESTART: a plugin sleeping or waiting in a system call sees EINTR and returns sooner.
 class InterruptGuard {
@@ -43,16 +47,43 @@ class InterruptGuard {
     action.sa_flags = SA_RESETHAND;
     sigaction(SIGINT, &action, &previous_interrupt_);
     sigaction(SIGTERM, &action, &previous_terminate_);
+    // mpirun passes SIGUSR1 on to every rank (SIGTERM and SIGINT it does not), and Slurm's --signal=USR1@SECONDS
+    // warns a job with it before its time is up: it stops a run as SIGTERM does (docs/cluster.md).
+    sigaction(SIGUSR1, &action, &previous_user1_);
   }
   ~InterruptGuard() {
     sigaction(SIGINT, &previous_interrupt_, nullptr);
     sigaction(SIGTERM, &previous_terminate_, nullptr);
+    sigaction(SIGUSR1, &previous_user1_, nullptr);
   }
   InterruptGuard(const InterruptGuard&) = delete;
   InterruptGuard& operator=(const InterruptGuard&) = delete;
 
  private:
-  struct sigaction previous_interrupt_ = {}, previous_terminate_ = {};
+  struct sigaction previous_interrupt_ = {}, previous_terminate_ = {}, previous_user1_ = {};
+};
+
+// Under MPI only rank 0 prints: the others' std::cout and std::cerr go nowhere while the run command lasts.
+class OnlyRankZeroSpeaks {
+ public:
+  explicit OnlyRankZeroSpeaks(const Ranks& ranks) {
+    if (ranks.rank() == 0) return;
+    out_ = std::cout.rdbuf(&nowhere_);
+    err_ = std::cerr.rdbuf(&nowhere_);
+  }
+  ~OnlyRankZeroSpeaks() {
+    if (out_) std::cout.rdbuf(out_);
+    if (err_) std::cerr.rdbuf(err_);
+  }
+  OnlyRankZeroSpeaks(const OnlyRankZeroSpeaks&) = delete;
+  OnlyRankZeroSpeaks& operator=(const OnlyRankZeroSpeaks&) = delete;
+
+ private:
+  struct Nowhere : std::streambuf {
+    int overflow(int c) override { return c; }
+  } nowhere_;
+  std::streambuf* out_ = nullptr;
+  std::streambuf* err_ = nullptr;
 };
 
 // Below this |relative energy error| a study's errors are at the round-off of double precision (about 500 units
@@ -174,13 +205,13 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
 
 // Runs `run` (run_job or run_study) with SIGINT and SIGTERM caught. Nothing, after saying why on stderr, when it
 // could not start (the output folder, a checkpoint to resume from); an interrupted outcome becomes "terminated"
-// after SIGTERM.
+// after SIGTERM or SIGUSR1.
 template <class Run>
 auto run_guarded(Run run) -> std::optional<decltype(run())> {
   InterruptGuard guard;
   try {
     auto outcome = run();
-    if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() == SIGTERM)
+    if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() != SIGINT)
       outcome.exit_status = ExitStatus::terminated;
     return outcome;
   } catch (const OutputError& error) {
@@ -193,9 +224,14 @@ auto run_guarded(Run run) -> std::optional<decltype(run())> {
   return std::nullopt;
 }
 
+const char* signal_name(int signal) {
+  return signal == SIGTERM ? "SIGTERM" : signal == SIGUSR1 ? "SIGUSR1" : "SIGINT";
+}
+
 int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& arguments,
                const std::filesystem::path& directory, int signal) {
-  const std::size_t trajectories = outcome.trajectories.size();
+  const StatusCounts& c = outcome.counts;
+  const std::size_t trajectories = c.completed + c.diverged + c.failed + c.inaccurate + c.interrupted;
   std::string line = std::string(to_string(outcome.status)) + ": " + std::to_string(trajectories) +
                      (trajectories == 1 ? " trajectory (" : " trajectories (") + counts_text(outcome.counts) + "), " +
                      time_text(job.run().time);
@@ -208,25 +244,47 @@ int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& ar
   } else {
     std::cerr << "nonsep: " << line << "\n";
     if (!outcome.error.empty()) std::cerr << "nonsep: " << outcome.error << "\n";
-    if (outcome.status == TrajectoryStatus::interrupted)
-      std::cerr << "nonsep: stopped by " << (signal == SIGTERM ? "SIGTERM" : "SIGINT") << " after step "
+    if (outcome.status == TrajectoryStatus::interrupted && outcome.distributed)
+      std::cerr << "nonsep: stopped by " << signal_name(signal) << "; `nonsep run "
+                << arguments.job_file << (arguments.output.empty() ? "" : " --output " + arguments.output)
+                << " --resume` continues the work units, with any number of MPI ranks\n";
+    else if (outcome.status == TrajectoryStatus::interrupted)
+      std::cerr << "nonsep: stopped by " << signal_name(signal) << " after step "
                 << outcome.steps_completed << "; `nonsep run " << arguments.job_file
                 << (arguments.output.empty() ? "" : " --output " + arguments.output)
                 << " --resume` continues from there\n";
   }
   for (const std::string& note : outcome.notes) std::cerr << "nonsep: note: " << note << "\n";
   report_trajectories(outcome, directory);
+  if (const std::size_t stopped = c.diverged + c.failed + c.inaccurate; outcome.distributed && stopped > 0)
+    std::cerr << "nonsep: " << stopped << " trajectories stopped early; " << (directory / "trajectories.csv").string()
+              << " says where and why\n";
   return to_int(outcome.exit_status);
 }
 
 }  // namespace
 
 int command_run(const RunArguments& arguments) {
+  std::unique_ptr<Ranks> ranks;
+  try {
+    ranks = Ranks::join();
+  } catch (const std::exception& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+    return to_int(ExitStatus::invalid_input);
+  }
+  const OnlyRankZeroSpeaks quiet(*ranks);
   std::optional<LoadedJob> loaded;
+  std::string invalid;
   try {
     loaded.emplace(load_job(arguments.job_file));
   } catch (const InvalidJob& error) {
-    return report_invalid_job(error);
+    invalid = error.what();
+  }
+  // A job or plugin that one rank cannot read (a node without the plugin): one message, exit 2 on every rank.
+  if (const auto failure = ranks->first_failure(!invalid.empty(), invalid); failure.rank >= 0) {
+    std::cerr << "nonsep: " << (failure.rank > 0 ? "rank " + std::to_string(failure.rank) + ": " : "")
+              << failure.message << "\n";
+    return to_int(ExitStatus::invalid_input);
   }
   if (arguments.resume && loaded->job.is_study()) {
     std::cerr << "nonsep: cannot resume: " << arguments.job_file
@@ -236,21 +294,42 @@ int command_run(const RunArguments& arguments) {
   RunOptions options;
   options.output_directory =
       arguments.output.empty() ? loaded->job.output_directory : std::filesystem::path(arguments.output);
-  options.show_progress = !arguments.quiet && stderr_is_terminal();
+  options.show_progress = !arguments.quiet && stderr_is_terminal() && ranks->size() == 1;
   options.stop_requested = &stop_requested;
   options.resume = arguments.resume;
   options.force = arguments.force;
   options.threads = arguments.threads;
   stop_requested.store(false);
   stop_signal.store(0);
-  if (loaded->job.is_study()) {
-    auto outcome = run_guarded([&] { return run_study(*loaded, options); });
-    return outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
-                   : to_int(ExitStatus::invalid_input);
+  // Work units over the ranks: a fresh run on several ranks, or the resume of such a run on any number.
+  const bool plain_checkpoint = arguments.resume && !has_units(options.output_directory);
+  if (!loaded->job.is_study() && (arguments.resume ? !plain_checkpoint : ranks->size() > 1)) {
+    try {
+      auto outcome = run_guarded([&] { return run_distributed(*loaded, options, *ranks); });
+      return outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
+                     : to_int(ExitStatus::invalid_input);
+    } catch (const RankFailure& failure) {
+      std::cerr << "nonsep: " << failure.what() << "\n";
+      return to_int(ExitStatus::invalid_input);
+    }
   }
-  auto outcome = run_guarded([&] { return run_job(*loaded, options); });
-  return outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
-                 : to_int(ExitStatus::invalid_input);
+  // A study, or the resume of a one-process run: rank 0 does it, the others wait for its exit status.
+  int status = 0;
+  if (ranks->rank() == 0) {
+    if (ranks->size() > 1)
+      std::cerr << "nonsep: note: " << (loaded->job.is_study() ? "a convergence study" : "a one-process run's checkpoint")
+                << " runs on rank 0 alone; the other " << ranks->size() - 1 << " rank(s) wait\n";
+    if (loaded->job.is_study()) {
+      auto outcome = run_guarded([&] { return run_study(*loaded, options); });
+      status = outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
+                       : to_int(ExitStatus::invalid_input);
+    } else {
+      auto outcome = run_guarded([&] { return run_job(*loaded, options); });
+      status = outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
+                       : to_int(ExitStatus::invalid_input);
+    }
+  }
+  return ranks->max(status);
 }
 
 }  // namespace nonsep::host::cli

@@ -18,7 +18,7 @@ std::string exit_status_text() {
          "       an output folder that cannot be created\n"
          "  130  interrupted (SIGINT): the current step was finished, outputs written with status \"interrupted\",\n"
          "       and a checkpoint: `nonsep run JOB --resume` continues the run\n"
-         "  143  terminated (SIGTERM): the same as 130\n";
+         "  143  terminated (SIGTERM, or SIGUSR1 as mpirun passes it on): the same as 130\n";
 }
 
 // Generated from nonsep::scheme_catalogue(), like the job reader's checks.

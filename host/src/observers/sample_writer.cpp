@@ -1,5 +1,7 @@
 #include "nonsep/host/observers/sample_writer.hpp"
 
+#include <algorithm>
+#include <tuple>
 
 #include "nonsep/host/checkpoint.hpp"
 
@@ -24,7 +26,8 @@ void SampleWriter::write_row(std::size_t trajectory, std::uint64_t step, std::sp
                              std::span<const double> p, std::optional<double> energy,
                              std::optional<double> energy_initial) {
   if (last_written_[trajectory] == step) return;
-  std::string& row = file_->row();
+  PendingRow& pending = pending_.emplace_back(PendingRow{step, trajectory, {}});
+  std::string& row = pending.text;
   row += std::to_string(trajectory);
   row += ',';
   row += std::to_string(step);
@@ -42,8 +45,19 @@ void SampleWriter::write_row(std::size_t trajectory, std::uint64_t step, std::sp
   append_csv_number(row, energy);
   row += ',';
   append_csv_number(row, relative_energy_error(energy, energy_initial));
-  file_->end_row();
   last_written_[trajectory] = step;
+}
+
+void SampleWriter::write_pending(std::uint64_t before) {
+  std::stable_sort(pending_.begin(), pending_.end(), [](const PendingRow& a, const PendingRow& b) {
+    return std::tie(a.step, a.trajectory) < std::tie(b.step, b.trajectory);
+  });
+  std::size_t written = 0;
+  for (; written < pending_.size() && pending_[written].step < before; ++written) {
+    file_->row() += pending_[written].text;
+    file_->end_row();
+  }
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(written));
 }
 
 void SampleWriter::on_event(const Event& event) {
@@ -57,14 +71,21 @@ void SampleWriter::on_retire(std::size_t trajectory, const TrajectoryRecord& rec
             record.energy_initial);
 }
 
-void SampleWriter::after_chunk(std::uint64_t) {
+void SampleWriter::after_chunk(std::uint64_t step) {
+  write_pending(step);  // rows at `step` itself wait: a trajectory stopping there at the end may still add one
   const auto now = std::chrono::steady_clock::now();
   if (now < next_flush_) return;
   file_->flush();
   next_flush_ = now + std::chrono::seconds(1);
 }
 
+void SampleWriter::on_end() {
+  write_pending(none);
+  file_->flush();
+}
+
 nlohmann::json SampleWriter::save() {
+  write_pending(none);
   nlohmann::json last = nlohmann::json::array();
   for (std::uint64_t step : last_written_) last.push_back(step == none ? nlohmann::json(nullptr) : nlohmann::json(step));
   nlohmann::json state = csv_checkpoint_state(*file_);

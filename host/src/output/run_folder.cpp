@@ -128,6 +128,11 @@ RunFolder::RunFolder(const std::filesystem::path& directory, const std::string& 
       throw FolderInUse("the output folder " + directory.string() +
                         " holds the checkpoint of an interrupted run (checkpoint.json): `--resume` continues it, "
                         "`--force` discards it and starts over");
+    if (std::filesystem::exists(std::filesystem::symlink_status(directory / units_folder)))
+      throw FolderInUse("the output folder " + directory.string() +
+                        " holds the work units of an interrupted distributed run (" + units_folder +
+                        "/): `--resume` continues it, with any number of MPI ranks; `--force` discards it and "
+                        "starts over");
     bool results = false;
     for (const auto& name : output_files())
       results |= std::filesystem::exists(std::filesystem::symlink_status(directory / name));
@@ -143,6 +148,8 @@ RunFolder::RunFolder(const std::filesystem::path& directory, const std::string& 
                         "); `--force` replaces them, or give this run another folder (--output)");
   }
   for (const auto& name : output_files()) std::filesystem::remove(directory / name, error);
+  std::filesystem::remove_all(directory / units_folder, error);
+  if (error) throw OutputError("cannot remove " + (directory / units_folder).string() + ": " + error.message());
   check_outputs_placeable(directory);
   // Also proves, before anything is computed, that the folder takes files and renames.
   write_file_atomically(directory / manifest_name, nlohmann::json{{"kind", kind}, {"job", job}}.dump(2) + "\n");

@@ -1,5 +1,6 @@
 #include "nonsep/host/run/run_job.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 
@@ -150,8 +151,11 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   const DriverEnd end = driver.run();
   RunOutcome outcome;
   outcome.error = driver.error();
-  outcome.steps_completed = driver.steps_completed();
   outcome.trajectories = driver.records();
+  // Not driver.steps_completed(), which can be the end of a chunk past the step where the last trajectory stopped
+  // and so depends on how the ensemble is cut into blocks (and on MPI work units).
+  for (const TrajectoryRecord& record : outcome.trajectories)
+    outcome.steps_completed = std::max(outcome.steps_completed, record.final_step);
   for (const TrajectoryRecord& record : outcome.trajectories) ++outcome.counts[record.status];
   outcome.status = run_status(end, outcome.counts);
   outcome.exit_status = exit_status_of(outcome.status);

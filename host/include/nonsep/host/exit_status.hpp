@@ -10,7 +10,8 @@ enum class ExitStatus : int {
                       // could not be written; `inspect --check` found wrong derivatives
   invalid_input = 2,  // nothing was run: bad usage, an invalid job file or parameters, a plugin that cannot load
   interrupted = 130,  // SIGINT: the current step was finished and the outputs written with status "interrupted"
-  terminated = 143,   // SIGTERM: the same as SIGINT (128 + the signal number, as a shell reports it)
+  terminated = 143,   // SIGTERM (or SIGUSR1, which mpirun passes on): the same as SIGINT (128 + 15, as a shell
+                      // reports SIGTERM)
 };
 
 constexpr int to_int(ExitStatus status) { return static_cast<int>(status); }

@@ -1,9 +1,14 @@
 #pragma once
 // trajectory.csv: the samples of every trajectory, streamed as the run goes. Header
 //   trajectory,step,t,q0,...,q<n-1>,p0,...,p<n-1>,H,relative_energy_error
-// One row per active trajectory at step 0, every `every`-th step and the last step (trajectory order within a
-// step), and one for each trajectory's final state where it stopped, unless that row is already there. H and
-// relative_energy_error are empty where H was not evaluated or H0 = 0. Flushed at least once a second.
+// One row per active trajectory at step 0, every `every`-th step and the last step, and one for each trajectory's
+// final state where it stopped, unless that row is already there; so (step, trajectory) names a row, and the rows
+// are in (step, trajectory) order (a chunk's rows wait in memory and are sorted before they are written). That
+// order does not depend on how the ensemble is cut into blocks, chunks, threads or MPI ranks, which is what lets
+// the files of ranks be merged into this one (cluster/merge_outputs.cpp). H and relative_energy_error are empty
+// where H was not evaluated or H0 = 0. Flushed at least once a second. (An interrupted run may end with rows at
+// its last step out of trajectory order: the rows of trajectories that stopped at that step are written by its
+// checkpoint before the interrupted ones; a resume cuts them off.)
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -31,7 +36,7 @@ class SampleWriter : public Observer {
   void on_event(const Event& event) override;
   void on_retire(std::size_t trajectory, const TrajectoryRecord& record) override;
   void after_chunk(std::uint64_t step) override;
-  void on_end() override { file_->flush(); }
+  void on_end() override;
 
   std::string name() const override { return "trajectory_csv"; }
   // Flushes; the state is the file's size and the step of each trajectory's last row.
@@ -43,12 +48,21 @@ class SampleWriter : public Observer {
   void write_row(std::size_t trajectory, std::uint64_t step, std::span<const double> q, std::span<const double> p,
                  std::optional<double> energy, std::optional<double> energy_initial);
 
+  // Writes the rows waiting in pending_ whose step is before `before`, in (step, trajectory) order.
+  void write_pending(std::uint64_t before);
+
+  struct PendingRow {
+    std::uint64_t step;
+    std::size_t trajectory;
+    std::string text;  // without its '\n'
+  };
   static constexpr std::uint64_t none = static_cast<std::uint64_t>(-1);
   std::filesystem::path path_;
   std::size_t dimension_;
   std::uint64_t every_, steps_;  // steps_: the last step, always sampled
   const TimeGrid& time_;
   std::optional<CsvAppender> file_;
+  std::vector<PendingRow> pending_;
   std::vector<std::uint64_t> last_written_;  // per trajectory, `none` before its first row
   std::chrono::steady_clock::time_point next_flush_;
 };

@@ -10,6 +10,7 @@
 // Earlier results. A new run refuses a folder that holds
 //   - a checkpoint (checkpoint.json): an interrupted run, which `--resume` continues and `--force` discards;
 //   - results of another job or kind, or nonsep results of unknown origin: unless `--force`.
+//   - the work units of an interrupted distributed run (`units/`, cluster/distributed_run.hpp): likewise.
 // Results of the same job (the same job file, the same kind) are the run's to replace. Starting (fresh or forced),
 // the run removes every file an earlier run left (the names in `output_files`), so a failed or killed run never
 // leaves the earlier run's summary beside its own partial files. Temporary files of dead runs (".*.tmp-*") are
@@ -26,6 +27,9 @@
 #include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
+
+// The folder of a distributed run's work units (cluster/distributed_run.hpp), removed by a fresh or forced start.
+inline constexpr const char* units_folder = "units";
 
 // What the folder is opened for.
 enum class FolderUse {

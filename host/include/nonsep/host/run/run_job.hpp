@@ -52,12 +52,14 @@ struct RunOutcome {
   // the first that applies.
   TrajectoryStatus status = TrajectoryStatus::completed;
   std::string error;  // why the run as a whole failed (an output could not be written, ...); "" otherwise
-  std::uint64_t steps_completed = 0;
+  std::uint64_t steps_completed = 0;  // the last step any trajectory reached
   StatusCounts counts;
   std::vector<TrajectoryRecord> trajectories;  // one per trajectory, in job order
   std::optional<LargestEnergyError> largest_energy_error;  // over the steps where H was evaluated
   nlohmann::ordered_json summary;  // what summary.json holds
   std::vector<std::string> notes;  // for the user, not errors (e.g. "ran on one thread: ...")
+  // Spread over work units (cluster/distributed_run.hpp): `trajectories` is empty (trajectories.csv has them).
+  bool distributed = false;
 };
 
 // The output folder as `options` ask to use it (output/run_folder.hpp).

@@ -1,0 +1,291 @@
+#include "nonsep/host/cluster/distributed_run.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/cluster/merge_outputs.hpp"
+#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/run_folder.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+
+namespace nonsep::host {
+
+namespace {
+
+using json = nlohmann::ordered_json;
+constexpr const char* plan_name = "plan.json";
+constexpr int plan_format = 1;
+constexpr std::size_t target_units = 64;  // enough to balance a few dozen ranks; each unit costs a folder and a merge
+
+std::filesystem::path unit_folder(const std::filesystem::path& directory, std::size_t unit) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06zu", unit);
+  return directory / units_folder / name;
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+struct Plan {
+  std::size_t trajectories = 0, unit_size = 0, units = 0;
+
+  std::size_t first(std::size_t unit) const { return unit * unit_size; }
+  std::size_t size(std::size_t unit) const { return std::min(unit_size, trajectories - first(unit)); }
+};
+
+json plan_json(const Plan& plan, const std::string& fingerprint) {
+  return {{"format", plan_format},
+          {"trajectories", plan.trajectories},
+          {"unit_size", plan.unit_size},
+          {"units", plan.units},
+          {"job_fingerprint", fingerprint}};
+}
+
+// Rank 0: takes the output folder and writes (fresh) or checks (resume) units/plan.json. Throws what RunFolder and
+// the checkpoint checks throw.
+Plan prepare_folder(const LoadedJob& loaded, const RunOptions& options, std::optional<RunFolder>& folder) {
+  const std::filesystem::path& directory = options.output_directory;
+  folder.emplace(directory, "run", loaded.job.file, folder_use(options));
+  const std::string fingerprint = job_fingerprint(loaded);
+  Plan plan;
+  plan.trajectories = loaded.job.initial.count;
+  plan.unit_size = unit_size(plan.trajectories);
+  plan.units = (plan.trajectories + plan.unit_size - 1) / plan.unit_size;
+  const auto path = directory / units_folder / plan_name;
+  if (options.resume) {
+    json saved;
+    try {
+      saved = json::parse(read_text(path));
+    } catch (const json::exception&) {
+      throw CheckpointError(path.string() + " is missing or damaged: there is no distributed run to resume here");
+    }
+    if (saved != plan_json(plan, fingerprint))
+      throw CheckpointError(path.string() + " was written by another job, or by this job before it was changed; "
+                            "run it again without --resume (--force discards the units)");
+    return plan;
+  }
+  std::error_code error;
+  std::filesystem::create_directories(directory / units_folder, error);
+  if (error) throw OutputError("cannot create " + (directory / units_folder).string() + ": " + error.message());
+  write_file_atomically(path, plan_json(plan, fingerprint).dump(2) + "\n");
+  return plan;
+}
+
+enum class UnitState { fresh, checkpointed, done };
+
+UnitState unit_state(const std::filesystem::path& folder) {
+  std::error_code error;
+  if (std::filesystem::exists(folder / checkpoint_file_name, error)) return UnitState::checkpointed;
+  if (!std::filesystem::exists(folder / "summary.json", error)) return UnitState::fresh;
+  try {
+    return json::parse(read_text(folder / "summary.json")).at("status") == "interrupted" ? UnitState::fresh
+                                                                                      : UnitState::done;
+  } catch (const json::exception&) {
+    return UnitState::fresh;  // a unit killed while writing it: run again
+  }
+}
+
+// The job restricted to `size` trajectories from `first`.
+LoadedJob unit_job(const LoadedJob& loaded, std::size_t first, std::size_t size) {
+  LoadedJob unit = loaded;
+  InitialStates& initial = unit.job.initial;
+  const std::size_t n = initial.dimension;
+  initial.q.assign(loaded.job.initial.q.begin() + static_cast<std::ptrdiff_t>(first * n),
+                   loaded.job.initial.q.begin() + static_cast<std::ptrdiff_t>((first + size) * n));
+  initial.p.assign(loaded.job.initial.p.begin() + static_cast<std::ptrdiff_t>(first * n),
+                   loaded.job.initial.p.begin() + static_cast<std::ptrdiff_t>((first + size) * n));
+  initial.count = size;
+  return unit;
+}
+
+std::string failure_text(const std::exception& error) {
+  if (dynamic_cast<const CheckpointError*>(&error)) return std::string("cannot resume: ") + error.what();
+  return error.what();
+}
+
+TrajectoryStatus status_named(const std::string& name) {
+  for (TrajectoryStatus status : {TrajectoryStatus::completed, TrajectoryStatus::diverged, TrajectoryStatus::failed,
+                                  TrajectoryStatus::inaccurate, TrajectoryStatus::interrupted})
+    if (name == to_string(status)) return status;
+  return TrajectoryStatus::failed;
+}
+
+ExitStatus exit_status_for(TrajectoryStatus status) {
+  if (status == TrajectoryStatus::completed) return ExitStatus::success;
+  if (status == TrajectoryStatus::interrupted) return ExitStatus::interrupted;
+  return ExitStatus::run_failed;
+}
+
+// Rank 0, every unit done: the run's files from the units'.
+RunOutcome merge_units(const RunOptions& options, const Plan& plan, double wall_seconds) {
+  const std::filesystem::path& directory = options.output_directory;
+  std::vector<UnitFile> parts;
+  std::vector<json> summaries;
+  std::vector<std::size_t> firsts;
+  for (std::size_t u = 0; u < plan.units; ++u) {
+    parts.push_back({unit_folder(directory, u), plan.first(u)});
+    firsts.push_back(plan.first(u));
+    try {
+      summaries.push_back(json::parse(read_text(parts.back().path / "summary.json")));
+    } catch (const json::exception& error) {
+      throw OutputError((parts.back().path / "summary.json").string() + " cannot be read: " + error.what());
+    }
+  }
+  const auto merge = [&](const char* name, std::vector<std::string> keys) {
+    if (!std::filesystem::exists(parts.front().path / name)) return;
+    std::vector<UnitFile> files = parts;
+    for (UnitFile& file : files) file.path /= name;
+    merge_csv(files, directory / name, keys);
+  };
+  merge("trajectory.csv", {"step", "trajectory"});
+  merge("poincare.csv", {"step", "trajectory"});
+  merge("lyapunov.csv", {"step", "trajectory"});
+  merge("trajectories.csv", {"trajectory"});
+  RunOutcome outcome;
+  outcome.distributed = true;
+  outcome.summary = merge_summaries(summaries, firsts, plan.trajectories, directory, wall_seconds);
+  write_file_atomically(directory / "summary.json", outcome.summary.dump(2) + "\n");
+  const json& summary = outcome.summary;
+  outcome.status = status_named(summary["status"].get<std::string>());
+  outcome.exit_status = exit_status_for(outcome.status);
+  outcome.error = summary.value("error", "");
+  outcome.steps_completed = summary["time"]["steps_completed"].get<std::uint64_t>();
+  for (TrajectoryStatus status : {TrajectoryStatus::completed, TrajectoryStatus::diverged, TrajectoryStatus::failed,
+                                  TrajectoryStatus::inaccurate, TrajectoryStatus::interrupted})
+    outcome.counts[status] = summary["counts"][to_string(status)].get<std::size_t>();
+  if (const json& largest = summary["energy"]["largest_relative_error"]; largest.is_object())
+    outcome.largest_energy_error =
+        LargestEnergyError{largest["value"].get<double>(), largest["trajectory"].get<std::size_t>()};
+  std::error_code ignored;
+  std::filesystem::remove_all(directory / units_folder, ignored);
+  std::filesystem::remove(directory / checkpoint_file_name, ignored);
+  return outcome;
+}
+
+// Rank 0, after an interrupt: summary.json says what is done; units/ is the checkpoint.
+RunOutcome interrupted_outcome(const LoadedJob& loaded, const RunOptions& options, const Plan& plan,
+                               const Ranks& ranks) {
+  std::size_t done = 0, checkpointed = 0;
+  for (std::size_t u = 0; u < plan.units; ++u) {
+    const UnitState state = unit_state(unit_folder(options.output_directory, u));
+    done += state == UnitState::done;
+    checkpointed += state == UnitState::checkpointed;
+  }
+  RunOutcome outcome;
+  outcome.distributed = true;
+  outcome.status = TrajectoryStatus::interrupted;
+  outcome.exit_status = ExitStatus::interrupted;
+  outcome.counts.interrupted = plan.trajectories;
+  outcome.notes.push_back(std::to_string(done) + " of " + std::to_string(plan.units) + " work units done, " +
+                          std::to_string(checkpointed) + " checkpointed, in " +
+                          (options.output_directory / units_folder).string());
+  outcome.summary = {{"status", "interrupted"},
+                     {"job", loaded.job.file.string()},
+                     {"trajectories", plan.trajectories},
+                     {"distributed", {{"ranks", ranks.size()},
+                                      {"units", plan.units},
+                                      {"unit_size", plan.unit_size},
+                                      {"units_done", done},
+                                      {"units_checkpointed", checkpointed},
+                                      {"folder", units_folder},
+                                      {"resume", "nonsep run JOB --resume, with any number of ranks"}}}};
+  write_file_atomically(options.output_directory / "summary.json", outcome.summary.dump(2) + "\n");
+  return outcome;
+}
+
+}  // namespace
+
+std::size_t unit_size(std::size_t trajectories) {
+  const std::size_t per_unit = (trajectories + target_units - 1) / target_units;
+  const std::size_t blocks = std::max<std::size_t>(1, (per_unit + run_block_size - 1) / run_block_size);
+  return blocks * run_block_size;
+}
+
+bool has_units(const std::filesystem::path& directory) {
+  std::error_code error;
+  return std::filesystem::exists(directory / units_folder / plan_name, error);
+}
+
+RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, const Ranks& ranks) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto fail_if_any = [&](const std::string& local) {
+    const Ranks::Failure failure = ranks.first_failure(!local.empty(), local);
+    if (failure.rank >= 0)
+      throw RankFailure(ranks.size() > 1 ? "rank " + std::to_string(failure.rank) + ": " + failure.message
+                                         : failure.message);
+  };
+
+  std::optional<RunFolder> folder;  // rank 0 holds the output folder's lock for the whole run
+  std::string local_failure;
+  Plan plan;
+  if (ranks.rank() == 0) {
+    try {
+      plan = prepare_folder(loaded, options, folder);
+    } catch (const std::exception& error) {
+      local_failure = failure_text(error);
+    }
+  }
+  fail_if_any(local_failure);
+  plan.trajectories = loaded.job.initial.count;  // every rank computes the same plan; rank 0 checked the folder's
+  plan.unit_size = unit_size(plan.trajectories);
+  plan.units = (plan.trajectories + plan.unit_size - 1) / plan.unit_size;
+
+  bool interrupted = false;
+  {
+    Ranks::UnitCounter counter(ranks);
+    while (local_failure.empty()) {
+      if (options.stop_requested && options.stop_requested->load()) {
+        interrupted = true;
+        break;
+      }
+      const std::uint64_t unit = counter.next();
+      if (unit >= plan.units) break;
+      const auto path = unit_folder(options.output_directory, unit);
+      const UnitState state = unit_state(path);
+      if (state == UnitState::done) continue;
+      RunOptions unit_options = options;
+      unit_options.output_directory = path;
+      unit_options.show_progress = false;
+      unit_options.resume = state == UnitState::checkpointed;
+      unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over
+      try {
+        const RunOutcome outcome = run_job(unit_job(loaded, plan.first(unit), plan.size(unit)), unit_options);
+        if (outcome.exit_status == ExitStatus::interrupted) interrupted = true;
+      } catch (const std::exception& error) {
+        local_failure = "work unit " + path.string() + " (trajectories " + std::to_string(plan.first(unit)) + " to " +
+                        std::to_string(plan.first(unit) + plan.size(unit) - 1) + "): " + failure_text(error);
+      }
+      if (interrupted) break;
+    }
+    ranks.barrier();  // every rank is done with the counter before it is freed
+  }
+  fail_if_any(local_failure);
+  interrupted = ranks.any(interrupted);
+
+  RunOutcome outcome;
+  if (ranks.rank() == 0) {
+    try {
+      outcome = interrupted ? interrupted_outcome(loaded, options, plan, ranks)
+                            : merge_units(options, plan,
+                                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                                              .count());
+    } catch (const std::exception& error) {
+      local_failure = std::string(error.what()) + " (the units' results stay in " +
+                      (options.output_directory / units_folder).string() + ")";
+    }
+  }
+  fail_if_any(local_failure);
+  outcome.exit_status = static_cast<ExitStatus>(ranks.max(static_cast<int>(outcome.exit_status)));
+  outcome.distributed = true;
+  return outcome;
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,202 @@
+#include "nonsep/host/cluster/merge_outputs.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <fstream>
+#include <memory>
+#include <queue>
+#include <tuple>
+
+#include "nonsep/host/output/files.hpp"
+
+namespace nonsep::host {
+
+namespace {
+
+// Reads one CSV record (quoted cells may hold commas and line breaks), without its final '\n'.
+bool read_record(std::istream& in, std::string& record) {
+  record.clear();
+  bool quoted = false;
+  for (int c = in.get(); c != std::char_traits<char>::eof(); c = in.get()) {
+    if (c == '"') quoted = !quoted;
+    if (c == '\n' && !quoted) return true;
+    record += static_cast<char>(c);
+  }
+  return !record.empty();
+}
+
+std::vector<std::string_view> leading_cells(std::string_view record, std::size_t count) {
+  std::vector<std::string_view> cells;
+  std::size_t start = 0;
+  while (cells.size() < count) {
+    const std::size_t comma = record.find(',', start);
+    cells.push_back(record.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return cells;
+}
+
+struct Part {
+  const UnitFile* file;
+  std::ifstream in;
+  std::string record;
+  std::vector<std::uint64_t> key;
+  std::uint64_t line = 1;
+};
+
+[[noreturn]] void unfit(const Part& part, const std::string& what) {
+  throw OutputError(part.file->path.string() + " line " + std::to_string(part.line) + ": " + what +
+                    " (a unit's file of a distributed run cannot be merged)");
+}
+
+}  // namespace
+
+void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& output,
+               std::span<const std::string> keys) {
+  std::vector<std::unique_ptr<Part>> open;
+  std::string header;
+  std::vector<std::size_t> key_columns;
+  std::size_t trajectory_column = 0, leading = 0;
+  for (const UnitFile& file : parts) {
+    auto part = std::make_unique<Part>();
+    part->file = &file;
+    part->in.open(file.path, std::ios::binary);
+    std::string first;
+    if (!part->in || !read_record(part->in, first)) unfit(*part, "missing or empty");
+    if (open.empty()) {
+      header = first;
+      const auto names = leading_cells(header, static_cast<std::size_t>(-1));
+      const auto column = [&](const std::string& name) {
+        const auto at = std::find(names.begin(), names.end(), name);
+        if (at == names.end()) unfit(*part, "no column " + name);
+        return static_cast<std::size_t>(at - names.begin());
+      };
+      for (const std::string& key : keys) key_columns.push_back(column(key));
+      trajectory_column = column("trajectory");
+      leading = std::max(trajectory_column, *std::max_element(key_columns.begin(), key_columns.end())) + 1;
+    } else if (first != header) {
+      unfit(*part, "its header differs from " + parts.front().path.string() + "'s");
+    }
+    open.push_back(std::move(part));
+  }
+  const auto advance = [&](Part& part) {
+    if (!read_record(part.in, part.record)) return false;
+    ++part.line;
+    const auto cells = leading_cells(part.record, leading);
+    if (cells.size() < leading) unfit(part, "too few cells");
+    part.key.clear();
+    for (std::size_t column : key_columns) {
+      std::uint64_t value = 0;
+      const auto cell = cells[column];
+      auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
+      if (error != std::errc() || end != cell.data() + cell.size()) unfit(part, "not an integer key");
+      if (column == trajectory_column) value += part.file->first_trajectory;
+      part.key.push_back(value);
+    }
+    return true;
+  };
+  const auto later = [](const Part* a, const Part* b) { return std::tie(a->key, a->file) > std::tie(b->key, b->file); };
+  std::priority_queue<Part*, std::vector<Part*>, decltype(later)> queue(later);
+  for (auto& part : open)
+    if (advance(*part)) queue.push(part.get());
+
+  AtomicFile file(output);
+  std::string text = header + "\n";
+  while (!queue.empty()) {
+    Part* part = queue.top();
+    queue.pop();
+    // The row with its trajectory number shifted: the cells before it, the new number, the rest.
+    const auto cells = leading_cells(part->record, trajectory_column + 1);
+    const std::size_t begin = static_cast<std::size_t>(cells[trajectory_column].data() - part->record.data());
+    text.append(part->record, 0, begin);
+    std::uint64_t local = 0;
+    std::from_chars(cells[trajectory_column].data(), cells[trajectory_column].data() + cells[trajectory_column].size(),
+                    local);
+    text += std::to_string(local + part->file->first_trajectory);
+    text.append(part->record, begin + cells[trajectory_column].size());
+    text += '\n';
+    if (text.size() >= (1 << 20)) {
+      file.write(text);
+      text.clear();
+    }
+    if (advance(*part)) queue.push(part);
+  }
+  for (auto& part : open)
+    if (part->in.bad()) unfit(*part, "read error");
+  file.write(text);
+  file.commit();
+}
+
+namespace {
+
+using json = nlohmann::ordered_json;
+
+const char* const status_order[] = {"interrupted", "failed", "diverged", "inaccurate", "completed"};
+
+std::size_t status_rank(const json& summary) {
+  const std::string status = summary.value("status", "failed");
+  for (std::size_t i = 0; i < std::size(status_order); ++i)
+    if (status == status_order[i]) return i;
+  return 1;
+}
+
+void add_counts(json& total, const json& part) {
+  for (auto& [name, value] : total.items())
+    if (part.contains(name) && value.is_number_integer())
+      value = value.get<std::uint64_t>() + part[name].get<std::uint64_t>();
+}
+
+}  // namespace
+
+json merge_summaries(std::span<const json> units, std::span<const std::size_t> first_trajectories,
+                     std::size_t trajectories, const std::filesystem::path& directory, double wall_seconds) {
+  json merged = units.front();
+  std::size_t status = status_rank(merged);
+  std::string error = merged.value("error", "");
+  for (std::size_t u = 1; u < units.size(); ++u) {
+    const json& unit = units[u];
+    status = std::min(status, status_rank(unit));
+    if (const std::string e = unit.value("error", ""); !e.empty() && error.find(e) == std::string::npos)
+      error += (error.empty() ? "" : "; ") + e;
+    add_counts(merged["counts"], unit["counts"]);
+    add_counts(merged["evaluations"], unit["evaluations"]);
+    auto& completed = merged["time"]["steps_completed"];
+    completed = std::max(completed.get<std::uint64_t>(), unit["time"]["steps_completed"].get<std::uint64_t>());
+    if (merged.contains("comparator"))
+      merged["comparator"]["max_copy_distance"] = std::max(merged["comparator"]["max_copy_distance"].get<double>(),
+                                                           unit["comparator"]["max_copy_distance"].get<double>());
+    if (merged.contains("analysis") && merged["analysis"].contains("poincare"))
+      merged["analysis"]["poincare"]["crossings"] = merged["analysis"]["poincare"]["crossings"].get<std::uint64_t>() +
+                                                    unit["analysis"]["poincare"]["crossings"].get<std::uint64_t>();
+  }
+  // The largest energy error: strictly larger wins, as one process scans the trajectories in order.
+  json largest = nullptr;
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    const json& energy = units[u]["energy"];
+    if (!energy.contains("largest_relative_error") || energy["largest_relative_error"].is_null()) continue;
+    const json& candidate = energy["largest_relative_error"];
+    if (largest.is_null() || candidate["value"].get<double>() > largest["value"].get<double>())
+      largest = {{"value", candidate["value"]},
+                 {"trajectory", candidate["trajectory"].get<std::uint64_t>() + first_trajectories[u]}};
+  }
+  if (merged["energy"].contains("largest_relative_error")) merged["energy"]["largest_relative_error"] = largest;
+  merged["status"] = status_order[status];
+  if (!error.empty()) {
+    // "error" follows "status", as run_summary writes it.
+    json ordered;
+    for (auto& [name, value] : merged.items()) {
+      if (name == "error") continue;
+      ordered[name] = value;
+      if (name == "status") ordered["error"] = error;
+    }
+    merged = std::move(ordered);
+  }
+  merged["output"]["directory"] = directory.string();
+  merged["trajectories"] = trajectories;
+  if (merged.contains("energy_shell")) merged["energy_shell"]["states"] = trajectories;
+  merged["wall_seconds"] = wall_seconds;
+  return merged;
+}
+
+}  // namespace nonsep::host

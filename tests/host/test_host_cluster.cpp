@@ -1,0 +1,129 @@
+// Work units and their merge (host/include/nonsep/host/cluster/): the pieces of a distributed run that need no MPI.
+// The runs under mpirun are tests/cluster/check_distributed_run.py.
+#include <doctest/doctest.h>
+
+#include <fstream>
+#include <vector>
+
+#include "host_test_support.hpp"
+#include "nonsep/host/cluster/distributed_run.hpp"
+#include "nonsep/host/cluster/merge_outputs.hpp"
+#include "nonsep/host/cluster/ranks.hpp"
+#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+
+using nonsep::host_testing::read_text;
+using nonsep::host_testing::TemporaryFolder;
+namespace host = nonsep::host;
+
+namespace {
+void write(const std::filesystem::path& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+}  // namespace
+
+TEST_CASE("merge_csv: rows in key order across parts, trajectory numbers shifted, quoted cells kept whole") {
+  const TemporaryFolder folder;
+  write(folder / "a.csv", "trajectory,step,message\n0,0,a\n1,0,\"x, \"\"y\"\"\nz\"\n0,5,b\n");
+  write(folder / "b.csv", "trajectory,step,message\n0,0,c\n0,3,d\n1,5,e\n");
+  const std::vector<host::UnitFile> parts{{folder / "a.csv", 0}, {folder / "b.csv", 2}};
+  const std::vector<std::string> keys{"step", "trajectory"};
+  host::merge_csv(parts, folder / "out.csv", keys);
+  CHECK(read_text(folder / "out.csv") ==
+        "trajectory,step,message\n0,0,a\n1,0,\"x, \"\"y\"\"\nz\"\n2,0,c\n2,3,d\n0,5,b\n3,5,e\n");
+  // trajectories.csv: one row per trajectory, merged by trajectory alone
+  write(folder / "c.csv", "trajectory,status\n0,completed\n1,diverged\n");
+  write(folder / "d.csv", "trajectory,status\n0,failed\n");
+  const std::vector<host::UnitFile> tables{{folder / "c.csv", 0}, {folder / "d.csv", 2}};
+  const std::vector<std::string> by_trajectory{"trajectory"};
+  host::merge_csv(tables, folder / "by_trajectory.csv", by_trajectory);
+  CHECK(read_text(folder / "by_trajectory.csv") == "trajectory,status\n0,completed\n1,diverged\n2,failed\n");
+}
+
+TEST_CASE("merge_csv: a part that does not fit is an OutputError naming it, and nothing is written") {
+  const TemporaryFolder folder;
+  write(folder / "a.csv", "trajectory,step\n0,0\n");
+  write(folder / "other_header.csv", "trajectory,step,x\n0,0,1\n");
+  write(folder / "bad_key.csv", "trajectory,step\n0,zero\n");
+  const std::vector<std::string> keys{"step", "trajectory"};
+  for (const char* name : {"other_header.csv", "bad_key.csv", "missing.csv"}) {
+    CAPTURE(name);
+    const std::vector<host::UnitFile> parts{{folder / "a.csv", 0}, {folder / name, 1}};
+    try {
+      host::merge_csv(parts, folder / "out.csv", keys);
+      FAIL("no error");
+    } catch (const host::OutputError& error) {
+      CHECK(std::string(error.what()).find(name) != std::string::npos);
+    }
+    CHECK_FALSE(std::filesystem::exists(folder / "out.csv"));
+  }
+  const std::vector<std::string> unknown{"crossing"};
+  const std::vector<host::UnitFile> parts{{folder / "a.csv", 0}};
+  CHECK_THROWS_AS(host::merge_csv(parts, folder / "out.csv", unknown), host::OutputError);
+}
+
+TEST_CASE("unit_size: whole blocks, about 64 units, the same for any number of ranks") {
+  CHECK(host::unit_size(1) == host::run_block_size);
+  CHECK(host::unit_size(1000) == host::run_block_size);
+  for (std::size_t count : {std::size_t{100000}, std::size_t{1000000}, std::size_t{12345678}}) {
+    const std::size_t size = host::unit_size(count);
+    CHECK(size % host::run_block_size == 0);
+    CHECK((count + size - 1) / size <= 64);
+    CHECK((count + size - 1) / size >= 56);
+  }
+}
+
+TEST_CASE("merge_summaries: sums, the largest energy error as one process finds it, the worst status") {
+  using json = nlohmann::ordered_json;
+  const auto unit = [](const char* status, std::uint64_t completed, double largest, std::uint64_t at) {
+    return json{{"status", status},
+                {"time", {{"steps_completed", completed}}},
+                {"energy", {{"largest_relative_error", {{"value", largest}, {"trajectory", at}}}}},
+                {"output", {{"directory", "unit"}}},
+                {"trajectories", 256},
+                {"counts", {{"completed", 250}, {"diverged", 6}}},
+                {"evaluations", {{"grad_T", 10}, {"grad_V", 20}}},
+                {"wall_seconds", 1.0}};
+  };
+  const std::vector<json> units{unit("completed", 100, 0.5, 3), unit("diverged", 90, 0.5, 1),
+                                unit("completed", 100, 0.25, 0)};
+  const std::vector<std::size_t> firsts{0, 256, 512};
+  const json merged = host::merge_summaries(units, firsts, 600, "out", 2.5);
+  CHECK(merged["status"] == "diverged");
+  CHECK(merged["counts"]["completed"] == 750);
+  CHECK(merged["counts"]["diverged"] == 18);
+  CHECK(merged["evaluations"]["grad_V"] == 60);
+  CHECK(merged["time"]["steps_completed"] == 100);
+  CHECK(merged["energy"]["largest_relative_error"]["trajectory"] == 3);  // a tie keeps the first
+  CHECK(merged["trajectories"] == 600);
+  CHECK(merged["output"]["directory"] == "out");
+  CHECK(merged["wall_seconds"] == 2.5);
+}
+
+TEST_CASE("a distributed run on one rank writes the files of an ordinary run, byte for byte") {
+  const TemporaryFolder folder;
+  const auto job = std::filesystem::path(NONSEP_SOURCE_DIR) / "tests/cluster/jobs/dynamics_grid.json";
+  const host::LoadedJob loaded = host::load_job(job);
+  host::RunOptions options;
+  options.threads = 2;
+  options.output_directory = folder / "plain";
+  const host::RunOutcome plain = host::run_job(loaded, options);
+  options.output_directory = folder / "units";
+  const host::Ranks one;
+  const host::RunOutcome units = host::run_distributed(loaded, options, one);
+  CHECK(units.exit_status == plain.exit_status);
+  CHECK(units.status == plain.status);
+  CHECK(units.counts.inaccurate == plain.counts.inaccurate);
+  CHECK(units.counts.inaccurate > 0);
+  CHECK(units.steps_completed == plain.steps_completed);
+  for (const char* name : {"trajectory.csv", "trajectories.csv", "poincare.csv", "lyapunov.csv"}) {
+    CAPTURE(name);
+    CHECK(read_text(folder / "units" / name) == read_text(folder / "plain" / name));
+  }
+  auto a = nonsep::host_testing::read_json(folder / "plain" / "summary.json");
+  auto b = nonsep::host_testing::read_json(folder / "units" / "summary.json");
+  for (auto* s : {&a, &b}) {
+    s->erase("wall_seconds");
+    (*s)["output"].erase("directory");
+  }
+  CHECK(a == b);
+  CHECK_FALSE(std::filesystem::exists(folder / "units" / host::units_folder));
+}
