@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "nonsep/host/number_format.hpp"
@@ -16,36 +17,46 @@ namespace {
 
 constexpr std::size_t rows_per_block = 65536;
 
-// Rows of a CSV file as csv.hpp writes them (RFC 4180 quoting, '\n' line ends).
+// Rows of a CSV file as csv.hpp writes them (RFC 4180 quoting, '\n' line ends), read through a buffer of 1 MiB.
 class CsvRows {
  public:
-  explicit CsvRows(const std::filesystem::path& path) : path_(path), in_(path, std::ios::binary) {
+  explicit CsvRows(const std::filesystem::path& path) : path_(path), in_(path, std::ios::binary), buffer_(1 << 20) {
     if (!in_) throw OutputError("cannot read " + path.string() + " to copy it into results.h5");
   }
-  // The next whole row, or false at the end (a last line without '\n' is not a row).
+  // The next whole row into `cells` (whose strings are reused), or false at the end (a last line without '\n' is
+  // not a row).
   bool next(std::vector<std::string>& cells) {
-    cells.assign(1, std::string());
+    std::size_t count = 0;
+    const auto start_cell = [&] {
+      if (count == cells.size()) cells.emplace_back();
+      cells[count++].clear();
+    };
+    start_cell();
     bool quoted = false;
     const std::uint64_t first_line = line_;
-    for (int c; (c = in_.get()) != EOF;) {
+    for (int c; (c = get()) != EOF;) {
       if (quoted) {
         if (c != '"') {
           line_ += c == '\n';
-          cells.back() += static_cast<char>(c);
-        } else if (in_.peek() == '"') {
-          cells.back() += static_cast<char>(in_.get());
+          cells[count - 1] += static_cast<char>(c);
+        } else if (peek() == '"') {
+          cells[count - 1] += static_cast<char>(get());
         } else {
           quoted = false;
         }
       } else if (c == '"') {
         quoted = true;
       } else if (c == ',') {
-        cells.emplace_back();
+        start_cell();
       } else if (c == '\n') {
         ++line_;
+        cells.resize(count);
         return true;
       } else {
-        cells.back() += static_cast<char>(c);
+        // The rest of an unquoted cell in the buffer at once: most cells are numbers with no quote.
+        const std::size_t begin = next_ - 1;
+        while (next_ < end_ && buffer_[next_] != ',' && buffer_[next_] != '\n' && buffer_[next_] != '"') ++next_;
+        cells[count - 1].append(buffer_.data() + begin, next_ - begin);
       }
     }
     if (quoted)
@@ -55,8 +66,26 @@ class CsvRows {
   std::uint64_t line() const { return line_ - 1; }  // of the row last read
 
  private:
+  int peek() {
+    if (next_ == end_) refill();
+    return next_ == end_ ? EOF : static_cast<unsigned char>(buffer_[next_]);
+  }
+  int get() {
+    const int c = peek();
+    if (c != EOF) ++next_;
+    return c;
+  }
+  void refill() {
+    in_.read(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    next_ = 0;
+    end_ = static_cast<std::size_t>(in_.gcount());
+    if (in_.bad()) throw OutputError("cannot read " + path_.string() + " to copy it into results.h5");
+  }
+
   std::filesystem::path path_;
   std::ifstream in_;
+  std::vector<char> buffer_;
+  std::size_t next_ = 0, end_ = 0;
   std::uint64_t line_ = 1;
 };
 
@@ -134,7 +163,7 @@ void write_rows(const Hdf5File& file, const Column& column, hid_t memory_type, h
 // column's kind: the file changed between the two readings).
 template <class Changed>
 void write_block(const Hdf5File& file, std::vector<Column>& columns, hid_t string_type,
-                 const std::vector<std::vector<std::string>>& block, std::uint64_t first, const std::string& where,
+                 std::span<const std::vector<std::string>> block, std::uint64_t first, const std::string& where,
                  Changed&& changed) {
   const hsize_t count = block.size();
   std::vector<std::int64_t> integers(block.size());
@@ -198,19 +227,20 @@ void write_csv_table(const Hdf5File& file, const std::string& group, const std::
     throw OutputError(csv.string() + " changed while it was copied into " + file.path().string());
   };
   CsvRows reader(csv);
-  std::vector<std::vector<std::string>> block;
+  std::vector<std::vector<std::string>> block(std::min<std::uint64_t>(rows, rows_per_block));
   std::vector<std::string> cells;
   reader.next(cells);  // the header
   std::uint64_t first = 0;
   for (bool more = true; more;) {
-    block.clear();
-    while (block.size() < rows_per_block && (more = reader.next(cells))) {
+    std::size_t used = 0;
+    while (used < block.size() && (more = reader.next(cells))) {
       if (cells.size() != columns.size()) changed();
-      block.push_back(cells);
+      std::swap(block[used++], cells);  // the row's strings change hands; no cell is copied
     }
-    if (first + block.size() > rows) changed();
-    if (!block.empty()) write_block(file, columns, string_type.get(), block, first, where, changed);
-    first += block.size();
+    if (first + used > rows) changed();
+    if (used > 0) write_block(file, columns, string_type.get(), std::span(block).first(used), first, where, changed);
+    first += used;
+    more = more && used > 0;
   }
 }
 
