@@ -79,7 +79,7 @@ TEST_CASE("write_csv_table: int64 trajectory and step, float64 numbers (empty = 
   CHECK(read_strings(file, "/table/note", 3) == std::vector<std::string>{"plain", "a, \"quoted\"\nline", "é"});
 }
 
-TEST_CASE("write_csv_table: a table without rows gets empty columns; bad files are OutputErrors naming the line") {
+TEST_CASE("write_csv_table: a table without rows gets empty columns, and bad files are OutputErrors naming the line") {
   TemporaryFolder folder;
   Hdf5File file = Hdf5File::create(folder / "out.h5");
   write_text(folder / "empty.csv", "trajectory,t,message\n");
