@@ -9,6 +9,7 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/host/build_features.hpp"
+#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/observers/hdf5_sample_writer.hpp"
 #include "nonsep/host/output/files.hpp"
@@ -165,4 +166,65 @@ TEST_CASE("/output/format: csv by default, hdf5 in a build with HDF5, anything e
     CHECK(refused[0].path == "/output/format");
     CHECK(contains(refused[0].allowed, "\"csv\" or \"hdf5\""));
   }
+}
+
+TEST_CASE("Hdf5SampleWriter: a trajectory that stops exactly at a sample step has its final state there as in "
+          "trajectory.csv, one that stopped before has NaN, and a resumed writer rewrites the rows after its checkpoint") {
+  TemporaryFolder folder;
+  const TimeGrid time = TimeGrid::of_steps(10, 0.5);
+  const auto path = folder / "results.h5";
+  const auto state = [](std::size_t trajectory, double x) {
+    static std::vector<double> storage(64);
+    storage[2 * trajectory] = x;
+    return StateView{.trajectory = trajectory, .q = std::span(storage).subspan(2 * trajectory, 1),
+                     .p = std::span(storage).subspan(2 * trajectory + 1, 1), .energy = x * 10};
+  };
+  TrajectoryRecord at_sample, between;
+  at_sample.final_step = 4;
+  at_sample.final_q = {7.0};
+  at_sample.final_p = {-7.0};
+  at_sample.energy_final = 70.0;
+  between.final_step = 3;
+  between.final_q = {9.0};
+  between.final_p = {-9.0};
+  nlohmann::json checkpoint;
+  {
+    Hdf5SampleWriter writer(path, 1, 3, 4, time, false);  // samples at steps 0, 4, 8, 10
+    std::vector<StateView> all{state(0, 1.0), state(1, 2.0), state(2, 3.0)};
+    writer.on_event({.step = 0, .t = 0.0, .states = all, .energy_evaluated = true});
+    checkpoint = writer.save();
+    CHECK(checkpoint == nlohmann::json{{"rows", 1}});
+    writer.on_retire(2, between);    // stopped at step 3: no sample
+    writer.on_retire(1, at_sample);  // stopped at step 4, before the event there
+    std::vector<StateView> left{state(0, 4.0)};
+    writer.on_event({.step = 4, .t = 2.0, .states = left, .energy_evaluated = true});
+    writer.on_event({.step = 8, .t = 4.0, .states = left, .energy_evaluated = false});
+    writer.on_end();
+  }
+  Hdf5File file = Hdf5File::open(path);
+  const auto q = read_all<double>(file, "/samples/q", H5T_NATIVE_DOUBLE, 12);  // [4 samples][3 trajectories][1]
+  const auto H = read_all<double>(file, "/samples/H", H5T_NATIVE_DOUBLE, 12);
+  CHECK(read_all<std::uint64_t>(file, "/samples/step", H5T_NATIVE_UINT64, 4) == std::vector<std::uint64_t>{0, 4, 8, 10});
+  CHECK(q[0] == 1.0);
+  CHECK(q[3 + 0] == 4.0);
+  CHECK(q[3 + 1] == 7.0);  // the final state at its sample step
+  CHECK(H[3 + 1] == 70.0);
+  CHECK(std::isnan(q[3 + 2]));  // stopped before
+  CHECK(std::isnan(q[6 + 1]));
+  CHECK(H[6 + 0] == 40.0);  // StateView::energy as given (the driver leaves it empty where H was not evaluated)
+  CHECK(std::isnan(q[9 + 0]));  // step 10 not reached
+  file.close();
+
+  Hdf5SampleWriter resumed(path, 1, 3, 4, time, true);
+  resumed.restore(checkpoint);
+  std::vector<StateView> other{state(0, 5.0)};
+  resumed.on_event({.step = 4, .t = 2.0, .states = other, .energy_evaluated = true});
+  resumed.on_end();
+  Hdf5File again = Hdf5File::open(path);
+  CHECK(read_all<double>(again, "/samples/q", H5T_NATIVE_DOUBLE, 12)[3] == 5.0);
+  again.close();
+  Hdf5SampleWriter wrong(path, 2, 3, 4, time, true);
+  CHECK_THROWS_WITH_AS(wrong.restore(checkpoint), doctest::Contains("cannot resume into"), nonsep::host::CheckpointError);
+  CHECK_THROWS_WITH_AS(resumed.restore(nlohmann::json{{"rows", 5}}), doctest::Contains("results_h5 state is damaged"),
+                       nonsep::host::CheckpointError);
 }
