@@ -131,6 +131,7 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   append_bits(parts[4], run.time.t_end);
   parts[4] += std::to_string(run.time.steps);
   parts[5] = std::to_string(run.every) + ' ' + std::to_string(run.energy_every);
+  if (run.format == OutputFormat::hdf5) parts[5] += " hdf5";  // csv adds nothing: older checkpoints stay valid
   if (run.analysis.closest_return_after) append_bits(parts[6], *run.analysis.closest_return_after);
   parts[6] += '|';
   if (run.analysis.max_relative_energy_error) append_bits(parts[6], *run.analysis.max_relative_energy_error);
@@ -227,8 +228,8 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)
     throw CheckpointError(path.string() + " belongs to a different job: its " +
                           fingerprint_difference(fingerprint, expected) +
-                          " differ (the plugin part covers the plugin file's bytes, output covers output.every and "
-                          "energy_every); run with --force to start over, or resume with the job that wrote it");
+                          " differ (the plugin part covers the plugin file's bytes, output covers output.every, "
+                          "energy_every and format); run with --force to start over, or resume with the job that wrote it");
   Checkpoint checkpoint;
   DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;

@@ -10,7 +10,7 @@ run(), validate() and the executable: nonsep.process; load() and Result: nonsep.
 """
 from .process import (ExecutableNotFound, Problem, RunError, RunInterrupted, executable, parse_problems, run,
                       validate)
-from .results import Crossings, LyapunovSeries, Orbit, Result, load
+from .results import Crossings, LyapunovSeries, Orbit, Result, Samples, load
 
 __all__ = ["Crossings", "ExecutableNotFound", "LyapunovSeries", "Orbit", "Problem", "Result", "RunError",
-           "RunInterrupted", "executable", "load", "parse_problems", "run", "validate"]
+           "RunInterrupted", "Samples", "executable", "load", "parse_problems", "run", "validate"]

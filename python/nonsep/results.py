@@ -4,6 +4,10 @@ Files read (README.md, "What a run leaves behind"); each is optional except summ
   summary.json       Result.summary, as a dict (non-finite numbers are None there, as the host writes null)
   trajectories.csv   Result.trajectories, one row per trajectory (None for a study)
   trajectory.csv     Result.samples() and Result.orbit(i): read on first use and kept
+  results.h5         instead of trajectory.csv with output.format "hdf5": the same Result.samples() and orbit(i) from
+                     its /samples (without trajectory.csv's rows of final states off the sample steps, which are in
+                     trajectories), and for either format Result.sample_arrays(): Samples(step, t, q, p, H) as
+                     [samples, trajectories, ...] arrays, NaN where a trajectory has no sample
   convergence.csv    Result.convergence (a study); Result.fits and Result.exponents come from summary.json's "fits"
   poincare.csv       Result.poincare (every crossing, rows in (step, trajectory) order; None without the file) and
                      Result.crossings(i) (trajectory i's crossings in order): read on first use and kept
@@ -11,7 +15,7 @@ Files read (README.md, "What a run leaves behind"); each is optional except summ
                      Result.lyapunov_series(i): read on first use and kept
   other *.csv        Result.dynamics[name] (poincare.csv and lyapunov.csv too, the same arrays): read by header on
                      first use, as tables.read_table types columns
-  results.h5         Result.dynamics["results.h5/<dataset path>"]: every dataset, read with h5py on first use
+  results.h5         also Result.dynamics["results.h5/<dataset path>"]: every dataset, read with h5py on first use
 """
 import json
 import math
@@ -36,6 +40,17 @@ class Orbit(NamedTuple):
     p: np.ndarray
     H: np.ndarray
     relative_energy_error: np.ndarray
+
+
+class Samples(NamedTuple):
+    """Every sample of a run as arrays, results.h5's /samples layout: step and t are [S] (step 0, every output.every-th
+    step, the last step), q and p [S, N, n] (N trajectories of dimension n), H [S, N]; NaN where a trajectory was no
+    longer active (or the run did not reach the sample), and in H where it was not evaluated."""
+    step: np.ndarray
+    t: np.ndarray
+    q: np.ndarray
+    p: np.ndarray
+    H: np.ndarray
 
 
 class Crossings(NamedTuple):
@@ -81,12 +96,39 @@ class Result:
     def status(self):
         return self.summary.get("status")
 
+    @property
+    def format(self):
+        """"csv" or "hdf5": the run's output.format (summary.json; "csv" for a study or an older run)."""
+        return (self.summary.get("output") or {}).get("format", "csv")
+
     def samples(self):
         """Every row of trajectory.csv as a structured array (fields named by the header: trajectory, step, t, q0,
-        ..., p0, ..., H, relative_energy_error). Raises FileNotFoundError when the run wrote none (output.every 0)."""
+        ..., p0, ..., H, relative_energy_error). For an output.format "hdf5" run, the same rows from results.h5's
+        /samples (one per trajectory and sample step where it has a state; the final rows that trajectory.csv adds
+        off the sample steps are not there). Raises FileNotFoundError when the run wrote none (output.every 0)."""
         if self._samples is None:
-            self._samples = read_table(self.directory / "trajectory.csv")
+            if self.format == "hdf5":
+                self._samples = _rows_of_arrays(self.sample_arrays(), self._initial_energies())
+            else:
+                self._samples = read_table(self.directory / "trajectory.csv")
         return self._samples
+
+    def sample_arrays(self):
+        """The samples as Samples(step, t, q, p, H) arrays (see Samples), from results.h5 (read with h5py) or from
+        trajectory.csv's rows at the sample steps. Raises FileNotFoundError when the run wrote no samples."""
+        if self.format == "hdf5":
+            import h5py  # only where results.h5 is read
+            path = self.directory / "results.h5"
+            with h5py.File(path, "r") as f:
+                if "samples" not in f:
+                    raise FileNotFoundError(f"{path} has no /samples (output.every was 0)")
+                g = f["samples"]
+                return Samples(g["step"][()], g["t"][()], g["q"][()], g["p"][()], g["H"][()])
+        return _arrays_of_rows(self.samples(), self.summary)
+
+    def _initial_energies(self):
+        count = len(self.trajectories)
+        return self.trajectories["H0"] if "H0" in self.trajectories.dtype.names else np.full(count, math.nan)
 
     def orbit(self, index):
         """The samples of trajectory `index` (its position in the job's initial states) as an Orbit. Raises
@@ -181,6 +223,49 @@ def _components(rows):
     q = np.column_stack([rows[f"q{k}"] for k in range(d)]) if d else np.empty((len(rows), 0))
     p = np.column_stack([rows[f"p{k}"] for k in range(d)]) if d else np.empty((len(rows), 0))
     return q, p
+
+
+def _sample_steps(steps, every):
+    """step 0, every, 2 every, ... and the last step: the host's sample steps."""
+    listed = list(range(0, steps + 1, every))
+    return np.array(listed + ([steps] if listed[-1] != steps else []), dtype=np.uint64)
+
+
+def _arrays_of_rows(rows, summary):
+    """Samples from trajectory.csv's rows: those at the sample steps, put at [sample, trajectory]."""
+    every, steps = summary["output"]["every"], summary["time"]["steps"]
+    count, (q, p) = summary["trajectories"], _components(rows)
+    if every == 0:
+        raise FileNotFoundError("the run wrote no samples (output.every 0)")
+    step = _sample_steps(steps, every)
+    d = q.shape[1]
+    # t as the host computes it (time_grid.hpp): step * dt, and t_end exactly at the last step
+    t = np.where(step == steps, summary["time"]["t_end"], step.astype(np.float64) * summary["time"]["dt"])
+    arrays = Samples(step, t, np.full((len(step), count, d), math.nan),
+                     np.full((len(step), count, d), math.nan), np.full((len(step), count), math.nan))
+    index = np.searchsorted(step, rows["step"].astype(np.uint64))
+    at_sample = (index < len(step)) & (step[np.minimum(index, len(step) - 1)] == rows["step"].astype(np.uint64))
+    i, j = index[at_sample], rows["trajectory"][at_sample]
+    arrays.q[i, j], arrays.p[i, j], arrays.H[i, j] = q[at_sample], p[at_sample], rows["H"][at_sample]
+    return arrays
+
+
+def _rows_of_arrays(arrays, energies_initial):
+    """trajectory.csv's structured rows from Samples: one per (sample, trajectory) with a state, in that order."""
+    count, d = arrays.q.shape[1], arrays.q.shape[2]
+    present = ~np.all(np.isnan(arrays.q), axis=2) if d else np.zeros(arrays.H.shape, dtype=bool)
+    i, j = np.nonzero(present)
+    names = ["trajectory", "step", "t"] + [f"q{k}" for k in range(d)] + [f"p{k}" for k in range(d)]
+    rows = np.empty(len(i), dtype=[(name, np.int64 if name in ("trajectory", "step") else np.float64)
+                                   for name in names] + [("H", np.float64), ("relative_energy_error", np.float64)])
+    rows["trajectory"], rows["step"], rows["t"] = j, arrays.step[i], arrays.t[i]
+    for k in range(d):
+        rows[f"q{k}"], rows[f"p{k}"] = arrays.q[i, j, k], arrays.p[i, j, k]
+    rows["H"] = arrays.H[i, j]
+    h0 = np.asarray(energies_initial, dtype=np.float64)[j] if count else np.empty(0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rows["relative_energy_error"] = np.where(h0 != 0, (rows["H"] - h0) / h0, math.nan)
+    return rows
 
 
 def _number(value):

@@ -10,6 +10,7 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/core/scheme_catalogue.hpp"
+#include "nonsep/host/build_features.hpp"
 #include "nonsep/host/job.hpp"
 
 using nlohmann::json;
@@ -327,5 +328,19 @@ TEST_CASE("load_job reports a missing file and a plugin that cannot be loaded as
   } catch (const InvalidJob& error) {
     CHECK(paths(error.issues()) == std::vector<std::string>{"/time/dt", "/model/plugin"});
     CHECK(std::string(error.what()).find("2 problems") != std::string::npos);
+  }
+}
+
+TEST_CASE("/output/format \"hdf5\": accepted by a build with HDF5, refused at /output/format by one without") {
+  json document = nonsep::host_testing::quickstart_job();
+  document["output"]["format"] = "hdf5";
+  const Parsed parsed = parse(document);
+  if (built_with_hdf5()) {
+    CHECK(parsed.issues.empty());
+    CHECK(parsed.job.run().format == OutputFormat::hdf5);
+  } else {
+    REQUIRE(parsed.issues.size() == 1);
+    CHECK(parsed.issues[0].path == "/output/format");
+    CHECK(parsed.issues[0].found.find("this build of nonsep has no HDF5") != std::string::npos);
   }
 }

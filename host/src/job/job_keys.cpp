@@ -120,6 +120,11 @@ const KeyTable& output_keys() {
        .default_value = 0,
        .description = "H is evaluated at step 0, at every written sample and at the end; energy_every > 0 also "
                       "evaluates it every energy_every-th step. Costs about a step's work per evaluation."},
+      {.name = "format", .type = ValueType::choice, .default_value = "csv",
+       .description = "\"csv\": the samples in trajectory.csv. \"hdf5\": the samples in results.h5 (group /samples) "
+                      "instead, and trajectories.csv, poincare.csv and lyapunov.csv copied into it at the end (the CSV "
+                      "files are kept); needs a build with HDF5 (`nonsep --version`). A study accepts \"csv\" only.",
+       .choices = {"csv", "hdf5"}},
   }};
   return table;
 }

@@ -2,7 +2,30 @@
 // run saves checkpoint.json).
 #include "sections.hpp"
 
+#include "nonsep/host/build_features.hpp"
+
 namespace nonsep::host::job_reader {
+
+namespace {
+
+// A study writes convergence.csv only; refusing "hdf5" there says so instead of ignoring what was asked. A build
+// without HDF5 refuses it here, before any plugin is loaded, rather than at the end of a run.
+OutputFormat read_format(Checker& check, const json& value, bool study) {
+  const std::string text = value.is_string() ? value.get<std::string>() : "";
+  if (text == "csv") return OutputFormat::csv;
+  if (text != "hdf5") {
+    check.issue("/output/format", describe(value), "\"csv\" or \"hdf5\"");
+  } else if (study) {
+    check.issue("/output/format", "\"hdf5\" together with /study",
+                "\"csv\": a study writes convergence.csv; results.h5 is written by single runs");
+  } else if (!built_with_hdf5()) {
+    check.issue("/output/format", "\"hdf5\", but this build of nonsep has no HDF5 (`nonsep --version`)",
+                "\"csv\", or a build configured with -DNONSEP_WITH_HDF5=ON and the HDF5 library installed");
+  }
+  return OutputFormat::hdf5;
+}
+
+}  // namespace
 
 void read_output(Checker& check, const json& document, Job& job) {
   SingleRun study_strides;  // a study's /output/every and /output/energy_every are checked but not used
@@ -26,6 +49,8 @@ void read_output(Checker& check, const json& document, Job& job) {
                                       "an integer >= 0: also evaluate H every n-th step (0: only at the written "
                                       "samples, the start and the end)"))
         run.energy_every = static_cast<std::uint64_t>(*stride);
+    if (const json* format = check.member(*section, "/output", "format", false, ""))
+      run.format = read_format(check, *format, job.is_study());
   }
   job.output_directory = output.is_absolute() ? output : job.directory / output;
 }

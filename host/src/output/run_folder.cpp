@@ -82,7 +82,7 @@ void check_outputs_placeable(const std::filesystem::path& directory) {
 const std::vector<std::string>& RunFolder::output_files() {
   static const std::vector<std::string> names{"summary.json",    "trajectory.csv",  "trajectories.csv",
                                               "poincare.csv",    "lyapunov.csv",    "checkpoint.json",
-                                              "convergence.csv", manifest_name};
+                                              "convergence.csv", "results.h5",     manifest_name};
   return names;
 }
 

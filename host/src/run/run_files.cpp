@@ -72,11 +72,14 @@ json run_summary(const RunFacts& facts) {
                      {"t_end", run.time.t_end},
                      {"steps_completed", outcome.steps_completed}};
   summary["energy"] = energy_facts(facts);
+  const bool hdf5 = run.format == OutputFormat::hdf5;
   summary["output"] = {{"directory", facts.directory.string()},
-                       {"trajectory", facts.samples_written ? json("trajectory.csv") : json(nullptr)},
+                       {"format", hdf5 ? "hdf5" : "csv"},
+                       {"trajectory", facts.samples_written && !hdf5 ? json("trajectory.csv") : json(nullptr)},
                        {"trajectories", trajectories_file_name},
                        {"every", run.every},
                        {"energy_every", run.energy_every}};
+  if (hdf5) summary["output"]["results"] = results_file_name;
   summary["trajectories"] = job.initial.count;
   summary["counts"] = {{"completed", outcome.counts.completed},
                        {"diverged", outcome.counts.diverged},

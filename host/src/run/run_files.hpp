@@ -16,6 +16,7 @@ namespace nonsep::host {
 
 inline constexpr const char* summary_file_name = "summary.json";
 inline constexpr const char* trajectories_file_name = "trajectories.csv";
+inline constexpr const char* results_file_name = "results.h5";  // output.format "hdf5" (run/results_file.hpp)
 
 struct RunFacts {
   const LoadedJob& loaded;

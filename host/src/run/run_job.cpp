@@ -14,6 +14,10 @@
 #include "nonsep/host/output/files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "run/run_files.hpp"
+#ifdef NONSEP_HAVE_HDF5
+#include "nonsep/host/observers/hdf5_sample_writer.hpp"
+#include "run/results_file.hpp"
+#endif
 
 namespace nonsep::host {
 
@@ -106,13 +110,23 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   std::optional<ClosestReturnObserver> closest;
   if (run.analysis.closest_return_after)
     closest.emplace(*run.analysis.closest_return_after, job.initial.dimension, job.initial.q, job.initial.p);
+  const bool hdf5 = run.format == OutputFormat::hdf5;
   std::optional<SampleWriter> samples;
-  if (run.every > 0) {
+  if (run.every > 0 && !hdf5) {
     samples.emplace(directory / SampleWriter::file_name, job.initial.dimension, count, run.every, driver.time(),
                     options.resume);
   } else {
     remove_stale(directory / SampleWriter::file_name);
   }
+#ifdef NONSEP_HAVE_HDF5
+  std::optional<Hdf5SampleWriter> hdf5_samples;
+  if (run.every > 0 && hdf5)
+    hdf5_samples.emplace(directory / results_file_name, job.initial.dimension, count, run.every, driver.time(),
+                         options.resume);
+#else
+  if (hdf5) throw OutputError("output.format \"hdf5\": this build of nonsep has no HDF5");  // the reader refuses it
+#endif
+  if (!hdf5 || (run.every == 0 && !options.resume)) remove_stale(directory / results_file_name);
   std::optional<PoincareSectionObserver> poincare;
   if (run.analysis.poincare)
     poincare.emplace(directory / PoincareSectionObserver::file_name, *run.analysis.poincare, run.integrator,
@@ -131,6 +145,9 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   if (chaos) observers.push_back(&*chaos);
   if (closest) observers.push_back(&*closest);
   if (samples) observers.push_back(&*samples);
+#ifdef NONSEP_HAVE_HDF5
+  if (hdf5_samples) observers.push_back(&*hdf5_samples);
+#endif
   if (poincare) observers.push_back(&*poincare);
   CheckpointSaver saver(directory / checkpoint_file_name, job_fingerprint(loaded), run.checkpoint, driver, observers);
   ProgressObserver progress(options.show_progress, driver, &energy);
@@ -163,7 +180,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   if (!loaded.plugin.thread_safe() && options.threads != 1)
     outcome.notes.push_back("ran on one thread: the plugin '" + loaded.plugin.name() +
                             "' declares \"thread_safe\": false (plugin_abi.h)");
-  const RunFacts facts{loaded, directory, driver, outcome, run.every > 0,
+  const RunFacts facts{loaded, directory, driver, outcome, run.every > 0 && !hdf5,
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
   outcome.summary = run_summary(facts);
   if (poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *poincare);
@@ -189,6 +206,14 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   } catch (const OutputError& error) {
     fail(error);
   }
+#ifdef NONSEP_HAVE_HDF5
+  // After trajectories.csv, which it copies, and before summary.json, so that a failure here is in summary.json.
+  if (hdf5) try {
+      write_results_file(directory / results_file_name, run.every > 0, facts, outcome.summary);
+    } catch (const OutputError& error) {
+      fail(error);
+    }
+#endif
   try {
     write_file_atomically(directory / summary_file_name, outcome.summary.dump(2) + "\n");
   } catch (const OutputError& error) {

@@ -10,7 +10,7 @@
 // (write_file_atomically): a crash while saving leaves the previous checkpoint.
 //
 // The fingerprint covers what determines the numbers: the plugin (name, version and its file's bytes), the model's
-// parameters, the integrator, the initial states, the time grid, output.every, output.energy_every and /analysis. It leaves out the output folder and the
+// parameters, the integrator, the initial states, the time grid, output.every, output.energy_every, output.format (hdf5 only) and /analysis. It leaves out the output folder and the
 // checkpoint policy, which may change between the interrupted run and the resumed one.
 #include <cstddef>
 #include <cstdint>

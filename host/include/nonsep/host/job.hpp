@@ -134,12 +134,18 @@ struct CheckpointPolicy {
   double every_seconds = 60.0;
 };
 
+// /output/format: where the samples and the tables go. csv: trajectory.csv (streamed) and the CSV tables; hdf5:
+// results.h5 (observers/hdf5_sample_writer.hpp, output/hdf5_*.hpp) instead of trajectory.csv, with the CSV tables
+// (kept as well) copied into it at the end. A study refuses hdf5 (it writes convergence.csv only).
+enum class OutputFormat { csv, hdf5 };
+
 // A single run (a job without /study): one integrator over one time grid for every initial state.
 struct SingleRun {
   IntegratorSpec integrator;  // /hamiltonian and /integrator, defaults filled in from the catalogue
   TimeGrid time;
   std::uint64_t every = 1;                 // /output/every; 0: no trajectory file
   std::uint64_t energy_every = 0;          // /output/energy_every; 0: H only at samples, start and end
+  OutputFormat format = OutputFormat::csv;  // /output/format
   Analysis analysis;                       // /analysis
   CheckpointPolicy checkpoint;             // /checkpoint
 };

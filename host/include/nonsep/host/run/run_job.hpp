@@ -2,6 +2,8 @@
 // Running a loaded job (or resuming one): an EnsembleDriver with the observers the job asks for, then the
 // run's files. In the output folder:
 //   trajectory.csv    the samples (observers/sample_writer.hpp), streamed; none when output.every is 0
+//   results.h5        output.format "hdf5" only, instead of trajectory.csv: the samples (observers/
+//                     hdf5_sample_writer.hpp), then the tables and the run's facts (run/results_file.hpp)
 //   trajectories.csv  one row per trajectory, written at the end (header below)
 //   summary.json      the run's facts (status, job, model, integrator, time grid, energy, counts, evaluations)
 //   checkpoint.json   while the run is interrupted (observers/checkpoint_saver.hpp)

@@ -1,0 +1,113 @@
+#include "nonsep/host/observers/hdf5_sample_writer.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/output/files.hpp"
+
+namespace nonsep::host {
+
+namespace {
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<std::uint64_t> Hdf5SampleWriter::sample_steps(std::uint64_t steps, std::uint64_t every) {
+  std::vector<std::uint64_t> list;
+  for (std::uint64_t step = 0; step <= steps; step += every) {
+    list.push_back(step);
+    if (steps - step < every) break;  // the next multiple would pass the end (or overflow)
+  }
+  if (list.back() != steps) list.push_back(steps);
+  return list;
+}
+
+Hdf5SampleWriter::Hdf5SampleWriter(const std::filesystem::path& path, std::size_t dimension,
+                                   std::size_t trajectories, std::uint64_t every, const TimeGrid& time,
+                                   bool resuming)
+    : path_(path), dimension_(dimension), every_(every), steps_(time.steps),
+      q_(trajectories * dimension, nan), p_(trajectories * dimension, nan), H_(trajectories, nan) {
+  const std::vector<std::uint64_t> steps = sample_steps(time.steps, every);
+  layout_ = {steps.size(), trajectories, dimension};
+  if (resuming) return;
+  std::vector<double> times;
+  times.reserve(steps.size());
+  for (std::uint64_t step : steps) times.push_back(time.time_at(step));
+  file_.emplace(Hdf5File::create(path));
+  datasets_.emplace(SampleDatasets::create(*file_, layout_, steps, times));
+}
+
+std::uint64_t Hdf5SampleWriter::row_of(std::uint64_t step) const {
+  if (step % every_ == 0 && step <= steps_) return step / every_;
+  return step == steps_ ? layout_.samples - 1 : none;
+}
+
+void Hdf5SampleWriter::put(std::size_t trajectory, std::span<const double> q, std::span<const double> p,
+                           std::optional<double> H) {
+  std::copy(q.begin(), q.end(), q_.begin() + static_cast<std::ptrdiff_t>(trajectory * dimension_));
+  std::copy(p.begin(), p.end(), p_.begin() + static_cast<std::ptrdiff_t>(trajectory * dimension_));
+  H_[trajectory] = H.value_or(nan);
+}
+
+void Hdf5SampleWriter::clear_row() {
+  std::fill(q_.begin(), q_.end(), nan);
+  std::fill(p_.begin(), p_.end(), nan);
+  std::fill(H_.begin(), H_.end(), nan);
+}
+
+void Hdf5SampleWriter::on_event(const Event& event) {
+  const std::uint64_t row = row_of(event.step);
+  if (row == none || row < rows_written_) return;  // not a sample, or written before a resume
+  for (const StateView& state : event.states) put(state.trajectory, state.q, state.p, state.energy);
+  datasets_->write({.first_sample = row, .samples = 1, .first_trajectory = 0, .trajectories = layout_.trajectories,
+                    .q = q_, .p = p_, .H = H_});
+  rows_written_ = row + 1;
+  clear_row();
+}
+
+void Hdf5SampleWriter::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
+  // Only a stop exactly at the next sample step, which the event there will write; a stop at a sample already
+  // written was written with it (the trajectory was active there), as trajectory.csv writes no second row.
+  if (const std::uint64_t row = row_of(record.final_step); row != none && row >= rows_written_)
+    put(trajectory, record.final_q, record.final_p, record.energy_final);
+}
+
+void Hdf5SampleWriter::on_end() {
+  datasets_.reset();
+  if (file_) file_->close();
+  file_.reset();
+}
+
+nlohmann::json Hdf5SampleWriter::save() {
+  // Checkpoints are taken after a chunk's events (checkpoint_saver.hpp), so no stopped trajectory waits in the
+  // next row: everything the run has is in the file.
+  file_->flush();
+  return {{"rows", rows_written_}};
+}
+
+void Hdf5SampleWriter::restore(const nlohmann::json& state) {
+  const auto refuse = [&](const std::string& why) {
+    throw CheckpointError("cannot resume into " + path_.string() + ": " + why +
+                          "; run with --force to start over");
+  };
+  if (!state.is_object() || !state.contains("rows") || !state["rows"].is_number_unsigned() ||
+      state["rows"].get<std::uint64_t>() > layout_.samples)
+    throw CheckpointError("its results_h5 state is damaged (no number of rows from 0 to " +
+                          std::to_string(layout_.samples) + ")");
+  try {
+    file_.emplace(Hdf5File::open(path_));
+    datasets_.emplace(SampleDatasets::open(*file_));
+  } catch (const OutputError& error) {
+    datasets_.reset();
+    file_.reset();
+    refuse(error.what());
+  }
+  if (!(datasets_->layout() == layout_))
+    refuse("its /samples has " + std::to_string(datasets_->layout().samples) + " samples of " +
+           std::to_string(datasets_->layout().trajectories) + " trajectories of dimension " +
+           std::to_string(datasets_->layout().dimension) + ", the run " + std::to_string(layout_.samples) + " of " +
+           std::to_string(layout_.trajectories) + " of dimension " + std::to_string(layout_.dimension));
+  rows_written_ = state["rows"].get<std::uint64_t>();
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,261 @@
+#include "nonsep/host/output/hdf5_tables.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/files.hpp"
+
+namespace nonsep::host {
+
+namespace {
+
+constexpr std::size_t rows_per_block = 65536;
+
+// Rows of a CSV file as csv.hpp writes them (RFC 4180 quoting, '\n' line ends), read through a buffer of 1 MiB.
+class CsvRows {
+ public:
+  explicit CsvRows(const std::filesystem::path& path) : path_(path), in_(path, std::ios::binary), buffer_(1 << 20) {
+    if (!in_) throw OutputError("cannot read " + path.string() + " to copy it into results.h5");
+  }
+  // The next whole row into `cells` (whose strings are reused), or false at the end (a last line without '\n' is
+  // not a row).
+  bool next(std::vector<std::string>& cells) {
+    std::size_t count = 0;
+    const auto start_cell = [&] {
+      if (count == cells.size()) cells.emplace_back();
+      cells[count++].clear();
+    };
+    start_cell();
+    bool quoted = false;
+    const std::uint64_t first_line = line_;
+    for (int c; (c = get()) != EOF;) {
+      if (quoted) {
+        if (c != '"') {
+          line_ += c == '\n';
+          cells[count - 1] += static_cast<char>(c);
+        } else if (peek() == '"') {
+          cells[count - 1] += static_cast<char>(get());
+        } else {
+          quoted = false;
+        }
+      } else if (c == '"') {
+        quoted = true;
+      } else if (c == ',') {
+        start_cell();
+      } else if (c == '\n') {
+        ++line_;
+        cells.resize(count);
+        return true;
+      } else {
+        // The rest of an unquoted cell in the buffer at once: most cells are numbers with no quote.
+        const std::size_t begin = next_ - 1;
+        while (next_ < end_ && buffer_[next_] != ',' && buffer_[next_] != '\n' && buffer_[next_] != '"') ++next_;
+        cells[count - 1].append(buffer_.data() + begin, next_ - begin);
+      }
+    }
+    if (quoted)
+      throw OutputError(path_.string() + ":" + std::to_string(first_line) + ": a quoted cell is not closed");
+    return false;
+  }
+  std::uint64_t line() const { return line_ - 1; }  // of the row last read
+
+ private:
+  int peek() {
+    if (next_ == end_) refill();
+    return next_ == end_ ? EOF : static_cast<unsigned char>(buffer_[next_]);
+  }
+  int get() {
+    const int c = peek();
+    if (c != EOF) ++next_;
+    return c;
+  }
+  void refill() {
+    in_.read(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    next_ = 0;
+    end_ = static_cast<std::size_t>(in_.gcount());
+    if (in_.bad()) throw OutputError("cannot read " + path_.string() + " to copy it into results.h5");
+  }
+
+  std::filesystem::path path_;
+  std::ifstream in_;
+  std::vector<char> buffer_;
+  std::size_t next_ = 0, end_ = 0;
+  std::uint64_t line_ = 1;
+};
+
+bool is_integer(const std::string& cell) {
+  std::int64_t value = 0;
+  const auto result = std::from_chars(cell.data(), cell.data() + cell.size(), value);
+  return !cell.empty() && result.ec == std::errc() && result.ptr == cell.data() + cell.size();
+}
+
+enum class Kind { integer, number, text };
+
+struct Column {
+  std::string name;
+  Kind kind = Kind::number;
+  Hdf5Handle dataset;
+};
+
+// The header and each column's kind, and the number of rows.
+std::vector<Column> survey(const std::filesystem::path& csv, std::uint64_t& rows) {
+  CsvRows reader(csv);
+  std::vector<std::string> cells;
+  if (!reader.next(cells)) throw OutputError(csv.string() + " has no header line to copy into results.h5");
+  std::vector<Column> columns(cells.size());
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    columns[k].name = cells[k];
+    columns[k].kind = cells[k] == "trajectory" || cells[k] == "step" ? Kind::integer : Kind::number;
+  }
+  rows = 0;
+  while (reader.next(cells)) {
+    if (cells.size() != columns.size())
+      throw OutputError(csv.string() + ":" + std::to_string(reader.line()) + ": found " + std::to_string(cells.size()) +
+                        " cells; expected " + std::to_string(columns.size()) + ", as in the header");
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      Kind& kind = columns[k].kind;
+      if (kind == Kind::integer && !is_integer(cells[k])) kind = Kind::number;
+      if (kind == Kind::number && !cells[k].empty() && !parse_number(cells[k])) kind = Kind::text;
+    }
+    ++rows;
+  }
+  return columns;
+}
+
+Hdf5Handle utf8_string_type(const Hdf5File& file) {
+  Hdf5Handle type = file.own(H5Tcopy(H5T_C_S1), H5Tclose, "make a string type");
+  file.check(H5Tset_size(type.get(), H5T_VARIABLE), "make a string type");
+  file.check(H5Tset_cset(type.get(), H5T_CSET_UTF8), "make a string type");
+  return type;
+}
+
+Hdf5Handle create_column(const Hdf5File& file, hid_t group, const std::string& where, const Column& column,
+                         hid_t type, std::uint64_t rows) {
+  const std::string what = "create " + where + "/" + column.name;
+  // A table without rows still gets its (empty) columns: chunked datasets need a chunk of at least one element,
+  // which only an extendible dataspace allows when there are none.
+  const hsize_t size = rows, unlimited = H5S_UNLIMITED, chunk = std::clamp<hsize_t>(rows, 1, rows_per_block);
+  const Hdf5Handle space = file.own(H5Screate_simple(1, &size, rows == 0 ? &unlimited : nullptr), H5Sclose, what);
+  const Hdf5Handle properties = untimed_dataset_properties(file);
+  file.check(H5Pset_chunk(properties.get(), 1, &chunk), what);
+  if (column.kind != Kind::text) file.check(H5Pset_shuffle(properties.get()), what);
+  file.check(H5Pset_deflate(properties.get(), 1), what);
+  return file.own(H5Dcreate2(group, column.name.c_str(), type, space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+                  H5Dclose, what);
+}
+
+void write_rows(const Hdf5File& file, const Column& column, hid_t memory_type, hsize_t first, hsize_t count,
+                const void* values, const std::string& where) {
+  const std::string what = "write " + where + "/" + column.name;
+  const Hdf5Handle space = file.own(H5Dget_space(column.dataset.get()), H5Sclose, what);
+  file.check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &first, nullptr, &count, nullptr), what);
+  const Hdf5Handle memory = file.own(H5Screate_simple(1, &count, nullptr), H5Sclose, what);
+  file.check(H5Dwrite(column.dataset.get(), memory_type, memory.get(), space.get(), H5P_DEFAULT, values), what);
+}
+
+// Writes the block of rows `cells` ([row][column]) starting at row `first`; `changed` throws (a cell no longer of its
+// column's kind: the file changed between the two readings).
+template <class Changed>
+void write_block(const Hdf5File& file, std::vector<Column>& columns, hid_t string_type,
+                 std::span<const std::vector<std::string>> block, std::uint64_t first, const std::string& where,
+                 Changed&& changed) {
+  const hsize_t count = block.size();
+  std::vector<std::int64_t> integers(block.size());
+  std::vector<double> numbers(block.size());
+  std::vector<const char*> texts(block.size());
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const Column& column = columns[k];
+    for (std::size_t r = 0; r < block.size(); ++r) {
+      const std::string& cell = block[r][k];
+      if (column.kind == Kind::integer) {
+        if (!is_integer(cell)) changed();
+        std::from_chars(cell.data(), cell.data() + cell.size(), integers[r]);
+      } else if (column.kind == Kind::number) {
+        const std::optional<double> number = cell.empty() ? std::numeric_limits<double>::quiet_NaN() : parse_number(cell);
+        if (!number) changed();
+        numbers[r] = *number;
+      } else {
+        texts[r] = cell.c_str();
+      }
+    }
+    if (column.kind == Kind::integer) write_rows(file, column, H5T_NATIVE_INT64, first, count, integers.data(), where);
+    else if (column.kind == Kind::number) write_rows(file, column, H5T_NATIVE_DOUBLE, first, count, numbers.data(), where);
+    else write_rows(file, column, string_type, first, count, texts.data(), where);
+  }
+}
+
+void replace_attribute_if_there(const Hdf5File& file, hid_t object, const std::string& name) {
+  if (file.check(H5Aexists(object, name.c_str()), "look for the attribute " + name) > 0)
+    file.check(H5Adelete(object, name.c_str()), "replace the attribute " + name);
+}
+
+void write_scalar_attribute(const Hdf5File& file, hid_t object, const std::string& name, hid_t stored, hid_t memory,
+                            const void* value) {
+  replace_attribute_if_there(file, object, name);
+  const std::string what = "write the attribute " + name;
+  const Hdf5Handle space = file.own(H5Screate(H5S_SCALAR), H5Sclose, what);
+  const Hdf5Handle attribute =
+      file.own(H5Acreate2(object, name.c_str(), stored, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  file.check(H5Awrite(attribute.get(), memory, value), what);
+}
+
+}  // namespace
+
+void write_csv_table(const Hdf5File& file, const std::string& group, const std::filesystem::path& csv) {
+  std::uint64_t rows = 0;
+  std::vector<Column> columns = survey(csv, rows);
+  const std::string where = group.starts_with('/') ? group : "/" + group;
+  if (file.check(H5Lexists(file.id(), where.c_str(), H5P_DEFAULT), "look for " + where) > 0)
+    file.check(H5Ldelete(file.id(), where.c_str(), H5P_DEFAULT), "replace " + where);
+  const Hdf5Handle properties = untimed_group_properties(file);
+  const Hdf5Handle handle = file.own(H5Gcreate2(file.id(), where.c_str(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+                                     H5Gclose, "create the group " + where);
+  const Hdf5Handle string_type = utf8_string_type(file);
+  for (Column& column : columns) {
+    const hid_t stored = column.kind == Kind::integer ? H5T_STD_I64LE
+                         : column.kind == Kind::number ? H5T_IEEE_F64LE
+                                                       : string_type.get();
+    column.dataset = create_column(file, handle.get(), where, column, stored, rows);
+  }
+  const auto changed = [&] {
+    throw OutputError(csv.string() + " changed while it was copied into " + file.path().string());
+  };
+  CsvRows reader(csv);
+  std::vector<std::vector<std::string>> block(std::min<std::uint64_t>(rows, rows_per_block));
+  std::vector<std::string> cells;
+  reader.next(cells);  // the header
+  std::uint64_t first = 0;
+  for (bool more = true; more;) {
+    std::size_t used = 0;
+    while (used < block.size() && (more = reader.next(cells))) {
+      if (cells.size() != columns.size()) changed();
+      std::swap(block[used++], cells);  // the row's strings change hands; no cell is copied
+    }
+    if (first + used > rows) changed();
+    if (used > 0) write_block(file, columns, string_type.get(), std::span(block).first(used), first, where, changed);
+    first += used;
+    more = more && used > 0;
+  }
+}
+
+void write_attribute(const Hdf5File& file, hid_t object, const std::string& name, const std::string& value) {
+  const Hdf5Handle type = utf8_string_type(file);
+  const char* text = value.c_str();
+  write_scalar_attribute(file, object, name, type.get(), type.get(), &text);
+}
+
+void write_attribute(const Hdf5File& file, hid_t object, const std::string& name, double value) {
+  write_scalar_attribute(file, object, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+}
+
+void write_attribute(const Hdf5File& file, hid_t object, const std::string& name, std::uint64_t value) {
+  write_scalar_attribute(file, object, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &value);
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,50 @@
+#include "run/results_file.hpp"
+
+#include <array>
+
+#include "nonsep/host/output/hdf5_file.hpp"
+#include "nonsep/host/output/hdf5_tables.hpp"
+
+namespace nonsep::host {
+
+void write_results_file(const std::filesystem::path& path, bool has_samples, const RunFacts& facts,
+                        const nlohmann::ordered_json& summary) {
+  Hdf5File file = has_samples ? Hdf5File::open(path) : Hdf5File::create(path);
+  const std::filesystem::path& directory = facts.directory;
+  write_csv_table(file, "/trajectories", directory / trajectories_file_name);
+  for (const char* table : {"poincare", "lyapunov"}) {
+    const std::filesystem::path csv = directory / (std::string(table) + ".csv");
+    if (std::filesystem::exists(csv)) {
+      write_csv_table(file, table, csv);
+    } else if (H5Lexists(file.id(), table, H5P_DEFAULT) > 0) {
+      file.check(H5Ldelete(file.id(), table, H5P_DEFAULT), std::string("remove the stale group /") + table);
+    }
+  }
+
+  const Hdf5Handle root = file.own(H5Oopen(file.id(), "/", H5P_DEFAULT), H5Oclose, "open the root group");
+  const auto attribute = [&](const std::string& name, const auto& value) {
+    write_attribute(file, root.get(), name, value);
+  };
+  const Job& job = facts.loaded.job;
+  const SingleRun& run = job.run();
+  unsigned major = 0, minor = 0, release = 0;
+  file.check(H5get_libversion(&major, &minor, &release), "read the HDF5 library's version");
+  attribute("nonsep_version", std::string(NONSEP_VERSION));
+  attribute("hdf5_version", std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(release));
+  attribute("format_version", results_format_version);
+  attribute("model", facts.loaded.plugin.name());
+  attribute("plugin_version", facts.loaded.plugin.version());
+  attribute("parameters", nlohmann::json(facts.loaded.model.parameters()).dump());
+  attribute("integrator", summary["integrator"].dump());
+  attribute("hamiltonian", summary["hamiltonian"].get<std::string>());
+  attribute("dt", run.time.dt);
+  attribute("steps", std::uint64_t{run.time.steps});
+  attribute("t_end", run.time.t_end);
+  attribute("every", std::uint64_t{run.every});
+  attribute("dimension", std::uint64_t{job.initial.dimension});
+  attribute("trajectories", std::uint64_t{job.initial.count});
+  attribute("summary", summary.dump(2) + "\n");
+  file.close();
+}
+
+}  // namespace nonsep::host
