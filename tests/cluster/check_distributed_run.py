@@ -10,6 +10,7 @@
   4. An unreadable job under mpirun: exit 2, the message printed once.
   5. SIGUSR1 to mpirun (passed on to the ranks): exit 143; --resume with another job's units: exit 2, "cannot
      resume"; the run resumed on two ranks ends byte for byte as an uninterrupted one.
+  6. output.format "hdf5" on two ranks: results.h5 holds the numbers and attributes of one process's.
 Usage: check_distributed_run.py NONSEP MPIEXEC JOB.json WORKDIR
 """
 import json
@@ -156,6 +157,46 @@ check(r.returncode == 2 and len(lines) == 1 and "cannot resume" in lines[0],
 r = mpirun(2, ["run", "-q", "--threads", "1", str(long_job), "--output", str(other), "--resume"], timeout=900)
 check(r.returncode == long_status, f"resumed on two ranks: exit {long_status} ({r.returncode})")
 same_results(reference, other, "interrupted on 2 ranks, resumed on 2")
+
+# 6. output.format "hdf5": the ranks write results.h5 together (MPI-IO); every dataset and attribute equals one
+# process's (the summary attribute but for wall_seconds and the folder)
+try:
+    import h5py
+    import numpy
+except ImportError as missing:
+    h5py = None
+    check(False, f"h5py for the HDF5 checks: {missing}")
+if h5py is not None:
+    h5_job = work / "hdf5.json"
+    document = json.loads(job.read_text())
+    document["output"]["format"] = "hdf5"
+    h5_job.write_text(json.dumps(document))
+    one, two = work / "h5_single", work / "h5_ranks2"
+    r1 = run([nonsep, "run", "-q", "--threads", "1", str(h5_job), "--output", str(one)])
+    r2 = mpirun(2, ["run", "-q", "--threads", "1", str(h5_job), "--output", str(two)])
+    check(r1.returncode == r2.returncode == 1, f"hdf5: exit 1 on one process and on 2 ranks ({r1.returncode}, {r2.returncode})")
+    with h5py.File(one / "results.h5", "r") as a, h5py.File(two / "results.h5", "r") as b:
+        names = []
+        a.visititems(lambda name, item: names.append(name) if isinstance(item, h5py.Dataset) else None)
+        check("samples/q" in names and "trajectories/status" in names and "poincare/t" in names,
+              f"hdf5: samples and tables present ({len(names)} datasets)")
+        for name in names:
+            x, y = a[name][()], b[name][()]
+            same = (numpy.array_equal(x, y, equal_nan=True) if x.dtype.kind == "f" else numpy.array_equal(x, y))
+            if not same:
+                check(False, f"hdf5: {name} equal on 2 ranks")
+        check(all(numpy.array_equal(a[n][()], b[n][()], equal_nan=a[n].dtype.kind == "f") for n in names),
+              "hdf5: every dataset equal on 2 ranks")
+        check(numpy.isnan(b["samples/q"][()]).any() and not numpy.isnan(b["samples/q"][0]).any(),
+              "hdf5: NaN after trajectories stopped, none at step 0")
+        for key in a.attrs:
+            if key != "summary":
+                check(a.attrs[key] == b.attrs[key], f"hdf5: attribute {key} equal")
+        sa, sb = json.loads(a.attrs["summary"]), json.loads(b.attrs["summary"])
+        for s in (sa, sb):
+            s.pop("wall_seconds")
+            s["output"].pop("directory")
+        check(sa == sb, "hdf5: summary attribute equal but for wall_seconds and the folder")
 
 print(f"{len(failures)} failed")
 sys.exit(1 if failures else 0)

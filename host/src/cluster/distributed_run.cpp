@@ -8,9 +8,14 @@
 
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/cluster/merge_outputs.hpp"
+#include "nonsep/host/cluster/merge_results_h5.hpp"
 #include "nonsep/host/output/files.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
+#include "run/run_files.hpp"
+#ifdef NONSEP_HAVE_HDF5
+#include "run/results_file.hpp"
+#endif
 
 namespace nonsep::host {
 
@@ -164,9 +169,6 @@ RunOutcome merge_units(const RunOptions& options, const Plan& plan, double wall_
   if (const json& largest = summary["energy"]["largest_relative_error"]; largest.is_object())
     outcome.largest_energy_error =
         LargestEnergyError{largest["value"].get<double>(), largest["trajectory"].get<std::size_t>()};
-  std::error_code ignored;
-  std::filesystem::remove_all(directory / units_folder, ignored);
-  std::filesystem::remove(directory / checkpoint_file_name, ignored);
   return outcome;
 }
 
@@ -199,6 +201,26 @@ RunOutcome interrupted_outcome(const LoadedJob& loaded, const RunOptions& option
                                       {"resume", "nonsep run JOB --resume, with any number of ranks"}}}};
   write_file_atomically(options.output_directory / "summary.json", outcome.summary.dump(2) + "\n");
   return outcome;
+}
+
+// output.format "hdf5": the ranks copy the units' /samples into results.h5 together, then rank 0 adds the tables
+// and attributes from the merged CSV files and summary (merge_results_h5.hpp). Collective.
+void finish_results_h5(const LoadedJob& loaded, const RunOptions& options, const Plan& plan, const json& summary,
+                       const Ranks& ranks) {
+  const SingleRun& run = loaded.job.run();
+  if (run.format != OutputFormat::hdf5) return;
+#ifdef NONSEP_HAVE_HDF5
+  const auto path = options.output_directory / results_file_name;
+  if (run.every > 0) {
+    std::vector<UnitRange> units;
+    for (std::size_t u = 0; u < plan.units; ++u)
+      units.push_back({unit_folder(options.output_directory, u), plan.first(u), plan.size(u)});
+    merge_samples_h5(path, loaded, units, ranks);
+  }
+  if (ranks.rank() == 0) write_results_file(path, run.every > 0, loaded, options.output_directory, summary);
+#else
+  (void)options, (void)plan, (void)summary, (void)ranks;
+#endif
 }
 
 }  // namespace
@@ -283,6 +305,19 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
     }
   }
   fail_if_any(local_failure);
+  if (!interrupted) {
+    try {
+      finish_results_h5(loaded, options, plan, outcome.summary, ranks);
+    } catch (const std::exception& error) {
+      local_failure = std::string(error.what()) + " (the units' results stay in " +
+                      (options.output_directory / units_folder).string() + ")";
+    }
+    fail_if_any(local_failure);
+    if (ranks.rank() == 0) {
+      std::error_code ignored;
+      std::filesystem::remove_all(options.output_directory / units_folder, ignored);
+    }
+  }
   outcome.exit_status = static_cast<ExitStatus>(ranks.max(static_cast<int>(outcome.exit_status)));
   outcome.distributed = true;
   return outcome;

@@ -1,6 +1,8 @@
 #include "nonsep/host/output/hdf5_samples.hpp"
 
 #include <algorithm>
+
+#include <algorithm>
 #include <array>
 #include <limits>
 #include <string>
@@ -47,20 +49,30 @@ Hdf5Handle open_dataset(const Hdf5File& file, const char* name, std::vector<hsiz
   return dataset;
 }
 
+// An empty `values` selects nothing: a rank's share of a collective write that has no slab this round.
 void write_block(const Hdf5File& file, hid_t dataset, const char* name, std::span<const hsize_t> start,
-                 std::span<const hsize_t> count, std::span<const double> values) {
+                 std::span<const hsize_t> count, std::span<const double> values, hid_t transfer) {
   const std::string what = std::string("write samples to ") + samples_group + "/" + name;
   const Hdf5Handle space = file.own(H5Dget_space(dataset), H5Sclose, what);
-  file.check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), what);
-  const hsize_t size = values.size();
+  const hsize_t size = std::max<hsize_t>(1, values.size());
   const Hdf5Handle memory = file.own(H5Screate_simple(1, &size, nullptr), H5Sclose, what);
-  file.check(H5Dwrite(dataset, H5T_NATIVE_DOUBLE, memory.get(), space.get(), H5P_DEFAULT, values.data()), what);
+  if (values.empty()) {
+    file.check(H5Sselect_none(space.get()), what);
+    file.check(H5Sselect_none(memory.get()), what);
+  } else {
+    file.check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), what);
+  }
+  const double nothing = 0.0;
+  file.check(H5Dwrite(dataset, H5T_NATIVE_DOUBLE, memory.get(), space.get(), transfer,
+                      values.empty() ? &nothing : values.data()),
+             what);
 }
 
 }  // namespace
 
 SampleDatasets SampleDatasets::create(const Hdf5File& file, const SampleLayout& layout,
-                                      std::span<const std::uint64_t> steps, std::span<const double> times) {
+                                      std::span<const std::uint64_t> steps, std::span<const double> times,
+                                      hid_t transfer) {
   if (steps.size() != layout.samples || times.size() != layout.samples || layout.samples == 0 ||
       layout.trajectories == 0 || layout.dimension == 0)
     file.fail("create " + std::string(samples_group) + " of " + std::to_string(layout.samples) + " samples with " +
@@ -76,12 +88,13 @@ SampleDatasets SampleDatasets::create(const Hdf5File& file, const SampleLayout& 
   const std::array<hsize_t, 2> energy{S, N}, energy_chunk{samples_per_chunk, trajectories_per_chunk};
 
   const Hdf5Handle step = create_dataset(file, group.get(), "step", H5T_NATIVE_UINT64, list, list_chunk);
-  file.check(H5Dwrite(step.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps.data()),
+  file.check(H5Dwrite(step.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, transfer, steps.data()),
              "write /samples/step");
   const Hdf5Handle t = create_dataset(file, group.get(), "t", H5T_NATIVE_DOUBLE, list, list_chunk);
-  file.check(H5Dwrite(t.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, times.data()), "write /samples/t");
+  file.check(H5Dwrite(t.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, transfer, times.data()), "write /samples/t");
   SampleDatasets datasets(file);
   datasets.layout_ = layout;
+  datasets.transfer_ = transfer;
   datasets.q_ = create_dataset(file, group.get(), "q", H5T_NATIVE_DOUBLE, state, state_chunk);
   datasets.p_ = create_dataset(file, group.get(), "p", H5T_NATIVE_DOUBLE, state, state_chunk);
   datasets.H_ = create_dataset(file, group.get(), "H", H5T_NATIVE_DOUBLE, energy, energy_chunk);
@@ -111,12 +124,12 @@ void SampleDatasets::write(const SampleSlab& slab) {
                 " of trajectories " + std::to_string(slab.first_trajectory) + " + " +
                 std::to_string(slab.trajectories) + " with " + std::to_string(slab.q.size()) + " numbers of q into " +
                 std::to_string(l.samples) + " samples of " + std::to_string(l.trajectories) + " trajectories");
-  if (cells == 0) return;
+  if (cells == 0 && transfer_ == H5P_DEFAULT) return;  // in a collective write, an empty share still takes part
   const std::array<hsize_t, 3> start{slab.first_sample, slab.first_trajectory, 0},
       count{slab.samples, slab.trajectories, l.dimension};
-  write_block(*file_, q_.get(), "q", start, count, slab.q);
-  write_block(*file_, p_.get(), "p", start, count, slab.p);
-  write_block(*file_, H_.get(), "H", std::span(start).first<2>(), std::span(count).first<2>(), slab.H);
+  write_block(*file_, q_.get(), "q", start, count, slab.q, transfer_);
+  write_block(*file_, p_.get(), "p", start, count, slab.p, transfer_);
+  write_block(*file_, H_.get(), "H", std::span(start).first<2>(), std::span(count).first<2>(), slab.H, transfer_);
 }
 
 }  // namespace nonsep::host

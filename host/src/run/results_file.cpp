@@ -7,10 +7,9 @@
 
 namespace nonsep::host {
 
-void write_results_file(const std::filesystem::path& path, bool has_samples, const RunFacts& facts,
-                        const nlohmann::ordered_json& summary) {
+void write_results_file(const std::filesystem::path& path, bool has_samples, const LoadedJob& loaded,
+                        const std::filesystem::path& directory, const nlohmann::ordered_json& summary) {
   Hdf5File file = has_samples ? Hdf5File::open(path) : Hdf5File::create(path);
-  const std::filesystem::path& directory = facts.directory;
   write_csv_table(file, "/trajectories", directory / trajectories_file_name);
   for (const char* table : {"poincare", "lyapunov"}) {
     const std::filesystem::path csv = directory / (std::string(table) + ".csv");
@@ -25,16 +24,16 @@ void write_results_file(const std::filesystem::path& path, bool has_samples, con
   const auto attribute = [&](const std::string& name, const auto& value) {
     write_attribute(file, root.get(), name, value);
   };
-  const Job& job = facts.loaded.job;
+  const Job& job = loaded.job;
   const SingleRun& run = job.run();
   unsigned major = 0, minor = 0, release = 0;
   file.check(H5get_libversion(&major, &minor, &release), "read the HDF5 library's version");
   attribute("nonsep_version", std::string(NONSEP_VERSION));
   attribute("hdf5_version", std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(release));
   attribute("format_version", results_format_version);
-  attribute("model", facts.loaded.plugin.name());
-  attribute("plugin_version", facts.loaded.plugin.version());
-  attribute("parameters", nlohmann::json(facts.loaded.model.parameters()).dump());
+  attribute("model", loaded.plugin.name());
+  attribute("plugin_version", loaded.plugin.version());
+  attribute("parameters", nlohmann::json(loaded.model.parameters()).dump());
   attribute("integrator", summary["integrator"].dump());
   attribute("hamiltonian", summary["hamiltonian"].get<std::string>());
   attribute("dt", run.time.dt);

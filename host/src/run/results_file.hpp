@@ -18,7 +18,8 @@ namespace nonsep::host {
 inline constexpr std::uint64_t results_format_version = 1;
 
 // Throws OutputError.
-void write_results_file(const std::filesystem::path& path, bool has_samples, const RunFacts& facts,
-                        const nlohmann::ordered_json& summary);
+// The tables come from the CSV files in `directory`.
+void write_results_file(const std::filesystem::path& path, bool has_samples, const LoadedJob& loaded,
+                        const std::filesystem::path& directory, const nlohmann::ordered_json& summary);
 
 }  // namespace nonsep::host

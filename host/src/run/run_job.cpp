@@ -209,7 +209,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
 #ifdef NONSEP_HAVE_HDF5
   // After trajectories.csv, which it copies, and before summary.json, so that a failure here is in summary.json.
   if (hdf5) try {
-      write_results_file(directory / results_file_name, run.every > 0, facts, outcome.summary);
+      write_results_file(directory / results_file_name, run.every > 0, loaded, directory, outcome.summary);
     } catch (const OutputError& error) {
       fail(error);
     }

@@ -40,9 +40,10 @@ struct SampleSlab {
 class SampleDatasets {
  public:
   // Creates /samples in `file` for `layout`, with step and t written (`steps` and `times`, S each) and q, p, H all
-  // NaN.
+  // NaN. `transfer`: the data transfer list of every write (collective MPI-IO for ranks writing one file together:
+  // then every rank calls create and each write, with an empty slab when it has nothing to write).
   static SampleDatasets create(const Hdf5File& file, const SampleLayout& layout, std::span<const std::uint64_t> steps,
-                               std::span<const double> times);
+                               std::span<const double> times, hid_t transfer = H5P_DEFAULT);
   // Opens /samples of `file`; OutputError when it is missing or not of this layout (names, types, ranks).
   static SampleDatasets open(const Hdf5File& file);
 
@@ -55,6 +56,7 @@ class SampleDatasets {
   const Hdf5File* file_;
   SampleLayout layout_;
   Hdf5Handle q_, p_, H_;
+  hid_t transfer_ = H5P_DEFAULT;
 };
 
 }  // namespace nonsep::host
