@@ -11,7 +11,8 @@
   5. SIGUSR1 to mpirun (passed on to the ranks): exit 143; --resume with another job's units: exit 2, "cannot
      resume"; the run resumed on two ranks ends byte for byte as an uninterrupted one.
   6. output.format "hdf5" on two ranks: results.h5 holds the numbers and attributes of one process's.
-Usage: check_distributed_run.py NONSEP MPIEXEC JOB.json WORKDIR
+  7. A rank that crashes (the blowup test plugin raises SIGSEGV in grad V): mpirun ends every rank, non-zero, no hang.
+Usage: check_distributed_run.py NONSEP MPIEXEC JOB.json WORKDIR [BLOWUP_PLUGIN.so]
 """
 import json
 import os
@@ -197,6 +198,18 @@ if h5py is not None:
             s.pop("wall_seconds")
             s["output"].pop("directory")
         check(sa == sb, "hdf5: summary attribute equal but for wall_seconds and the folder")
+
+if len(sys.argv) > 5:
+    crash_job = work / "crash.json"
+    crash_job.write_text(json.dumps({
+        "model": {"plugin": sys.argv[5], "parameters": {"crash_after": 2000, "crash_how": 1}},
+        "integrator": {"scheme": "basic"},
+        "initial": {"grid": {"q": [{"from": 0.1, "to": 1.0, "count": 600}], "p": [0.0]}},
+        "time": {"dt": 0.001, "steps": 100000}, "output": {"every": 0}}))
+    started = time.monotonic()
+    r = mpirun(2, ["run", "-q", "--threads", "1", str(crash_job), "--output", str(work / "crash")], timeout=120)
+    check(r.returncode != 0 and time.monotonic() - started < 100,
+          f"a rank crashing: mpirun ends non-zero without hanging ({r.returncode}, {time.monotonic() - started:.1f} s)")
 
 print(f"{len(failures)} failed")
 sys.exit(1 if failures else 0)
