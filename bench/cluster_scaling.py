@@ -17,8 +17,9 @@ machine), then measures, REPEATS times and interleaved (a b c d e, a b c d e, ..
   d  mpirun -n 2 nonsep run --threads 1, one core kept busy     2 ranks while a Python busy loop runs
 
 Wall time is that of the whole command (mpirun's start, the units, rank 0's merge). It prints the median and the
-spread (min-max) of each, the ratios a/x, and checks that every run wrote the files of (a) byte for byte
-(summary.json but for wall_seconds and the output folder). Print `uptime` before and after: other work on the
+spread (min-max) of each, the ratios a/x, the CPU seconds other processes used during each run (/proc/stat's
+busy time minus this script's children's: the busy loop of d counts as ours), and checks that every run wrote
+the files of (a) byte for byte (summary.json but for wall_seconds and the output folder). Print `uptime` before and after: other work on the
 machine shows in the numbers. Exit status 1 when an output differs.
 
 Running as root, it sets OMPI_ALLOW_RUN_AS_ROOT(_CONFIRM); it also sets OMPI_MCA_rmaps_base_oversubscribe=1 so that
@@ -27,6 +28,7 @@ Running as root, it sets OMPI_ALLOW_RUN_AS_ROOT(_CONFIRM); it also sets OMPI_MCA
 import argparse
 import json
 import os
+import resource
 import shutil
 import statistics
 import subprocess
@@ -77,6 +79,17 @@ cases = {
 }
 
 
+def busy_cpu_seconds():
+    """CPU seconds the whole machine has spent busy since boot (/proc/stat; Linux)."""
+    fields = [int(x) for x in open("/proc/stat").readline().split()[1:]]
+    return (sum(fields[:8]) - fields[3] - fields[4]) / os.sysconf("SC_CLK_TCK")  # all but idle and iowait
+
+
+def children_cpu_seconds():
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def uptime():
     return subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
 
@@ -101,6 +114,7 @@ def same_results(a, b):
 print("before:", uptime(), flush=True)
 print(f"job: {job} ({args.grid}x{args.grid} grid on the shell, {args.steps} steps)", flush=True)
 times = {key: [] for key in cases}
+others = {key: [] for key in cases}  # CPU seconds used by processes not started here, during each run
 statuses = set()
 differences = []
 reference = None
@@ -108,6 +122,7 @@ for repeat in range(args.repeats):
     for key, (what, command) in cases.items():
         out = work / f"{key.replace(chr(39), 'p')}_{repeat}"
         busy = None
+        machine, ours = busy_cpu_seconds(), children_cpu_seconds()
         if key == "d":
             busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
             time.sleep(0.5)
@@ -117,11 +132,13 @@ for repeat in range(args.repeats):
         if busy is not None:
             busy.kill()
             busy.wait()
+        foreign = max(0.0, (busy_cpu_seconds() - machine) - (children_cpu_seconds() - ours))
+        others[key].append(foreign)
         statuses.add(r.returncode)
         if r.returncode not in (0, 1):
             sys.exit(f"{key} ({what}) failed with exit status {r.returncode}: {r.stderr[-800:]}")
         times[key].append(seconds)
-        print(f"  repeat {repeat + 1} {key:2} {what:36} {seconds:7.2f} s", flush=True)
+        print(f"  repeat {repeat + 1} {key:2} {what:36} {seconds:7.2f} s   others' CPU {foreign:6.1f} s", flush=True)
         if reference is None:
             reference = out
         else:
@@ -134,12 +151,12 @@ trajectories = json.loads((reference / "summary.json").read_text())["trajectorie
 
 median_a = statistics.median(times["a"])
 print(f"\n{trajectories} trajectories x {args.steps} steps, {args.repeats} repeats, wall seconds of the command\n")
-print("| case | run | median s | min-max s | 1 process / this |")
-print("|---|---|---|---|---|")
+print("| case | run | median s | min-max s | 1 process / this | others' CPU s (max) |")
+print("|---|---|---|---|---|---|")
 for key, (what, _) in cases.items():
     t = times[key]
     print(f"| {key} | {what} | {statistics.median(t):.2f} | {min(t):.2f}-{max(t):.2f} | "
-          f"{median_a / statistics.median(t):.2f}x |")
+          f"{median_a / statistics.median(t):.2f}x | {max(others[key]):.1f} |")
 print()
 if differences:
     print("FAILED: outputs differ from one process's:", *differences, sep="\n  ")
