@@ -12,9 +12,10 @@
 // poincare.csv, lyapunov.csv, trajectories.csv and summary.json are byte for byte those of one process with one
 // thread (summary.json's wall_seconds aside), and removes units/.
 //
-// Interrupts. SIGINT or SIGTERM (mpirun and Slurm pass them to every rank): each rank's current unit saves its
+// Interrupts. SIGINT or SIGTERM delivered to the ranks (Slurm's scancel does), or SIGUSR1 (which mpirun passes on
+// to every rank; OpenMPI 4.1's mpirun does not pass SIGTERM or SIGINT on): each rank's current unit saves its
 // checkpoint and stops, no rank takes another unit, rank 0 writes summary.json with status "interrupted" and what
-// is done, and every rank exits with 130 or 143. units/ (plan.json, the finished units, the checkpoints of the
+// is done, and every rank exits with 130 (SIGINT) or 143. units/ (plan.json, the finished units, the checkpoints of the
 // others) is the checkpoint: `nonsep run JOB.json --resume` continues it with any number of ranks, one process
 // included, and ends bit for bit as an uninterrupted run.
 //
