@@ -42,6 +42,11 @@ std::string read_text(const std::filesystem::path& path) {
 struct Plan {
   std::size_t trajectories = 0, unit_size = 0, units = 0;
 
+  // The cut of an ensemble of `count` trajectories: the same on every rank and for any number of ranks.
+  static Plan of(std::size_t count) {
+    const std::size_t size = host::unit_size(count);
+    return {count, size, (count + size - 1) / size};
+  }
   std::size_t first(std::size_t unit) const { return unit * unit_size; }
   std::size_t size(std::size_t unit) const { return std::min(unit_size, trajectories - first(unit)); }
 };
@@ -54,16 +59,13 @@ json plan_json(const Plan& plan, const std::string& fingerprint) {
           {"job_fingerprint", fingerprint}};
 }
 
-// Rank 0: takes the output folder and writes (fresh) or checks (resume) units/plan.json. Throws what RunFolder and
+// Rank 0: takes the output folder and writes `plan` to units/plan.json (fresh) or checks it against it (resume). Throws what RunFolder and
 // the checkpoint checks throw.
-Plan prepare_folder(const LoadedJob& loaded, const RunOptions& options, std::optional<RunFolder>& folder) {
+void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Plan& plan,
+                    std::optional<RunFolder>& folder) {
   const std::filesystem::path& directory = options.output_directory;
   folder.emplace(directory, "run", loaded.job.file, folder_use(options));
   const std::string fingerprint = job_fingerprint(loaded);
-  Plan plan;
-  plan.trajectories = loaded.job.initial.count;
-  plan.unit_size = unit_size(plan.trajectories);
-  plan.units = (plan.trajectories + plan.unit_size - 1) / plan.unit_size;
   const auto path = directory / units_folder / plan_name;
   if (options.resume) {
     json saved;
@@ -75,13 +77,12 @@ Plan prepare_folder(const LoadedJob& loaded, const RunOptions& options, std::opt
     if (saved != plan_json(plan, fingerprint))
       throw CheckpointError(path.string() + " was written by another job, or by this job before it was changed; "
                             "run it again without --resume (--force discards the units)");
-    return plan;
+    return;
   }
   std::error_code error;
   std::filesystem::create_directories(directory / units_folder, error);
   if (error) throw OutputError("cannot create " + (directory / units_folder).string() + ": " + error.message());
   write_file_atomically(path, plan_json(plan, fingerprint).dump(2) + "\n");
-  return plan;
 }
 
 enum class UnitState { fresh, checkpointed, done };
@@ -116,19 +117,6 @@ std::string failure_text(const std::exception& error) {
   return error.what();
 }
 
-TrajectoryStatus status_named(const std::string& name) {
-  for (TrajectoryStatus status : {TrajectoryStatus::completed, TrajectoryStatus::diverged, TrajectoryStatus::failed,
-                                  TrajectoryStatus::inaccurate, TrajectoryStatus::interrupted})
-    if (name == to_string(status)) return status;
-  return TrajectoryStatus::failed;
-}
-
-ExitStatus exit_status_for(TrajectoryStatus status) {
-  if (status == TrajectoryStatus::completed) return ExitStatus::success;
-  if (status == TrajectoryStatus::interrupted) return ExitStatus::interrupted;
-  return ExitStatus::run_failed;
-}
-
 // Rank 0, every unit done: the run's files from the units'.
 RunOutcome merge_units(const RunOptions& options, const Plan& plan, double wall_seconds) {
   const std::filesystem::path& directory = options.output_directory;
@@ -159,8 +147,8 @@ RunOutcome merge_units(const RunOptions& options, const Plan& plan, double wall_
   outcome.summary = merge_summaries(summaries, firsts, plan.trajectories, directory, wall_seconds);
   write_file_atomically(directory / "summary.json", outcome.summary.dump(2) + "\n");
   const json& summary = outcome.summary;
-  outcome.status = status_named(summary["status"].get<std::string>());
-  outcome.exit_status = exit_status_for(outcome.status);
+  outcome.status = trajectory_status_from_string(summary["status"].get<std::string>()).value_or(TrajectoryStatus::failed);
+  outcome.exit_status = exit_status_of(outcome.status);
   outcome.error = summary.value("error", "");
   outcome.steps_completed = summary["time"]["steps_completed"].get<std::uint64_t>();
   for (TrajectoryStatus status : {TrajectoryStatus::completed, TrajectoryStatus::diverged, TrajectoryStatus::failed,
@@ -247,18 +235,15 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
 
   std::optional<RunFolder> folder;  // rank 0 holds the output folder's lock for the whole run
   std::string local_failure;
-  Plan plan;
+  const Plan plan = Plan::of(loaded.job.initial.count);  // rank 0 checks it against the folder's plan.json
   if (ranks.rank() == 0) {
     try {
-      plan = prepare_folder(loaded, options, folder);
+      prepare_folder(loaded, options, plan, folder);
     } catch (const std::exception& error) {
       local_failure = failure_text(error);
     }
   }
   fail_if_any(local_failure);
-  plan.trajectories = loaded.job.initial.count;  // every rank computes the same plan; rank 0 checked the folder's
-  plan.unit_size = unit_size(plan.trajectories);
-  plan.units = (plan.trajectories + plan.unit_size - 1) / plan.unit_size;
 
   bool interrupted = false;
   {

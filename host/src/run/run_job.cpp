@@ -41,12 +41,6 @@ TrajectoryStatus run_status(DriverEnd end, const StatusCounts& counts) {
   return TrajectoryStatus::completed;
 }
 
-ExitStatus exit_status_of(TrajectoryStatus status) {
-  if (status == TrajectoryStatus::completed) return ExitStatus::success;
-  if (status == TrajectoryStatus::interrupted) return ExitStatus::interrupted;
-  return ExitStatus::run_failed;
-}
-
 // An earlier run's file that this run does not write would mislead.
 void remove_stale(const std::filesystem::path& path) {
   std::error_code ignored;
@@ -86,6 +80,12 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
 }
 
 }  // namespace
+
+ExitStatus exit_status_of(TrajectoryStatus status) {
+  if (status == TrajectoryStatus::completed) return ExitStatus::success;
+  if (status == TrajectoryStatus::interrupted) return ExitStatus::interrupted;
+  return ExitStatus::run_failed;
+}
 
 FolderUse folder_use(const RunOptions& options) {
   return options.resume ? FolderUse::resume : options.force ? FolderUse::force : FolderUse::fresh;

@@ -64,6 +64,9 @@ struct RunOutcome {
   bool distributed = false;
 };
 
+// The exit status of a run that ended with `status`: success, interrupted or run_failed.
+ExitStatus exit_status_of(TrajectoryStatus status);
+
 // The output folder as `options` ask to use it (output/run_folder.hpp).
 FolderUse folder_use(const RunOptions& options);
 
