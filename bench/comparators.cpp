@@ -188,8 +188,8 @@ int main(int argc, char** argv) {
           if (!hand_midpoint(hand.q()[b], hand.p()[b])) std::abort();
     });
     agree &= same(generic, hand, "gauss 2");
-    std::printf("%-8s %9zu %8d %16.1f %16.1f %7.2f\n", "gauss 2", count, steps, gauss_generic * per,
-                gauss_hand * per, gauss_generic / gauss_hand);
+    std::printf("%-8s %9zu %8d %16.1f %16.1f %7.2f\n", "gauss 2", count, steps, gauss_generic * per, gauss_hand * per,
+                gauss_generic / gauss_hand);
   }
   const auto exact = nonsep::reference::paper1d_quarter(2.0);
   std::printf("\n%-8s %9s %13s %13s %12s\n", "method", "steps", "grad H/step", "iterations", "phase error");

@@ -13,19 +13,18 @@
 //   --smoke        1024 trajectories, 2 repetitions (the ctest bench.output_formats.smoke)
 //   --repetitions  per configuration (default 5)
 //   --threads      worker threads of every run (default 2)
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/run/run_job.hpp"
@@ -71,9 +70,12 @@ int main(int argc, char** argv) {
   unsigned threads = 2;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
-    if (argument == "--smoke") smoke = true;
-    else if (argument == "--repetitions" && i + 1 < argc) repetitions = std::atoi(argv[++i]);
-    else if (argument == "--threads" && i + 1 < argc) threads = static_cast<unsigned>(std::atoi(argv[++i]));
+    if (argument == "--smoke")
+      smoke = true;
+    else if (argument == "--repetitions" && i + 1 < argc)
+      repetitions = std::atoi(argv[++i]);
+    else if (argument == "--threads" && i + 1 < argc)
+      threads = static_cast<unsigned>(std::atoi(argv[++i]));
     else {
       std::fprintf(stderr, "usage: %s [--smoke] [--repetitions N] [--threads N]\n", argv[0]);
       return 2;
@@ -105,8 +107,8 @@ int main(int argc, char** argv) {
                      std::string(nonsep::host::to_string(outcome.status)).c_str(), outcome.error.c_str());
         ok = false;
       }
-      const auto samples = options.output_directory / (configurations[k].format == "hdf5" ? "results.h5"
-                                                                                           : "trajectory.csv");
+      const auto samples =
+          options.output_directory / (configurations[k].format == "hdf5" ? "results.h5" : "trajectory.csv");
       configurations[k].bytes = std::filesystem::exists(samples) ? std::filesystem::file_size(samples) : 0;
     }
   // Pairs of the same `every` (H is evaluated at the samples, so max_abs_relative_energy_error depends on it).

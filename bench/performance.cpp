@@ -32,6 +32,10 @@
 //   --only          one group of figures: 1, 2, 3 (3, 3b, 3c), 4, 6b or 6c (e.g. to run one under callgrind)
 // Exit status 1 when a check fails; the figures' targets are reported, not enforced (timings on a shared machine
 // are not a test).
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -40,21 +44,16 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <nlohmann/json.hpp>
-
+#include "hand_written.hpp"
 #include "nonsep/core/chin_basic_step.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/run_job.hpp"
-#include "hand_written.hpp"
 #include "paper1d/paper1d.hpp"
 
 namespace {
@@ -106,15 +105,18 @@ double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vect
 }
 
 // Seconds for the hand-written loop on `job`'s states: one (q, p) through the scalar loop when the job has one
-// trajectory, else all of them through both loops over states (the faster one's time). dt and t2 are taken from the loaded job, not from
-// constants, so that cbrt runs at run time as in the host (a compile-time cbrt may round differently).
+// trajectory, else all of them through both loops over states (the faster one's time). dt and t2 are taken from the
+// loaded job, not from constants, so that cbrt runs at run time as in the host (a compile-time cbrt may round
+// differently).
 double time_hand_written(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
   const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
   std::vector<double> q(job.job.initial.q), p(job.job.initial.p), g(q.size());
   const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
-  if (q.size() == 1) bench::hand_written_run(c, q[0], p[0], steps);
-  else bench::hand_written_run(c, q.data(), p.data(), g.data(), q.size(), steps);
+  if (q.size() == 1)
+    bench::hand_written_run(c, q[0], p[0], steps);
+  else
+    bench::hand_written_run(c, q.data(), p.data(), g.data(), q.size(), steps);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
   final_q = q;
   if (q.size() == 1) return elapsed.count();
@@ -191,10 +193,10 @@ class BusyCore {
 
 struct Figure {
   std::string name, unit, target;
-  double value;          // median measured / median reference
-  double low, high;      // smallest and largest per-repetition ratio
-  double measured;       // median of the configuration, in `unit`
-  double reference;      // median of the reference, in `unit`
+  double value;      // median measured / median reference
+  double low, high;  // smallest and largest per-repetition ratio
+  double measured;   // median of the configuration, in `unit`
+  double reference;  // median of the reference, in `unit`
 };
 
 // Runs `a` and `b` interleaved `repetitions` times (after one warm-up each); their times, in seconds.
@@ -216,8 +218,8 @@ Figure figure(std::string name, std::string target, std::string unit, const std:
   std::vector<double> ratios;
   for (std::size_t r = 0; r < a.size(); ++r) ratios.push_back(a[r] / b[r]);
   const auto [low, high] = std::minmax_element(ratios.begin(), ratios.end());
-  return {std::move(name), std::move(unit), std::move(target), median(a) / median(b), *low, *high,
-          median(a) * per, median(b) * per};
+  return {std::move(name), std::move(unit), std::move(target), median(a) / median(b), *low,
+          *high,           median(a) * per, median(b) * per};
 }
 
 }  // namespace
@@ -229,10 +231,14 @@ int main(int argc, char** argv) {
   std::string only;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--smoke") smoke = true;
-    else if (arg == "--repetitions" && i + 1 < argc) repetitions = std::max(1, std::atoi(argv[++i]));
-    else if (arg == "--scale" && i + 1 < argc) scale = std::atof(argv[++i]);
-    else if (arg == "--only" && i + 1 < argc) only = argv[++i];
+    if (arg == "--smoke")
+      smoke = true;
+    else if (arg == "--repetitions" && i + 1 < argc)
+      repetitions = std::max(1, std::atoi(argv[++i]));
+    else if (arg == "--scale" && i + 1 < argc)
+      scale = std::atof(argv[++i]);
+    else if (arg == "--only" && i + 1 < argc)
+      only = argv[++i];
     else {
       std::fprintf(stderr, "usage: %s [--smoke] [--repetitions N] [--scale X] [--only F]\n", argv[0]);
       return 2;
@@ -273,8 +279,10 @@ int main(int argc, char** argv) {
     const bool exact = host == reference;
     all_exact = all_exact && exact;
     if (exact || (close && !exact_expected)) return;
-    std::fprintf(stderr, "%s: the host's final states differ from the hand-written loop's (%zu, %zu states; "
-                 "first q %.17g, %.17g)\n", what, host.size(), reference.size(), host.empty() ? 0.0 : host[0],
+    std::fprintf(stderr,
+                 "%s: the host's final states differ from the hand-written loop's (%zu, %zu states; "
+                 "first q %.17g, %.17g)\n",
+                 what, host.size(), reference.size(), host.empty() ? 0.0 : host[0],
                  reference.empty() ? 0.0 : reference[0]);
     agree = false;
   };
@@ -288,8 +296,8 @@ int main(int argc, char** argv) {
     const auto [host, limit] = interleaved(
         repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_hand_written(job, reference_q); });
     check("figure 1", host_q, reference_q);
-    figures.push_back(figure("1. one trajectory: host / hand-written", "<= 1.2", "ns per basic step", host, limit,
-                             per));
+    figures.push_back(
+        figure("1. one trajectory: host / hand-written", "<= 1.2", "ns per basic step", host, limit, per));
     const auto [core, limit_c] = interleaved(
         repetitions, [&] { return time_core(job, core_q); }, [&] { return time_hand_written(job, reference_q); });
     check("figure 1c", core_q, reference_q);
@@ -342,9 +350,9 @@ int main(int argc, char** argv) {
                                "ns per basic step per trajectory", busy_one, busy_two, per));
     }
     std::vector<double> limit_two_q;
-    const auto [limit_one, limit_two] =
-        interleaved(repetitions, [&] { return time_hand_written_blocks(job, 1, reference_q); },
-                    [&] { return time_hand_written_blocks(job, 2, limit_two_q); });
+    const auto [limit_one, limit_two] = interleaved(
+        repetitions, [&] { return time_hand_written_blocks(job, 1, reference_q); },
+        [&] { return time_hand_written_blocks(job, 2, limit_two_q); });
     check("figure 3c (1 thread)", host_q, reference_q);
     check("figure 3c (2 threads)", host_q, limit_two_q);
     figures.push_back(figure("3c. 8192 trajectories, hand-written: 1 thread / 2 threads (the machine's speed-up)",
@@ -402,12 +410,14 @@ int main(int argc, char** argv) {
 
   double load[3] = {0, 0, 0};
   if (::getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = -1;
-  std::printf("paper1d, basic step, dt = %g; median of %d interleaved repetitions%s; %u hardware threads; "
-              "SIMD: %s; load average at the end %.2f %.2f %.2f\n",
-              dt, repetitions, smoke ? " (smoke run: short, not for the record)" : "",
-              std::thread::hardware_concurrency(), simd, load[0], load[1], load[2]);
-  std::printf("| figure | ratio | spread (min-max) | target | measured | reference | unit |\n"
-              "|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "paper1d, basic step, dt = %g; median of %d interleaved repetitions%s; %u hardware threads; "
+      "SIMD: %s; load average at the end %.2f %.2f %.2f\n",
+      dt, repetitions, smoke ? " (smoke run: short, not for the record)" : "", std::thread::hardware_concurrency(),
+      simd, load[0], load[1], load[2]);
+  std::printf(
+      "| figure | ratio | spread (min-max) | target | measured | reference | unit |\n"
+      "|---|---|---|---|---|---|---|\n");
   for (const auto& f : figures)
     std::printf("| %s | %.3f | %.3f-%.3f | %s | %.4g | %.4g | %s |\n", f.name.c_str(), f.value, f.low, f.high,
                 f.target.c_str(), f.measured, f.reference, f.unit.c_str());

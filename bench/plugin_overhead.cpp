@@ -100,8 +100,8 @@ int main(int argc, char** argv) {
     const double automatic_over_analytic_compiled = median(configurations[2].steps_per_second) / reference;
     const double automatic_over_analytic_plugin =
         median(configurations[3].steps_per_second) / median(configurations[1].steps_per_second);
-    std::printf("%-8zu ratios: plugin/compiled-in %.3f, AD/analytic compiled-in %.3f, AD/analytic plugin %.3f\n",
-                count, plugin_over_compiled, automatic_over_analytic_compiled, automatic_over_analytic_plugin);
+    std::printf("%-8zu ratios: plugin/compiled-in %.3f, AD/analytic compiled-in %.3f, AD/analytic plugin %.3f\n", count,
+                plugin_over_compiled, automatic_over_analytic_compiled, automatic_over_analytic_plugin);
     // Same model and arithmetic through the plugin: bit-for-bit the same final state. AD rounds differently from
     // the analytic formula, so its trajectories agree closely but not exactly.
     const bool identical = configurations[1].checksum == configurations[0].checksum &&

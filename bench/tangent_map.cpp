@@ -86,10 +86,11 @@ bool measure(const char* name, const M& model, int repetitions, std::uint64_t st
   }
   const auto [low_1, high_1] = std::minmax_element(ratio_1.begin(), ratio_1.end());
   const auto [low_2n, high_2n] = std::minmax_element(ratio_2n.begin(), ratio_2n.end());
-  std::printf("%-8s plain %6.1f ns per basic step per trajectory | k = 1: %5.2fx [%4.2f, %4.2f] | k = %zu: %5.2fx "
-              "[%4.2f, %4.2f]%s\n",
-              name, median(plain_ns), median(ratio_1), *low_1, *high_1, 2 * n, median(ratio_2n), *low_2n, *high_2n,
-              identical ? "" : "  STATES DIFFER");
+  std::printf(
+      "%-8s plain %6.1f ns per basic step per trajectory | k = 1: %5.2fx [%4.2f, %4.2f] | k = %zu: %5.2fx "
+      "[%4.2f, %4.2f]%s\n",
+      name, median(plain_ns), median(ratio_1), *low_1, *high_1, 2 * n, median(ratio_2n), *low_2n, *high_2n,
+      identical ? "" : "  STATES DIFFER");
   return identical;
 }
 
@@ -116,9 +117,10 @@ int main(int argc, char** argv) {
   // can differ in the last bit from the run-time cbrt.
   volatile double opaque_dt = 1e-4;
   const double dt = opaque_dt;
-  std::printf("tangent map cost, 1024 trajectories, basic step, dt = 1e-4, %d repetitions of %llu steps "
-              "(median ratio [lowest, highest])\n",
-              repetitions, static_cast<unsigned long long>(steps));
+  std::printf(
+      "tangent map cost, 1024 trajectories, basic step, dt = 1e-4, %d repetitions of %llu steps "
+      "(median ratio [lowest, highest])\n",
+      repetitions, static_cast<unsigned long long>(steps));
   const nonsep::sdk::ModelAdapter<Paper1D> paper1d;
   const auto paper2d = nonsep::sdk::ModelAdapter<Paper2D>::from_json("{}");
   bool identical = measure("paper1d", paper1d, repetitions, steps, dt);

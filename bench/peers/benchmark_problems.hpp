@@ -23,25 +23,55 @@ namespace nonsep::bench {
 // The paper's 1D test (eq. algham): T = p + p^3/6, V = q^2/2 + q^4/12, H = (1 + p^2/2)^2 (1 + q^2).
 struct Paper1D {
   static constexpr const char* name = "paper1d";
-  template <class Real> static Real T(Real p) { return p + p * p * p / 6; }
-  template <class Real> static Real grad_T(Real p) { return 1 + p * p / 2; }
-  template <class Real> static Real hessian_T(Real p) { return p; }
-  template <class Real> static Real third_T(Real) { return 1; }
-  template <class Real> static Real V(Real q) { return q * q / 2 + q * q * q * q / 12; }
-  template <class Real> static Real grad_V(Real q) { return q + q * q * q / 3; }
-  template <class Real> static Real hessian_V(Real q) { return 1 + q * q; }
-  template <class Real> static Real third_V(Real q) { return 2 * q; }
+  template <class Real>
+  static Real T(Real p) {
+    return p + p * p * p / 6;
+  }
+  template <class Real>
+  static Real grad_T(Real p) {
+    return 1 + p * p / 2;
+  }
+  template <class Real>
+  static Real hessian_T(Real p) {
+    return p;
+  }
+  template <class Real>
+  static Real third_T(Real) {
+    return 1;
+  }
+  template <class Real>
+  static Real V(Real q) {
+    return q * q / 2 + q * q * q * q / 12;
+  }
+  template <class Real>
+  static Real grad_V(Real q) {
+    return q + q * q * q / 3;
+  }
+  template <class Real>
+  static Real hessian_V(Real q) {
+    return 1 + q * q;
+  }
+  template <class Real>
+  static Real third_V(Real q) {
+    return 2 * q;
+  }
 
-  template <class Real> static Real H(Real q, Real p) {
+  template <class Real>
+  static Real H(Real q, Real p) {
     const Real u = 1 + p * p / 2;
     return u * u * (1 + q * q);
   }
-  template <class Real> static Real dH_dq(Real q, Real p) {
+  template <class Real>
+  static Real dH_dq(Real q, Real p) {
     const Real u = 1 + p * p / 2;
     return 2 * q * u * u;
   }
-  template <class Real> static Real dH_dp(Real q, Real p) { return 2 * p * (1 + p * p / 2) * (1 + q * q); }
-  template <class Real> static std::array<Real, 4> jacobian(Real q, Real p) {
+  template <class Real>
+  static Real dH_dp(Real q, Real p) {
+    return 2 * p * (1 + p * p / 2) * (1 + q * q);
+  }
+  template <class Real>
+  static std::array<Real, 4> jacobian(Real q, Real p) {
     const Real u = 1 + p * p / 2;
     return {4 * q * p * u, 2 * (1 + 3 * p * p / 2) * (1 + q * q),  //
             -2 * u * u, -4 * q * p * u};
@@ -53,24 +83,54 @@ struct Paper1D {
 // T = (p sqrt(1 + p^2) + asinh p) / (2 sqrt 2) is needed only to check grad_T.
 struct TaoProduct {
   static constexpr const char* name = "tao_product";
-  template <class Real> static Real T(Real p) {
+  template <class Real>
+  static Real T(Real p) {
     return (p * std::sqrt(1 + p * p) + std::asinh(p)) / (2 * std::sqrt(Real(2)));
   }
-  template <class Real> static Real grad_T(Real p) { return std::sqrt((1 + p * p) / 2); }
-  template <class Real> static Real hessian_T(Real p) { return p / (2 * grad_T(p)); }
-  template <class Real> static Real third_T(Real p) {
+  template <class Real>
+  static Real grad_T(Real p) {
+    return std::sqrt((1 + p * p) / 2);
+  }
+  template <class Real>
+  static Real hessian_T(Real p) {
+    return p / (2 * grad_T(p));
+  }
+  template <class Real>
+  static Real third_T(Real p) {
     const Real g = grad_T(p);
     return 1 / (2 * g) - p * p / (4 * g * g * g);
   }
-  template <class Real> static Real V(Real q) { return q * q / 2 + q * q * q * q / 12; }
-  template <class Real> static Real grad_V(Real q) { return q + q * q * q / 3; }
-  template <class Real> static Real hessian_V(Real q) { return 1 + q * q; }
-  template <class Real> static Real third_V(Real q) { return 2 * q; }
+  template <class Real>
+  static Real V(Real q) {
+    return q * q / 2 + q * q * q * q / 12;
+  }
+  template <class Real>
+  static Real grad_V(Real q) {
+    return q + q * q * q / 3;
+  }
+  template <class Real>
+  static Real hessian_V(Real q) {
+    return 1 + q * q;
+  }
+  template <class Real>
+  static Real third_V(Real q) {
+    return 2 * q;
+  }
 
-  template <class Real> static Real H(Real q, Real p) { return (q * q + 1) * (p * p + 1) / 2; }
-  template <class Real> static Real dH_dq(Real q, Real p) { return q * (1 + p * p); }
-  template <class Real> static Real dH_dp(Real q, Real p) { return p * (1 + q * q); }
-  template <class Real> static std::array<Real, 4> jacobian(Real q, Real p) {
+  template <class Real>
+  static Real H(Real q, Real p) {
+    return (q * q + 1) * (p * p + 1) / 2;
+  }
+  template <class Real>
+  static Real dH_dq(Real q, Real p) {
+    return q * (1 + p * p);
+  }
+  template <class Real>
+  static Real dH_dp(Real q, Real p) {
+    return p * (1 + q * q);
+  }
+  template <class Real>
+  static std::array<Real, 4> jacobian(Real q, Real p) {
     return {2 * p * q, 1 + q * q,  //
             -(1 + p * p), -2 * p * q};
   }

@@ -130,12 +130,14 @@ void measure(const Setup& s, const std::vector<double>& targets, bool smoke, std
   const std::size_t max_steps = smoke ? 512 : (1u << 22);
   const double floor_error = smoke ? 1e-5 : 1e-11;
   for (const IntegratorSpec& spec : symplectic_schemes())
-    ladder([&](std::size_t steps) {
-      Point point{label(spec), "steps=" + std::to_string(steps), steps, 0.0, spec};
-      point.error = run_nonsep<P>(s, spec, steps, 1);
-      point.seconds = median_seconds([&] { return run_nonsep<P>(s, spec, steps, 1); });
-      return point;
-    }, floor_error, max_steps, nonsep_points);
+    ladder(
+        [&](std::size_t steps) {
+          Point point{label(spec), "steps=" + std::to_string(steps), steps, 0.0, spec};
+          point.error = run_nonsep<P>(s, spec, steps, 1);
+          point.seconds = median_seconds([&] { return run_nonsep<P>(s, spec, steps, 1); });
+          return point;
+        },
+        floor_error, max_steps, nonsep_points);
 #ifdef NONSEP_BENCH_HAVE_GSL
   gsl_set_error_handler_off();
   const std::pair<const char*, const gsl_odeiv2_step_type*> methods[] = {{"gsl rk2imp", gsl_odeiv2_step_rk2imp},
@@ -143,15 +145,17 @@ void measure(const Setup& s, const std::vector<double>& targets, bool smoke, std
   for (const auto& [name, type] : methods)
     for (const double tolerance : {1e-5, 1e-8, 1e-11, 1e-14}) {
       GslFixedStep<P> gsl(type, tolerance);
-      ladder([&](std::size_t steps) {
-        const RunResult r = gsl.run(s.q0, s.p0, s.t_end, steps);
-        char setting[64];
-        std::snprintf(setting, sizeof setting, "steps=%zu tol=%g", steps, tolerance);
-        Point point{name, setting, steps, tolerance, {}};
-        point.error = r.succeeded ? std::hypot(r.q - s.q_end, r.p - s.p_end) : std::nan("");
-        point.seconds = median_seconds([&] { return gsl.run(s.q0, s.p0, s.t_end, steps).q; });
-        return point;
-      }, floor_error, max_steps, gsl_points);
+      ladder(
+          [&](std::size_t steps) {
+            const RunResult r = gsl.run(s.q0, s.p0, s.t_end, steps);
+            char setting[64];
+            std::snprintf(setting, sizeof setting, "steps=%zu tol=%g", steps, tolerance);
+            Point point{name, setting, steps, tolerance, {}};
+            point.error = r.succeeded ? std::hypot(r.q - s.q_end, r.p - s.p_end) : std::nan("");
+            point.seconds = median_seconds([&] { return gsl.run(s.q0, s.p0, s.t_end, steps).q; });
+            return point;
+          },
+          floor_error, max_steps, gsl_points);
     }
 #endif
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
@@ -229,8 +233,10 @@ int main(int argc, char** argv) {
   csv << "problem,target,nonsep_single,nonsep_single_seconds,gsl_single,gsl_single_seconds,nonsep_ensemble,"
          "nonsep_ensemble_seconds_per_trajectory,threads\n";
   std::printf("threads for the ensemble: %u\n", std::max(1u, std::thread::hardware_concurrency()));
-  std::printf("| problem | target | fastest nonsep (1 trajectory) | s | fastest GSL symplectic | s | ratio GSL/nonsep "
-              "| nonsep 1024-ensemble: s per trajectory | ratio GSL/nonsep per trajectory |\n|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| problem | target | fastest nonsep (1 trajectory) | s | fastest GSL symplectic | s | ratio GSL/nonsep "
+      "| nonsep 1024-ensemble: s per trajectory | ratio GSL/nonsep per trajectory "
+      "|\n|---|---|---|---|---|---|---|---|---|\n");
   measure<Paper1D>({"paper1d", 2.0, 0.0, quarter.period, 0.0, quarter.p_final}, targets, smoke, csv);
   // tao_product's end point: RKF78 at tolerance 1e-14 (docs/performance-peers.md), good to about 5e-12.
   measure<TaoProduct>({"tao_product", -3.0, 0.0, 5.0, 2.831292408550297, -0.3303220398135333}, targets, smoke, csv);

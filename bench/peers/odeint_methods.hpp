@@ -47,8 +47,7 @@ RunResult odeint_dopri5(double q0, double p0, double t_end, double tolerance) {
   RunResult result;
   OdeintState x{q0, p0};
   auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<OdeintState>());
-  odeint::integrate_adaptive(stepper, CountedHamiltonEquations<P>{&result.evaluations}, x, 0.0, t_end,
-                             t_end / 100.0);
+  odeint::integrate_adaptive(stepper, CountedHamiltonEquations<P>{&result.evaluations}, x, 0.0, t_end, t_end / 100.0);
   result.q = x[0];
   result.p = x[1];
   return result;

@@ -51,24 +51,22 @@ struct Options {
 };
 
 struct Policy {
-  double ladder_factor;       // ratio of successive step counts
-  double tolerance_factor;    // ratio of successive dopri5 tolerances
-  int repetitions;            // timed batches per setting; the median is reported
-  double min_sample_seconds;  // each batch repeats the run until it lasts this long
-  double max_run_seconds;     // a ladder stops after the first run longer than this
-  std::size_t max_steps;      // ... or beyond this many steps
-  double stop_error;          // ... or once both errors are below this
+  double ladder_factor;             // ratio of successive step counts
+  double tolerance_factor;          // ratio of successive dopri5 tolerances
+  int repetitions;                  // timed batches per setting; the median is reported
+  double min_sample_seconds;        // each batch repeats the run until it lasts this long
+  double max_run_seconds;           // a ladder stops after the first run longer than this
+  std::size_t max_steps;            // ... or beyond this many steps
+  double stop_error;                // ... or once both errors are below this
   std::vector<std::string> orders;  // orders of triplet and MPE
   std::vector<double> extra_t2;     // t2 values tried besides the default (triplet and MPE)
   std::size_t drift_periods, drift_steps_per_period;
 };
 
-Policy smoke_policy() {
-  return {4.0, 100.0, 5, 2e-4, 2e-3, 1u << 14, 1e-11, {"4/3", "4"}, {}, 100, 512};
-}
+Policy smoke_policy() { return {4.0, 100.0, 5, 2e-4, 2e-3, 1u << 14, 1e-11, {"4/3", "4"}, {}, 100, 512}; }
 Policy full_policy() {
-  return {std::sqrt(2.0), std::sqrt(10.0), 5, 5e-3, 0.1, 1u << 26, 1e-11, {"4/3", "2", "8/3", "10/3", "4"},
-          {-1.5, -2.5}, 10000, 512};
+  return {std::sqrt(2.0), std::sqrt(10.0), 5,  5e-3, 0.1, 1u << 26, 1e-11, {"4/3", "2", "8/3", "10/3", "4"},
+          {-1.5, -2.5},   10000,           512};
 }
 
 // One problem as the benchmark sees it: start, end time, the exact (or reference) end point and how well that
@@ -77,8 +75,8 @@ struct Setup {
   std::string name;
   double q0, p0, t_end;
   double q_end, p_end;
-  double energy;             // H(q0, p0)
-  double end_point_error;    // estimated error of (q_end, p_end)
+  double energy;           // H(q0, p0)
+  double end_point_error;  // estimated error of (q_end, p_end)
 };
 
 struct Row {
@@ -109,20 +107,26 @@ std::pair<RunResult, double> time_run(const std::function<RunResult()>& run, con
     for (std::size_t i = 0; i < per_batch; ++i) sink = sink + run().q;
     samples.push_back(std::chrono::duration<double>(clock::now() - start).count() / static_cast<double>(per_batch));
   }
-  std::nth_element(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples.size() / 2),
-                   samples.end());
+  std::nth_element(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples.size() / 2), samples.end());
   return {result, samples[samples.size() / 2]};
 }
 
 template <class P>
-Row make_row(const Setup& setup, std::string method, std::string family, std::string setting,
-             double dt_or_tolerance, const RunResult& r, double seconds) {
+Row make_row(const Setup& setup, std::string method, std::string family, std::string setting, double dt_or_tolerance,
+             const RunResult& r, double seconds) {
   const double energy_error = std::abs(P::H(r.q, r.p) - setup.energy) / setup.energy;
   const double phase_error = std::hypot(r.q - setup.q_end, r.p - setup.p_end);
-  return {method, std::move(family), setup.name, std::move(setting), dt_or_tolerance, seconds,
+  return {method,
+          std::move(family),
+          setup.name,
+          std::move(setting),
+          dt_or_tolerance,
+          seconds,
           r.succeeded ? energy_error : std::numeric_limits<double>::quiet_NaN(),
           r.succeeded ? phase_error : std::numeric_limits<double>::quiet_NaN(),
-          r.evaluations, r.jacobian_evaluations, r.succeeded,
+          r.evaluations,
+          r.jacobian_evaluations,
+          r.succeeded,
           method.starts_with("basic") || method.starts_with("triplet") || method.starts_with("gsl")};
 }
 
@@ -193,30 +197,36 @@ void run_problem(const Setup& setup, const Policy& policy, std::vector<Row>& row
   for (const auto& spec : specs) {
     const std::string method = spec.scheme == "basic" ? "basic" : spec.scheme + " " + spec.order.to_string();
     const std::string t2 = spec.t2 == ChinCoefficients::default_t2() ? "default" : format_double(spec.t2);
-    step_ladder(policy, 2, [&](std::size_t steps, double* first) -> Row {
-      const double dt = setup.t_end / static_cast<double>(steps);
-      auto run = [&] {
-        const BatchedModel<P> model;
-        Integrator integrator(spec);
-        const double q[1] = {setup.q0}, p[1] = {setup.p0};
-        auto x = PhaseSpaceBatch::single(q, p);
-        for (std::size_t i = 0; i < steps; ++i) integrator.step(model, x, dt);
-        const auto& counts = integrator.evaluations();
-        return RunResult{x.q()[0], x.p()[0], counts.grad_T + counts.grad_V, 0, true};
-      };
-      const auto [result, seconds] = time_run(run, policy, first);
-      return make_row<P>(setup, method, "nonsep", "steps=" + std::to_string(steps) + " t2=" + t2, dt, result,
-                         seconds);
-    }, rows);
+    step_ladder(
+        policy, 2,
+        [&](std::size_t steps, double* first) -> Row {
+          const double dt = setup.t_end / static_cast<double>(steps);
+          auto run = [&] {
+            const BatchedModel<P> model;
+            Integrator integrator(spec);
+            const double q[1] = {setup.q0}, p[1] = {setup.p0};
+            auto x = PhaseSpaceBatch::single(q, p);
+            for (std::size_t i = 0; i < steps; ++i) integrator.step(model, x, dt);
+            const auto& counts = integrator.evaluations();
+            return RunResult{x.q()[0], x.p()[0], counts.grad_T + counts.grad_V, 0, true};
+          };
+          const auto [result, seconds] = time_run(run, policy, first);
+          return make_row<P>(setup, method, "nonsep", "steps=" + std::to_string(steps) + " t2=" + t2, dt, result,
+                             seconds);
+        },
+        rows);
   }
 
   std::cout << "[" << setup.name << "] peers" << std::endl;
-  step_ladder(policy, 2, [&](std::size_t steps, double* first) -> Row {
-    auto run = [&] { return odeint_runge_kutta4<P>(setup.q0, setup.p0, setup.t_end, steps); };
-    const auto [result, seconds] = time_run(run, policy, first);
-    return make_row<P>(setup, "odeint runge_kutta4", "peer", "steps=" + std::to_string(steps),
-                       setup.t_end / static_cast<double>(steps), result, seconds);
-  }, rows);
+  step_ladder(
+      policy, 2,
+      [&](std::size_t steps, double* first) -> Row {
+        auto run = [&] { return odeint_runge_kutta4<P>(setup.q0, setup.p0, setup.t_end, steps); };
+        const auto [result, seconds] = time_run(run, policy, first);
+        return make_row<P>(setup, "odeint runge_kutta4", "peer", "steps=" + std::to_string(steps),
+                           setup.t_end / static_cast<double>(steps), result, seconds);
+      },
+      rows);
   {
     LadderStop stop(policy);
     for (double tolerance = 1e-3; tolerance >= 1e-15; tolerance /= policy.tolerance_factor) {
@@ -235,13 +245,16 @@ void run_problem(const Setup& setup, const Policy& policy, std::vector<Row>& row
   for (const auto& [name, type] : gsl_methods) {
     for (const double tolerance : {1e-5, 1e-8, 1e-11, 1e-14}) {
       GslFixedStep<P> gsl(type, tolerance);
-      step_ladder(policy, 2, [&](std::size_t steps, double* first) -> Row {
-        auto run = [&] { return gsl.run(setup.q0, setup.p0, setup.t_end, steps); };
-        const auto [result, seconds] = time_run(run, policy, first);
-        return make_row<P>(setup, name, "peer",
-                           "steps=" + std::to_string(steps) + " tol=" + format_double(tolerance),
-                           setup.t_end / static_cast<double>(steps), result, seconds);
-      }, rows);
+      step_ladder(
+          policy, 2,
+          [&](std::size_t steps, double* first) -> Row {
+            auto run = [&] { return gsl.run(setup.q0, setup.p0, setup.t_end, steps); };
+            const auto [result, seconds] = time_run(run, policy, first);
+            return make_row<P>(setup, name, "peer",
+                               "steps=" + std::to_string(steps) + " tol=" + format_double(tolerance),
+                               setup.t_end / static_cast<double>(steps), result, seconds);
+          },
+          rows);
     }
   }
 #endif
@@ -262,9 +275,9 @@ void write_work_precision_csv(const std::filesystem::path& path, const std::vect
          "jacobian_evaluations,symplectic,status\n";
   for (const auto& r : rows)
     out << r.method << ',' << r.family << ',' << r.problem << ',' << r.setting << ',' << csv_number(r.dt_or_tolerance)
-        << ',' << csv_number(r.wall_seconds) << ',' << csv_number(r.energy_error) << ','
-        << csv_number(r.phase_error) << ',' << r.evaluations << ',' << r.jacobian_evaluations << ','
-        << (r.symplectic ? "yes" : "no") << ',' << (r.succeeded ? "ok" : "failed") << '\n';
+        << ',' << csv_number(r.wall_seconds) << ',' << csv_number(r.energy_error) << ',' << csv_number(r.phase_error)
+        << ',' << r.evaluations << ',' << r.jacobian_evaluations << ',' << (r.symplectic ? "yes" : "no") << ','
+        << (r.succeeded ? "ok" : "failed") << '\n';
   if (!out) throw std::runtime_error("could not write " + path.string());
 }
 
@@ -283,10 +296,11 @@ const Row* cheapest(const std::vector<Row>& rows, const std::string& problem, co
 }
 
 void print_target_table(const std::vector<Row>& rows, const std::vector<Setup>& setups, bool symplectic_only) {
-  std::printf("\nTarget table%s: wall time of the cheapest run meeting each target (median of repetitions);\n"
-              "ratio = nonsep time / peer time (< 1: nonsep is faster).\n\n",
-              symplectic_only ? ", symplectic methods only (nonsep basic and triplet against GSL rk2imp and rk4imp)"
-                              : ", all methods");
+  std::printf(
+      "\nTarget table%s: wall time of the cheapest run meeting each target (median of repetitions);\n"
+      "ratio = nonsep time / peer time (< 1: nonsep is faster).\n\n",
+      symplectic_only ? ", symplectic methods only (nonsep basic and triplet against GSL rk2imp and rk4imp)"
+                      : ", all methods");
   std::printf("| problem | error | target | cheapest nonsep | time [s] | cheapest peer | time [s] | ratio |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const auto& setup : setups) {
@@ -300,13 +314,17 @@ void print_target_table(const std::vector<Row>& rows, const std::vector<Setup>& 
         const Row* ours = cheapest(rows, setup.name, "nonsep", symplectic_only, energy, target);
         const Row* peer = cheapest(rows, setup.name, "peer", symplectic_only, energy, target);
         auto cell = [](const Row* r) {
-          if (!r) std::printf(" not reached | |");
-          else std::printf(" %s (%s) | %.3g |", r->method.c_str(), r->setting.c_str(), r->wall_seconds);
+          if (!r)
+            std::printf(" not reached | |");
+          else
+            std::printf(" %s (%s) | %.3g |", r->method.c_str(), r->setting.c_str(), r->wall_seconds);
         };
         cell(ours);
         cell(peer);
-        if (ours && peer) std::printf(" %.3g |\n", ours->wall_seconds / peer->wall_seconds);
-        else std::printf(" - |\n");
+        if (ours && peer)
+          std::printf(" %.3g |\n", ours->wall_seconds / peer->wall_seconds);
+        else
+          std::printf(" - |\n");
       }
     }
   }
@@ -325,8 +343,8 @@ void energy_drift(const Policy& policy, const std::filesystem::path& path) {
   std::ofstream out(path);
   out.precision(10);
   out << "method,dt,period,time,energy_error_end,energy_error_max\n";
-  std::printf("\nEnergy drift: paper1d from (2, 0), period %.10g, dt = period/%zu = %.4g, %zu periods\n", period, n,
-              dt, policy.drift_periods);
+  std::printf("\nEnergy drift: paper1d from (2, 0), period %.10g, dt = period/%zu = %.4g, %zu periods\n", period, n, dt,
+              policy.drift_periods);
   std::printf("| method | max rel. energy error, first 10%% of periods | last 10%% | ratio last/first |\n");
   std::printf("|---|---|---|---|\n");
 
@@ -342,8 +360,8 @@ void energy_drift(const Policy& policy, const std::filesystem::path& path) {
         if (std::isnan(e)) e = std::numeric_limits<double>::infinity();  // diverged
         period_max = std::max(period_max, e);
       }
-      out << method << ',' << dt << ',' << k << ',' << static_cast<double>(k) * period << ',' << e << ','
-          << period_max << '\n';
+      out << method << ',' << dt << ',' << k << ',' << static_cast<double>(k) * period << ',' << e << ',' << period_max
+          << '\n';
       if (k <= tenth) first_max = std::max(first_max, period_max);
       if (k > policy.drift_periods - tenth) last_max = std::max(last_max, period_max);
     }
@@ -386,8 +404,10 @@ Setup tao_product_setup() {
   const double energy = TaoProduct::H(q0, p0);
   const double difference = std::hypot(fine[0] - coarse[0], fine[1] - coarse[1]);
   const double energy_error = std::abs(TaoProduct::H(fine[0], fine[1]) - energy) / energy;
-  std::printf("tao_product reference at t = %g: (q, p) = (%.16g, %.16g); |tol 1e-14 - tol 1e-13| = %.2e, "
-              "relative energy error %.2e\n", t_end, fine[0], fine[1], difference, energy_error);
+  std::printf(
+      "tao_product reference at t = %g: (q, p) = (%.16g, %.16g); |tol 1e-14 - tol 1e-13| = %.2e, "
+      "relative energy error %.2e\n",
+      t_end, fine[0], fine[1], difference, energy_error);
   const double error = std::max({difference, energy_error * std::hypot(fine[0], fine[1]), 1e-16});
   return {TaoProduct::name, q0, p0, t_end, fine[0], fine[1], energy, error};
 }

@@ -43,8 +43,9 @@ Fraction Fraction::parse(std::string_view text) {
     // Appended, not built with operator+ on a temporary: GCC 12 -O3 warns falsely (-Wrestrict) about the latter.
     std::string message = "'";
     message.append(text);
-    message.append("' is not an exact fraction; write it as \"a/b\" or \"a\" with integers a and b, for example "
-                   "\"4/3\" or \"2\"");
+    message.append(
+        "' is not an exact fraction; write it as \"a/b\" or \"a\" with integers a and b, for example "
+        "\"4/3\" or \"2\"");
     return InvalidArgument(message);
   };
   std::int64_t numerator = 0;
@@ -52,8 +53,8 @@ Fraction Fraction::parse(std::string_view text) {
   const auto slash = text.find('/');
   if (slash == std::string_view::npos) {
     if (!parse_integer(text, numerator)) throw bad();
-  } else if (!parse_integer(text.substr(0, slash), numerator) ||
-             !parse_integer(text.substr(slash + 1), denominator) || denominator == 0) {
+  } else if (!parse_integer(text.substr(0, slash), numerator) || !parse_integer(text.substr(slash + 1), denominator) ||
+             denominator == 0) {
     throw bad();
   }
   return Fraction(numerator, denominator);

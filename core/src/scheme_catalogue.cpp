@@ -1,11 +1,11 @@
 // The scheme catalogue (scheme_catalogue.hpp): each entry's description, orders, options and factory.
 #include "nonsep/core/scheme_catalogue.hpp"
 
-#include "nonsep/core/integrator.hpp"
-
 #include <array>
 #include <cmath>
 #include <cstdio>
+
+#include "nonsep/core/integrator.hpp"
 
 namespace nonsep {
 
@@ -67,52 +67,79 @@ const std::string comparator_cost_note =
     "contraction); no tangent map (no Lyapunov/MEGNO).";
 
 constexpr int triplet_orders = TripletComposition<>::max_levels + 1;  // order 2j/3 has j - 1 levels
-constexpr int mpe_orders = MultiProductExpansion<>::max_terms;         // order 2m/3 has m terms
+constexpr int mpe_orders = MultiProductExpansion<>::max_terms;        // order 2m/3 has m terms
 }  // namespace
 
 std::span<const Scheme> scheme_catalogue() {
   static const std::array<Scheme, 6> catalogue = {
-      Scheme{{"basic", "Chin basic 9-stage splitting", "eq. (expalg)",
+      Scheme{{"basic",
+              "Chin basic 9-stage splitting",
+              "eq. (expalg)",
               "One palindromic 9-stage splitting of the separable T(p) + V(q) with eps = cbrt(dt); solves H_TTV "
               "(or H_VVT with T and V interchanged). Order 2/3; 4 grad T + 4 grad V evaluations per step.",
-              "chin", true, true, {order_parameter("2/3", "only 2/3 exists"), t2_parameter()}, 1, {}},
+              "chin",
+              true,
+              true,
+              {order_parameter("2/3", "only 2/3 exists"), t2_parameter()},
+              1,
+              {}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
                ChinBasicStep base(spec.form, spec.t2);
                chin_index(spec, 1, "basic");
                return base;
              }},
-      Scheme{{"triplet", "Triplet composition of the basic step", "eqs. (sym43), (sym63), applied recursively",
+      Scheme{{"triplet",
+              "Triplet composition of the basic step",
+              "eqs. (sym43), (sym63), applied recursively",
               "T_{(k+2)/3}(dt) = T_{k/3}(dt/(2-s)) T_{k/3}(-s dt/(2-s)) T_{k/3}(dt/(2-s)), s = 2^(3/(k+3)). "
               "Symplectic and time-reversible; order 2j/3 costs 3^(j-1) basic steps per step.",
-              "chin", true, true, {order_parameter_up_to("4/3", triplet_orders), t2_parameter()}, triplet_orders, {}},
+              "chin",
+              true,
+              true,
+              {order_parameter_up_to("4/3", triplet_orders), t2_parameter()},
+              triplet_orders,
+              {}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
                ChinBasicStep base(spec.form, spec.t2);
                return TripletComposition<>(std::move(base), chin_index(spec, triplet_orders, "triplet") - 1);
              }},
-      Scheme{{"mpe", "Multi-product expansion of the basic step", "eqs. (mpe43), (mpe63), any number of terms",
+      Scheme{{"mpe",
+              "Multi-product expansion of the basic step",
+              "eqs. (mpe43), (mpe63), any number of terms",
               "sum_i c_i T^i(dt/i), c_i = prod_{j != i} i^n/(i^n - j^n), n = 2/3. Not symplectic, not exactly "
               "time-reversible; order 2m/3 with m terms costs m(m+1)/2 basic steps per step.",
-              "chin", false, false, {order_parameter_up_to("4/3", mpe_orders), t2_parameter()}, mpe_orders, {}},
+              "chin",
+              false,
+              false,
+              {order_parameter_up_to("4/3", mpe_orders), t2_parameter()},
+              mpe_orders,
+              {}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
                ChinBasicStep base(spec.form, spec.t2);
                return MultiProductExpansion<>(std::move(base), chin_index(spec, mpe_orders, "mpe"));
              }},
-      Scheme{{"tao", "Tao's explicit symplectic integrator in extended phase space (comparator)",
+      Scheme{{"tao",
+              "Tao's explicit symplectic integrator in extended phase space (comparator)",
               "M. Tao, Phys. Rev. E 94, 043303 (2016)",
               "Two copies (q, p), (x, y) bound by omega |(q, p) - (x, y)|^2 / 2; Strang splitting of the three "
               "exactly solvable parts (order 2), triple jumps for 4 and 6. Explicit; symplectic and symmetric on "
               "the extended phase space, not on (q, p) alone. Cost 3^(order/2) grad H per step plus 1 at the "
               "start. Reports the largest distance between the copies (summary.json comparator.max_copy_distance)." +
                   comparator_cost_note,
-              "comparator", true, true,
+              "comparator",
+              true,
+              true,
               {order_parameter("2", "2, 4 or 6"),
-               number_parameter("omega", "20", "binding of the two copies, finite and > 0; Tao's error bound grows "
-                                               "with omega and needs dt << omega^(-1/order)")},
-              1, {Fraction(2), Fraction(4), Fraction(6)}},
+               number_parameter("omega", "20",
+                                "binding of the two copies, finite and > 0; Tao's error bound grows "
+                                "with omega and needs dt << omega^(-1/order)")},
+              1,
+              {Fraction(2), Fraction(4), Fraction(6)}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
                return TaoExtendedPhaseSpace(spec.form, tao_order(spec.order), spec.omega);
              }},
-      Scheme{{"implicit_midpoint", "Implicit midpoint rule (comparator)",
+      Scheme{{"implicit_midpoint",
+              "Implicit midpoint rule (comparator)",
               "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VIII.6",
               "z' = z + dt f((z + z')/2), Gauss-Legendre with 1 stage; order 2, symplectic and symmetric. Solved by "
               "fixed-point iteration from Z = 0 (no Newton), 1 grad H per state per iteration. Stopping rule per "
@@ -120,20 +147,29 @@ std::span<const Scheme> scheme_catalogue() {
               "<= 64 ulp; failed when an iterate is not finite or after max_iterations: the trajectory then "
               "retires with status failed and the reason, never with an inaccurate step." +
                   comparator_cost_note,
-              "comparator", true, true, {max_iterations_parameter()}, 1, {Fraction(2)}},
+              "comparator",
+              true,
+              true,
+              {max_iterations_parameter()},
+              1,
+              {Fraction(2)}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
                return GaussLegendre(spec.form, 2, whole_number(spec.max_iterations, "max_iterations"));
              }},
-      Scheme{{"gauss", "Gauss-Legendre collocation (comparator)",
+      Scheme{{"gauss",
+              "Gauss-Legendre collocation (comparator)",
               "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6",
               "s-stage Gauss-Legendre Runge-Kutta method on Hamilton's equations of H, order 2s; symplectic and "
               "symmetric. Fixed-point iteration from Z = 0 (no Newton), s grad H per state per iteration, with the "
               "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed)." +
                   comparator_cost_note,
-              "comparator", true, true,
+              "comparator",
+              true,
+              true,
               {number_parameter("stages", "2", "number of stages s: 1, 2 or 3 (orders 2, 4, 6)"),
                max_iterations_parameter()},
-              1, {Fraction(2), Fraction(4), Fraction(6)}},
+              1,
+              {Fraction(2), Fraction(4), Fraction(6)}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
                const int stages = whole_number(spec.stages, "stages");
                if (stages < 1 || stages > 3)

@@ -3,14 +3,16 @@
 //   T(p) = sqrt(1 + p^2),  V(q) = g (1 - cos q)
 // so the integrators solve H_TTV = T'(p)^2 V''(q) = g cos(q) p^2 / (1 + p^2).
 #include <cmath>
-
 #include <nonsep/plugin_sdk.hpp>
 
 struct RelativisticPendulum {
   static constexpr std::size_t dimension = 1;
-  static constexpr nonsep::sdk::Parameter parameters[] = {
-      {.name = "g", .type = nonsep::sdk::ParameterType::number, .default_value = 1.0, .minimum = 0.0,
-       .unit = "1/time^2", .description = "gravitational acceleration over length"}};
+  static constexpr nonsep::sdk::Parameter parameters[] = {{.name = "g",
+                                                           .type = nonsep::sdk::ParameterType::number,
+                                                           .default_value = 1.0,
+                                                           .minimum = 0.0,
+                                                           .unit = "1/time^2",
+                                                           .description = "gravitational acceleration over length"}};
 
   explicit RelativisticPendulum(const nonsep::sdk::ParameterValues& values) : g(values.number("g")) {}
   double g;

@@ -31,12 +31,16 @@ json encode(const std::optional<double>& value) { return value ? encode(*value) 
 
 // A LyapunovRecord as numbers: steps, steps since renormalisation, time, time since, ln |v_1|, then the k sums.
 json encode(const LyapunovRecord& record, std::size_t k) {
-  std::vector<double> numbers{static_cast<double>(record.steps), static_cast<double>(record.steps_since_renormalization),
-                              record.time, record.time_since_renormalization, record.log_norm_first};
-  numbers.insert(numbers.end(), record.log_stretch.begin(), record.log_stretch.begin() + static_cast<std::ptrdiff_t>(k));
+  std::vector<double> numbers{static_cast<double>(record.steps),
+                              static_cast<double>(record.steps_since_renormalization), record.time,
+                              record.time_since_renormalization, record.log_norm_first};
+  numbers.insert(numbers.end(), record.log_stretch.begin(),
+                 record.log_stretch.begin() + static_cast<std::ptrdiff_t>(k));
   return encode(numbers);
 }
-json encode(const MegnoRecord& record) { return encode(std::vector<double>{record.time, record.weighted_growth, record.integrated_y}); }
+json encode(const MegnoRecord& record) {
+  return encode(std::vector<double>{record.time, record.weighted_growth, record.integrated_y});
+}
 
 // Every read of a malformed file ends here, with what was wrong.
 [[noreturn]] void damaged(const std::filesystem::path& path, const std::string& what) {
@@ -97,8 +101,8 @@ void check_consistency(const std::filesystem::path& path, const DriverState& sta
   for (std::size_t index : state.active) active[index] = true;
   for (std::size_t i = 0; i < state.records.size(); ++i)
     if (active[i] != (state.records[i].status == TrajectoryStatus::running))
-      damaged(path, "trajectory " + std::to_string(i) + (active[i] ? " is active but its record says \"" :
-                                                                     " is not active but its record says \"") +
+      damaged(path, "trajectory " + std::to_string(i) +
+                        (active[i] ? " is active but its record says \"" : " is not active but its record says \"") +
                         std::string(to_string(state.records[i].status)) + "\"");
 }
 
@@ -110,8 +114,8 @@ namespace {
 std::uint64_t file_hash(const std::filesystem::path& path) { return file_content_hash(path).value_or(0); }
 
 // The parts of a fingerprint, "name:hash" separated by spaces, in this order.
-constexpr const char* fingerprint_parts[] = {"plugin", "parameters", "integrator", "initial", "time", "output",
-                                             "analysis"};
+constexpr const char* fingerprint_parts[] = {"plugin", "parameters", "integrator", "initial",
+                                             "time",   "output",     "analysis"};
 
 }  // namespace
 
@@ -119,7 +123,8 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   const Job& job = loaded.job;
   const SingleRun& run = job.run();
   std::string parts[7];
-  parts[0] = loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + content_hash_hex(file_hash(loaded.plugin.path()));
+  parts[0] =
+      loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + content_hash_hex(file_hash(loaded.plugin.path()));
   parts[1] = loaded.model.parameters().dump();
   parts[2] = run.integrator.scheme + '\n' + run.integrator.order.to_string() + '\n';
   append_bits(parts[2], run.integrator.t2);
@@ -182,20 +187,21 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
   const std::size_t k = state.active.empty() ? 0 : state.tangent_q.size() / std::max<std::size_t>(1, state.q.size());
   for (const LyapunovRecord& record : state.lyapunov) lyapunov.push_back(encode(record, k));
   for (const MegnoRecord& record : state.megno) megno.push_back(encode(record));
-  const json document = {
-      {"format", format_tag},
-      {"job_fingerprint", fingerprint},
-      {"step", state.step},
-      {"evaluations", {{"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}}},
-      {"active",
-       {{"trajectories", state.active}, {"q", encode(state.q)}, {"p", encode(state.p)},
-        {"energies", encode(state.energies)},
-        {"tangent_q", encode(state.tangent_q)},
-        {"tangent_p", encode(state.tangent_p)},
-        {"lyapunov", std::move(lyapunov)},
-        {"megno", std::move(megno)}}},
-      {"records", std::move(records)},
-      {"observers", checkpoint.observers}};
+  const json document = {{"format", format_tag},
+                         {"job_fingerprint", fingerprint},
+                         {"step", state.step},
+                         {"evaluations", {{"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}}},
+                         {"active",
+                          {{"trajectories", state.active},
+                           {"q", encode(state.q)},
+                           {"p", encode(state.p)},
+                           {"energies", encode(state.energies)},
+                           {"tangent_q", encode(state.tangent_q)},
+                           {"tangent_p", encode(state.tangent_p)},
+                           {"lyapunov", std::move(lyapunov)},
+                           {"megno", std::move(megno)}}},
+                         {"records", std::move(records)},
+                         {"observers", checkpoint.observers}};
   // The checksum covers everything else, as dumped (keys sorted, numbers as strings): an edited or damaged
   // checkpoint is refused instead of changing the results.
   json signed_document = document;
@@ -226,10 +232,10 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     damaged(path, "its content does not match its checksum: it was edited or damaged");
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
   if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)
-    throw CheckpointError(path.string() + " belongs to a different job: its " +
-                          fingerprint_difference(fingerprint, expected) +
-                          " differ (the plugin part covers the plugin file's bytes, output covers output.every, "
-                          "energy_every and format); run with --force to start over, or resume with the job that wrote it");
+    throw CheckpointError(
+        path.string() + " belongs to a different job: its " + fingerprint_difference(fingerprint, expected) +
+        " differ (the plugin part covers the plugin file's bytes, output covers output.every, "
+        "energy_every and format); run with --force to start over, or resume with the job that wrote it");
   Checkpoint checkpoint;
   DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;

@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <span>
 #include <thread>
 #include <vector>
-#include <span>
 
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/number_format.hpp"
@@ -140,9 +140,8 @@ std::vector<EvaluationFunction> evaluation_functions(const Plugin& plugin, std::
   using Out = std::span<double>;
   using M = const PluginModel&;
   using C = std::size_t;
-  std::vector<EvaluationFunction> functions{
-      {"grad_T", "p", n, [](M m, X x, X, Out out, C c) { m.grad_T(x, out, c); }},
-      {"grad_V", "q", n, [](M m, X x, X, Out out, C c) { m.grad_V(x, out, c); }}};
+  std::vector<EvaluationFunction> functions{{"grad_T", "p", n, [](M m, X x, X, Out out, C c) { m.grad_T(x, out, c); }},
+                                            {"grad_V", "q", n, [](M m, X x, X, Out out, C c) { m.grad_V(x, out, c); }}};
   if (plugin.has_hessians()) {
     functions.push_back({"hessian_T", "p", n * n, [](M m, X x, X, Out out, C c) { m.hessian_T(x, out, c); }});
     functions.push_back({"hessian_V", "q", n * n, [](M m, X x, X, Out out, C c) { m.hessian_V(x, out, c); }});
@@ -163,8 +162,8 @@ struct Samples {
   };
   Points p, q;
   Samples(std::size_t n, const DerivativeCheckSettings& settings) {
-    const auto random = sample_points(settings.random_points * n, 0x9E3779B97F4A7C15ull, settings.box_low,
-                                      settings.box_high);
+    const auto random =
+        sample_points(settings.random_points * n, 0x9E3779B97F4A7C15ull, settings.box_low, settings.box_high);
     for (auto [points, given] : {std::pair{&p, &settings.p_points}, std::pair{&q, &settings.q_points}}) {
       points->at = random;
       for (const auto& x : *given) points->at.insert(points->at.end(), x.begin(), x.end());
@@ -248,11 +247,12 @@ std::string thread_difference(const PluginModel& model, const Plugin& plugin, co
 
 double derivative_check_bytes(std::size_t n, bool third_derivatives, const DerivativeCheckSettings& settings) {
   const double dimension = static_cast<double>(n);
-  const double points = static_cast<double>(settings.random_points + std::max(settings.p_points.size(),
-                                                                              settings.q_points.size()));
+  const double points =
+      static_cast<double>(settings.random_points + std::max(settings.p_points.size(), settings.q_points.size()));
   // The SDK's stencils (4n points of n numbers, their gradients, n x n Hessians; 4n Hessians for the third
   // derivatives), the reference results of the thread check and each thread's copy (all points, every function).
-  const double numbers = 9.0 * dimension * dimension + (third_derivatives ? 4.0 * dimension * dimension * dimension : 0.0) +
+  const double numbers = 9.0 * dimension * dimension +
+                         (third_derivatives ? 4.0 * dimension * dimension * dimension : 0.0) +
                          6.0 * points * (4.0 * dimension + 2.0 * dimension * dimension);
   return 8.0 * numbers;
 }
@@ -292,8 +292,8 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
              DerivativeCheckReport::scientific(settings.box_high, 3) + "]^" + std::to_string(n);
   if (!settings.p_points.empty())
     points += (points.empty() ? "" : " and ") + std::to_string(settings.p_points.size()) + " given (p for T, q for V)";
-  result.text = "sample points: " + points + "; tolerance " + DerivativeCheckReport::scientific(settings.tolerance, 3) +
-                "\n";
+  result.text =
+      "sample points: " + points + "; tolerance " + DerivativeCheckReport::scientific(settings.tolerance, 3) + "\n";
   result.text += report.summary();
   if (!options.check_gradients) result.text += "  skipped: gradients: the plugin has no value_T/value_V\n";
   if (!options.check_hessians) result.text += "  skipped: Hessians: the plugin has no hessian_T/hessian_V\n";
@@ -312,15 +312,17 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
                                          " (instances share mutable state: the plugin must declare "
                                          "\"thread_safe\": false, or keep its state per instance)\n";
   } else {
-    result.text += "threads: skipped: the plugin declares \"thread_safe\": false (the host runs it as one instance on "
-                   "one thread)\n";
+    result.text +=
+        "threads: skipped: the plugin declares \"thread_safe\": false (the host runs it as one instance on "
+        "one thread)\n";
   }
   result.passed = report.passed() && difference.empty() && threads.empty();
   if (!result.passed)
     result.text += "derivative check FAILED\n";
   else if (report.comparisons == 0)
-    result.text += "consistency checks passed; no derivative was compared with finite differences (the plugin has "
-                   "no value_T/value_V and no Hessians to difference)\n";
+    result.text +=
+        "consistency checks passed; no derivative was compared with finite differences (the plugin has "
+        "no value_T/value_V and no Hessians to difference)\n";
   else
     result.text += "derivative check passed\n";
   return result;

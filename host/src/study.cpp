@@ -31,7 +31,10 @@ json optional_number(std::optional<double> value) {
 class StudyExecution {
  public:
   StudyExecution(const LoadedJob& loaded, const RunOptions& options)
-      : loaded_(loaded), job_(loaded.job), study_(loaded.job.study()), options_(options),
+      : loaded_(loaded),
+        job_(loaded.job),
+        study_(loaded.job.study()),
+        options_(options),
         folder_(options.output_directory, "study", loaded.job.file, folder_use(options)),
         energy_available_(loaded.plugin.has_hessians()),
         csv_(options.output_directory / "convergence.csv",
@@ -92,13 +95,13 @@ class StudyExecution {
   void compute_reference(const StudyIntegrator& reference) {
     const std::uint64_t steps = reference.steps.front();
     const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
-    EnsembleDriver driver(loaded_.plugin, loaded_.model,
-                          {reference.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
-                           options_.stop_requested});
+    EnsembleDriver driver(
+        loaded_.plugin, loaded_.model,
+        {reference.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1, options_.stop_requested});
     if (driver.run() != DriverEnd::completed || driver.records().front().status != TrajectoryStatus::completed)
-      throw std::runtime_error("the reference run (/study/reference_run, " + reference.spec.scheme + " with " +
-                               std::to_string(steps) + " steps) did not complete: " +
-                               (driver.error().empty() ? driver.records().front().message : driver.error()));
+      throw std::runtime_error(
+          "the reference run (/study/reference_run, " + reference.spec.scheme + " with " + std::to_string(steps) +
+          " steps) did not complete: " + (driver.error().empty() ? driver.records().front().message : driver.error()));
     reference_q_ = driver.records().front().final_q;
     reference_p_ = driver.records().front().final_p;
   }
@@ -205,8 +208,8 @@ class StudyExecution {
       if (parameter.name == "order") {
         value = spec.order.to_string();
       } else {
-        const double number = parameter.name == "t2"      ? spec.t2
-                              : parameter.name == "omega" ? spec.omega
+        const double number = parameter.name == "t2"       ? spec.t2
+                              : parameter.name == "omega"  ? spec.omega
                               : parameter.name == "stages" ? spec.stages
                                                            : spec.max_iterations;
         append_number(value, number);
@@ -269,7 +272,8 @@ class StudyExecution {
     }
     summary["fits"] = std::move(fits);
     if (!failures.empty()) summary["failures"] = std::move(failures);
-    summary["output"] = {{"directory", options_.output_directory.string()}, {"convergence", "convergence.csv"},
+    summary["output"] = {{"directory", options_.output_directory.string()},
+                         {"convergence", "convergence.csv"},
                          {"work_precision", "work_precision.csv"}};
     summary["study"]["repeats"] = study_.repeats;
     summary["wall_seconds"] = wall_seconds;

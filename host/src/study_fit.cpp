@@ -76,8 +76,8 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
   fit.integrator = integrator.label;
   fit.description = description;
   fit.steps_from = integrator.steps_from;
-  fit.points = static_cast<std::size_t>(std::count_if(energy_errors.begin(), energy_errors.end(),
-                                                      [](double e) { return std::isfinite(e) && e != 0.0; }));
+  fit.points = static_cast<std::size_t>(
+      std::count_if(energy_errors.begin(), energy_errors.end(), [](double e) { return std::isfinite(e) && e != 0.0; }));
   // The sign of the energy error at the smallest dt fitted (the largest step count).
   double sign = 1.0;
   for (std::size_t i = dts.size(); i-- > 0;)
@@ -101,8 +101,8 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
   if (usable.size() >= 2) {
     const std::size_t large = usable.front(), small = usable.back();
     fit.energy_error_excess_at_smallest_dt =
-        std::abs(energy_errors[small]) / (std::abs(energy_errors[large]) *
-                                          std::pow(std::abs(dts[small] / dts[large]), description.order.value()));
+        std::abs(energy_errors[small]) /
+        (std::abs(energy_errors[large]) * std::pow(std::abs(dts[small] / dts[large]), description.order.value()));
   }
   if (!dts.empty()) {
     const auto [dt_min, dt_max] =

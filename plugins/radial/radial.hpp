@@ -12,20 +12,18 @@
 // everywhere (written in |q|^2, never |q|), including q = 0, where grad V = 0 and Hess V = identity.
 #include <algorithm>
 #include <cmath>
-#include <string>
-
 #include <nonsep/plugin_sdk.hpp>
+#include <string>
 
 struct Radial {
   static constexpr std::size_t max_dimension = 16;
   static constexpr const char* dimension_parameter = "dimension";
-  static constexpr nonsep::sdk::Parameter parameters[] = {
-      {.name = "dimension",
-       .type = nonsep::sdk::ParameterType::integer,
-       .default_value = 2,
-       .minimum = 1,
-       .maximum = 16,
-       .description = "number of degrees of freedom N"}};
+  static constexpr nonsep::sdk::Parameter parameters[] = {{.name = "dimension",
+                                                           .type = nonsep::sdk::ParameterType::integer,
+                                                           .default_value = 2,
+                                                           .minimum = 1,
+                                                           .maximum = 16,
+                                                           .description = "number of degrees of freedom N"}};
 
   template <class S>
   static S squared_norm(nonsep::sdk::Vector<S> x) {

@@ -5,7 +5,6 @@
 // (This H is a standard test of non-separable integrators, e.g. Tao's.) Defined everywhere. Analytic gradients;
 // Hessians by automatic differentiation.
 #include <cmath>
-
 #include <nonsep/plugin_sdk.hpp>
 
 struct TaoProduct {

@@ -82,8 +82,8 @@ const IntegratorSpec mpe4{"mpe", Fraction(4)};
 
 TEST_CASE("integrable paper1d: the exponent decays like log(t)/t and <Y> tends to 2") {
   const Orbit orbit = follow(Paper1D{}, triplet2, {1.0}, {0.3}, delta1, 0.01, 100000);
-  MESSAGE("paper1d: lambda(t = " << orbit.times.back() << ") = " << orbit.exponents.back() << ", <Y> = "
-                                 << orbit.mean_y.back() << ", |delta| ~ t^" << growth_power(orbit));
+  MESSAGE("paper1d: lambda(t = " << orbit.times.back() << ") = " << orbit.exponents.back()
+                                 << ", <Y> = " << orbit.mean_y.back() << ", |delta| ~ t^" << growth_power(orbit));
   CHECK(std::abs(growth_power(orbit) - 1.0) < 0.1);
   CHECK(orbit.exponents.back() < 2.0 * std::log(orbit.times.back()) / orbit.times.back());
   CHECK(orbit.mean_y.back() == doctest::Approx(2.0).epsilon(0.05));
@@ -92,8 +92,8 @@ TEST_CASE("integrable paper1d: the exponent decays like log(t)/t and <Y> tends t
 TEST_CASE("integrable radial model in 2D with angular momentum: the exponent decays like log(t)/t and <Y> -> 2") {
   // q x p = 0.8 != 0 keeps |p| >= 0.8/|q| away from 0, where the model is undefined.
   const Orbit orbit = follow(Radial2D{}, triplet2, {1.0, 0.0}, {0.2, 0.8}, delta2, 0.002, 200000);
-  MESSAGE("radial: lambda(t = " << orbit.times.back() << ") = " << orbit.exponents.back() << ", <Y> = "
-                                << orbit.mean_y.back() << ", |delta| ~ t^" << growth_power(orbit));
+  MESSAGE("radial: lambda(t = " << orbit.times.back() << ") = " << orbit.exponents.back()
+                                << ", <Y> = " << orbit.mean_y.back() << ", |delta| ~ t^" << growth_power(orbit));
   CHECK(std::abs(growth_power(orbit) - 1.0) < 0.1);
   CHECK(orbit.exponents.back() < 2.0 * std::log(orbit.times.back()) / orbit.times.back());
   CHECK(orbit.mean_y.back() == doctest::Approx(2.0).epsilon(0.05));

@@ -3,12 +3,11 @@
 // against the reference are in test_chaos_against_reference.cpp.
 #include <doctest/doctest.h>
 
+#include <Eigen/Dense>
 #include <array>
 #include <cmath>
 #include <type_traits>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "nonsep/core.hpp"
 #include "nonsep/core/lyapunov_exponents.hpp"
@@ -35,8 +34,11 @@ struct IndicatorRun {
   // `delta` holds the k initial vectors one after the other, each (dq, dp).
   IndicatorRun(const M& m, const IntegratorSpec& spec, std::vector<double> q, std::vector<double> p,
                const std::vector<double>& delta, std::size_t renormalize_every)
-      : model(m), integrator(spec), lyapunov(delta.size() / (2 * q.size()), renormalize_every),
-        x(PhaseSpaceBatch::single(q, p)), tangents(q.size(), delta.size() / (2 * q.size())) {
+      : model(m),
+        integrator(spec),
+        lyapunov(delta.size() / (2 * q.size()), renormalize_every),
+        x(PhaseSpaceBatch::single(q, p)),
+        tangents(q.size(), delta.size() / (2 * q.size())) {
     const std::size_t n = q.size();
     for (std::size_t j = 0; j < tangents.count(); ++j)
       for (std::size_t i = 0; i < n; ++i) {
@@ -85,7 +87,8 @@ TEST_CASE("modified Gram-Schmidt gives the Q and |R_jj| of a QR factorisation") 
       }
     const Eigen::HouseholderQR<Eigen::MatrixXd> qr(v);
     const Eigen::MatrixXd r = qr.matrixQR().triangularView<Eigen::Upper>();
-    for (Eigen::Index j = 0; j < 3; ++j) CHECK(log_norms[static_cast<std::size_t>(j)] == doctest::Approx(std::log(std::abs(r(j, j)))).epsilon(1e-13));
+    for (Eigen::Index j = 0; j < 3; ++j)
+      CHECK(log_norms[static_cast<std::size_t>(j)] == doctest::Approx(std::log(std::abs(r(j, j)))).epsilon(1e-13));
     CHECK((q.transpose() * q - Eigen::MatrixXd::Identity(3, 3)).cwiseAbs().maxCoeff() < 1e-14);
     CHECK((q.transpose() * v).triangularView<Eigen::StrictlyLower>().toDenseMatrix().cwiseAbs().maxCoeff() < 1e-14);
   }
@@ -149,7 +152,7 @@ TEST_CASE("the full spectrum of a symplectic map sums to zero (det M = 1), and M
     if (spec.scheme == "triplet")
       CHECK(std::abs(sum) < 1e-11);  // measured 5e-14
     else
-      CHECK(std::abs(sum) > 1e-7);  // measured 4e-6
+      CHECK(std::abs(sum) > 1e-7);               // measured 4e-6
     CHECK(r.exponent(0) + r.exponent(1) > 0.1);  // areas grow: the orbit is chaotic
   }
 }

@@ -57,7 +57,6 @@ double measured_order(const std::string& name, const Run& run, double q0, double
   return n;
 }
 
-
 }  // namespace
 
 TEST_CASE("the gradient of H is the derivative of the energy, both forms") {
@@ -113,6 +112,5 @@ TEST_CASE("the VVT form: both comparators converge to the flow of H_VVT = (q + q
   // Slopes from 4 steps up: tao 4.16, 3.74, 3.77, 3.92, 3.98, 3.995, 3.9986 (64 .. 512 steps used);
   // gauss 3.96, 3.99, 3.998, 3.9993, 3.9986 (8 .. 64 steps used).
   CHECK(std::abs(measured_order("tao 4 VVT", tao, 0.5, 0.5, t_end, reference[0], reference[1], 64, 3) - 4.0) < 0.1);
-  CHECK(std::abs(measured_order("gauss 4 VVT", gauss, 0.5, 0.5, t_end, reference[0], reference[1], 8, 3) - 4.0) <
-        0.1);
+  CHECK(std::abs(measured_order("gauss 4 VVT", gauss, 0.5, 0.5, t_end, reference[0], reference[1], 8, 3) - 4.0) < 0.1);
 }

@@ -1,26 +1,26 @@
 // Structural properties of the comparator schemes: symplecticity of every catalogue scheme (one-step Jacobian;
-// Tao's on the extended phase space), time reversibility, the per-state failure of the implicit iteration, batch versus single bit equality,
-// evaluation counts, and the handling of Tao's extended copies (compaction, single-state redo, distance).
+// Tao's on the extended phase space), time reversibility, the per-state failure of the implicit iteration, batch versus
+// single bit equality, evaluation counts, and the handling of Tao's extended copies (compaction, single-state redo,
+// distance).
 #include <doctest/doctest.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <span>
-#include <variant>
 #include <limits>
+#include <span>
 #include <string>
+#include <variant>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "nonsep/core/gauss_legendre.hpp"
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/core/tao_extended_phase_space.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
-#include "support/phase_space_jacobian.hpp"
 #include "support/models.hpp"
 #include "support/nan_aware.hpp"
+#include "support/phase_space_jacobian.hpp"
 
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
@@ -295,9 +295,9 @@ TEST_CASE("Tao's extended copies: start on (q, p), stay close, compact with the 
   for (int s = 0; s < 99; ++s) tao.step(Coupled2D{}, batch, 0.01);
   tao.copy_distance(batch, distance);
   MESSAGE("distance between the copies after 100 steps of 0.01: " << distance[0] << ", " << distance[1] << ", "
-                                                                   << distance[2]);
+                                                                  << distance[2]);
   for (const double d : distance) {
-    CHECK(d > 0.0);    // the copies separate at the size of the scheme's error ...
+    CHECK(d > 0.0);   // the copies separate at the size of the scheme's error ...
     CHECK(d < 1e-6);  // ... and the binding keeps them together
   }
   // Retiring state 1 and compacting batch and copies alike continues states 0 and 2 as if nothing happened.

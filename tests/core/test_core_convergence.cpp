@@ -2,9 +2,10 @@
 // the catalogue (Chin's and the comparators), each built through Integrator from an IntegratorSpec as the host
 // builds it. The cases are one table (order_cases); the last test fails for a catalogue entry without a case.
 // The reference point is exact: from (q0, 0) the orbit reaches (0, p_quarter) after the quarter period and
-// returns to (q0, 0) after four, both computed by quadrature of the conserved energy (nonsep/reference/paper1d_exact.hpp).
-// Each case halves dt over a range chosen inside the asymptotic regime (found by printing the local slopes
-// log2(e(dt)/e(dt/2)) from dt = T/4 down to round-off) and fits the slope of log(phase error) vs log(dt).
+// returns to (q0, 0) after four, both computed by quadrature of the conserved energy
+// (nonsep/reference/paper1d_exact.hpp). Each case halves dt over a range chosen inside the asymptotic regime (found by
+// printing the local slopes log2(e(dt)/e(dt/2)) from dt = T/4 down to round-off) and fits the slope of log(phase error)
+// vs log(dt).
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -13,10 +14,10 @@
 #include <vector>
 
 #include "nonsep/core.hpp"
+#include "nonsep/reference/hamiltonian_flow.hpp"
+#include "nonsep/reference/paper1d_exact.hpp"
 #include "support/convergence.hpp"
 #include "support/models.hpp"
-#include "nonsep/reference/paper1d_exact.hpp"
-#include "nonsep/reference/hamiltonian_flow.hpp"
 
 using namespace nonsep;
 using nonsep::testing::Paper1D;
@@ -25,7 +26,7 @@ namespace {
 
 struct Study {
   IntegratorSpec spec;
-  double nominal;   // the order the fit must find within 0.1
+  double nominal;  // the order the fit must find within 0.1
   double q0;
   int quarters;     // integrate to quarters * (quarter period); 1 or 4
   int first_steps;  // steps over that time at the largest dt; each further dt halves the step

@@ -49,20 +49,33 @@ TEST_CASE("orders that do not exist are rejected with the list of those that do"
   const auto message = error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(1)}); });
   CHECK(contains(message, "order 1 does not exist for triplet"));
   CHECK(contains(message, "2/3, 4/3, 2, 8/3, 10/3, 4"));
-  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(5, 3)}); }), "order 5/3 does not exist for mpe"));
+  CHECK(contains(error_of([] {
+                   Integrator(IntegratorSpec{"mpe", Fraction(5, 3)});
+                 }),
+                 "order 5/3 does not exist for mpe"));
   CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(-2, 3)}); }), "does not exist"));
-  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"basic", Fraction(4, 3)}); }),
+  CHECK(contains(error_of([] {
+                   Integrator(IntegratorSpec{"basic", Fraction(4, 3)});
+                 }),
                  "beyond the highest order of basic, 2/3"));
   CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(40)}); }), "beyond the highest order of mpe"));
   CHECK(contains(error_of([] { Integrator(IntegratorSpec{"leapfrog"}); }), "unknown integrator scheme 'leapfrog'"));
   // Orders near the int64 limit (found by fuzzing: 3a overflowed) are refused, not computed with.
-  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"mpe", Fraction(6148914691236517204)}); }),
+  CHECK(contains(error_of([] {
+                   Integrator(IntegratorSpec{"mpe", Fraction(6148914691236517204)});
+                 }),
                  "beyond the highest order of mpe"));
-  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(9223372036854775806, 3)}); }),
+  CHECK(contains(error_of([] {
+                   Integrator(IntegratorSpec{"triplet", Fraction(9223372036854775806, 3)});
+                 }),
                  "beyond the highest order of triplet"));
-  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(9223372036854775807)}); }),
+  CHECK(contains(error_of([] {
+                   Integrator(IntegratorSpec{"triplet", Fraction(9223372036854775807)});
+                 }),
                  "does not exist for triplet"));
-  CHECK(contains(error_of([] { Integrator(IntegratorSpec{"triplet", Fraction(-9223372036854775807, 3)}); }),
+  CHECK(contains(error_of([] {
+                   Integrator(IntegratorSpec{"triplet", Fraction(-9223372036854775807, 3)});
+                 }),
                  "does not exist for triplet"));
   // Every valid order up to the limits is accepted and reported back exactly.
   for (int j = 1; j <= 8; ++j) {
@@ -136,7 +149,8 @@ TEST_CASE("each catalogue entry builds exactly its orders, with its own flags") 
     const bool chin = scheme.family == "chin";
     CHECK((chin || scheme.family == "comparator"));
     const auto orders = scheme.orders();
-    REQUIRE(orders.size() == (chin ? static_cast<std::size_t>(scheme.highest_order_index) : scheme.comparator_orders.size()));
+    REQUIRE(orders.size() ==
+            (chin ? static_cast<std::size_t>(scheme.highest_order_index) : scheme.comparator_orders.size()));
     // A comparator's order is its "order" option (tao) or twice its stages (gauss); implicit_midpoint has only 2.
     const auto spec_of = [&](const Fraction& order) {
       IntegratorSpec spec{scheme.name, order, -2.0};

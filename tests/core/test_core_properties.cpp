@@ -2,21 +2,20 @@
 // consistency, first-same-as-last evaluation counts, energy, and the VVT form against an independent reference.
 #include <doctest/doctest.h>
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <span>
-#include <algorithm>
 #include <vector>
 
-#include <Eigen/Dense>
-
 #include "nonsep/core.hpp"
+#include "nonsep/reference/hamiltonian_flow.hpp"
 #include "support/convergence.hpp"
-#include "support/phase_space_jacobian.hpp"
 #include "support/models.hpp"
 #include "support/nan_aware.hpp"
-#include "nonsep/reference/hamiltonian_flow.hpp"
+#include "support/phase_space_jacobian.hpp"
 
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
@@ -214,7 +213,9 @@ struct Chain {
     for (std::size_t b = 0; b < count; ++b)
       for (std::size_t i = 0; i < n; ++i)
         for (std::size_t j = 0; j < n; ++j)
-          out[(b * n + i) * n + j] = i == j ? 3.0 * q[b * n + i] * q[b * n + i] : (i + 1 == j || j + 1 == i) ? 0.5 : 0.0;
+          out[(b * n + i) * n + j] = i == j                       ? 3.0 * q[b * n + i] * q[b * n + i]
+                                     : (i + 1 == j || j + 1 == i) ? 0.5
+                                                                  : 0.0;
   }
 };
 }  // namespace
@@ -255,7 +256,8 @@ TEST_CASE("the VVT form converges to the exact flow of H_VVT = (q + q^3/3)^2 p")
   };
   const double t_end = 0.5;
   const auto reference = nonsep::reference::hamiltonian_flow(rhs, {0.5, 0.5}, t_end);
-  for (const auto& [order, expected, first] : {std::tuple{Fraction(2, 3), 2.0 / 3, 512}, std::tuple{Fraction(4, 3), 4.0 / 3, 256}}) {
+  for (const auto& [order, expected, first] :
+       {std::tuple{Fraction(2, 3), 2.0 / 3, 512}, std::tuple{Fraction(4, 3), 4.0 / 3, 256}}) {
     CAPTURE(order.to_string());
     std::vector<double> dts, errors;
     for (int steps = first; steps <= 8 * first; steps *= 2) {

@@ -56,8 +56,9 @@ int check_crossings(const M& model, const IntegratorSpec& spec, PhaseSpaceBatch 
     for (int k = 0; k < 64; ++k) fine_integrator.step(model, fine, tau / 64);
     for (int k = 0; k < 64; ++k) fine_integrator.step(model, fine_step, dt / 64);
     Integrator(spec).step(model, coarse_step, dt);
-    const double step_error = std::hypot(distance(std::vector<double>(coarse_step.q().begin(), coarse_step.q().end()), fine_step.q()),
-                                         distance(std::vector<double>(coarse_step.p().begin(), coarse_step.p().end()), fine_step.p()));
+    const double step_error =
+        std::hypot(distance(std::vector<double>(coarse_step.q().begin(), coarse_step.q().end()), fine_step.q()),
+                   distance(std::vector<double>(coarse_step.p().begin(), coarse_step.p().end()), fine_step.p()));
     const double located_error = std::hypot(distance(crossing.q, fine.q()), distance(crossing.p, fine.p()));
     CAPTURE(step_error);
     CHECK(located_error <= 2.0 * step_error + 1e-14);

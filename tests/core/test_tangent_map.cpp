@@ -3,17 +3,16 @@
 // states' numbers bit for bit those of the plain steppers, and they count their Hessian evaluations.
 #include <doctest/doctest.h>
 
+#include <Eigen/Dense>
 #include <array>
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include <Eigen/Dense>
-
 #include "nonsep/core.hpp"
 #include "nonsep/core/tangent_integrator.hpp"
-#include "support/phase_space_jacobian.hpp"
 #include "support/models.hpp"
+#include "support/phase_space_jacobian.hpp"
 
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
@@ -35,8 +34,10 @@ const std::array<HamiltonianForm, 2> forms{HamiltonianForm::TTV, HamiltonianForm
 // The specs every property is checked on: basic, triplet of orders 4/3 and 2, MPE of orders 4/3 and 2.
 std::vector<IntegratorSpec> all_specs(HamiltonianForm form) {
   const double t2 = ChinCoefficients::default_t2();
-  return {{"basic", Fraction(2, 3), -2.5, form},       {"triplet", Fraction(4, 3), t2, form},
-          {"triplet", Fraction(2), t2, form},          {"mpe", Fraction(4, 3), t2, form},
+  return {{"basic", Fraction(2, 3), -2.5, form},
+          {"triplet", Fraction(4, 3), t2, form},
+          {"triplet", Fraction(2), t2, form},
+          {"mpe", Fraction(4, 3), t2, form},
           {"mpe", Fraction(2), t2, form}};
 }
 

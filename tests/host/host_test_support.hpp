@@ -12,13 +12,12 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 extern char** environ;
 
@@ -107,7 +106,7 @@ inline Process start_nonsep(const std::vector<std::string>& args, const std::fil
 }
 
 struct Result {
-  int status = -1;  // the exit status, or 128 + signal number when killed by a signal
+  int status = -1;      // the exit status, or 128 + signal number when killed by a signal
   bool killed = false;  // ended by a signal rather than by exiting (status 143 alone does not tell)
   std::string out, err;
 };
@@ -173,7 +172,6 @@ inline std::vector<std::vector<std::string>> parse_csv(const std::string& csv) {
 inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& path) {
   return parse_csv(read_text(path));
 }
-
 
 // A run's results as one JSON value: summary.json with "trajectories" set to one object per row of
 // trajectories.csv: {index, status, final {t, step, q, p}, energy {initial, final, relative_error_final,

@@ -17,7 +17,9 @@ using nonsep::host_testing::TemporaryFolder;
 namespace host = nonsep::host;
 
 namespace {
-void write(const std::filesystem::path& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+void write(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
 }  // namespace
 
 TEST_CASE("merge_csv: rows in key order across parts, trajectory numbers shifted, quoted cells kept whole") {

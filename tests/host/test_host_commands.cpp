@@ -34,8 +34,8 @@ TEST_CASE("an output folder that cannot be created is invalid input: exit 2") {
   TemporaryFolder folder;
   write_text(folder / "blocker", "a file, not a folder");
   const auto file = write_job(folder / "job.json", quickstart_job());
-  const auto result = run_nonsep({"run", "--quiet", "--output", (folder / "blocker" / "out").string(), file.string()},
-                                 folder.path());
+  const auto result =
+      run_nonsep({"run", "--quiet", "--output", (folder / "blocker" / "out").string(), file.string()}, folder.path());
   CHECK(result.status == 2);
   CHECK(result.err.find("blocker") != std::string::npos);
 }
@@ -72,14 +72,13 @@ TEST_CASE("usage: --version, --help with the schemes, options and exit statuses,
     }
     for (const char* status : {"  0 ", "  1 ", "  2 ", "  130 "}) CHECK(result.out.find(status) != std::string::npos);
   }
-  for (const std::vector<std::string>& args : {std::vector<std::string>{}, {"run"}, {"frobnicate"}, {"run", "a", "b"},
-                                              {"inspect", "paper1d", "--nope"}}) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{}, {"run"}, {"frobnicate"}, {"run", "a", "b"}, {"inspect", "paper1d", "--nope"}}) {
     CHECK(run_nonsep(args, folder.path()).status == 2);
   }
   const auto unknown = run_nonsep({"frobnicate", "job.json"}, folder.path());
   CHECK(unknown.err.find("unknown command 'frobnicate'; the commands are run, validate, inspect, models, example and "
-                         "schema") !=
-        std::string::npos);
+                         "schema") != std::string::npos);
   for (const char* command : {"models", "example"}) CHECK(unknown.err.find(command) != std::string::npos);
 }
 
@@ -87,7 +86,8 @@ TEST_CASE("models lists every plugin on the search path, one line each") {
   TemporaryFolder folder;
   const auto result = run_nonsep({"models"}, folder.path());
   CHECK(result.status == 0);
-  for (const char* name : {"paper1d", "radial", "quadratic_kinetic", "tao_product", "blowup", "blowup_gradients_only"}) {
+  for (const char* name :
+       {"paper1d", "radial", "quadratic_kinetic", "tao_product", "blowup", "blowup_gradients_only"}) {
     CAPTURE(name);
     const auto at = result.out.find(std::string(name) + "  ");
     REQUIRE(at != std::string::npos);
@@ -113,8 +113,7 @@ TEST_CASE("inspect shows the metadata, --json the raw metadata, --check the deri
     result = run_nonsep({"inspect", good, "--check"}, folder.path());
     CHECK(result.status == 0);
     CHECK(result.out.find("derivative check passed") != std::string::npos);
-    CHECK(result.out.find("threads: two instances on two threads give the numbers of one thread") !=
-          std::string::npos);
+    CHECK(result.out.find("threads: two instances on two threads give the numbers of one thread") != std::string::npos);
   }
   // The SDK's plugins have third derivatives, checked against differences of the Hessians.
   result = run_nonsep({"inspect", "radial", "--check"}, folder.path());

@@ -89,11 +89,13 @@ TEST_CASE("gauss: a trajectory whose fixed-point iteration fails retires as fail
   CHECK(summary["trajectories"][0]["status"] == "completed");
   CHECK(summary["trajectories"][2]["status"] == "completed");
   // The survivors have the numbers of a run without the failing trajectory.
-  const CoreRun alone = core_run([] {
-    nonsep::IntegratorSpec spec{"gauss"};
-    spec.max_iterations = 60;
-    return spec;
-  }(), 1.5, 0.1, 0.05, 6);
+  const CoreRun alone = core_run(
+      [] {
+        nonsep::IntegratorSpec spec{"gauss"};
+        spec.max_iterations = 60;
+        return spec;
+      }(),
+      1.5, 0.1, 0.05, 6);
   CHECK(number(summary["trajectories"][2]["final"]["q"][0]) == alone.state.q()[0]);
 }
 
@@ -127,8 +129,8 @@ TEST_CASE("comparators need Hessians and third derivatives: refused at the schem
     json job = blowup_job(state(1.0, 0.5), json::object(), plugin);
     job["integrator"] = {{"scheme", "tao"}};
     const auto file = write_job(folder / (std::string(plugin) + ".json"), job);
-    const auto result = run_nonsep({"run", "--quiet", "--output", (folder / plugin).string(), file.string()},
-                                   folder.path());
+    const auto result =
+        run_nonsep({"run", "--quiet", "--output", (folder / plugin).string(), file.string()}, folder.path());
     CHECK(result.status == 2);
     CHECK(result.err.find("/integrator/scheme") != std::string::npos);
     CHECK(result.err.find(std::string(plugin) == "blowup" ? "no third derivatives" : "no Hessians") !=
@@ -147,19 +149,19 @@ TEST_CASE("--help names each scheme's family") {
 
 TEST_CASE("a study of Chin's schemes and comparators writes work_precision.csv with medians over the repeats") {
   TemporaryFolder folder;
-  const json job = {
-      {"model", {{"plugin", "paper1d"}}},
-      {"initial", state(2.0, 0.0)},
-      {"time", {{"t_end", quarter_period}}},
-      {"study",
-       {{"repeats", 3},
-        {"reference", {{"q", {0.0}}, {"p", {p_at_quarter}}}},
-        {"integrators",
-         {{{"scheme", "triplet"}, {"order", 2}, {"steps", {64, 128}}},
-          {{"scheme", "tao"}, {"order", 4}, {"steps", {64, 128}}},
-          {{"scheme", "gauss"}, {"stages", 2}, {"label", "gauss 4"}, {"steps", {16, 32}}}}}}}};
+  const json job = {{"model", {{"plugin", "paper1d"}}},
+                    {"initial", state(2.0, 0.0)},
+                    {"time", {{"t_end", quarter_period}}},
+                    {"study",
+                     {{"repeats", 3},
+                      {"reference", {{"q", {0.0}}, {"p", {p_at_quarter}}}},
+                      {"integrators",
+                       {{{"scheme", "triplet"}, {"order", 2}, {"steps", {64, 128}}},
+                        {{"scheme", "tao"}, {"order", 4}, {"steps", {64, 128}}},
+                        {{"scheme", "gauss"}, {"stages", 2}, {"label", "gauss 4"}, {"steps", {16, 32}}}}}}}};
   const auto file = write_job(folder / "wp.json", job);
-  const auto result = run_nonsep({"run", "--quiet", "--output", (folder / "wp").string(), file.string()}, folder.path());
+  const auto result =
+      run_nonsep({"run", "--quiet", "--output", (folder / "wp").string(), file.string()}, folder.path());
   INFO("stderr: " << result.err);
   REQUIRE(result.status == 0);
   const auto rows = read_csv(folder / "wp" / "work_precision.csv");
@@ -218,7 +220,8 @@ TEST_CASE("a study's reference_run: its end state is the reference of the phase 
   job["study"].erase("reference_run");
   job["study"]["reference"] = {{"q", {reference.state.q()[0]}}, {"p", {reference.state.p()[0]}}};
   run_study("given");
-  const auto a = read_csv(folder / "with-run" / "work_precision.csv"), b = read_csv(folder / "given" / "work_precision.csv");
+  const auto a = read_csv(folder / "with-run" / "work_precision.csv"),
+             b = read_csv(folder / "given" / "work_precision.csv");
   REQUIRE(a.size() == 3);
   REQUIRE(b.size() == 3);
   const std::size_t phase = column(a[0], "phase_error");

@@ -4,9 +4,9 @@
 // plugin failing while a crossing is located.
 #include <doctest/doctest.h>
 
-#include <csignal>
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <map>
 #include <string>
 #include <vector>
@@ -26,12 +26,9 @@ const std::vector<double> chaotic_q{-0.75, 0.3}, chaotic_p{-1.5, 0.2};
 // MPE of order 4 at dt = 0.005 keeps |H/H0 - 1| below 1e-4 on these orbits for t = 400 (the symplectic triplet 4/3
 // with the default t2 diverges on the chaotic orbit at dt = 0.002: its error constant is large in 2D).
 json paper2d_job(json initial, json time, json analysis) {
-  return {{"model", {{"plugin", "paper2d"}}},
-          {"integrator", {{"scheme", "mpe"}, {"order", 4}}},
-          {"initial", std::move(initial)},
-          {"time", std::move(time)},
-          {"output", {{"every", 0}}},
-          {"analysis", std::move(analysis)}};
+  return {{"model", {{"plugin", "paper2d"}}}, {"integrator", {{"scheme", "mpe"}, {"order", 4}}},
+          {"initial", std::move(initial)},    {"time", std::move(time)},
+          {"output", {{"every", 0}}},         {"analysis", std::move(analysis)}};
 }
 
 json state2(const std::vector<double>& q, const std::vector<double>& p) { return {{"q", q}, {"p", p}}; }
@@ -105,9 +102,8 @@ TEST_CASE("poincare.csv: every crossing of q0 = 0 upwards lies on the plane to 1
 TEST_CASE("a general normal, direction both, and max_crossings stopping a trajectory as completed at that step") {
   TemporaryFolder folder;
   // The plane q0 + p1 = 0.1, both directions; two crossings each, then the trajectory stops.
-  const json analysis = {{"poincare",
-                          {{"normal", {1.0, 0.0, 0.0, 1.0}}, {"offset", 0.1}, {"direction", "both"},
-                           {"max_crossings", 2}}}};
+  const json analysis = {
+      {"poincare", {{"normal", {1.0, 0.0, 0.0, 1.0}}, {"offset", 0.1}, {"direction", "both"}, {"max_crossings", 2}}}};
   const auto result = run_named(folder, "run",
                                 paper2d_job(json::array({state2(regular_q, regular_p), state2(chaotic_q, chaotic_p)}),
                                             {{"dt", 0.005}, {"steps", 5000}}, analysis));
@@ -164,8 +160,8 @@ TEST_CASE("the host's largest exponent and states are the core's, bit for bit, w
   TemporaryFolder folder;
   const std::uint64_t steps = 3000;
   const json analysis = {{"lyapunov", {{"vectors", 2}, {"renormalize_every", 7}}}, {"megno", true}};
-  const auto result = run_named(folder, "run",
-                                paper2d_job(state2(chaotic_q, chaotic_p), {{"dt", 0.005}, {"steps", steps}}, analysis));
+  const auto result =
+      run_named(folder, "run", paper2d_job(state2(chaotic_q, chaotic_p), {{"dt", 0.005}, {"steps", steps}}, analysis));
   INFO("stderr: " << result.err);
   REQUIRE(result.status == 0);
   const auto rows = table(folder / "run/trajectories.csv");
@@ -265,8 +261,8 @@ TEST_CASE("killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv b
 
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", job);
-  const auto process = start_nonsep({"run", "--quiet", "--output", (folder / "out").string(), file.string()},
-                                    folder.path());
+  const auto process =
+      start_nonsep({"run", "--quiet", "--output", (folder / "out").string(), file.string()}, folder.path());
   REQUIRE(wait_until([&] {
     try {
       return read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>() >= 20000;
@@ -340,7 +336,8 @@ TEST_CASE("a chunk redone step by step after a divergence keeps the crossings an
   const json analysis = {{"poincare", {{"component", "q0"}, {"max_crossings", 3}}}, {"megno", true}};
   // Alone, and in one block with a state that overflows at once: that block's chunk is redone step by step, after
   // the regular orbit already left it at its third crossing in the unchecked pass.
-  const json alone = paper2d_job(json::array({state2(regular_q, regular_p)}), {{"dt", 0.005}, {"steps", 6000}}, analysis);
+  const json alone =
+      paper2d_job(json::array({state2(regular_q, regular_p)}), {{"dt", 0.005}, {"steps", 6000}}, analysis);
   json together = alone;
   together["initial"].push_back(state2({1e103, 0.0}, {0.0, 0.0}));
   REQUIRE(run_named(folder, "alone", alone).status == 0);

@@ -14,7 +14,8 @@ using namespace nonsep::host_testing;
 
 TEST_CASE("without Hessians the energy is null, the CSV's energy cells empty, and the summary says why") {
   TemporaryFolder folder;
-  const json summary = run_job(folder, "no-energy", blowup_job(state(1.0, 0.5), json::object(), "blowup_gradients_only"));
+  const json summary =
+      run_job(folder, "no-energy", blowup_job(state(1.0, 0.5), json::object(), "blowup_gradients_only"));
   CHECK(summary["status"] == "completed");
   CHECK(summary["energy"]["available"] == false);
   CHECK(summary["energy"]["reason"].get<std::string>().find("Hessians") != std::string::npos);

@@ -74,8 +74,8 @@ TEST_CASE("every listed example is written with --output and passes nonsep valid
   const auto unknown = run_nonsep({"example", "figure9"}, folder.path());
   CHECK(unknown.status == 2);
   CHECK(unknown.err.find("no example named 'figure9'; the examples are quickstart, ") != std::string::npos);
-  const auto unwritable = run_nonsep({"example", "--output", (folder / "no" / "such" / "x.json").string()},
-                                     folder.path());
+  const auto unwritable =
+      run_nonsep({"example", "--output", (folder / "no" / "such" / "x.json").string()}, folder.path());
   CHECK(unwritable.status == 2);
   CHECK(unwritable.err.find("cannot write the example job to " + (folder / "no/such/x.json").string()) !=
         std::string::npos);
@@ -86,14 +86,15 @@ TEST_CASE("an executable copied without share/nonsep still writes the compiled-i
   fs::create_directories(folder / "bin");
   const fs::path copy = folder / "bin" / "nonsep";
   fs::copy_file(NONSEP_EXECUTABLE, copy);
-  const std::string command = copy.string() + " example > " + (folder / "out.json").string() + " 2> " +
-                              (folder / "err.txt").string();
+  const std::string command =
+      copy.string() + " example > " + (folder / "out.json").string() + " 2> " + (folder / "err.txt").string();
   REQUIRE(std::system(command.c_str()) == 0);
   const std::string source = read_text(fs::path(NONSEP_SOURCE_DIR) / "examples" / "jobs" / "quickstart.json");
   CHECK(read_text(folder / "out.json") == source);
   const std::string help = copy.string() + " --help > " + (folder / "help.txt").string();
   REQUIRE(std::system(help.c_str()) == 0);
-  CHECK(read_text(folder / "help.txt").find("README.md of the nonsep sources (not found beside this executable: "
-                                            "looked in " + (folder / "share" / "nonsep").string()) !=
-        std::string::npos);
+  CHECK(read_text(folder / "help.txt")
+            .find("README.md of the nonsep sources (not found beside this executable: "
+                  "looked in " +
+                  (folder / "share" / "nonsep").string()) != std::string::npos);
 }

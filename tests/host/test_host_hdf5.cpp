@@ -108,9 +108,10 @@ TEST_CASE("SampleDatasets: NaN until written, slabs at any sample and trajectory
     // What a rank holding trajectories 1 and 2 writes: samples 1..2 of them.
     const std::vector<double> q{1, 2, 3, 4, 5, 6, 7, 8}, p{-1, -2, -3, -4, -5, -6, -7, -8}, H{10, 20, 30, 40};
     samples.write({.first_sample = 1, .samples = 2, .first_trajectory = 1, .trajectories = 2, .q = q, .p = p, .H = H});
-    CHECK_THROWS_WITH_AS(samples.write({.first_sample = 2, .samples = 2, .first_trajectory = 0, .trajectories = 1,
-                                        .q = q, .p = p, .H = H}),
-                         doctest::Contains("results.h5: cannot write samples 2 + 2"), OutputError);
+    CHECK_THROWS_WITH_AS(
+        samples.write(
+            {.first_sample = 2, .samples = 2, .first_trajectory = 0, .trajectories = 1, .q = q, .p = p, .H = H}),
+        doctest::Contains("results.h5: cannot write samples 2 + 2"), OutputError);
     file.close();
   }
   Hdf5File file = Hdf5File::open(folder / "results.h5");
@@ -168,16 +169,19 @@ TEST_CASE("/output/format: csv by default, hdf5 in a build with HDF5, anything e
   }
 }
 
-TEST_CASE("Hdf5SampleWriter: a trajectory that stops exactly at a sample step has its final state there as in "
-          "trajectory.csv, one that stopped before has NaN, and a resumed writer rewrites the rows after its checkpoint") {
+TEST_CASE(
+    "Hdf5SampleWriter: a trajectory that stops exactly at a sample step has its final state there as in "
+    "trajectory.csv, one that stopped before has NaN, and a resumed writer rewrites the rows after its checkpoint") {
   TemporaryFolder folder;
   const TimeGrid time = TimeGrid::of_steps(10, 0.5);
   const auto path = folder / "results.h5";
   const auto state = [](std::size_t trajectory, double x) {
     static std::vector<double> storage(64);
     storage[2 * trajectory] = x;
-    return StateView{.trajectory = trajectory, .q = std::span(storage).subspan(2 * trajectory, 1),
-                     .p = std::span(storage).subspan(2 * trajectory + 1, 1), .energy = x * 10};
+    return StateView{.trajectory = trajectory,
+                     .q = std::span(storage).subspan(2 * trajectory, 1),
+                     .p = std::span(storage).subspan(2 * trajectory + 1, 1),
+                     .energy = x * 10};
   };
   TrajectoryRecord at_sample, between;
   at_sample.final_step = 4;
@@ -204,14 +208,15 @@ TEST_CASE("Hdf5SampleWriter: a trajectory that stops exactly at a sample step ha
   Hdf5File file = Hdf5File::open(path);
   const auto q = read_all<double>(file, "/samples/q", H5T_NATIVE_DOUBLE, 12);  // [4 samples][3 trajectories][1]
   const auto H = read_all<double>(file, "/samples/H", H5T_NATIVE_DOUBLE, 12);
-  CHECK(read_all<std::uint64_t>(file, "/samples/step", H5T_NATIVE_UINT64, 4) == std::vector<std::uint64_t>{0, 4, 8, 10});
+  CHECK(read_all<std::uint64_t>(file, "/samples/step", H5T_NATIVE_UINT64, 4) ==
+        std::vector<std::uint64_t>{0, 4, 8, 10});
   CHECK(q[0] == 1.0);
   CHECK(q[3 + 0] == 4.0);
   CHECK(q[3 + 1] == 7.0);  // the final state at its sample step
   CHECK(H[3 + 1] == 70.0);
   CHECK(std::isnan(q[3 + 2]));  // stopped before
   CHECK(std::isnan(q[6 + 1]));
-  CHECK(H[6 + 0] == 40.0);  // StateView::energy as given (the driver leaves it empty where H was not evaluated)
+  CHECK(H[6 + 0] == 40.0);      // StateView::energy as given (the driver leaves it empty where H was not evaluated)
   CHECK(std::isnan(q[9 + 0]));  // step 10 not reached
   file.close();
 
@@ -224,7 +229,8 @@ TEST_CASE("Hdf5SampleWriter: a trajectory that stops exactly at a sample step ha
   CHECK(read_all<double>(again, "/samples/q", H5T_NATIVE_DOUBLE, 12)[3] == 5.0);
   again.close();
   Hdf5SampleWriter wrong(path, 2, 3, 4, time, true);
-  CHECK_THROWS_WITH_AS(wrong.restore(checkpoint), doctest::Contains("cannot resume into"), nonsep::host::CheckpointError);
+  CHECK_THROWS_WITH_AS(wrong.restore(checkpoint), doctest::Contains("cannot resume into"),
+                       nonsep::host::CheckpointError);
   CHECK_THROWS_WITH_AS(resumed.restore(nlohmann::json{{"rows", 5}}), doctest::Contains("results_h5 state is damaged"),
                        nonsep::host::CheckpointError);
 }

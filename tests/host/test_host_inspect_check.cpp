@@ -71,7 +71,8 @@ TEST_CASE("inspect --check --box LO,HI samples there, --tolerance is the allowed
   TemporaryFolder folder;
   auto result = run_nonsep({"inspect", "domain_edge", "--check", "--box", "0.5,2"}, folder.path());
   CHECK(result.status == 0);
-  CHECK(result.out.find("sample points: 16 random in [5.000e-01, 2.000e+00]^1; tolerance 1.000e-06") != std::string::npos);
+  CHECK(result.out.find("sample points: 16 random in [5.000e-01, 2.000e+00]^1; tolerance 1.000e-06") !=
+        std::string::npos);
   CHECK(result.out.find("NaN both") == std::string::npos);
   CHECK(result.out.find("derivative check passed") != std::string::npos);
 
@@ -133,8 +134,8 @@ TEST_CASE("inspect --check --job and --points-from take a job's parameters and i
 
 TEST_CASE("inspect --check --parameter name=value: parameters of the check, each refused clearly when wrong") {
   TemporaryFolder folder;
-  auto result = run_nonsep({"inspect", "domain_edge", "--check", "--parameter", "dimension=3", "--box", "0.5,2"},
-                           folder.path());
+  auto result =
+      run_nonsep({"inspect", "domain_edge", "--check", "--parameter", "dimension=3", "--box", "0.5,2"}, folder.path());
   CHECK(result.status == 0);
   CHECK(result.out.find("(--parameter, dimension 3)") != std::string::npos);
   CHECK(result.out.find("]^3;") != std::string::npos);
@@ -162,8 +163,7 @@ TEST_CASE("inspect --check that compares nothing is invalid input (dimension 0),
 
 TEST_CASE("inspect --check too large for memory is invalid input with a clear message") {
   TemporaryFolder folder;
-  auto result =
-      run_nonsep({"inspect", "domain_edge", "--check", "--parameter", "dimension=1000000000"}, folder.path());
+  auto result = run_nonsep({"inspect", "domain_edge", "--check", "--parameter", "dimension=1000000000"}, folder.path());
   CHECK(result.status == 2);
   CHECK(result.err.find("dimension 1000000000") != std::string::npos);
   CHECK(result.err.find("of memory, more than this machine's") != std::string::npos);
@@ -181,7 +181,8 @@ TEST_CASE("inspect --check too large for memory is invalid input with a clear me
   const std::string err = read_text(folder / "err.txt");
   INFO(err);
   CHECK(err.find("nonsep: the derivative check of domain_edge (dimension 2000") == 0);
-  CHECK((err.find("ran out of memory") != std::string::npos || err.find("more than this machine's") != std::string::npos));
+  CHECK((err.find("ran out of memory") != std::string::npos ||
+         err.find("more than this machine's") != std::string::npos));
   CHECK(err.find("unexpected error") == std::string::npos);
 #endif
 }

@@ -72,22 +72,14 @@ TEST_CASE("one rule for a parameter value: the job reader refuses exactly what t
     bool accepted;
   };
   const Case cases[] = {
-      {"dimension", 2, true},
-      {"dimension", 2.0, true},
-      {"dimension", 16.0, true},
-      {"dimension", 1e0, true},
-      {"dimension", 2.5, false},
-      {"dimension", 17, false},
-      {"dimension", 0.0, false},
-      {"dimension", "2", false},
-      {"dimension", true, false},
-      {"mass", 0, true},
-      {"mass", -0.0, true},
-      {"mass", 1e300, true},
-      {"mass", -1e-300, false},
-      {"mass", std::numeric_limits<double>::infinity(), false},
-      {"mass", nullptr, false},
-      {"damped", false, true},
+      {"dimension", 2, true},     {"dimension", 2.0, true},
+      {"dimension", 16.0, true},  {"dimension", 1e0, true},
+      {"dimension", 2.5, false},  {"dimension", 17, false},
+      {"dimension", 0.0, false},  {"dimension", "2", false},
+      {"dimension", true, false}, {"mass", 0, true},
+      {"mass", -0.0, true},       {"mass", 1e300, true},
+      {"mass", -1e-300, false},   {"mass", std::numeric_limits<double>::infinity(), false},
+      {"mass", nullptr, false},   {"damped", false, true},
       {"damped", 0, false},
   };
   for (const auto& c : cases) {
@@ -96,8 +88,8 @@ TEST_CASE("one rule for a parameter value: the job reader refuses exactly what t
     std::vector<JobIssue> issues;
     check_model_parameters(json{{c.name, c.value}}, declared, issues);
     CHECK(issues.empty() == c.accepted);
-    const auto& row = *std::find_if(declared.begin(), declared.end(),
-                                    [&](const PluginParameter& p) { return p.name == c.name; });
+    const auto& row =
+        *std::find_if(declared.begin(), declared.end(), [&](const PluginParameter& p) { return p.name == c.name; });
     CHECK(nonsep::sdk::check_parameter_value(row.name, row.type, row.minimum, row.maximum, c.value).empty() ==
           c.accepted);
   }

@@ -32,7 +32,8 @@ Parsed parse(const json& document, const std::string& file = "/jobs/test.json") 
 
 Parsed parse_text(const std::string& text) {
   Parsed parsed;
-  if (auto document = parse_job_text(text, parsed.issues)) parsed.job = parse_job(*document, "/jobs/test.json", parsed.issues);
+  if (auto document = parse_job_text(text, parsed.issues))
+    parsed.job = parse_job(*document, "/jobs/test.json", parsed.issues);
   return parsed;
 }
 
@@ -81,7 +82,8 @@ TEST_CASE("integrator options left out take the catalogue's defaults") {
     REQUIRE(parsed.issues.empty());
     for (const auto& parameter : scheme.parameters) {
       REQUIRE_FALSE(parameter.default_text.empty());
-      if (parameter.name == "order") CHECK(parsed.job.run().integrator.order == Fraction::parse(parameter.default_text));
+      if (parameter.name == "order")
+        CHECK(parsed.job.run().integrator.order == Fraction::parse(parameter.default_text));
       if (parameter.name == "t2") CHECK(parsed.job.run().integrator.t2 == std::stod(parameter.default_text));
     }
   }
@@ -162,8 +164,8 @@ TEST_CASE("initial states: one, a list, or a grid in row-major order (last axis 
   CHECK(parsed.job.initial.q == std::vector<double>{1.0, 2.0});
   CHECK(parsed.job.initial.p == std::vector<double>{0.5, -0.5});
 
-  document["initial"] = {{"grid", {{"q", {{{"from", 0.0}, {"to", 1.0}, {"count", 3}}, 7.0}},
-                                   {"p", {{{"values", {5.0, 6.0}}}, -1.0}}}}};
+  document["initial"] = {
+      {"grid", {{"q", {{{"from", 0.0}, {"to", 1.0}, {"count", 3}}, 7.0}}, {"p", {{{"values", {5.0, 6.0}}}, -1.0}}}}};
   parsed = parse(document);
   REQUIRE(parsed.issues.empty());
   const InitialStates& states = parsed.job.initial;
@@ -174,8 +176,9 @@ TEST_CASE("initial states: one, a list, or a grid in row-major order (last axis 
   CHECK(states.q == std::vector<double>{0.0, 7.0, 0.0, 7.0, 0.5, 7.0, 0.5, 7.0, 1.0, 7.0, 1.0, 7.0});
   CHECK(states.p == std::vector<double>{5.0, -1.0, 6.0, -1.0, 5.0, -1.0, 6.0, -1.0, 5.0, -1.0, 6.0, -1.0});
 
-  document["initial"] = {{"grid", {{"q", {{{"from", 0.0}, {"to", 1.0}, {"count", 1000}}}},
-                                   {"p", {{{"from", 0.0}, {"to", 1.0}, {"count", 1001}}}}}}};
+  document["initial"] = {{"grid",
+                          {{"q", {{{"from", 0.0}, {"to", 1.0}, {"count", 1000}}}},
+                           {"p", {{{"from", 0.0}, {"to", 1.0}, {"count", 1001}}}}}}};
   CHECK(paths(parse(document).issues) == std::vector<std::string>{"/initial/grid"});
 
   // Found by fuzzing: axes are refused as soon as their product is too large, before the rest are allocated

@@ -52,10 +52,15 @@ TEST_CASE("the schema's ranges of numbers and integers are the reader's") {
   const json schema = job_schema();
   const json finite = schema["$defs"]["finite"];
   int checked = 0;
-  for (const auto& [section, key] : std::vector<std::pair<std::string, std::string>>{
-           {"time", "dt"}, {"time", "steps"}, {"output", "every"}, {"output", "energy_every"},
-           {"checkpoint", "every_steps"}, {"checkpoint", "every_seconds"}, {"analysis", "closest_return_after"},
-           {"analysis", "max_relative_energy_error"}}) {
+  for (const auto& [section, key] :
+       std::vector<std::pair<std::string, std::string>>{{"time", "dt"},
+                                                        {"time", "steps"},
+                                                        {"output", "every"},
+                                                        {"output", "energy_every"},
+                                                        {"checkpoint", "every_steps"},
+                                                        {"checkpoint", "every_seconds"},
+                                                        {"analysis", "closest_return_after"},
+                                                        {"analysis", "max_relative_energy_error"}}) {
     const std::string path = "/" + section + "/" + key;
     CAPTURE(path);
     const json rule = property_schema(schema, section, key);

@@ -2,17 +2,15 @@
 // run's checkpoint, stale files of the same job, planted links and orphaned temporary files, whole rows after a hard
 // kill, and an output that cannot be written found before computing.
 #include <doctest/doctest.h>
-
 #include <signal.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "host_test_support.hpp"
 
@@ -216,10 +214,10 @@ TEST_CASE("a full disk (a file size limit) leaves trajectory.csv ending in a who
   const auto file = write_job(folder / "job.json", paper1d_job(1.0, 10'000'000, 1));
   // 64 blocks of 512 bytes: the limit is hit partway through a buffer; SIGXFSZ ignored, so write() comes back
   // short and then fails with EFBIG, as on a full disk.
-  const Process running = start_process(
-      {"/bin/sh", "-c", "ulimit -f 64 && trap '' XFSZ && exec \"$0\" run --quiet \"$1\"", NONSEP_EXECUTABLE,
-       file.string()},
-      folder.path());
+  const Process running =
+      start_process({"/bin/sh", "-c", "ulimit -f 64 && trap '' XFSZ && exec \"$0\" run --quiet \"$1\"",
+                     NONSEP_EXECUTABLE, file.string()},
+                    folder.path());
   const Result result = finish(running);
   CHECK(result.status == 1);
   CHECK(contains(result.err, "trajectory.csv"));

@@ -171,8 +171,9 @@ TEST_CASE("an exception inside the plugin partway: every row before it complete,
   // H_TTV = p^2 from (0.5, 0.5): q = 0.5 + t (to the method's error), past 1.1 at t = 0.6. grad V throws where
   // |q| > 1.1; the stages of a step reach well beyond its ends (the drifts of eq. expalg are of size
   // cbrt(dt) = 0.2 here, forwards and backwards), so the first throw comes at some step before t = 0.6.
-  const Ran ran = run(folder, job_with(broken_plugin("evaluation_throws"), state(0.5, 0.5),
-                                       {{"throw_above_p", 10.0}, {"throw_above_q", 1.1}}, {{"dt", 0.01}, {"steps", 200}}),
+  const Ran ran = run(folder,
+                      job_with(broken_plugin("evaluation_throws"), state(0.5, 0.5),
+                               {{"throw_above_p", 10.0}, {"throw_above_q", 1.1}}, {{"dt", 0.01}, {"steps", 200}}),
                       1);
   const json& trajectory = ran.summary["trajectories"][0];
   CHECK(trajectory["status"] == "failed");
@@ -436,9 +437,9 @@ TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3),
   for (const auto& [how, status] : cases) {
     CAPTURE(how);
     TemporaryFolder folder;
-    const auto file = write_job(
-        folder / "job.json",
-        job_with("blowup", state(0.5, 0.5), {{"crash_after", 50000}, {"crash_how", how}}, {{"dt", 1e-4}, {"steps", 1000000}}));
+    const auto file =
+        write_job(folder / "job.json", job_with("blowup", state(0.5, 0.5), {{"crash_after", 50000}, {"crash_how", how}},
+                                                {{"dt", 1e-4}, {"steps", 1000000}}));
     const Result result = run_nonsep({"run", "--quiet", file.string()}, folder.path());
     CHECK(result.status == status);
     CHECK(result.killed == (how != 2));

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "host_run_support.hpp"
-#include "support/models.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
+#include "support/models.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host_testing;
@@ -85,8 +85,7 @@ TEST_CASE("every scheme and both Hamiltonian forms agree with the core bit for b
     CAPTURE(scheme);
     CAPTURE(order);
     CAPTURE(form);
-    json job = paper1d_job(state(q0, 0.25), {{"dt", 0.01}, {"steps", 25}},
-                           {{"scheme", c.scheme}, {"order", c.order}});
+    json job = paper1d_job(state(q0, 0.25), {{"dt", 0.01}, {"steps", 25}}, {{"scheme", c.scheme}, {"order", c.order}});
     job["hamiltonian"] = c.form;
     const json summary = run_job(folder, std::string(c.scheme) + "-" + c.form, job);
     nonsep::IntegratorSpec spec{c.scheme, nonsep::Fraction::parse(c.order)};
@@ -97,7 +96,7 @@ TEST_CASE("every scheme and both Hamiltonian forms agree with the core bit for b
     CHECK(summary["integrator"]["symplectic"] == (std::string(c.scheme) != "mpe"));
     const double q = core.state.q()[0], p = core.state.p()[0];
     const double energy = spec.form == nonsep::HamiltonianForm::TTV ? nonsep::testing::Paper1D::H_TTV(q, p)
-                                                                     : nonsep::testing::Paper1D::H_VVT(q, p);
+                                                                    : nonsep::testing::Paper1D::H_VVT(q, p);
     CHECK(number(summary["trajectories"][0]["energy"]["final"]) == doctest::Approx(energy).epsilon(1e-13));
   }
 }
@@ -151,7 +150,8 @@ TEST_CASE("an ensemble gives each trajectory exactly the numbers of its single r
   const auto ensemble_rows = read_csv(folder / "ensemble" / "trajectory.csv");
   for (std::size_t i = 0; i < starts.size(); ++i) {
     CAPTURE(i);
-    const json single = run_job(folder, "single" + std::to_string(i), paper1d_job(state(starts[i].first, starts[i].second), time));
+    const json single =
+        run_job(folder, "single" + std::to_string(i), paper1d_job(state(starts[i].first, starts[i].second), time));
     CHECK(ensemble["trajectories"][i]["final"] == single["trajectories"][0]["final"]);
     CHECK(ensemble["trajectories"][i]["energy"] == single["trajectories"][0]["energy"]);
     const auto single_rows = read_csv(folder / ("single" + std::to_string(i)) / "trajectory.csv");
@@ -164,13 +164,15 @@ TEST_CASE("an ensemble gives each trajectory exactly the numbers of its single r
   }
   // One batched call per stage: the ensemble costs 3 times the gradients of one run, in a third of the calls.
   CHECK(ensemble["evaluations"]["grad_T"].get<std::uint64_t>() ==
-        3 * run_job(folder, "single0-again", paper1d_job(state(0.5, 0.0), time))["evaluations"]["grad_T"].get<std::uint64_t>());
+        3 * run_job(folder, "single0-again", paper1d_job(state(0.5, 0.0), time))["evaluations"]["grad_T"]
+                .get<std::uint64_t>());
 }
 
 TEST_CASE("a grid job runs its states in the documented order") {
   TemporaryFolder folder;
-  const json job = paper1d_job({{"grid", {{"q", {{{"from", 1.0}, {"to", 2.0}, {"count", 2}}}}, {"p", {{{"values", {0.0, 0.5}}}}}}}},
-                               {{"dt", 0.01}, {"steps", 10}});
+  const json job =
+      paper1d_job({{"grid", {{"q", {{{"from", 1.0}, {"to", 2.0}, {"count", 2}}}}, {"p", {{{"values", {0.0, 0.5}}}}}}}},
+                  {{"dt", 0.01}, {"steps", 10}});
   const json summary = run_job(folder, "grid", job);
   REQUIRE(summary["trajectories"].size() == 4);
   const auto rows = read_csv(folder / "grid" / "trajectory.csv");  // step 0 first, in trajectory order

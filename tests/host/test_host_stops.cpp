@@ -105,4 +105,3 @@ TEST_CASE("many trajectories stop: stderr names the first 20 and says how many m
   CHECK(result.err.find("... and 5 more trajectories that stopped early; ") != std::string::npos);
   CHECK(read_json(folder / "many.out/summary.json")["counts"]["diverged"] == 25);
 }
-

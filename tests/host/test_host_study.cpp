@@ -30,8 +30,10 @@ json study_job(json integrators, json steps) {
   return {{"model", {{"plugin", "paper1d"}}},
           {"initial", {{"q", {2.0}}, {"p", {0.0}}}},
           {"time", {{"t_end", quarter_period}}},
-          {"study", {{"steps", std::move(steps)}, {"reference", {{"q", {0.0}}, {"p", {p_at_quarter}}}},
-                     {"integrators", std::move(integrators)}}}};
+          {"study",
+           {{"steps", std::move(steps)},
+            {"reference", {{"q", {0.0}}, {"p", {p_at_quarter}}}},
+            {"integrators", std::move(integrators)}}}};
 }
 
 struct Finished {
@@ -113,7 +115,8 @@ TEST_CASE("a study's rows are the core's runs bit for bit, and its fit is the sl
     const std::uint64_t steps = std::stoull(row[6]);
     const double dt = quarter_period / static_cast<double>(steps);
     CHECK(std::stod(row[5]) == dt);
-    nonsep::Integrator integrator({basic ? "basic" : "mpe", basic ? nonsep::Fraction(2, 3) : nonsep::Fraction(2), -2.0});
+    nonsep::Integrator integrator(
+        {basic ? "basic" : "mpe", basic ? nonsep::Fraction(2, 3) : nonsep::Fraction(2), -2.0});
     auto x = nonsep::PhaseSpaceBatch::single(q0, p0);
     for (std::uint64_t k = 0; k < steps; ++k) integrator.step(model, x, dt);
     CHECK(std::stoull(row[7]) == steps * (basic ? 1 : 6));
@@ -160,7 +163,8 @@ TEST_CASE("a study run that blows up is a diverged row, left out of the fit, and
   CHECK(run.summary["failures"][0]["steps"] == 16);
   // The report goes to stderr even with --quiet, and names the run that diverged.
   CHECK(run.out.empty());
-  CHECK(run.err == "nonsep: " + expected_report(run.summary, folder / "failing") + "nonsep: triplet 8/3 with 16 steps " +
+  CHECK(run.err == "nonsep: " + expected_report(run.summary, folder / "failing") +
+                       "nonsep: triplet 8/3 with 16 steps " +
                        "diverged: " + run.summary["failures"][0]["error"].get<std::string>() + "\n");
 }
 
@@ -173,7 +177,8 @@ TEST_CASE("closest_return is the minimum distance to the start over every step f
                     {"analysis", {{"closest_return_after", 1.2}}},
                     {"output", {{"every", 1}}}};
   const auto file = write_job(folder / "orbit.json", job);
-  const auto result = run_nonsep({"run", "--quiet", "--output", (folder / "orbit").string(), file.string()}, folder.path());
+  const auto result =
+      run_nonsep({"run", "--quiet", "--output", (folder / "orbit").string(), file.string()}, folder.path());
   REQUIRE(result.status == 0);
   const json summary = read_run(folder / "orbit");
   const auto rows = read_csv(folder / "orbit" / "trajectory.csv");
@@ -209,17 +214,19 @@ TEST_CASE("the study's report: exponents to 4 significant digits, and a warning 
   TemporaryFolder folder;
   // MPE 4 to 4096 steps reaches the round-off of paper1d (about 1e-11, of random sign); triplet 4/3 on these step
   // counts stays in its asymptotic range (the control: no warning).
-  json job = study_job({{{"scheme", "mpe"}, {"order", "4"}, {"t2", -2.5},
-                         {"steps", {64, 128, 256, 512, 1024, 2048, 4096}}},
-                        {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}, {"steps", {256, 512, 1024, 2048}}}},
-                       json::array());
+  json job =
+      study_job({{{"scheme", "mpe"}, {"order", "4"}, {"t2", -2.5}, {"steps", {64, 128, 256, 512, 1024, 2048, 4096}}},
+                 {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}, {"steps", {256, 512, 1024, 2048}}}},
+                json::array());
   job["study"].erase("steps");  // each integrator has its own
   const auto file = write_job(folder / "round_off.json", job);
   const auto result = run_nonsep({"run", "--output", (folder / "out").string(), file.string()}, folder.path());
   INFO(result.out, result.err);
   CHECK(result.status == 0);
-  CHECK(std::regex_search(result.out, std::regex(R"(  mpe 4: energy error exponent \d\.\d{3} \(nominal 4 = 4\.000\) \(see warning\)\n)")));
-  CHECK(std::regex_search(result.out, std::regex(R"(  triplet 4/3: energy error exponent 1\.\d{3} \(nominal 4/3 = 1\.333\)\n)")));
+  CHECK(std::regex_search(
+      result.out, std::regex(R"(  mpe 4: energy error exponent \d\.\d{3} \(nominal 4 = 4\.000\) \(see warning\)\n)")));
+  CHECK(std::regex_search(result.out,
+                          std::regex(R"(  triplet 4/3: energy error exponent 1\.\d{3} \(nominal 4/3 = 1\.333\)\n)")));
   CHECK(result.err.find("nonsep: warning: mpe 4: the energy error reaches round-off") != std::string::npos);
   CHECK(result.err.find("move its step range to larger dt (fewer steps)") != std::string::npos);
   CHECK(result.err.find("nonsep: warning: mpe 4: the energy error changes sign") != std::string::npos);
@@ -230,8 +237,8 @@ TEST_CASE("the study's report: exponents to 4 significant digits, and a warning 
   CHECK(std::abs(summary["fits"][1]["energy_error_excess_at_smallest_dt"].get<double>() - 1.0) < 0.2);
 
   // --quiet keeps the warnings (on stderr) and drops the report.
-  const auto quiet = run_nonsep({"run", "--quiet", "--force", "--output", (folder / "out").string(), file.string()},
-                                folder.path());
+  const auto quiet =
+      run_nonsep({"run", "--quiet", "--force", "--output", (folder / "out").string(), file.string()}, folder.path());
   CHECK(quiet.out.empty());
   CHECK(quiet.err.find("nonsep: warning: mpe 4: the energy error reaches round-off") != std::string::npos);
 }

@@ -11,7 +11,9 @@
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
-TEST_CASE("threads: 1, 2 and 3 threads write byte-identical trajectory.csv, trajectories.csv and summary.json (but wall_seconds)") {
+TEST_CASE(
+    "threads: 1, 2 and 3 threads write byte-identical trajectory.csv, trajectories.csv and summary.json (but "
+    "wall_seconds)") {
   TemporaryFolder folder;
   use_test_plugins();
   // 600 trajectories: three blocks of run_block_size = 256. A diverging state in the first block and, in the
@@ -23,9 +25,10 @@ TEST_CASE("threads: 1, 2 and 3 threads write byte-identical trajectory.csv, traj
     failing.push_back(i == 550 ? state(5.0, 0.0) : state(q, 0.25));
     completing.push_back(state(q, 0.25));
   }
-  for (const auto& [name, job, expected] : {std::tuple{"diverging", blowup_job(diverging), 1},
-                                            std::tuple{"failing", blowup_job(failing, {{"fail_above", 3.0}}), 1},
-                                            std::tuple{"paper1d", paper1d_job(completing, {{"dt", 0.002}, {"steps", 30}}), 0}}) {
+  for (const auto& [name, job, expected] :
+       {std::tuple{"diverging", blowup_job(diverging), 1},
+        std::tuple{"failing", blowup_job(failing, {{"fail_above", 3.0}}), 1},
+        std::tuple{"paper1d", paper1d_job(completing, {{"dt", 0.002}, {"steps", 30}}), 0}}) {
     const std::string job_name = name;
     CAPTURE(job_name);
     const auto file = write_job(folder / (std::string(name) + ".json"), job);
@@ -57,8 +60,9 @@ TEST_CASE("a plugin that declares \"thread_safe\": false runs on one thread with
   TemporaryFolder folder;
   json states = json::array();
   for (int i = 0; i < 600; ++i) states.push_back(state(0.5 + 0.001 * i, 0.25));
-  const auto file = write_job(
-      folder / "job.json", blowup_job(states, json::object(), std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/global_state.so"));
+  const auto file =
+      write_job(folder / "job.json",
+                blowup_job(states, json::object(), std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/global_state.so"));
   std::vector<std::string> tables;
   for (const char* threads : {"1", "2"}) {
     const auto out = folder / (std::string("out-") + threads);
@@ -81,7 +85,8 @@ TEST_CASE("--threads must be a whole number from 1 to 4096") {
   CHECK(run_nonsep({"run", "--threads", "two", file.string()}, folder.path()).status == 2);
 }
 
-TEST_CASE("closest_return is the same whether the run steps in chunks (every = 0) or sample by sample, and on a replay") {
+TEST_CASE(
+    "closest_return is the same whether the run steps in chunks (every = 0) or sample by sample, and on a replay") {
   TemporaryFolder folder;
   use_test_plugins();
   // Blowup with a diverging middle state: the block replays its first chunk step by step.
@@ -100,4 +105,3 @@ TEST_CASE("closest_return is the same whether the run steps in chunks (every = 0
   }
   CHECK(chunked["trajectories"][1]["closest_return"] == sampled["trajectories"][1]["closest_return"]);
 }
-

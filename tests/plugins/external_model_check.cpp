@@ -51,8 +51,8 @@ int main(int argc, char** argv) {
       const double drift = std::abs(energy.evaluate_one(model, x) - h0);
       worst = std::isnan(worst) || std::isnan(drift) ? std::nan("") : std::max(worst, drift);  // NaN is kept
     }
-    expect(worst < 1e-3 && x.q()[0] != q0[0], "H_TTV conserved while the state moves (largest drift " +
-                                                   std::to_string(worst) + ")");
+    expect(worst < 1e-3 && x.q()[0] != q0[0],
+           "H_TTV conserved while the state moves (largest drift " + std::to_string(worst) + ")");
   } catch (const std::exception& e) {
     expect(false, std::string("exception: ") + e.what());
   }

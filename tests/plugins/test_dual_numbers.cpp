@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "nonsep/sdk/dual.hpp"
-#include "support/finite_difference.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
+#include "support/finite_difference.hpp"
 
 using nonsep::sdk::Dual;
 
@@ -134,12 +134,28 @@ struct BinaryCase {
 };
 
 // The using-directive gives the double versions (nonsep::sdk's using-declarations of std's); ADL the dual ones.
-#define NONSEP_TEST_BINARY(name, expression, x, y)                                              \
-  BinaryCase {                                                                                  \
-    name, [](auto v) { using namespace nonsep::sdk; return expression; },                       \
-        [](auto v) { using namespace nonsep::sdk; return expression; },                         \
-        [](auto v) { using namespace nonsep::sdk; return expression; },                         \
-        [](auto v) { using namespace nonsep::sdk; return expression; }, { x, y }                \
+#define NONSEP_TEST_BINARY(name, expression, x, y) \
+  BinaryCase {                                     \
+    name,                                          \
+        [](auto v) {                               \
+          using namespace nonsep::sdk;             \
+          return expression;                       \
+        },                                         \
+        [](auto v) {                               \
+          using namespace nonsep::sdk;             \
+          return expression;                       \
+        },                                         \
+        [](auto v) {                               \
+          using namespace nonsep::sdk;             \
+          return expression;                       \
+        },                                         \
+        [](auto v) {                               \
+          using namespace nonsep::sdk;             \
+          return expression;                       \
+        },                                         \
+    {                                              \
+      x, y                                         \
+    }                                              \
   }
 
 // Central difference of g (a vector of `size` numbers at a 2-point) along e_k, component i.
@@ -155,8 +171,9 @@ double difference(const G& g, std::array<double, 2> at, std::size_t k, std::size
 
 }  // namespace
 
-TEST_CASE("two-argument functions and pow with a variable exponent: gradients, Hessians and third derivatives "
-          "of every nesting agree with finite differences") {
+TEST_CASE(
+    "two-argument functions and pow with a variable exponent: gradients, Hessians and third derivatives "
+    "of every nesting agree with finite differences") {
   using nonsep::sdk::detail::directional_third_by_dual;
   using nonsep::sdk::detail::gradient_by_dual;
   using nonsep::sdk::detail::hessian_by_dual;
@@ -219,10 +236,9 @@ TEST_CASE("directional third derivatives of a function of three variables are ex
   const double f_xxy = 2 * z, f_xxz = 2 * y, f_xyz = 2 * x, f_yyy = e * z * z * z, f_yyz = 3 * e * z * z,
                f_yzz = 6 * e * z, f_zzz = 6 * e;
   const double ux = u[0], uy = u[1], uz = u[2];
-  const double expected[] = {2 * f_xxy * ux * uy + 2 * f_xxz * ux * uz + 2 * f_xyz * uy * uz,
-                             f_xxy * ux * ux + 2 * f_xyz * ux * uz + f_yyy * uy * uy + 2 * f_yyz * uy * uz +
-                                 f_yzz * uz * uz,
-                             f_xxz * ux * ux + 2 * f_xyz * ux * uy + f_yyz * uy * uy + 2 * f_yzz * uy * uz +
-                                 f_zzz * uz * uz};
+  const double expected[] = {
+      2 * f_xxy * ux * uy + 2 * f_xxz * ux * uz + 2 * f_xyz * uy * uz,
+      f_xxy * ux * ux + 2 * f_xyz * ux * uz + f_yyy * uy * uy + 2 * f_yyz * uy * uz + f_yzz * uz * uz,
+      f_xxz * ux * ux + 2 * f_xyz * ux * uy + f_yyz * uy * uy + 2 * f_yzz * uy * uz + f_zzz * uz * uz};
   for (int k = 0; k < 3; ++k) CHECK(third[k] == doctest::Approx(expected[k]).epsilon(1e-14));
 }

@@ -63,8 +63,9 @@ TEST_CASE("the valid hand-written plugin loads, so each defect below is the only
 
 TEST_CASE("missing file: the resolved path and what it was relative to") {
   const std::string message = load_error("models/absent.so", "/jobs/run1");
-  CHECK(message == "plugin file '/jobs/run1/models/absent.so' does not exist ('models/absent.so' relative to "
-                   "'/jobs/run1')");
+  CHECK(message ==
+        "plugin file '/jobs/run1/models/absent.so' does not exist ('models/absent.so' relative to "
+        "'/jobs/run1')");
   CHECK(load_error("/nowhere/absent.so") == "plugin file '/nowhere/absent.so' does not exist");
 }
 
@@ -106,9 +107,10 @@ TEST_CASE("no plugin symbol") {
 TEST_CASE("a plugin of ABI version 1 (its entry function, no plugin symbol): expected and found") {
   const std::string file = (test_plugins / "version_1_entry.so").string();
   CHECK(load_error("version_1_entry.so") ==
-        "plugin '" + file + "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
-        "version 3 (expected 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) and "
-        "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
+        "plugin '" + file +
+            "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
+            "version 3 (expected 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) and "
+            "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
 }
 
 TEST_CASE("a plugin of ABI version 2 (the one with integrate): expected and found, and how to rebuild") {
@@ -146,8 +148,8 @@ TEST_CASE("capabilities that disagree with the table") {
                  "says capability \"hessian_T\" is true but the table's hessian_T pointer is null"));
   CHECK(contains(load_error("claims_absent_d3T.so"),
                  "says capability \"d3T\" is true but the table's d3T pointer is null"));
-  CHECK(contains(load_error("unclaimed_d3V.so"),
-                 "says capability \"d3V\" is false but the table's d3V pointer is set"));
+  CHECK(
+      contains(load_error("unclaimed_d3V.so"), "says capability \"d3V\" is false but the table's d3V pointer is set"));
 }
 
 TEST_CASE("metadata without \"thread_safe\" (required since ABI version 3)") {
@@ -168,23 +170,33 @@ TEST_CASE("create failing inside the plugin: its message names the parameter") {
   const Plugin plugin = load_plugin("create_failing.so", test_plugins);
   CHECK(plugin.create({{"inner_radius", 1.5}}).dimension() == 1);
   const std::string message = error_of([&] { plugin.create({{"inner_radius", 3.0}}); });
-  CHECK(contains(message, "could not create a model (invalid parameters): parameter 'inner_radius' must be "
-                          "smaller than 'outer_radius'"));
+  CHECK(contains(message,
+                 "could not create a model (invalid parameters): parameter 'inner_radius' must be "
+                 "smaller than 'outer_radius'"));
 }
 
 TEST_CASE("parameters refused by the host before create(), each naming the parameter") {
   const Plugin radial = load_plugin("radial", "");
-  CHECK(contains(error_of([&] { radial.create({{"dimension", 17}}); }),
+  CHECK(contains(error_of([&] {
+                   radial.create({{"dimension", 17}});
+                 }),
                  "parameter 'dimension' = 17 is above its maximum 16"));
-  CHECK(contains(error_of([&] { radial.create({{"dimension", 2.5}}); }),
+  CHECK(contains(error_of([&] {
+                   radial.create({{"dimension", 2.5}});
+                 }),
                  "parameter 'dimension' must be an integer (found 2.5)"));
-  CHECK(contains(error_of([&] { radial.create({{"dimenson", 3}}); }),
+  CHECK(contains(error_of([&] {
+                   radial.create({{"dimenson", 3}});
+                 }),
                  "unknown parameter 'dimenson' (known parameters: dimension)"));
-  CHECK(contains(error_of([&] { radial.create(nlohmann::json::array()); }),
-                 "the parameters must be a JSON object"));
-  CHECK(contains(error_of([&] { load_plugin("quadratic_kinetic", "").create({{"lambda", "big"}}); }),
+  CHECK(contains(error_of([&] { radial.create(nlohmann::json::array()); }), "the parameters must be a JSON object"));
+  CHECK(contains(error_of([&] {
+                   load_plugin("quadratic_kinetic", "").create({{"lambda", "big"}});
+                 }),
                  "parameter 'lambda' must be a number (found \"big\")"));
-  CHECK(contains(error_of([&] { load_plugin("paper1d", "").create({{"lambda", 1}}); }),
+  CHECK(contains(error_of([&] {
+                   load_plugin("paper1d", "").create({{"lambda", 1}});
+                 }),
                  "unknown parameter 'lambda' (this model has no parameters)"));
   CHECK(radial.create({{"dimension", 16}}).parameters() == nlohmann::json{{"dimension", 16}});
   CHECK(radial.create(nlohmann::json::object()).dimension() == 2);

@@ -1,7 +1,7 @@
 // The plugin's library stays loaded exactly as long as a Plugin or PluginModel from it is alive. Checked with
 // dlopen(RTLD_NOLOAD), which finds a library only if it is currently loaded.
-#include <doctest/doctest.h>
 #include <dlfcn.h>
+#include <doctest/doctest.h>
 
 #include <filesystem>
 #include <optional>

@@ -145,7 +145,8 @@ TEST_CASE("each shipped model documents T, V and the Hamiltonian it solves") {
 
 TEST_CASE("the energy of each shipped model is the Hamiltonian it documents") {
   SUBCASE("paper1d: (1 + p^2/2)^2 (1 + q^2)") {
-    check_energy(shipped("paper1d"), [](auto q, auto p) { return std::pow(1 + p[0] * p[0] / 2, 2) * (1 + q[0] * q[0]); });
+    check_energy(shipped("paper1d"),
+                 [](auto q, auto p) { return std::pow(1 + p[0] * p[0] / 2, 2) * (1 + q[0] * q[0]); });
   }
   SUBCASE("radial: (1 + p^2/2)^2 [1 + q^2/3 + (2/3) q^2 (p_hat . q_hat)^2]") {
     for (int dimension : {1, 2, 3, 7}) {
@@ -162,7 +163,8 @@ TEST_CASE("the energy of each shipped model is the Hamiltonian it documents") {
   SUBCASE("quadratic_kinetic: p_i V_ij p_j of Henon-Heiles") {
     const double lambda = 0.8;
     check_energy(shipped("quadratic_kinetic", {{"lambda", lambda}}), [&](auto q, auto p) {
-      return p[0] * p[0] + p[1] * p[1] + 2 * lambda * (q[1] * p[0] * p[0] + 2 * q[0] * p[0] * p[1] - q[1] * p[1] * p[1]);
+      return p[0] * p[0] + p[1] * p[1] +
+             2 * lambda * (q[1] * p[0] * p[0] + 2 * q[0] * p[0] * p[1] - q[1] * p[1] * p[1]);
     });
   }
   SUBCASE("paper2d: grad T . Hess V grad T, and its lower bound 2 + |p|^2 + 2c|q|^2") {
@@ -213,8 +215,8 @@ void check_energy_gradient(const PluginModel& model, nonsep::HamiltonianForm for
   model.hessian_T(p, hessian_T, 1);
   model.hessian_V(q, hessian_V, 1);
   // The variable of the third derivative (q for TTV, p for VVT) and the other one (p, q), from the plugin.
-  std::vector<double> d_third(n), d_other = times(ttv ? hessian_T : hessian_V, times(ttv ? hessian_V : hessian_T,
-                                                                                  ttv ? grad_T : grad_V));
+  std::vector<double> d_third(n),
+      d_other = times(ttv ? hessian_T : hessian_V, times(ttv ? hessian_V : hessian_T, ttv ? grad_T : grad_V));
   for (double& x : d_other) x *= 2.0;
   if (ttv)
     model.d3V(q, grad_T, d_third, 1);
@@ -233,8 +235,7 @@ void check_energy_gradient(const PluginModel& model, nonsep::HamiltonianForm for
         (in_q ? shifted_q : shifted_p)[k] += offset * step;
         return h(shifted_q, shifted_p);
       };
-      const double expected =
-          (difference(-2) - 8 * difference(-1) + 8 * difference(1) - difference(2)) / (12 * step);
+      const double expected = (difference(-2) - 8 * difference(-1) + 8 * difference(1) - difference(2)) / (12 * step);
       const double computed = in_q == ttv ? d_third[k] : d_other[k];
       CAPTURE(k);
       CAPTURE(in_q);

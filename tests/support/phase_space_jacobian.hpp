@@ -2,13 +2,12 @@
 // Jacobians of maps of phase space by central differences (support/finite_difference.hpp), and the symplectic
 // defect of a Jacobian, for the symplecticity and tangent-map tests. Phase space is ordered (q_0 .. q_n-1,
 // p_0 .. p_n-1); a map takes and returns 2n numbers.
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/core/phase_space_batch.hpp"

@@ -1,12 +1,11 @@
 #pragma once
 // Internal to nonsep::loader (host/loader/src/): what a Plugin and a PluginModel hold, shared by the loader
 // (plugin_loader.cpp), the metadata checks (plugin_metadata.cpp) and the evaluations (plugin_model.cpp).
+#include <boost/shared_ptr.hpp>
 #include <cstddef>
 #include <filesystem>
-#include <string>
-
-#include <boost/shared_ptr.hpp>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/plugin_abi.h"
@@ -16,7 +15,7 @@ namespace nonsep::host {
 struct Plugin::Loaded {
   boost::shared_ptr<const nonsep_plugin_api> table;  // from import_alias: owns the loaded library
   std::filesystem::path path;
-  const nonsep_plugin_api* api = nullptr;            // table.get()
+  const nonsep_plugin_api* api = nullptr;  // table.get()
   nlohmann::json metadata;
 };
 

@@ -4,19 +4,18 @@
 #include "nonsep/host/plugin_loader.hpp"
 
 #include <algorithm>
+#include <boost/dll/import.hpp>
+#include <boost/dll/runtime_symbol_info.hpp>
+#include <boost/dll/shared_library.hpp>
+#include <boost/shared_ptr.hpp>
 #include <cstdlib>
 #include <set>
 #include <sstream>
 #include <system_error>
 
-#include <boost/dll/runtime_symbol_info.hpp>
-#include <boost/dll/import.hpp>
-#include <boost/dll/shared_library.hpp>
-#include <boost/shared_ptr.hpp>
-
 #include "nonsep/plugin_abi.h"
-#include "plugin_internals.hpp"
 #include "nonsep/sdk/parameters.hpp"
+#include "plugin_internals.hpp"
 
 namespace nonsep::host {
 
@@ -25,15 +24,13 @@ using nlohmann::json;
 
 namespace {
 
-
 // The remedy for a plugin of another ABI version, named in both version refusals.
 const std::string rebuild_hint =
     "rebuild the plugin against the installed SDK (find_package(nonsep) and nonsep_add_model, or the headers of "
     "this nonsep's include/nonsep/plugin_abi.h)";
 
 bool looks_like_path(const std::string& spec) {
-  return spec.find('/') != std::string::npos ||
-         (spec.size() > 3 && spec.compare(spec.size() - 3, 3, ".so") == 0);
+  return spec.find('/') != std::string::npos || (spec.size() > 3 && spec.compare(spec.size() - 3, 3, ".so") == 0);
 }
 
 }  // namespace
@@ -42,8 +39,7 @@ std::vector<fs::path> plugin_search_path() {
   std::vector<fs::path> directories;
   auto add = [&](const fs::path& directory) {
     const fs::path normal = directory.lexically_normal();
-    if (std::find(directories.begin(), directories.end(), normal) == directories.end())
-      directories.push_back(normal);
+    if (std::find(directories.begin(), directories.end(), normal) == directories.end()) directories.push_back(normal);
   };
   if (const char* variable = std::getenv("NONSEP_PLUGIN_PATH")) {
     std::stringstream entries(variable);
@@ -126,16 +122,16 @@ PluginModel Plugin::create(const json& parameters_or_null) const {
   if (status != NONSEP_OK) {
     if (instance->handle != nullptr) api.destroy(instance->handle);
     instance->handle = nullptr;
-    throw PluginError(who + " could not create a model (" + status_name(status) + "): " +
-                      (message[0] ? message : "the plugin gave no message"));
+    throw PluginError(who + " could not create a model (" + status_name(status) +
+                      "): " + (message[0] ? message : "the plugin gave no message"));
   }
-  if (instance->handle == nullptr)
-    throw PluginError(who + ": create() reported success but returned no instance");
+  if (instance->handle == nullptr) throw PluginError(who + ": create() reported success but returned no instance");
 
   instance->dimension = api.dimension(instance->handle);
   if (instance->dimension == 0)
-    throw PluginError(who + ": the instance has dimension 0 (the ABI requires at least one degree of freedom; "
-                            "check the parameters that set the dimension)");
+    throw PluginError(who +
+                      ": the instance has dimension 0 (the ABI requires at least one degree of freedom; "
+                      "check the parameters that set the dimension)");
   const json& dimension = loaded_->metadata["dimension"];
   const std::size_t expected = dimension.contains("fixed")
                                    ? dimension["fixed"].get<std::size_t>()
@@ -172,8 +168,10 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
       tried += "\n  " + candidate.string() + " (no such file)";
     }
     if (file.empty())
-      throw PluginError("plugin '" + name_or_path + "' not found; looked in NONSEP_PLUGIN_PATH, the install's "
-                        "plugin folder and the build tree's, trying:" + tried);
+      throw PluginError("plugin '" + name_or_path +
+                        "' not found; looked in NONSEP_PLUGIN_PATH, the install's "
+                        "plugin folder and the build tree's, trying:" +
+                        tried);
   }
   // The checks of plugin_abi.h, in its order.
   const fs::path& path = file;
@@ -187,18 +185,22 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
   }
   if (!library.has(NONSEP_PLUGIN_SYMBOL)) {
     if (library.has(NONSEP_PLUGIN_V1_ENTRY_SYMBOL))
-      throw PluginError("plugin " + quoted(path) + " uses plugin ABI version 1 (it exports '"
-                        NONSEP_PLUGIN_V1_ENTRY_SYMBOL "') but this host uses version " +
+      throw PluginError("plugin " + quoted(path) +
+                        " uses plugin ABI version 1 (it exports '" NONSEP_PLUGIN_V1_ENTRY_SYMBOL
+                        "') but this host uses version " +
                         std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
                         std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found 1); " + rebuild_hint);
-    throw PluginError(quoted(path) + " is a shared library but not a nonsep plugin: it does not export the symbol '"
-                      NONSEP_PLUGIN_SYMBOL "' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp, or "
-                      "NONSEP_DEFINE_PLUGIN, see plugin_abi.h)");
+    throw PluginError(
+        quoted(path) +
+        " is a shared library but not a nonsep plugin: it does not export the symbol '" NONSEP_PLUGIN_SYMBOL
+        "' (define it with NONSEP_EXPORT_MODEL, see plugin_sdk.hpp, or "
+        "NONSEP_DEFINE_PLUGIN, see plugin_abi.h)");
   }
   // The symbol is a pointer to the table; import_alias returns the table as a shared_ptr that owns the library.
   loaded->table = boost::dll::import_alias<const nonsep_plugin_api>(std::move(library), NONSEP_PLUGIN_SYMBOL);
   const nonsep_plugin_api* api = loaded->table.get();
-  if (api == nullptr) throw PluginError("the symbol '" NONSEP_PLUGIN_SYMBOL "' of plugin " + quoted(path) + " is a null table");
+  if (api == nullptr)
+    throw PluginError("the symbol '" NONSEP_PLUGIN_SYMBOL "' of plugin " + quoted(path) + " is a null table");
   if (api->abi_version != NONSEP_PLUGIN_ABI_VERSION)
     throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(api->abi_version) +
                       " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
@@ -206,14 +208,17 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                       "); " + rebuild_hint);
   if (api->struct_size != sizeof(nonsep_plugin_api))
     throw PluginError("plugin " + quoted(path) + " has a function table of " + std::to_string(api->struct_size) +
-                      " bytes but ABI version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " defines " + std::to_string(sizeof(nonsep_plugin_api)) +
-                      " (expected " + std::to_string(sizeof(nonsep_plugin_api)) + ", found " +
-                      std::to_string(api->struct_size) + "); the plugin was built against a different plugin_abi.h");
-  const std::pair<const char*, bool> required[] = {
-      {"metadata_json", api->metadata_json != nullptr}, {"create", api->create != nullptr},
-      {"destroy", api->destroy != nullptr},             {"dimension", api->dimension != nullptr},
-      {"grad_T", api->grad_T != nullptr},               {"grad_V", api->grad_V != nullptr},
-      {"last_error", api->last_error != nullptr}};
+                      " bytes but ABI version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " defines " +
+                      std::to_string(sizeof(nonsep_plugin_api)) + " (expected " +
+                      std::to_string(sizeof(nonsep_plugin_api)) + ", found " + std::to_string(api->struct_size) +
+                      "); the plugin was built against a different plugin_abi.h");
+  const std::pair<const char*, bool> required[] = {{"metadata_json", api->metadata_json != nullptr},
+                                                   {"create", api->create != nullptr},
+                                                   {"destroy", api->destroy != nullptr},
+                                                   {"dimension", api->dimension != nullptr},
+                                                   {"grad_T", api->grad_T != nullptr},
+                                                   {"grad_V", api->grad_V != nullptr},
+                                                   {"last_error", api->last_error != nullptr}};
   for (const auto& [function, present] : required)
     if (!present)
       throw PluginError("plugin " + quoted(path) + " lacks the required function " + function +

@@ -55,9 +55,9 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
   } else if (dimension.contains("parameter")) {
     const json& parameter = dimension["parameter"];
     const auto& parameters = m["parameters"];
-    const bool declared = parameter.is_string() && std::any_of(parameters.begin(), parameters.end(), [&](const json& p) {
-                            return p["name"] == parameter && p["type"] == "integer";
-                          });
+    const bool declared = parameter.is_string() &&
+                          std::any_of(parameters.begin(), parameters.end(),
+                                      [&](const json& p) { return p["name"] == parameter && p["type"] == "integer"; });
     if (!declared)
       fail("sets the dimension by parameter " + parameter.dump() + ", which is not a declared integer parameter");
   } else {
@@ -65,9 +65,10 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
   }
 
   if (!m.contains("thread_safe") || !m["thread_safe"].is_boolean())
-    fail("lacks the boolean \"thread_safe\" (required since plugin ABI version 3; true when distinct instances "
-         "share no mutable state, false to be run as one instance on one thread" +
-         (m.contains("thread_safe") ? "; found " + m["thread_safe"].dump() : std::string()) + ")");
+    fail(
+        "lacks the boolean \"thread_safe\" (required since plugin ABI version 3; true when distinct instances "
+        "share no mutable state, false to be run as one instance on one thread" +
+        (m.contains("thread_safe") ? "; found " + m["thread_safe"].dump() : std::string()) + ")");
 
   if (!m.contains("capabilities") || !m["capabilities"].is_object()) fail("lacks the object \"capabilities\"");
   const std::pair<const char*, bool> present[] = {{"value_T", api.value_T != nullptr},

@@ -1,10 +1,9 @@
 #include "nonsep/host/command_line.hpp"
 
+#include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "cli/commands.hpp"
 #include "nonsep/host/build_features.hpp"
@@ -24,7 +23,8 @@ int run_command_line(int argc, char** argv) {
     CLI::App app{"nonsep " NONSEP_VERSION
                  ": explicit symplectic integrators for non-separable Hamiltonians H = T_i(p) V_ij(q) T_j(p)\n"
                  "(S. A. Chin). Models are plugins; runs are described by JSON job files. The manual (section\n"
-                 "Running nonsep): " + manual_location(),
+                 "Running nonsep): " +
+                     manual_location(),
                  "nonsep"};
     app.set_version_flag("--version", [] { return build_features_text(); });
     app.require_subcommand(1);
@@ -36,10 +36,11 @@ int run_command_line(int argc, char** argv) {
     std::string job_file;
     InspectArguments inspect_arguments;
 
-    auto* run = app.add_subcommand("run",
-                                   "Run a job: trajectory.csv (streamed), trajectories.csv and summary.json in the output folder "
-                                   "(with /analysis/poincare also poincare.csv, with /analysis/lyapunov/every lyapunov.csv); a "
-                                   "study (/study): convergence.csv, work_precision.csv, and summary.json with the fitted exponents");
+    auto* run = app.add_subcommand(
+        "run",
+        "Run a job: trajectory.csv (streamed), trajectories.csv and summary.json in the output folder "
+        "(with /analysis/poincare also poincare.csv, with /analysis/lyapunov/every lyapunov.csv); a "
+        "study (/study): convergence.csv, work_precision.csv, and summary.json with the fitted exponents");
     run->add_option("JOB.json", arguments.job_file, "the job file")->required();
     run->add_option("--output,-o", arguments.output,
                     "output folder, relative to the current directory (overrides the job's output.directory)");
@@ -62,28 +63,33 @@ int run_command_line(int argc, char** argv) {
     validate->footer(exit_status_text());
 
     auto* inspect = app.add_subcommand("inspect", "Show a plugin's metadata: parameters with defaults, ranges, units");
-    inspect->add_option("PLUGIN", inspect_arguments.name,
-                        "a plugin name (see `nonsep models`) or the path of a .so file")
+    inspect
+        ->add_option("PLUGIN", inspect_arguments.name, "a plugin name (see `nonsep models`) or the path of a .so file")
         ->required();
     inspect->add_flag("--json", inspect_arguments.as_json, "print the raw metadata JSON");
     auto* check = inspect->add_flag("--check", inspect_arguments.check,
                                     "also compare the plugin's derivatives with finite differences; exit 1 if they "
                                     "disagree, 2 if nothing could be compared (dimension 0)");
-    inspect->add_option("--parameter", inspect_arguments.parameters,
-                        "name=value: a model parameter for --check (repeatable; default: the plugin's defaults)")
+    inspect
+        ->add_option("--parameter", inspect_arguments.parameters,
+                     "name=value: a model parameter for --check (repeatable; default: the plugin's defaults)")
         ->needs(check);
-    inspect->add_option("--job", inspect_arguments.parameters_job,
-                        "JOB.json: --check with the model parameters of this job (--parameter overrides them)")
+    inspect
+        ->add_option("--job", inspect_arguments.parameters_job,
+                     "JOB.json: --check with the model parameters of this job (--parameter overrides them)")
         ->needs(check);
-    inspect->add_option("--box", inspect_arguments.box,
-                        "LO,HI: --check at 16 random points in [LO, HI]^n, each as p and as q (default -1.5,1.5)")
+    inspect
+        ->add_option("--box", inspect_arguments.box,
+                     "LO,HI: --check at 16 random points in [LO, HI]^n, each as p and as q (default -1.5,1.5)")
         ->needs(check);
-    inspect->add_option("--points-from", inspect_arguments.points_job,
-                        "JOB.json: --check at the job's initial states (p for T, q for V) instead of random points "
-                        "(as well, with --box)")
+    inspect
+        ->add_option("--points-from", inspect_arguments.points_job,
+                     "JOB.json: --check at the job's initial states (p for T, q for V) instead of random points "
+                     "(as well, with --box)")
         ->needs(check);
-    inspect->add_option("--tolerance", inspect_arguments.tolerance,
-                        "allowed error relative to max(1, |finite difference|) (default 1e-6)")
+    inspect
+        ->add_option("--tolerance", inspect_arguments.tolerance,
+                     "allowed error relative to max(1, |finite difference|) (default 1e-6)")
         ->check(CLI::PositiveNumber)
         ->needs(check);
     inspect->footer(exit_status_text());
@@ -93,8 +99,9 @@ int run_command_line(int argc, char** argv) {
 
     ExampleArguments example_arguments;
     auto* example = app.add_subcommand(
-        "example", "Write a starting job file: the quickstart job, or the example NAME (see --list), to standard "
-                   "output or FILE; it passes `nonsep validate` as written");
+        "example",
+        "Write a starting job file: the quickstart job, or the example NAME (see --list), to standard "
+        "output or FILE; it passes `nonsep validate` as written");
     example->add_option("NAME", example_arguments.name, "the example (default: quickstart)");
     example->add_option("--output,-o", example_arguments.output, "the file to write (never overwritten)");
     example->add_flag("--list", example_arguments.list, "list the examples, one line each")
@@ -103,8 +110,9 @@ int run_command_line(int argc, char** argv) {
     example->footer(exit_status_text());
 
     auto* schema = app.add_subcommand(
-        "schema", "Print the JSON Schema of job files (schemas/job.schema.json), generated from the job reader's "
-                  "tables and the scheme catalogue");
+        "schema",
+        "Print the JSON Schema of job files (schemas/job.schema.json), generated from the job reader's "
+        "tables and the scheme catalogue");
     schema->footer(exit_status_text());
 
     // CLI11 would call an unknown command a missing subcommand without naming it.

@@ -1,21 +1,20 @@
-#include <iostream>
-#include <string>
-
-#include "cli/commands.hpp"
-#include "nonsep/host/exit_status.hpp"
-#include "nonsep/host/number_format.hpp"
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <vector>
 #include <filesystem>
+#include <iostream>
 #include <memory>
-#include <streambuf>
 #include <optional>
+#include <streambuf>
+#include <string>
+#include <vector>
 
+#include "cli/commands.hpp"
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/cluster/distributed_run.hpp"
 #include "nonsep/host/cluster/ranks.hpp"
+#include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/files.hpp"
 #include "nonsep/host/progress_bar.hpp"
 #include "nonsep/host/run/run_job.hpp"
@@ -35,9 +34,9 @@ extern "C" void request_stop(int signal) {
   stop_requested.store(true);
 }
 
-// Catches the first SIGINT, SIGTERM or SIGUSR1 (the run finishes its step, flushes trajectory.csv and writes its checkpoint
-// and summary); SA_RESETHAND restores the default action, so a second signal of the same kind ends the process at
-// once. No SA_RESTART: a plugin sleeping or waiting in a system call sees EINTR and returns sooner.
+// Catches the first SIGINT, SIGTERM or SIGUSR1 (the run finishes its step, flushes trajectory.csv and writes its
+// checkpoint and summary); SA_RESETHAND restores the default action, so a second signal of the same kind ends the
+// process at once. No SA_RESTART: a plugin sleeping or waiting in a system call sees EINTR and returns sooner.
 class InterruptGuard {
  public:
   InterruptGuard() {
@@ -118,7 +117,8 @@ std::vector<std::string> fit_warnings(const StudyFit& fit) {
                        (fit.dt_min ? " (dt_min = " + four_digits(*fit.dt_min) + ")" : std::string()) +
                        "; move its step range to larger dt (fewer steps) so that every point is above it");
   if (fit.energy_error_changes_sign)
-    warnings.push_back(fit.integrator + ": the energy error changes sign within the fitted range, so the fit mixes a "
+    warnings.push_back(fit.integrator +
+                       ": the energy error changes sign within the fitted range, so the fit mixes a "
                        "zero crossing into the power law; move its step range to where the error keeps one sign (" +
                        (round_off.empty() ? std::string("smaller dt, more steps, when the larger dt are not yet "
                                                         "asymptotic")
@@ -224,9 +224,7 @@ auto run_guarded(Run run) -> std::optional<decltype(run())> {
   return std::nullopt;
 }
 
-const char* signal_name(int signal) {
-  return signal == SIGTERM ? "SIGTERM" : signal == SIGUSR1 ? "SIGUSR1" : "SIGINT";
-}
+const char* signal_name(int signal) { return signal == SIGTERM ? "SIGTERM" : signal == SIGUSR1 ? "SIGUSR1" : "SIGINT"; }
 
 int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& arguments,
                const std::filesystem::path& directory, int signal) {
@@ -245,12 +243,12 @@ int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& ar
     std::cerr << "nonsep: " << line << "\n";
     if (!outcome.error.empty()) std::cerr << "nonsep: " << outcome.error << "\n";
     if (outcome.status == TrajectoryStatus::interrupted && outcome.distributed)
-      std::cerr << "nonsep: stopped by " << signal_name(signal) << "; `nonsep run "
-                << arguments.job_file << (arguments.output.empty() ? "" : " --output " + arguments.output)
+      std::cerr << "nonsep: stopped by " << signal_name(signal) << "; `nonsep run " << arguments.job_file
+                << (arguments.output.empty() ? "" : " --output " + arguments.output)
                 << " --resume` continues the work units, with any number of MPI ranks\n";
     else if (outcome.status == TrajectoryStatus::interrupted)
-      std::cerr << "nonsep: stopped by " << signal_name(signal) << " after step "
-                << outcome.steps_completed << "; `nonsep run " << arguments.job_file
+      std::cerr << "nonsep: stopped by " << signal_name(signal) << " after step " << outcome.steps_completed
+                << "; `nonsep run " << arguments.job_file
                 << (arguments.output.empty() ? "" : " --output " + arguments.output)
                 << " --resume` continues from there\n";
   }
@@ -317,7 +315,8 @@ int command_run(const RunArguments& arguments) {
   int status = 0;
   if (ranks->rank() == 0) {
     if (ranks->size() > 1)
-      std::cerr << "nonsep: note: " << (loaded->job.is_study() ? "a convergence study" : "a one-process run's checkpoint")
+      std::cerr << "nonsep: note: "
+                << (loaded->job.is_study() ? "a convergence study" : "a one-process run's checkpoint")
                 << " runs on rank 0 alone; the other " << ranks->size() - 1 << " rank(s) wait\n";
     if (loaded->job.is_study()) {
       auto outcome = run_guarded([&] { return run_study(*loaded, options); });

@@ -2,9 +2,9 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "nonsep/core/scheme_catalogue.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/core/scheme_catalogue.hpp"
 
 namespace nonsep::host::cli {
 
@@ -43,8 +43,8 @@ int report_invalid_job(const InvalidJob& error) {
 }
 
 std::string time_text(const TimeGrid& time) {
-  return std::to_string(time.steps) + " steps of dt = " + format_number(time.dt) + " to t_end = " +
-         format_number(time.t_end) +
+  return std::to_string(time.steps) + " steps of dt = " + format_number(time.dt) +
+         " to t_end = " + format_number(time.t_end) +
          (time.from_t_end && time.dt != time.dt_requested ? " (dt requested " + format_number(time.dt_requested) + ")"
                                                           : "");
 }

@@ -16,9 +16,9 @@ int command_validate(const std::string& job_file) {
       std::cout << "valid: " << job_file << "\n"
                 << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
                 << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
-                << "  study:       " << study.integrators.size() << " integrators to t_end = "
-                << format_number(study.t_end) << (study.reference_q.empty() ? "" : ", with a reference")
-                << "\n";
+                << "  study:       " << study.integrators.size()
+                << " integrators to t_end = " << format_number(study.t_end)
+                << (study.reference_q.empty() ? "" : ", with a reference") << "\n";
       for (const auto& integrator : study.integrators)
         std::cout << "    " << integrator.label << ": " << integrator.spec.scheme << ", order "
                   << integrator.spec.order.to_string() << ", t2 = " << format_number(integrator.spec.t2) << ", "
@@ -33,8 +33,9 @@ int command_validate(const std::string& job_file) {
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
               << "  parameters:  " << loaded.model.parameters().dump() << "\n"
-              << "  integrator:  " << spec.scheme << ", order " << spec.order.to_string() << ", t2 = "
-              << format_number(spec.t2) << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT") << "\n"
+              << "  integrator:  " << spec.scheme << ", order " << spec.order.to_string()
+              << ", t2 = " << format_number(spec.t2) << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT")
+              << "\n"
               << "  initial:     " << job.initial.count << " state" << (job.initial.count == 1 ? "" : "s") << " ("
               << job.initial.shape << ")\n"
               << "  time:        " << time_text(run.time) << "\n"

@@ -59,8 +59,8 @@ json plan_json(const Plan& plan, const std::string& fingerprint) {
           {"job_fingerprint", fingerprint}};
 }
 
-// Rank 0: takes the output folder and writes `plan` to units/plan.json (fresh) or checks it against it (resume). Throws what RunFolder and
-// the checkpoint checks throw.
+// Rank 0: takes the output folder and writes `plan` to units/plan.json (fresh) or checks it against it (resume). Throws
+// what RunFolder and the checkpoint checks throw.
 void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Plan& plan,
                     std::optional<RunFolder>& folder) {
   const std::filesystem::path& directory = options.output_directory;
@@ -75,7 +75,8 @@ void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Pl
       throw CheckpointError(path.string() + " is missing or damaged: there is no distributed run to resume here");
     }
     if (saved != plan_json(plan, fingerprint))
-      throw CheckpointError(path.string() + " was written by another job, or by this job before it was changed; "
+      throw CheckpointError(path.string() +
+                            " was written by another job, or by this job before it was changed; "
                             "run it again without --resume (--force discards the units)");
     return;
   }
@@ -93,7 +94,7 @@ UnitState unit_state(const std::filesystem::path& folder) {
   if (!std::filesystem::exists(folder / "summary.json", error)) return UnitState::fresh;
   try {
     return json::parse(read_text(folder / "summary.json")).at("status") == "interrupted" ? UnitState::fresh
-                                                                                      : UnitState::done;
+                                                                                         : UnitState::done;
   } catch (const json::exception&) {
     return UnitState::fresh;  // a unit killed while writing it: run again
   }
@@ -147,7 +148,8 @@ RunOutcome merge_units(const RunOptions& options, const Plan& plan, double wall_
   outcome.summary = merge_summaries(summaries, firsts, plan.trajectories, directory, wall_seconds);
   write_file_atomically(directory / "summary.json", outcome.summary.dump(2) + "\n");
   const json& summary = outcome.summary;
-  outcome.status = trajectory_status_from_string(summary["status"].get<std::string>()).value_or(TrajectoryStatus::failed);
+  outcome.status =
+      trajectory_status_from_string(summary["status"].get<std::string>()).value_or(TrajectoryStatus::failed);
   outcome.exit_status = exit_status_of(outcome.status);
   outcome.error = summary.value("error", "");
   outcome.steps_completed = summary["time"]["steps_completed"].get<std::uint64_t>();
@@ -180,13 +182,14 @@ RunOutcome interrupted_outcome(const LoadedJob& loaded, const RunOptions& option
   outcome.summary = {{"status", "interrupted"},
                      {"job", loaded.job.file.string()},
                      {"trajectories", plan.trajectories},
-                     {"distributed", {{"ranks", ranks.size()},
-                                      {"units", plan.units},
-                                      {"unit_size", plan.unit_size},
-                                      {"units_done", done},
-                                      {"units_checkpointed", checkpointed},
-                                      {"folder", units_folder},
-                                      {"resume", "nonsep run JOB --resume, with any number of ranks"}}}};
+                     {"distributed",
+                      {{"ranks", ranks.size()},
+                       {"units", plan.units},
+                       {"unit_size", plan.unit_size},
+                       {"units_done", done},
+                       {"units_checkpointed", checkpointed},
+                       {"folder", units_folder},
+                       {"resume", "nonsep run JOB --resume, with any number of ranks"}}}};
   write_file_atomically(options.output_directory / "summary.json", outcome.summary.dump(2) + "\n");
   return outcome;
 }
@@ -280,10 +283,10 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
   RunOutcome outcome;
   if (ranks.rank() == 0) {
     try {
-      outcome = interrupted ? interrupted_outcome(loaded, options, plan, ranks)
-                            : merge_units(options, plan,
-                                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                                              .count());
+      outcome = interrupted
+                    ? interrupted_outcome(loaded, options, plan, ranks)
+                    : merge_units(options, plan,
+                                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     } catch (const std::exception& error) {
       local_failure = std::string(error.what()) + " (the units' results stay in " +
                       (options.output_directory / units_folder).string() + ")";

@@ -3,11 +3,10 @@
 // Checker, the typed reads every section uses. Each read of Checker either returns the value or adds one JobIssue
 // (path, what was found, what is allowed) and returns nothing, so a section goes on and reports all its problems.
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/host/job.hpp"
 

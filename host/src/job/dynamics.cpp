@@ -3,8 +3,8 @@
 // needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
 #include <limits>
 
-#include "nonsep/core/lyapunov_exponents.hpp"
 #include "job_keys.hpp"
+#include "nonsep/core/lyapunov_exponents.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -34,8 +34,8 @@ std::optional<PoincareSection> read_poincare(Checker& check, const json& value, 
   const std::size_t issues = check.issue_count();
   PoincareSection section;
   const bool has_component = value.contains("component"), has_normal = value.contains("normal");
-  const std::string components = dimension > 0 ? "\"q0\" .. \"q" + std::to_string(dimension - 1) + "\" or \"p0\" .. \"p" +
-                                                     std::to_string(dimension - 1) + "\""
+  const std::string components = dimension > 0 ? "\"q0\" .. \"q" + std::to_string(dimension - 1) +
+                                                     "\" or \"p0\" .. \"p" + std::to_string(dimension - 1) + "\""
                                                : "\"q<i>\" or \"p<i>\"";
   if (has_component == has_normal) {
     check.issue(path, has_component ? "both \"component\" and \"normal\"" : "neither \"component\" nor \"normal\"",
@@ -64,14 +64,18 @@ std::optional<PoincareSection> read_poincare(Checker& check, const json& value, 
     check.issue(path, "both \"value\" and \"offset\"", "one of them: the plane is normal . (q, p) = value");
   for (const char* key : {"value", "offset"})
     if (const json* c = check.member(value, path, key, false, ""))
-      if (auto number = check.finite_number(*c, child(path, key), "a finite number: the plane is normal . (q, p) = "
-                                                                   "value (default 0)"))
+      if (auto number = check.finite_number(*c, child(path, key),
+                                            "a finite number: the plane is normal . (q, p) = "
+                                            "value (default 0)"))
         section.offset = *number;
   if (const json* direction = check.member(value, path, "direction", false, "")) {
     const std::string text = direction->is_string() ? direction->get<std::string>() : "";
-    if (text == "+") section.direction = CrossingDirection::up;
-    else if (text == "-") section.direction = CrossingDirection::down;
-    else if (text == "both") section.direction = CrossingDirection::both;
+    if (text == "+")
+      section.direction = CrossingDirection::up;
+    else if (text == "-")
+      section.direction = CrossingDirection::down;
+    else if (text == "both")
+      section.direction = CrossingDirection::both;
     else
       check.issue(child(path, "direction"), describe(*direction),
                   "\"+\" (normal . (q, p) - value goes from < 0 to >= 0; the default), \"-\" or \"both\"");

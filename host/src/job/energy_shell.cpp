@@ -3,7 +3,6 @@
 // from p_i = 0 outwards (doubling) and refined by Boost.Math's TOMS 748 to the last bits; the state keeps the
 // evaluated p_i with the smallest |H - E|.
 #include <boost/math/tools/toms748_solve.hpp>
-
 #include <cmath>
 
 #include "nonsep/core/energy.hpp"
@@ -71,8 +70,10 @@ void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues) {
     return h - shell.energy;
   };
   for (std::size_t b = 0; b < initial.count; ++b) {
-    q.assign(initial.q.begin() + static_cast<std::ptrdiff_t>(b * n), initial.q.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
-    p.assign(initial.p.begin() + static_cast<std::ptrdiff_t>(b * n), initial.p.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
+    q.assign(initial.q.begin() + static_cast<std::ptrdiff_t>(b * n),
+             initial.q.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
+    p.assign(initial.p.begin() + static_cast<std::ptrdiff_t>(b * n),
+             initial.p.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
     double lower = 0.0, g_lower = excess(0.0), upper = 1.0, g_upper = 0.0;
     bool bracketed = false;
     if (std::isfinite(g_lower) && g_lower <= 0.0) {
@@ -104,8 +105,8 @@ void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues) {
   }
   if (kept_q.empty()) {
     issues.push_back({"/initial/energy", format_number(shell.energy) + ", which no state of the grid reaches",
-                      "an energy that some states of the grid reach by solving for " + shell.solve_for +
-                          " (H at " + shell.solve_for.substr(shell.negative ? 1 : 0) + " = 0 must not exceed it)"});
+                      "an energy that some states of the grid reach by solving for " + shell.solve_for + " (H at " +
+                          shell.solve_for.substr(shell.negative ? 1 : 0) + " = 0 must not exceed it)"});
     return;
   }
   initial.q = std::move(kept_q);

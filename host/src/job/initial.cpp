@@ -49,10 +49,11 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
     from = check.finite_number(*v, child(path, "from"), "the first value, a finite number");
   if (const json* v = check.member(value, path, "to", keys["to"].required, "the last value, a finite number"))
     to = check.finite_number(*v, child(path, "to"), "the last value, a finite number");
-  if (const json* v = check.member(value, path, "count", keys["count"].required, "the number of values, an integer >= 1"))
+  if (const json* v =
+          check.member(value, path, "count", keys["count"].required, "the number of values, an integer >= 1"))
     count = check.integer(*v, child(path, "count"), keys["count"].minimum, keys["count"].maximum,
-                          "the number of values, an integer from " + std::to_string(keys["count"].minimum) +
-                              " to " + std::to_string(keys["count"].maximum));
+                          "the number of values, an integer from " + std::to_string(keys["count"].minimum) + " to " +
+                              std::to_string(keys["count"].maximum));
   if (!from || !to || !count) return std::nullopt;
   std::vector<double> values(static_cast<std::size_t>(*count));
   const auto n = values.size();
@@ -92,7 +93,8 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
   bool ok = true;
   for (int which = 0; which < 2; ++which) {
     const std::string name = which == 0 ? "q" : "p";
-    const json* list = check.member(grid, path, name, grid_keys()[name].required, "an array of axes, one per component");
+    const json* list =
+        check.member(grid, path, name, grid_keys()[name].required, "an array of axes, one per component");
     if (!list) {
       ok = false;
       continue;
@@ -126,8 +128,7 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
   if (!ok) return;
   const std::size_t n = sizes[0];
   if (count > max_initial_values / n) {
-    check.issue(path, "a grid of " + std::to_string(count) + " states of dimension " + std::to_string(n),
-                values_limit);
+    check.issue(path, "a grid of " + std::to_string(count) + " states of dimension " + std::to_string(n), values_limit);
     return;
   }
   fill_grid(axes, n, count, states);
@@ -220,8 +221,9 @@ namespace nonsep::host {
 
 void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues) {
   if (initial.count == 0 || initial.dimension == model_dimension) return;
-  const std::string path =
-      initial.shape == "list" ? "/initial/0/q" : initial.shape == "grid" ? "/initial/grid/q" : "/initial/q";
+  const std::string path = initial.shape == "list"   ? "/initial/0/q"
+                           : initial.shape == "grid" ? "/initial/grid/q"
+                                                     : "/initial/q";
   issues.push_back({path,
                     std::to_string(initial.dimension) + (initial.shape == "grid" ? " axes" : " components") +
                         (initial.shape == "list" && initial.count > 1 ? " (in every state)" : ""),

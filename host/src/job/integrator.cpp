@@ -1,11 +1,12 @@
 // /hamiltonian and /integrator: the scheme and its options, read against the core's catalogue
 // (nonsep::scheme_catalogue()); whether an option's value is valid is decided by the core, by building the scheme.
+#include "nonsep/core/integrator.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <stdexcept>
 
 #include "nonsep/core/error.hpp"
-#include "nonsep/core/integrator.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -129,8 +130,8 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
       if (!parameter.default_text.empty()) set_option(spec, parameter, default_option(parameter));
   for (const auto& parameter : parameters) {
     const std::string option_path = child(path, parameter.name);
-    const json* given = check.member(integrator, path, parameter.name, parameter.default_text.empty(),
-                                     parameter.description);
+    const json* given =
+        check.member(integrator, path, parameter.name, parameter.default_text.empty(), parameter.description);
     if (!given) {
       if (!parameter.default_text.empty()) set_option(spec, parameter, default_option(parameter));
       continue;

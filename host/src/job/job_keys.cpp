@@ -2,11 +2,10 @@
 // constants (job.hpp, time_grid.hpp).
 #include "job_keys.hpp"
 
-#include "nonsep/core/lyapunov_exponents.hpp"
-
 #include <limits>
 #include <stdexcept>
 
+#include "nonsep/core/lyapunov_exponents.hpp"
 #include "nonsep/host/job.hpp"
 
 namespace nonsep::host::job_reader {
@@ -38,37 +37,57 @@ const KeyRule& KeyTable::operator[](std::string_view name) const {
 
 const KeyTable& document_keys() {
   static const KeyTable table{{
-      {.name = "$schema", .type = ValueType::string,
+      {.name = "$schema",
+       .type = ValueType::string,
        .description = "The schema the file follows (for editors); ignored by nonsep."},
       {.name = "description", .type = ValueType::text, .description = "Free text; ignored by nonsep."},
-      {.name = "model", .type = ValueType::object, .required = true, .description = "The model plugin.",
+      {.name = "model",
+       .type = ValueType::object,
+       .required = true,
+       .description = "The model plugin.",
        .keys = model_keys},
-      {.name = "hamiltonian", .type = ValueType::form, .default_value = "TTV",
+      {.name = "hamiltonian",
+       .type = ValueType::form,
+       .default_value = "TTV",
        .description = "TTV: H = T_i(p) V_ij(q) T_j(p); VVT: H = V_i(q) T_ij(p) V_j(q)."},
-      {.name = "integrator", .type = ValueType::defined,
+      {.name = "integrator",
+       .type = ValueType::defined,
        .description = "The scheme and its options (a run; required there, refused in a study).",
-       .definition = "integrator", .run_only = true, .in_study_found = "an integrator together with /study",
+       .definition = "integrator",
+       .run_only = true,
+       .in_study_found = "an integrator together with /study",
        .in_study_allowed = "no /integrator in a study: each entry of /study/integrators is one"},
-      {.name = "initial", .type = ValueType::defined, .required = true,
+      {.name = "initial",
+       .type = ValueType::defined,
+       .required = true,
        .description = "One state, a non-empty array of states (an ensemble), or a grid of states; a study has one "
                       "state.",
        .definition = "initial"},
-      {.name = "time", .type = ValueType::object, .required = true,
+      {.name = "time",
+       .type = ValueType::object,
+       .required = true,
        .description = "The time grid: {dt, t_end or steps} for a run, {t_end} for a study."},
       {.name = "output", .type = ValueType::object, .description = "Where results go.", .keys = output_keys},
-      {.name = "analysis", .type = ValueType::object,
-       .description = "Per-trajectory analysis of a run (not of a study).", .keys = analysis_keys,
-       .run_only = true, .in_study_found = "an analysis together with /study",
+      {.name = "analysis",
+       .type = ValueType::object,
+       .description = "Per-trajectory analysis of a run (not of a study).",
+       .keys = analysis_keys,
+       .run_only = true,
+       .in_study_found = "an analysis together with /study",
        .in_study_allowed = "/analysis in single runs only"},
-      {.name = "study", .type = ValueType::object,
+      {.name = "study",
+       .type = ValueType::object,
        .description = "A convergence study: each integrator runs from the one initial state to time.t_end at each of "
                       "its step counts; outputs convergence.csv and the fitted exponents in summary.json. Step "
                       "counts come from the integrator's own steps or dt, else from the study's.",
        .keys = study_keys},
-      {.name = "checkpoint", .type = ValueType::object,
+      {.name = "checkpoint",
+       .type = ValueType::object,
        .description = "When checkpoint.json is saved in the output folder, for `nonsep run JOB --resume`. Always "
                       "saved when a run is interrupted. Runs only: a study is not resumed.",
-       .keys = checkpoint_keys, .run_only = true, .in_study_found = "a checkpoint policy together with /study",
+       .keys = checkpoint_keys,
+       .run_only = true,
+       .in_study_found = "a checkpoint policy together with /study",
        .in_study_allowed = "/checkpoint in single runs only (a study is not resumed)"},
   }};
   return table;
@@ -76,10 +95,14 @@ const KeyTable& document_keys() {
 
 const KeyTable& model_keys() {
   static const KeyTable table{{
-      {.name = "plugin", .type = ValueType::path, .required = true,
+      {.name = "plugin",
+       .type = ValueType::path,
+       .required = true,
        .description = "A plugin name (looked up as <name>.so on the search path, see `nonsep models`) or a path to a "
                       ".so file (contains '/' or ends in .so; relative to the job file's folder)."},
-      {.name = "parameters", .type = ValueType::defined, .default_value = nlohmann::ordered_json::object(),
+      {.name = "parameters",
+       .type = ValueType::defined,
+       .default_value = nlohmann::ordered_json::object(),
        .description = "The plugin's parameters by name (see `nonsep inspect PLUGIN`); missing ones take the "
                       "plugin's defaults.",
        .definition = "parameters"},
@@ -89,12 +112,18 @@ const KeyTable& model_keys() {
 
 const KeyTable& run_time_keys() {
   static const KeyTable table{{
-      {.name = "dt", .type = ValueType::nonzero, .required = true,
+      {.name = "dt",
+       .type = ValueType::nonzero,
+       .required = true,
        .description = "Time step; negative integrates backwards (t_end must then be negative too)."},
-      {.name = "t_end", .type = ValueType::nonzero,
+      {.name = "t_end",
+       .type = ValueType::nonzero,
        .description = "End time, same sign as dt. steps = ceil((t_end/dt)(1 - 1e-9)), and the step actually used "
                       "is t_end/steps, so the run ends exactly at t_end."},
-      {.name = "steps", .type = ValueType::integer, .minimum = 1, .maximum = steps_limit,
+      {.name = "steps",
+       .type = ValueType::integer,
+       .minimum = 1,
+       .maximum = steps_limit,
        .description = "Number of steps of exactly dt."},
   }};
   return table;
@@ -102,7 +131,9 @@ const KeyTable& run_time_keys() {
 
 const KeyTable& study_time_keys() {
   static const KeyTable table{{
-      {.name = "t_end", .type = ValueType::nonzero, .required = true,
+      {.name = "t_end",
+       .type = ValueType::nonzero,
+       .required = true,
        .description = "The end time of every run of the study."},
   }};
   return table;
@@ -110,17 +141,27 @@ const KeyTable& study_time_keys() {
 
 const KeyTable& output_keys() {
   static const KeyTable table{{
-      {.name = "directory", .type = ValueType::path,
+      {.name = "directory",
+       .type = ValueType::path,
        .description = "Output folder, relative to the job file's folder; default <job file name without .json>.out "
                       "beside the job file. `nonsep run --output DIR` overrides it."},
-      {.name = "every", .type = ValueType::integer, .minimum = 0, .maximum = int64_limit, .default_value = 1,
+      {.name = "every",
+       .type = ValueType::integer,
+       .minimum = 0,
+       .maximum = int64_limit,
+       .default_value = 1,
        .description = "trajectory.csv gets steps 0, every, 2 every, ... and the final step; 0 writes no "
                       "trajectory.csv."},
-      {.name = "energy_every", .type = ValueType::integer, .minimum = 0, .maximum = int64_limit,
+      {.name = "energy_every",
+       .type = ValueType::integer,
+       .minimum = 0,
+       .maximum = int64_limit,
        .default_value = 0,
        .description = "H is evaluated at step 0, at every written sample and at the end; energy_every > 0 also "
                       "evaluates it every energy_every-th step. Costs about a step's work per evaluation."},
-      {.name = "format", .type = ValueType::choice, .default_value = "csv",
+      {.name = "format",
+       .type = ValueType::choice,
+       .default_value = "csv",
        .description = "\"csv\": the samples in trajectory.csv. \"hdf5\": the samples in results.h5 (group /samples) "
                       "instead, and trajectories.csv, poincare.csv and lyapunov.csv copied into it at the end (the CSV "
                       "files are kept); needs a build with HDF5 (`nonsep --version`). A study accepts \"csv\" only.",
@@ -131,25 +172,31 @@ const KeyTable& output_keys() {
 
 const KeyTable& analysis_keys() {
   static const KeyTable table{{
-      {.name = "closest_return_after", .type = ValueType::finite,
+      {.name = "closest_return_after",
+       .type = ValueType::finite,
        .description = "From |t| >= this time on, the smallest Euclidean phase-space distance |(q, p) - (q0, p0)| "
                       "of each trajectory to its initial state is tracked at every step (trajectories.csv: "
                       "closest_return_distance, _t, _step)."},
-      {.name = "max_relative_energy_error", .type = ValueType::positive,
+      {.name = "max_relative_energy_error",
+       .type = ValueType::positive,
        .description = "A bound on the relative energy error |H(t) - H0| / |H0|: a trajectory that exceeds it is "
                       "retired with status \"inaccurate\". Absent: no bound."},
-      {.name = "poincare", .type = ValueType::object,
+      {.name = "poincare",
+       .type = ValueType::object,
        .description = "A surface of section normal . (q, p) = value: every crossing of every trajectory goes to "
                       "poincare.csv (trajectory, crossing, step, t, q, p, H), located on the numerical trajectory by "
                       "a fractional step of the run's integrator (|normal . (q, p) - value| at round-off). Exactly "
                       "one of component and normal.",
        .keys = poincare_keys},
-      {.name = "lyapunov", .type = ValueType::object,
+      {.name = "lyapunov",
+       .type = ValueType::object,
        .description = "Finite-time Lyapunov exponents (Benettin et al.) from the exact tangent map of the run's "
                       "integrator: trajectories.csv columns lyapunov0 .. lyapunov<k-1>. The plugin must have "
                       "Hessians. The first tangent vector is (1, 1/2, ..., 1/(2n)) over (dq, dp), normalised.",
        .keys = lyapunov_keys},
-      {.name = "megno", .type = ValueType::boolean, .default_value = false,
+      {.name = "megno",
+       .type = ValueType::boolean,
+       .default_value = false,
        .description = "MEGNO of the first tangent vector (Cincotta and Simo): trajectories.csv columns megno (Y) and "
                       "mean_megno (<Y>: -> 2 on quasi-periodic orbits, ~ lambda t / 2 on chaotic ones). The plugin "
                       "must have Hessians."},
@@ -160,19 +207,28 @@ const KeyTable& analysis_keys() {
 const KeyTable& poincare_keys() {
   static const KeyTable table{
       {
-          {.name = "component", .type = ValueType::string,
+          {.name = "component",
+           .type = ValueType::string,
            .description = "The plane component = value, e.g. \"q0\" or \"p1\" (0-based, below the dimension).",
            .pattern = "^[qp](0|[1-9][0-9]*)$"},
-          {.name = "normal", .type = ValueType::defined,
-           .description = "2n numbers, n for q then n for p, not all zero.", .definition = "vector"},
-          {.name = "value", .type = ValueType::finite, .default_value = 0,
+          {.name = "normal",
+           .type = ValueType::defined,
+           .description = "2n numbers, n for q then n for p, not all zero.",
+           .definition = "vector"},
+          {.name = "value",
+           .type = ValueType::finite,
+           .default_value = 0,
            .description = "The offset c of the plane normal . (q, p) = c."},
           {.name = "offset", .type = ValueType::finite, .default_value = 0, .description = "Another name for value."},
-          {.name = "direction", .type = ValueType::choice, .default_value = "+",
+          {.name = "direction",
+           .type = ValueType::choice,
+           .default_value = "+",
            .description = "\"+\": crossings where normal . (q, p) - value goes from < 0 to >= 0; \"-\": from > 0 "
                           "to <= 0; \"both\".",
            .choices = {"+", "-", "both"}},
-          {.name = "max_crossings", .type = ValueType::integer, .minimum = 1,
+          {.name = "max_crossings",
+           .type = ValueType::integer,
+           .minimum = 1,
            .maximum = std::numeric_limits<std::int64_t>::max(),
            .description = "A trajectory stops at the step of its N-th crossing, with status \"completed\" and a "
                           "message saying so. Absent: no limit."},
@@ -184,13 +240,23 @@ const KeyTable& poincare_keys() {
 
 const KeyTable& lyapunov_keys() {
   static const KeyTable table{{
-      {.name = "vectors", .type = ValueType::integer, .minimum = 1,
-       .maximum = static_cast<std::int64_t>(LyapunovRecord::max_exponents), .default_value = 1,
+      {.name = "vectors",
+       .type = ValueType::integer,
+       .minimum = 1,
+       .maximum = static_cast<std::int64_t>(LyapunovRecord::max_exponents),
+       .default_value = 1,
        .description = "k, the number of largest exponents (at most 2n)."},
-      {.name = "renormalize_every", .type = ValueType::integer, .minimum = 1, .maximum = steps_limit,
+      {.name = "renormalize_every",
+       .type = ValueType::integer,
+       .minimum = 1,
+       .maximum = steps_limit,
        .default_value = 1,
        .description = "Steps between re-orthonormalisations (modified Gram-Schmidt) of the tangent vectors."},
-      {.name = "every", .type = ValueType::integer, .minimum = 0, .maximum = steps_limit, .default_value = 0,
+      {.name = "every",
+       .type = ValueType::integer,
+       .minimum = 0,
+       .maximum = steps_limit,
+       .default_value = 0,
        .description = "Write the running estimates to lyapunov.csv every n-th step (with megno and mean_megno when "
                       "megno is true); 0: no time series."},
   }};
@@ -199,9 +265,15 @@ const KeyTable& lyapunov_keys() {
 
 const KeyTable& checkpoint_keys() {
   static const KeyTable table{{
-      {.name = "every_steps", .type = ValueType::integer, .minimum = 0, .maximum = steps_limit, .default_value = 0,
+      {.name = "every_steps",
+       .type = ValueType::integer,
+       .minimum = 0,
+       .maximum = steps_limit,
+       .default_value = 0,
        .description = "Save a checkpoint every n steps; 0: not by steps."},
-      {.name = "every_seconds", .type = ValueType::nonnegative, .default_value = 60,
+      {.name = "every_seconds",
+       .type = ValueType::nonnegative,
+       .default_value = 60,
        .description = "Save a checkpoint when this many seconds of wall time have passed since the last one; 0: "
                       "not by time."},
   }};
@@ -209,34 +281,45 @@ const KeyTable& checkpoint_keys() {
 }
 
 const KeyTable& study_keys() {
-  static const KeyTable table{{
-      {.name = "integrators", .type = ValueType::defined, .required = true,
-       .description = "The integrators, each as /integrator of a run with an optional label and its own steps or "
-                      "dt.",
-       .definition = "study_integrators"},
-      {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
-      {.name = "dt", .type = ValueType::defined, .definition = "step_sizes"},
-      {.name = "reference", .type = ValueType::defined,
-       .description = "The exact state at t_end: convergence.csv then has each run's phase-space error "
-                      "|(q, p) - (q_ref, p_ref)|, and the fits its exponent.",
-       .definition = "state"},
-      {.name = "reference_run", .type = ValueType::defined,
-       .description = "Instead of reference: an integrator with exactly one step count (\"steps\": [N]) or size, "
-                      "run first from the initial state to t_end; its end state is the reference of the phase-space "
-                      "errors (summary.json study.reference says which).",
-       .definition = "study_integrator"},
-      {.name = "repeats", .type = ValueType::integer, .minimum = 1, .maximum = 1000, .default_value = 1,
-       .description = "How many times each run is repeated for its wall time: work_precision.csv gives the median "
-                      "over the repeats and their count (the errors and evaluation counts are those of the first: "
-                      "every repeat computes the same numbers)."},
-  },
-  {{"dependentSchemas", {{"reference_run", {{"not", {{"required", {"reference"}}}}}}}}}};
+  static const KeyTable table{
+      {
+          {.name = "integrators",
+           .type = ValueType::defined,
+           .required = true,
+           .description = "The integrators, each as /integrator of a run with an optional label and its own steps or "
+                          "dt.",
+           .definition = "study_integrators"},
+          {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
+          {.name = "dt", .type = ValueType::defined, .definition = "step_sizes"},
+          {.name = "reference",
+           .type = ValueType::defined,
+           .description = "The exact state at t_end: convergence.csv then has each run's phase-space error "
+                          "|(q, p) - (q_ref, p_ref)|, and the fits its exponent.",
+           .definition = "state"},
+          {.name = "reference_run",
+           .type = ValueType::defined,
+           .description =
+               "Instead of reference: an integrator with exactly one step count (\"steps\": [N]) or size, "
+               "run first from the initial state to t_end; its end state is the reference of the phase-space "
+               "errors (summary.json study.reference says which).",
+           .definition = "study_integrator"},
+          {.name = "repeats",
+           .type = ValueType::integer,
+           .minimum = 1,
+           .maximum = 1000,
+           .default_value = 1,
+           .description = "How many times each run is repeated for its wall time: work_precision.csv gives the median "
+                          "over the repeats and their count (the errors and evaluation counts are those of the first: "
+                          "every repeat computes the same numbers)."},
+      },
+      {{"dependentSchemas", {{"reference_run", {{"not", {{"required", {"reference"}}}}}}}}}};
   return table;
 }
 
 const KeyTable& study_integrator_keys() {
   static const KeyTable table{{
-      {.name = "label", .type = ValueType::string,
+      {.name = "label",
+       .type = ValueType::string,
        .description = "The integrator's name in convergence.csv and the fits; default \"<scheme> <order>\" "
                       "(\"basic\" for the basic step); distinct per integrator."},
       {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
@@ -247,39 +330,56 @@ const KeyTable& study_integrator_keys() {
 
 const KeyTable& state_keys() {
   static const KeyTable table{{
-      {.name = "q", .type = ValueType::defined, .required = true,
-       .description = "Positions, one per degree of freedom.", .definition = "vector"},
-      {.name = "p", .type = ValueType::defined, .required = true, .description = "Momenta, as many as q.",
+      {.name = "q",
+       .type = ValueType::defined,
+       .required = true,
+       .description = "Positions, one per degree of freedom.",
+       .definition = "vector"},
+      {.name = "p",
+       .type = ValueType::defined,
+       .required = true,
+       .description = "Momenta, as many as q.",
        .definition = "vector"},
   }};
   return table;
 }
 
 const KeyTable& initial_grid_keys() {
-  static const KeyTable table{{
-      {.name = "grid", .type = ValueType::object, .required = true,
-       .description = "One axis per component of q and of p; the states are every combination, in row-major order "
-                      "over q0, q1, ..., p0, p1, ... (the last axis varies fastest). At most " +
+  static const KeyTable table{
+      {
+          {.name = "grid",
+           .type = ValueType::object,
+           .required = true,
+           .description = "One axis per component of q and of p; the states are every combination, in row-major order "
+                          "over q0, q1, ..., p0, p1, ... (the last axis varies fastest). At most " +
                           std::to_string(max_initial_states) + " states, and at most " +
                           std::to_string(max_initial_values) + " numbers in q (states times dimension).",
-       .keys = grid_keys},
-      {.name = "energy", .type = ValueType::finite,
-       .description = "Put every state of the grid on the energy shell H = energy by solving for the momentum "
-                      "component solve_for names (the grid's value of it is ignored); states that cannot reach the "
-                      "shell are left out (summary.json energy_shell.left_out)."},
-      {.name = "solve_for", .type = ValueType::string,
-       .description = "\"p<i>\": the root p_i >= 0 nearest to 0; \"-p<i>\": the root p_i <= 0.",
-       .pattern = "^-?p(0|[1-9][0-9]*)$"},
-  },
-                              {{"dependentRequired", {{"energy", {"solve_for"}}, {"solve_for", {"energy"}}}}}};
+           .keys = grid_keys},
+          {.name = "energy",
+           .type = ValueType::finite,
+           .description = "Put every state of the grid on the energy shell H = energy by solving for the momentum "
+                          "component solve_for names (the grid's value of it is ignored); states that cannot reach the "
+                          "shell are left out (summary.json energy_shell.left_out)."},
+          {.name = "solve_for",
+           .type = ValueType::string,
+           .description = "\"p<i>\": the root p_i >= 0 nearest to 0; \"-p<i>\": the root p_i <= 0.",
+           .pattern = "^-?p(0|[1-9][0-9]*)$"},
+      },
+      {{"dependentRequired", {{"energy", {"solve_for"}}, {"solve_for", {"energy"}}}}}};
   return table;
 }
 
 const KeyTable& grid_keys() {
   static const KeyTable table{{
-      {.name = "q", .type = ValueType::defined, .required = true, .description = "The axes of q0, q1, ...",
+      {.name = "q",
+       .type = ValueType::defined,
+       .required = true,
+       .description = "The axes of q0, q1, ...",
        .definition = "axes"},
-      {.name = "p", .type = ValueType::defined, .required = true, .description = "The axes of p0, p1, ...",
+      {.name = "p",
+       .type = ValueType::defined,
+       .required = true,
+       .description = "The axes of p0, p1, ...",
        .definition = "axes"},
   }};
   return table;
@@ -289,7 +389,11 @@ const KeyTable& range_axis_keys() {
   static const KeyTable table{{
       {.name = "from", .type = ValueType::finite, .required = true, .description = "The first value."},
       {.name = "to", .type = ValueType::finite, .required = true, .description = "The last value."},
-      {.name = "count", .type = ValueType::integer, .required = true, .minimum = 1, .maximum = states_limit,
+      {.name = "count",
+       .type = ValueType::integer,
+       .required = true,
+       .minimum = 1,
+       .maximum = states_limit,
        .description = "The number of values."},
   }};
   return table;
@@ -297,7 +401,10 @@ const KeyTable& range_axis_keys() {
 
 const KeyTable& values_axis_keys() {
   static const KeyTable table{{
-      {.name = "values", .type = ValueType::defined, .required = true, .description = "The values listed.",
+      {.name = "values",
+       .type = ValueType::defined,
+       .required = true,
+       .description = "The values listed.",
        .definition = "vector"},
   }};
   return table;

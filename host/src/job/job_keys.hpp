@@ -7,11 +7,10 @@
 // tests/host/test_host_job_schema.cpp holds the readers to the types written here. Other messages stay with the
 // readers.
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/core/chin_basic_step.hpp"
 
@@ -39,13 +38,13 @@ struct KeyRule {
   std::string name = {};
   ValueType type = ValueType::finite;
   bool required = false;
-  std::int64_t minimum = 0, maximum = 0;   // ValueType::integer
+  std::int64_t minimum = 0, maximum = 0;           // ValueType::integer
   nlohmann::ordered_json default_value = nullptr;  // as a job file would write it; null: no default
-  std::string description = {};  // for the schema
-  const KeyTable& (*keys)() = nullptr;      // ValueType::object
-  std::string definition = {};   // ValueType::defined
-  std::vector<std::string> choices = {};  // ValueType::choice
-  std::string pattern = {};      // ValueType::string: a regular expression the string matches (in the schema)
+  std::string description = {};                    // for the schema
+  const KeyTable& (*keys)() = nullptr;             // ValueType::object
+  std::string definition = {};                     // ValueType::defined
+  std::vector<std::string> choices = {};           // ValueType::choice
+  std::string pattern = {};  // ValueType::string: a regular expression the string matches (in the schema)
   // A document key refused in a study: what the issue says was found and what is allowed instead.
   bool run_only = false;
   std::string in_study_found = {}, in_study_allowed = {};
@@ -66,14 +65,14 @@ struct KeyTable {
 // The document and its sections.
 const KeyTable& document_keys();
 const KeyTable& model_keys();
-const KeyTable& run_time_keys();      // a run's /time: "dt" and exactly one of "t_end", "steps"
-const KeyTable& study_time_keys();    // a study's /time
+const KeyTable& run_time_keys();    // a run's /time: "dt" and exactly one of "t_end", "steps"
+const KeyTable& study_time_keys();  // a study's /time
 const KeyTable& output_keys();
 const KeyTable& analysis_keys();
-const KeyTable& poincare_keys();      // /analysis/poincare
-const KeyTable& lyapunov_keys();      // /analysis/lyapunov
+const KeyTable& poincare_keys();  // /analysis/poincare
+const KeyTable& lyapunov_keys();  // /analysis/lyapunov
 const KeyTable& checkpoint_keys();
-const KeyTable& study_keys();         // at most one of "steps", "dt"
+const KeyTable& study_keys();  // at most one of "steps", "dt"
 // The keys a study's integrator has besides the scheme's options (at most one of "steps", "dt").
 const KeyTable& study_integrator_keys();
 // /initial and the states of /study/reference.

@@ -36,16 +36,28 @@ schema_json value_schema(const KeyRule& rule) {
       if (rule.keys) return object_schema(rule.keys(), rule.description);
       schema = {{"type", "object"}};
       break;
-    case ValueType::text: schema = {{"type", "string"}}; break;
+    case ValueType::text:
+      schema = {{"type", "string"}};
+      break;
     case ValueType::string:
       schema = {{"type", "string"}, {"minLength", 1}};
       if (!rule.pattern.empty()) schema["pattern"] = rule.pattern;
       break;
-    case ValueType::boolean: schema = {{"type", "boolean"}}; break;
-    case ValueType::choice: schema = {{"enum", rule.choices}}; break;
-    case ValueType::path: schema = {{"type", "string"}, {"minLength", 1}, {"pattern", "^[^\\u0000]*$"}}; break;
-    case ValueType::finite: schema = ref("finite"); break;
-    case ValueType::nonzero: schema = ref("nonzero"); break;
+    case ValueType::boolean:
+      schema = {{"type", "boolean"}};
+      break;
+    case ValueType::choice:
+      schema = {{"enum", rule.choices}};
+      break;
+    case ValueType::path:
+      schema = {{"type", "string"}, {"minLength", 1}, {"pattern", "^[^\\u0000]*$"}};
+      break;
+    case ValueType::finite:
+      schema = ref("finite");
+      break;
+    case ValueType::nonzero:
+      schema = ref("nonzero");
+      break;
     case ValueType::positive:
       schema = ref("finite");
       schema["exclusiveMinimum"] = 0;
@@ -57,8 +69,12 @@ schema_json value_schema(const KeyRule& rule) {
     case ValueType::integer:
       schema = {{"type", "integer"}, {"minimum", rule.minimum}, {"maximum", rule.maximum}};
       break;
-    case ValueType::form: schema = {{"enum", forms()}}; break;
-    case ValueType::defined: schema = ref(rule.definition); break;
+    case ValueType::form:
+      schema = {{"enum", forms()}};
+      break;
+    case ValueType::defined:
+      schema = ref(rule.definition);
+      break;
   }
   if (!rule.default_value.is_null()) schema["default"] = rule.default_value;
   if (!rule.description.empty()) schema["description"] = rule.description;
@@ -142,26 +158,27 @@ schema_json definitions() {
       {"oneOf",
        {{{"type", "string"}, {"pattern", "^[ \\t]*\\+?[0-9]+[ \\t]*(/[ \\t]*[0-9]+[ \\t]*)?$"}},
         {{"type", "integer"}, {"minimum", 1}}}}};
-  defs["integrator"] = integrator_schema(nullptr, "The scheme (nonsep::scheme_catalogue(), `nonsep --help`) and "
-                                                  "its options; a missing option takes its default.");
+  defs["integrator"] = integrator_schema(nullptr,
+                                         "The scheme (nonsep::scheme_catalogue(), `nonsep --help`) and "
+                                         "its options; a missing option takes its default.");
   defs["study_integrators"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("study_integrator")}};
-  defs["study_integrator"] =
-      integrator_schema(&study_integrator_keys(), "An integrator as /integrator of a run, with an optional label and "
-                                                  "its own steps or dt (which override the study's).");
+  defs["study_integrator"] = integrator_schema(&study_integrator_keys(),
+                                               "An integrator as /integrator of a run, with an optional label and "
+                                               "its own steps or dt (which override the study's).");
   defs["run_time"] = object_schema(run_time_keys());
   defs["run_time"]["oneOf"] = {{{"required", {"t_end"}}}, {{"required", {"steps"}}}};
   defs["study_time"] = object_schema(study_time_keys());
-  defs["step_counts"] = {
-      {"type", "array"},
-      {"minItems", 1},
-      {"uniqueItems", true},
-      {"items", {{"type", "integer"}, {"minimum", 1}, {"maximum", max_steps}}},
-      {"description", "Step counts over t_end: dt = t_end / steps exactly."}};
+  defs["step_counts"] = {{"type", "array"},
+                         {"minItems", 1},
+                         {"uniqueItems", true},
+                         {"items", {{"type", "integer"}, {"minimum", 1}, {"maximum", max_steps}}},
+                         {"description", "Step counts over t_end: dt = t_end / steps exactly."}};
   defs["step_sizes"] = {{"type", "array"},
                         {"minItems", 1},
                         {"items", ref("nonzero")},
-                        {"description", "Step sizes of the sign of t_end; each becomes steps = ceil((t_end/dt)(1 - "
-                                        "1e-9)) as in a run."}};
+                        {"description",
+                         "Step sizes of the sign of t_end; each becomes steps = ceil((t_end/dt)(1 - "
+                         "1e-9)) as in a run."}};
   defs["parameters"] = {{"type", "object"}, {"additionalProperties", {{"type", {"number", "boolean"}}}}};
   defs["vector"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("finite")}};
   defs["state"] = object_schema(state_keys());
@@ -172,12 +189,12 @@ schema_json definitions() {
   defs["axes"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("axis")}};
   schema_json fixed = ref("finite");
   fixed["description"] = "A fixed value.";
-  defs["axis"] = {
-      {"oneOf",
-       {std::move(fixed),
-        object_schema(range_axis_keys(), "count evenly spaced values from `from` to `to`, both included (count 1: "
-                                         "just `from`)."),
-        object_schema(values_axis_keys(), "The values listed.")}}};
+  defs["axis"] = {{"oneOf",
+                   {std::move(fixed),
+                    object_schema(range_axis_keys(),
+                                  "count evenly spaced values from `from` to `to`, both included (count 1: "
+                                  "just `from`)."),
+                    object_schema(values_axis_keys(), "The values listed.")}}};
   return defs;
 }
 
@@ -202,12 +219,11 @@ schema_json job_schema() {
   schema_json run_only = schema_json::array();
   for (const auto& rule : keys.rules)
     if (rule.run_only) run_only.push_back({{"required", {rule.name}}});
-  schema["allOf"] = {
-      {{"if", {{"required", {"study"}}}},
-       {"then",
-        {{"not", {{"anyOf", std::move(run_only)}}},
-         {"properties", {{"initial", ref("state")}, {"time", ref("study_time")}}}}},
-       {"else", {{"required", {"integrator"}}, {"properties", {{"time", ref("run_time")}}}}}}};
+  schema["allOf"] = {{{"if", {{"required", {"study"}}}},
+                      {"then",
+                       {{"not", {{"anyOf", std::move(run_only)}}},
+                        {"properties", {{"initial", ref("state")}, {"time", ref("study_time")}}}}},
+                      {"else", {{"required", {"integrator"}}, {"properties", {{"time", ref("run_time")}}}}}}};
   schema["properties"]["study"]["not"] = not_both("steps", "dt");
   schema["$defs"] = definitions();
   return schema;

@@ -53,8 +53,8 @@ std::optional<std::string> read_job_text(const std::filesystem::path& job_file, 
     while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
       text.append(buffer, static_cast<std::size_t>(in.gcount()));
       if (text.size() > max_job_file_bytes) {
-        issues.push_back({"", "more than " + std::to_string(max_job_file_bytes) + " bytes at " + job_file.string(),
-                          limit});
+        issues.push_back(
+            {"", "more than " + std::to_string(max_job_file_bytes) + " bytes at " + job_file.string(), limit});
         return std::nullopt;
       }
     }
@@ -103,12 +103,14 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   }
   check_dimension(checked.initial, loaded.model.dimension(), issues);
   if (const std::size_t n = loaded.model.dimension(); loaded.plugin.has_hessians() && n > max_hessian_values / n)
-    issues.push_back({"/model", "a model of dimension " + std::to_string(n) + ", whose Hessian (for H) would take " +
-                                    gibibytes(n * n * sizeof(double)) + " GiB",
+    issues.push_back({"/model",
+                      "a model of dimension " + std::to_string(n) + ", whose Hessian (for H) would take " +
+                          gibibytes(n * n * sizeof(double)) + " GiB",
                       "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians"});
   if (issues.size() == before) place_on_energy_shell(loaded, issues);
   if (!checked.is_study())
-    if (const Analysis& analysis = checked.run().analysis; analysis.tangent_vectors() > 0 && !loaded.plugin.has_hessians())
+    if (const Analysis& analysis = checked.run().analysis;
+        analysis.tangent_vectors() > 0 && !loaded.plugin.has_hessians())
       issues.push_back({analysis.lyapunov ? "/analysis/lyapunov" : "/analysis/megno",
                         "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
                         "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them "
@@ -117,11 +119,12 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   const bool has_gradient_of_h = loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives();
   const auto check_comparator = [&](const IntegratorSpec& spec, const std::string& path) {
     if (!Integrator(spec).is_comparator() || has_gradient_of_h) return;
-    issues.push_back({path, "\"" + spec.scheme + "\" with the plugin '" + loaded.plugin.name() + "', which has " +
-                                (loaded.plugin.has_hessians() ? "no third derivatives (d3T, d3V)"
-                                                              : "no Hessians (hessian_T, hessian_V)"),
-                      "a plugin with Hessians and third derivatives (the gradient of H needs both; the SDK provides "
-                      "them by automatic differentiation), or a Chin scheme (basic, triplet, mpe)"});
+    issues.push_back(
+        {path,
+         "\"" + spec.scheme + "\" with the plugin '" + loaded.plugin.name() + "', which has " +
+             (loaded.plugin.has_hessians() ? "no third derivatives (d3T, d3V)" : "no Hessians (hessian_T, hessian_V)"),
+         "a plugin with Hessians and third derivatives (the gradient of H needs both; the SDK provides "
+         "them by automatic differentiation), or a Chin scheme (basic, triplet, mpe)"});
   };
   if (checked.is_study()) {
     const auto& integrators = checked.study().integrators;

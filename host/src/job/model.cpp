@@ -50,7 +50,8 @@ void check_model_parameters(const nlohmann::json& given, const std::vector<Plugi
                                   : it->type == "integer" ? "an integer" + range
                                                           : "a finite number" + range;
     switch (sdk::parameter_fault(it->type, it->minimum, it->maximum, value)) {
-      case sdk::ParameterFault::none: break;
+      case sdk::ParameterFault::none:
+        break;
       case sdk::ParameterFault::wrong_type:
         check.issue(path, job_reader::describe(value), type_text + ": " + it->description);
         break;

@@ -1,9 +1,8 @@
 // Pass 2 of the job reader: the whole document, section by section (sections.hpp), and the rules that join
 // sections: a study has no /integrator, /analysis or /checkpoint, one initial state, and a reference of its
 // dimension.
-#include "sections.hpp"
-
 #include "nonsep/host/installation.hpp"
+#include "sections.hpp"
 
 namespace nonsep::host {
 

@@ -43,7 +43,8 @@ class StrictDocumentBuilder : public nlohmann::json_sax<json> {
     std::string message = error.what();
     const auto bracket = message.find("] ");
     if (message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos) message = message.substr(bracket + 2);
-    issues_.push_back({"", "text that is not JSON (" + message + ")", "a JSON object as described in " + manual_location() + ", section Running nonsep"});
+    issues_.push_back({"", "text that is not JSON (" + message + ")",
+                       "a JSON object as described in " + manual_location() + ", section Running nonsep"});
     return false;
   }
 
@@ -83,8 +84,8 @@ class StrictDocumentBuilder : public nlohmann::json_sax<json> {
   bool open(json container, const char* what) {
     std::string path = next_path();
     if (frames_.size() >= max_nesting_depth) {
-      issues_.push_back({std::move(path), std::string(what) + " nested " + std::to_string(frames_.size() + 1) +
-                                              " levels deep",
+      issues_.push_back({std::move(path),
+                         std::string(what) + " nested " + std::to_string(frames_.size() + 1) + " levels deep",
                          "at most " + std::to_string(max_nesting_depth) +
                              " levels of nesting (objects and arrays within each other; the document is level 1)"});
       return false;

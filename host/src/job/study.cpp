@@ -160,8 +160,8 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
     }
   }
   if (const json* repeats = check.member(study_value, path, "repeats", false, ""))
-    if (const auto n = check.integer(*repeats, child(path, "repeats"), keys["repeats"].minimum,
-                                     keys["repeats"].maximum, "a whole number of repeats from 1 to 1000"))
+    if (const auto n = check.integer(*repeats, child(path, "repeats"), keys["repeats"].minimum, keys["repeats"].maximum,
+                                     "a whole number of repeats from 1 to 1000"))
       study.repeats = static_cast<int>(*n);
   if (const json* reference = check.member(study_value, path, "reference", false, "")) {
     const std::string reference_path = child(path, "reference");

@@ -25,7 +25,8 @@ TimeGrid read_time(Checker& check, const json& document) {
   check.known_keys(*time, "/time", keys.names());
   // NaN marks a value that is missing or invalid (and already reported).
   double dt = std::nan("");
-  if (const json* value = check.member(*time, "/time", "dt", keys["dt"].required, "the time step, a finite non-zero number")) {
+  if (const json* value =
+          check.member(*time, "/time", "dt", keys["dt"].required, "the time step, a finite non-zero number")) {
     if (const auto x = check.finite_number(*value, "/time/dt", "the time step, a finite non-zero number")) {
       if (*x == 0.0)
         check.issue("/time/dt", describe(*value), "a finite non-zero number (negative integrates backwards in time)");
@@ -58,9 +59,9 @@ TimeGrid read_time(Checker& check, const json& document) {
     return grid;
   }
   const KeyRule& rule = keys["steps"];
-  const auto steps = check.integer(*steps_value, "/time/steps", rule.minimum, rule.maximum,
-                                   "an integer from " + std::to_string(rule.minimum) + " to " +
-                                       std::to_string(rule.maximum));
+  const auto steps =
+      check.integer(*steps_value, "/time/steps", rule.minimum, rule.maximum,
+                    "an integer from " + std::to_string(rule.minimum) + " to " + std::to_string(rule.maximum));
   if (!steps || std::isnan(dt)) return grid;
   grid = TimeGrid::of_steps(static_cast<std::uint64_t>(*steps), dt);
   if (!std::isfinite(grid.t_end))
@@ -76,7 +77,8 @@ TimeGrid read_study_time(Checker& check, const json& document) {
   if (!time || !check.object(*time, "/time", what)) return grid;
   const KeyTable& keys = study_time_keys();
   check.known_keys(*time, "/time", keys.names());
-  if (const json* value = check.member(*time, "/time", "t_end", keys["t_end"].required, "the end time, a finite non-zero number"))
+  if (const json* value =
+          check.member(*time, "/time", "t_end", keys["t_end"].required, "the end time, a finite non-zero number"))
     if (const auto t_end = check.finite_number(*value, "/time/t_end", "the end time, a finite non-zero number")) {
       if (*t_end == 0.0)
         check.issue("/time/t_end", describe(*value), "a finite non-zero number (negative integrates backwards)");

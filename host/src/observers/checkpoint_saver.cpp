@@ -6,10 +6,13 @@ namespace nonsep::host {
 
 CheckpointSaver::CheckpointSaver(std::filesystem::path path, std::string fingerprint, const CheckpointPolicy& policy,
                                  const EnsembleDriver& driver, std::vector<Observer*> observers)
-    : path_(std::move(path)), fingerprint_(std::move(fingerprint)), policy_(policy), driver_(driver),
+    : path_(std::move(path)),
+      fingerprint_(std::move(fingerprint)),
+      policy_(policy),
+      driver_(driver),
       observers_(std::move(observers)),
-      next_save_(Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(policy.every_seconds))) {}
+      next_save_(Clock::now() +
+                 std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(policy.every_seconds))) {}
 
 std::uint64_t CheckpointSaver::next_event(std::uint64_t step) const {
   return policy_.every_steps > 0 ? (step / policy_.every_steps + 1) * policy_.every_steps : no_event;
@@ -36,8 +39,8 @@ void CheckpointSaver::save_now() {
     if (const std::string name = observer->name(); !name.empty()) checkpoint.observers[name] = observer->save();
   checkpoint.driver = driver_.state();
   save_checkpoint(path_, checkpoint, fingerprint_);
-  next_save_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                  std::chrono::duration<double>(policy_.every_seconds));
+  next_save_ =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(policy_.every_seconds));
 }
 
 }  // namespace nonsep::host

@@ -27,8 +27,8 @@ void EnergyErrorObserver::on_event(const Event& event) {
     if (bound_ && !(std::abs(*error) <= *bound_))
       event.retire->push_back({state.trajectory, TrajectoryStatus::inaccurate,
                                "the relative energy error " + format_number(*error) + " at step " +
-                                   std::to_string(event.step) + " exceeds analysis.max_relative_energy_error = " +
-                                   format_number(*bound_)});
+                                   std::to_string(event.step) +
+                                   " exceeds analysis.max_relative_energy_error = " + format_number(*bound_)});
   }
 }
 

@@ -22,11 +22,15 @@ std::vector<std::uint64_t> Hdf5SampleWriter::sample_steps(std::uint64_t steps, s
   return list;
 }
 
-Hdf5SampleWriter::Hdf5SampleWriter(const std::filesystem::path& path, std::size_t dimension,
-                                   std::size_t trajectories, std::uint64_t every, const TimeGrid& time,
-                                   bool resuming)
-    : path_(path), dimension_(dimension), every_(every), steps_(time.steps),
-      q_(trajectories * dimension, nan), p_(trajectories * dimension, nan), H_(trajectories, nan) {
+Hdf5SampleWriter::Hdf5SampleWriter(const std::filesystem::path& path, std::size_t dimension, std::size_t trajectories,
+                                   std::uint64_t every, const TimeGrid& time, bool resuming)
+    : path_(path),
+      dimension_(dimension),
+      every_(every),
+      steps_(time.steps),
+      q_(trajectories * dimension, nan),
+      p_(trajectories * dimension, nan),
+      H_(trajectories, nan) {
   const std::vector<std::uint64_t> steps = sample_steps(time.steps, every);
   layout_ = {steps.size(), trajectories, dimension};
   if (resuming) return;
@@ -59,8 +63,13 @@ void Hdf5SampleWriter::on_event(const Event& event) {
   const std::uint64_t row = row_of(event.step);
   if (row == none || row < rows_written_) return;  // not a sample, or written before a resume
   for (const StateView& state : event.states) put(state.trajectory, state.q, state.p, state.energy);
-  datasets_->write({.first_sample = row, .samples = 1, .first_trajectory = 0, .trajectories = layout_.trajectories,
-                    .q = q_, .p = p_, .H = H_});
+  datasets_->write({.first_sample = row,
+                    .samples = 1,
+                    .first_trajectory = 0,
+                    .trajectories = layout_.trajectories,
+                    .q = q_,
+                    .p = p_,
+                    .H = H_});
   rows_written_ = row + 1;
   clear_row();
 }
@@ -87,8 +96,7 @@ nlohmann::json Hdf5SampleWriter::save() {
 
 void Hdf5SampleWriter::restore(const nlohmann::json& state) {
   const auto refuse = [&](const std::string& why) {
-    throw CheckpointError("cannot resume into " + path_.string() + ": " + why +
-                          "; run with --force to start over");
+    throw CheckpointError("cannot resume into " + path_.string() + ": " + why + "; run with --force to start over");
   };
   if (!state.is_object() || !state.contains("rows") || !state["rows"].is_number_unsigned() ||
       state["rows"].get<std::uint64_t>() > layout_.samples)

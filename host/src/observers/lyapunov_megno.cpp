@@ -1,6 +1,5 @@
 #include "nonsep/host/observers/lyapunov_megno.hpp"
 
-
 #include "nonsep/host/checkpoint.hpp"
 
 namespace nonsep::host {
@@ -45,9 +44,7 @@ void LyapunovMegnoObserver::on_event(const Event& event) {
   }
 }
 
-nlohmann::json LyapunovMegnoObserver::save() {
-  return csv_checkpoint_state(*file_);
-}
+nlohmann::json LyapunovMegnoObserver::save() { return csv_checkpoint_state(*file_); }
 
 void LyapunovMegnoObserver::restore(const nlohmann::json& state) {
   const auto damaged = [](const std::string& what) {

@@ -14,9 +14,17 @@ PoincareSectionObserver::PoincareSectionObserver(const std::filesystem::path& pa
                                                  const IntegratorSpec& integrator, const TimeGrid& time,
                                                  std::size_t dimension, std::size_t trajectories, bool energy,
                                                  bool resuming)
-    : plane_(section.normal, section.offset), direction_(section.direction), max_crossings_(section.max_crossings),
-      integrator_(integrator), time_(time), dimension_(dimension), energy_(energy), path_(path),
-      previous_q_(trajectories * dimension), previous_p_(trajectories * dimension), counts_(trajectories, 0) {
+    : plane_(section.normal, section.offset),
+      direction_(section.direction),
+      max_crossings_(section.max_crossings),
+      integrator_(integrator),
+      time_(time),
+      dimension_(dimension),
+      energy_(energy),
+      path_(path),
+      previous_q_(trajectories * dimension),
+      previous_p_(trajectories * dimension),
+      counts_(trajectories, 0) {
   std::string header = "trajectory,crossing,step,t";
   for (const char* name : {"q", "p"})
     for (std::size_t i = 0; i < dimension; ++i) header += "," + std::string(name) + std::to_string(i);
@@ -27,8 +35,8 @@ PoincareSectionObserver::PoincareSectionObserver(const std::filesystem::path& pa
 void PoincareSectionObserver::prepare_blocks(std::size_t blocks) {
   blocks_.clear();
   for (std::size_t b = 0; b < blocks; ++b)
-    blocks_.push_back({PoincareCrossingLocator<Integrator>(Integrator(integrator_)),
-                       EnergyEvaluator(integrator_.form), {}, {}, {}});
+    blocks_.push_back(
+        {PoincareCrossingLocator<Integrator>(Integrator(integrator_)), EnergyEvaluator(integrator_.form), {}, {}, {}});
 }
 
 bool PoincareSectionObserver::crosses(double before, double after) const {
@@ -52,12 +60,11 @@ void PoincareSectionObserver::on_step(std::uint64_t step, double, const BlockVie
     const std::size_t trajectory = block.trajectories[slot];
     const std::span<const double> q_before(previous_q_.data() + trajectory * n, n),
         p_before(previous_p_.data() + trajectory * n, n), q = block.q.subspan(slot * n, n),
-        p = block.p.subspan(slot * n, n);
+                                                          p = block.p.subspan(slot * n, n);
     if (!crosses(plane_.distance(q_before, p_before), plane_.distance(q, p))) continue;
     Found found{step, trajectory, counts_[trajectory], 0.0, {}, {}, {}};
     try {
-      state.locator.locate(*block.model, q_before, p_before, time_.time_at(step - 1), time_.dt, plane_,
-                           state.crossing);
+      state.locator.locate(*block.model, q_before, p_before, time_.time_at(step - 1), time_.dt, plane_, state.crossing);
       if (energy_) {
         double h = 0.0;
         state.energy.evaluate(*block.model, PhaseSpaceBatch::single(state.crossing.q, state.crossing.p),
@@ -67,8 +74,8 @@ void PoincareSectionObserver::on_step(std::uint64_t step, double, const BlockVie
     } catch (const ModelError& error) {
       if (block.retire)
         block.retire->push_back({trajectory, TrajectoryStatus::failed,
-                                 "the model failed while locating a Poincare crossing in step " +
-                                     std::to_string(step) + ": " + error.what()});
+                                 "the model failed while locating a Poincare crossing in step " + std::to_string(step) +
+                                     ": " + error.what()});
       continue;
     }
     ++counts_[trajectory];
@@ -77,9 +84,9 @@ void PoincareSectionObserver::on_step(std::uint64_t step, double, const BlockVie
     found.p = state.crossing.p;
     state.found.push_back(std::move(found));
     if (max_crossings_ && counts_[trajectory] == *max_crossings_ && block.retire)
-      block.retire->push_back({trajectory, TrajectoryStatus::completed,
-                               "stopped at its " + std::to_string(*max_crossings_) +
-                                   "-th Poincare crossing (max_crossings)"});
+      block.retire->push_back(
+          {trajectory, TrajectoryStatus::completed,
+           "stopped at its " + std::to_string(*max_crossings_) + "-th Poincare crossing (max_crossings)"});
   }
   remember(block);
 }

@@ -9,8 +9,13 @@ namespace nonsep::host {
 
 SampleWriter::SampleWriter(const std::filesystem::path& path, std::size_t dimension, std::size_t trajectories,
                            std::uint64_t every, const TimeGrid& time, bool resuming)
-    : path_(path), dimension_(dimension), every_(every), steps_(time.steps), time_(time),
-      last_written_(trajectories, none), next_flush_(std::chrono::steady_clock::now() + std::chrono::seconds(1)) {
+    : path_(path),
+      dimension_(dimension),
+      every_(every),
+      steps_(time.steps),
+      time_(time),
+      last_written_(trajectories, none),
+      next_flush_(std::chrono::steady_clock::now() + std::chrono::seconds(1)) {
   std::string header = "trajectory,step,t";
   for (const char* name : {"q", "p"})
     for (std::size_t i = 0; i < dimension; ++i) {
@@ -67,8 +72,7 @@ void SampleWriter::on_event(const Event& event) {
 }
 
 void SampleWriter::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
-  write_row(trajectory, record.final_step, record.final_q, record.final_p, record.energy_final,
-            record.energy_initial);
+  write_row(trajectory, record.final_step, record.final_q, record.final_p, record.energy_final, record.energy_initial);
 }
 
 void SampleWriter::after_chunk(std::uint64_t step) {
@@ -87,7 +91,8 @@ void SampleWriter::on_end() {
 nlohmann::json SampleWriter::save() {
   write_pending(none);
   nlohmann::json last = nlohmann::json::array();
-  for (std::uint64_t step : last_written_) last.push_back(step == none ? nlohmann::json(nullptr) : nlohmann::json(step));
+  for (std::uint64_t step : last_written_)
+    last.push_back(step == none ? nlohmann::json(nullptr) : nlohmann::json(step));
   nlohmann::json state = csv_checkpoint_state(*file_);
   state["last_written_step"] = std::move(last);
   return state;

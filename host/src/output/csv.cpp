@@ -58,7 +58,7 @@ CsvAppender::CsvAppender(const std::filesystem::path& path, std::uint64_t size, 
     descriptor_ = -1;
     throw OutputError("cannot resume " + path.string() + ": " + reason);
   };
-  struct stat status{};
+  struct stat status {};
   if (::fstat(descriptor_, &status) != 0) refuse(std::strerror(errno));
   if (!S_ISREG(status.st_mode)) refuse("it is not a regular file");
   if (static_cast<std::uint64_t>(status.st_size) < size)
@@ -96,10 +96,9 @@ void CsvAppender::flush() {
       // this flush wrote completely, so that no reader (and no resume) sees a row cut short.
       const std::size_t last_newline = done ? buffer_.rfind('\n', done - 1) : std::string::npos;
       const std::size_t whole = last_newline == std::string::npos ? 0 : last_newline + 1;
-      const std::string cut =
-          ::ftruncate(descriptor_, static_cast<off_t>(flushed_size_ + whole)) == 0
-              ? "; the file ends at its last whole row"
-              : "; the last row may be cut short (" + std::string(std::strerror(errno)) + ")";
+      const std::string cut = ::ftruncate(descriptor_, static_cast<off_t>(flushed_size_ + whole)) == 0
+                                  ? "; the file ends at its last whole row"
+                                  : "; the last row may be cut short (" + std::string(std::strerror(errno)) + ")";
       flushed_size_ += whole;
       flushed_hash_ = content_hash(std::string_view(buffer_.data(), whole), flushed_hash_);
       buffer_.clear();

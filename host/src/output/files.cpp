@@ -1,18 +1,17 @@
 #include "nonsep/host/output/files.hpp"
 
-#include <algorithm>
-#include <cstdint>
-#include <limits>
-#include <string>
-
-#include "nonsep/host/output/content_hash.hpp"
-
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
+#include <limits>
+#include <string>
+
+#include "nonsep/host/output/content_hash.hpp"
 
 namespace nonsep::host {
 

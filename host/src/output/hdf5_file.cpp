@@ -46,8 +46,8 @@ Hdf5File Hdf5File::create(const std::filesystem::path& path, hid_t access) {
   Hdf5File file(path, H5I_INVALID_HID);
   // The root group is created with the file: its creation list (which is also a group's) must say "no times".
   const Hdf5Handle creation = untimed_properties(file, H5P_FILE_CREATE);
-  file.file_ = file.own(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, creation.get(), access), H5Fclose,
-                        "create the HDF5 file");
+  file.file_ =
+      file.own(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, creation.get(), access), H5Fclose, "create the HDF5 file");
   return file;
 }
 

@@ -1,8 +1,6 @@
 #include "nonsep/host/output/hdf5_samples.hpp"
 
 #include <algorithm>
-
-#include <algorithm>
 #include <array>
 #include <limits>
 #include <string>
@@ -19,7 +17,8 @@ constexpr hsize_t chunk_numbers = 65536;
 Hdf5Handle create_dataset(const Hdf5File& file, hid_t group, const char* name, hid_t type,
                           std::span<const hsize_t> dims, std::span<const hsize_t> chunk) {
   const std::string what = std::string("create ") + samples_group + "/" + name;
-  const Hdf5Handle space = file.own(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, what);
+  const Hdf5Handle space =
+      file.own(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, what);
   const Hdf5Handle properties = untimed_dataset_properties(file);
   file.check(H5Pset_chunk(properties.get(), static_cast<int>(chunk.size()), chunk.data()), what);
   file.check(H5Pset_shuffle(properties.get()), what);
@@ -33,8 +32,8 @@ Hdf5Handle create_dataset(const Hdf5File& file, hid_t group, const char* name, h
   const Hdf5Handle access = file.own(H5Pcreate(H5P_DATASET_ACCESS), H5Pclose, what);
   file.check(H5Pset_chunk_cache(access.get(), 521, 4u << 20, 1.0), what);
   const hid_t stored = H5Tequal(type, H5T_NATIVE_DOUBLE) > 0 ? H5T_IEEE_F64LE : H5T_STD_U64LE;
-  return file.own(H5Dcreate2(group, name, stored, space.get(), H5P_DEFAULT, properties.get(), access.get()),
-                  H5Dclose, what);
+  return file.own(H5Dcreate2(group, name, stored, space.get(), H5P_DEFAULT, properties.get(), access.get()), H5Dclose,
+                  what);
 }
 
 Hdf5Handle open_dataset(const Hdf5File& file, const char* name, std::vector<hsize_t>& dims) {
@@ -88,8 +87,7 @@ SampleDatasets SampleDatasets::create(const Hdf5File& file, const SampleLayout& 
   const std::array<hsize_t, 2> energy{S, N}, energy_chunk{samples_per_chunk, trajectories_per_chunk};
 
   const Hdf5Handle step = create_dataset(file, group.get(), "step", H5T_NATIVE_UINT64, list, list_chunk);
-  file.check(H5Dwrite(step.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, transfer, steps.data()),
-             "write /samples/step");
+  file.check(H5Dwrite(step.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, transfer, steps.data()), "write /samples/step");
   const Hdf5Handle t = create_dataset(file, group.get(), "t", H5T_NATIVE_DOUBLE, list, list_chunk);
   file.check(H5Dwrite(t.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, transfer, times.data()), "write /samples/t");
   SampleDatasets datasets(file);
@@ -108,8 +106,7 @@ SampleDatasets SampleDatasets::open(const Hdf5File& file) {
   datasets.p_ = open_dataset(file, "p", p);
   datasets.H_ = open_dataset(file, "H", H);
   open_dataset(file, "step", step);
-  if (q.size() != 3 || p != q || H.size() != 2 || H[0] != q[0] || H[1] != q[1] || step.size() != 1 ||
-      step[0] != q[0])
+  if (q.size() != 3 || p != q || H.size() != 2 || H[0] != q[0] || H[1] != q[1] || step.size() != 1 || step[0] != q[0])
     file.fail("use /samples: its datasets q [S, N, n], p [S, N, n], H [S, N] and step [S] do not fit together");
   datasets.layout_ = {q[0], q[1], q[2]};
   return datasets;

@@ -59,8 +59,7 @@ class CsvRows {
         cells[count - 1].append(buffer_.data() + begin, next_ - begin);
       }
     }
-    if (quoted)
-      throw OutputError(path_.string() + ":" + std::to_string(first_line) + ": a quoted cell is not closed");
+    if (quoted) throw OutputError(path_.string() + ":" + std::to_string(first_line) + ": a quoted cell is not closed");
     return false;
   }
   std::uint64_t line() const { return line_ - 1; }  // of the row last read
@@ -135,8 +134,8 @@ Hdf5Handle utf8_string_type(const Hdf5File& file) {
   return type;
 }
 
-Hdf5Handle create_column(const Hdf5File& file, hid_t group, const std::string& where, const Column& column,
-                         hid_t type, std::uint64_t rows) {
+Hdf5Handle create_column(const Hdf5File& file, hid_t group, const std::string& where, const Column& column, hid_t type,
+                         std::uint64_t rows) {
   const std::string what = "create " + where + "/" + column.name;
   // A table without rows still gets its (empty) columns: chunked datasets need a chunk of at least one element,
   // which only an extendible dataspace allows when there are none.
@@ -177,16 +176,20 @@ void write_block(const Hdf5File& file, std::vector<Column>& columns, hid_t strin
         if (!is_integer(cell)) changed();
         std::from_chars(cell.data(), cell.data() + cell.size(), integers[r]);
       } else if (column.kind == Kind::number) {
-        const std::optional<double> number = cell.empty() ? std::numeric_limits<double>::quiet_NaN() : parse_number(cell);
+        const std::optional<double> number =
+            cell.empty() ? std::numeric_limits<double>::quiet_NaN() : parse_number(cell);
         if (!number) changed();
         numbers[r] = *number;
       } else {
         texts[r] = cell.c_str();
       }
     }
-    if (column.kind == Kind::integer) write_rows(file, column, H5T_NATIVE_INT64, first, count, integers.data(), where);
-    else if (column.kind == Kind::number) write_rows(file, column, H5T_NATIVE_DOUBLE, first, count, numbers.data(), where);
-    else write_rows(file, column, string_type, first, count, texts.data(), where);
+    if (column.kind == Kind::integer)
+      write_rows(file, column, H5T_NATIVE_INT64, first, count, integers.data(), where);
+    else if (column.kind == Kind::number)
+      write_rows(file, column, H5T_NATIVE_DOUBLE, first, count, numbers.data(), where);
+    else
+      write_rows(file, column, string_type, first, count, texts.data(), where);
   }
 }
 
@@ -218,7 +221,7 @@ void write_csv_table(const Hdf5File& file, const std::string& group, const std::
                                      H5Gclose, "create the group " + where);
   const Hdf5Handle string_type = utf8_string_type(file);
   for (Column& column : columns) {
-    const hid_t stored = column.kind == Kind::integer ? H5T_STD_I64LE
+    const hid_t stored = column.kind == Kind::integer  ? H5T_STD_I64LE
                          : column.kind == Kind::number ? H5T_IEEE_F64LE
                                                        : string_type.get();
     column.dataset = create_column(file, handle.get(), where, column, stored, rows);

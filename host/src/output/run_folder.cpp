@@ -8,9 +8,8 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <optional>
-
 #include <nlohmann/json.hpp>
+#include <optional>
 
 namespace nonsep::host {
 
@@ -32,7 +31,9 @@ std::string read_head(const std::filesystem::path& path, std::size_t limit) {
   return text;
 }
 
-bool is_temporary(const std::string& name) { return name.size() > 1 && name[0] == '.' && name.find(".tmp-") != std::string::npos; }
+bool is_temporary(const std::string& name) {
+  return name.size() > 1 && name[0] == '.' && name.find(".tmp-") != std::string::npos;
+}
 
 struct Manifest {
   std::string kind, job;
@@ -80,8 +81,8 @@ void check_outputs_placeable(const std::filesystem::path& directory) {
 }  // namespace
 
 const std::vector<std::string>& RunFolder::output_files() {
-  static const std::vector<std::string> names{"summary.json",    "trajectory.csv",  "trajectories.csv",
-                                              "poincare.csv",    "lyapunov.csv",    "checkpoint.json",
+  static const std::vector<std::string> names{"summary.json",    "trajectory.csv", "trajectories.csv",
+                                              "poincare.csv",    "lyapunov.csv",   "checkpoint.json",
                                               "convergence.csv", "results.h5",     manifest_name};
   return names;
 }
@@ -138,8 +139,8 @@ RunFolder::RunFolder(const std::filesystem::path& directory, const std::string& 
       results |= std::filesystem::exists(std::filesystem::symlink_status(directory / name));
     const auto manifest = read_manifest(directory);
     if (results && !manifest)
-      throw FolderInUse("the output folder " + directory.string() +
-                        " holds results of unknown origin (no " + manifest_name +
+      throw FolderInUse("the output folder " + directory.string() + " holds results of unknown origin (no " +
+                        manifest_name +
                         " nor a summary.json naming their job); `--force` removes them, or give this run another "
                         "folder (--output)");
     if (manifest && (manifest->kind != kind || manifest->job != job))

@@ -28,7 +28,7 @@ struct Departure {
   int phase = 0;                 // 0: while stepping, 1: while evaluating H at `step`, 2: asked by an observer
   std::uint64_t final_step = 0;  // the step of its final state
   TrajectoryStatus status = TrajectoryStatus::failed;
-  std::string variable;          // diverged: the first non-finite variable
+  std::string variable;  // diverged: the first non-finite variable
   std::string message;
   std::vector<double> q, p;      // the final state
   std::optional<double> energy;  // H of the final state, when known
@@ -90,23 +90,25 @@ std::vector<std::string> isolate_failures(PhaseSpaceBatch& x, const PhaseSpaceBa
 // Consecutive trajectories stepped together; the unit of work of a thread.
 struct alignas(64) Block {  // a cache line of its own: threads count evaluations in neighbouring blocks
   PhaseSpaceBatch batch;
-  std::vector<std::size_t> trajectories;   // slot in batch -> trajectory index
+  std::vector<std::size_t> trajectories;  // slot in batch -> trajectory index
   Integrator integrator;
-  std::vector<double> energies;            // per slot at energy_step (NaN when unknown)
+  std::vector<double> energies;  // per slot at energy_step (NaN when unknown)
   std::optional<std::uint64_t> energy_step;
-  std::vector<Departure> departures;       // found in the current chunk
-  PhaseSpaceBatch chunk_start;             // the block at the start of the current chunk
+  std::vector<Departure> departures;  // found in the current chunk
+  PhaseSpaceBatch chunk_start;        // the block at the start of the current chunk
   std::optional<Integrator> chunk_start_integrator;
-  std::optional<BlockTangents> tangents;   // when the run follows tangent vectors; then it steps the block
+  std::optional<BlockTangents> tangents;  // when the run follows tangent vectors; then it steps the block
   std::optional<BlockTangents> chunk_start_tangents;
   std::vector<std::size_t> chunk_start_trajectories;
   std::vector<double> chunk_start_energies;
   std::size_t chunk_start_departures = 0;
-  std::exception_ptr error;                // anything but a ModelError, thrown in the current chunk
+  std::exception_ptr error;  // anything but a ModelError, thrown in the current chunk
 
   Block(const IntegratorSpec& spec, std::size_t dimension, std::span<const std::size_t> members,
         std::span<const double> q, std::span<const double> p)
-      : batch(dimension, members.size()), trajectories(members.begin(), members.end()), integrator(spec),
+      : batch(dimension, members.size()),
+        trajectories(members.begin(), members.end()),
+        integrator(spec),
         energies(members.size(), std::nan("")) {
     std::copy(q.begin(), q.end(), batch.q().begin());
     std::copy(p.begin(), p.end(), batch.p().begin());
@@ -180,9 +182,9 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
   void retire_requested(std::span<const RetirementRequest> requests, std::uint64_t step, Energy&& energy) {
     std::vector<bool> retire(trajectories.size(), false);
     for (std::size_t slot = 0; slot < trajectories.size(); ++slot) {
-      const auto found =
-          std::lower_bound(requests.begin(), requests.end(), trajectories[slot],
-                           [](const RetirementRequest& r, std::size_t trajectory) { return r.trajectory < trajectory; });
+      const auto found = std::lower_bound(
+          requests.begin(), requests.end(), trajectories[slot],
+          [](const RetirementRequest& r, std::size_t trajectory) { return r.trajectory < trajectory; });
       if (found == requests.end() || found->trajectory != trajectories[slot]) continue;
       retire[slot] = true;
       Departure departure;

@@ -7,8 +7,12 @@
 namespace nonsep::host {
 
 BlockView BlockStepper::view(const Block& block, const Worker& worker) const {
-  return {static_cast<std::size_t>(&block - blocks.data()), setup.dimension, block.trajectories, block.batch.q(),
-          block.batch.p(), &worker.model};
+  return {static_cast<std::size_t>(&block - blocks.data()),
+          setup.dimension,
+          block.trajectories,
+          block.batch.q(),
+          block.batch.p(),
+          &worker.model};
 }
 
 // The every-step observers see the block at `step`; the trajectories they ask to stop leave it there.
@@ -131,6 +135,5 @@ std::vector<std::string> BlockStepper::compute_energies(Block& block, Worker& wo
     if (!errors[slot].empty()) block.energies[slot] = std::nan("");
   return errors;
 }
-
 
 }  // namespace nonsep::host

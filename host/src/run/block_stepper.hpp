@@ -30,14 +30,16 @@ inline void sort_requests(std::vector<RetirementRequest>& requests) {
             [](const RetirementRequest& a, const RetirementRequest& b) { return a.trajectory < b.trajectory; });
 }
 
-
 class BlockStepper {
  public:
   // The references are the driver's and outlive the stepper; `blocks` is not resized after construction.
   BlockStepper(const EnsembleSetup& setup, const std::vector<Block>& blocks,
                const std::vector<Observer*>& step_watchers, std::vector<TrajectoryRecord>& records,
                bool energy_available)
-      : setup(setup), blocks(blocks), step_watchers(step_watchers), records(records),
+      : setup(setup),
+        blocks(blocks),
+        step_watchers(step_watchers),
+        records(records),
         energy_available(energy_available) {}
 
   // Steps `block` from step `from` to `to` (see above).

@@ -1,5 +1,7 @@
 #include "nonsep/host/run/ensemble_driver.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -7,8 +9,6 @@
 #include <numeric>
 #include <optional>
 #include <tuple>
-
-#include <omp.h>
 
 #include "nonsep/core/energy.hpp"
 #include "nonsep/core/error.hpp"

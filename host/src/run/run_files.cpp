@@ -87,12 +87,14 @@ json run_summary(const RunFacts& facts) {
                        {"inaccurate", outcome.counts.inaccurate},
                        {"interrupted", outcome.counts.interrupted}};
   const auto evaluations = facts.driver.evaluations();
-  summary["evaluations"] = {{"grad_T", evaluations.grad_T}, {"grad_V", evaluations.grad_V}, {"grad_H", evaluations.grad_H}};
+  summary["evaluations"] = {
+      {"grad_T", evaluations.grad_T}, {"grad_V", evaluations.grad_V}, {"grad_H", evaluations.grad_H}};
   if (run.integrator.scheme == "tao")
     summary["comparator"] = {{"omega", run.integrator.omega},
                              {"max_copy_distance", facts.driver.max_copy_distance()},
-                             {"max_copy_distance_note", "largest |(q, p) - (x, y)| over the trajectories and steps "
-                                                        "of this process (a resumed run counts from the resume)"}};
+                             {"max_copy_distance_note",
+                              "largest |(q, p) - (x, y)| over the trajectories and steps "
+                              "of this process (a resumed run counts from the resume)"}};
   summary["wall_seconds"] = facts.wall_seconds;
   return summary;
 }

@@ -2,10 +2,9 @@
 // What a run writes at its end: summary.json (the run's facts, written with nlohmann-json) and trajectories.csv
 // (one row per trajectory; columns in run_job.hpp). Both are replaced atomically.
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"

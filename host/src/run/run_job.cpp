@@ -23,11 +23,16 @@ namespace nonsep::host {
 
 std::size_t& StatusCounts::operator[](TrajectoryStatus status) {
   switch (status) {
-    case TrajectoryStatus::completed: return completed;
-    case TrajectoryStatus::diverged: return diverged;
-    case TrajectoryStatus::failed: return failed;
-    case TrajectoryStatus::inaccurate: return inaccurate;
-    default: return interrupted;
+    case TrajectoryStatus::completed:
+      return completed;
+    case TrajectoryStatus::diverged:
+      return diverged;
+    case TrajectoryStatus::failed:
+      return failed;
+    case TrajectoryStatus::inaccurate:
+      return inaccurate;
+    default:
+      return interrupted;
   }
 }
 
@@ -58,15 +63,17 @@ nlohmann::ordered_json poincare_facts(const PoincareSection& section, const Poin
           {"direction", direction},
           {"max_crossings", section.max_crossings ? nlohmann::ordered_json(*section.max_crossings) : nullptr},
           {"crossings", observer.total_crossings()},
-          {"located_by", "a fractional step of the run's integrator from the state before the step, its length "
-                         "found by TOMS 748 (core/poincare_crossing.hpp)"}};
+          {"located_by",
+           "a fractional step of the run's integrator from the state before the step, its length "
+           "found by TOMS 748 (core/poincare_crossing.hpp)"}};
 }
 
 nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
   nlohmann::ordered_json facts = {
       {"vectors", analysis.tangent_vectors()},
-      {"first_vector", "(1, 1/2, ..., 1/(2n)) over (dq, dp), normalised; vector j >= 1 starts as the unit vector of "
-                       "component j (run/tangent_block.hpp)"},
+      {"first_vector",
+       "(1, 1/2, ..., 1/(2n)) over (dq, dp), normalised; vector j >= 1 starts as the unit vector of "
+       "component j (run/tangent_block.hpp)"},
       {"method", "the exact tangent map of the run's integrator (core/tangent_integrator.hpp)"}};
   if (const auto& l = analysis.lyapunov)
     facts["lyapunov"] = {{"exponents", l->vectors},
@@ -103,7 +110,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   EnsembleDriver driver(loaded.plugin, loaded.model,
                         {run.integrator, run.time, job.initial.dimension, job.initial.q, job.initial.p, options.threads,
                          options.stop_requested, run.analysis.tangent_vectors(),
-                        run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1});
+                         run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1});
   const std::size_t count = job.initial.count;
   EnergyErrorObserver energy(count, driver.energy_available() ? run.energy_every : 0,
                              run.analysis.max_relative_energy_error);
@@ -180,7 +187,11 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   if (!loaded.plugin.thread_safe() && options.threads != 1)
     outcome.notes.push_back("ran on one thread: the plugin '" + loaded.plugin.name() +
                             "' declares \"thread_safe\": false (plugin_abi.h)");
-  const RunFacts facts{loaded, directory, driver, outcome, run.every > 0 && !hdf5,
+  const RunFacts facts{loaded,
+                       directory,
+                       driver,
+                       outcome,
+                       run.every > 0 && !hdf5,
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
   outcome.summary = run_summary(facts);
   if (poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *poincare);

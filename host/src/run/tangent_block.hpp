@@ -41,8 +41,13 @@ struct BlockTangents {
 
   BlockTangents(const IntegratorSpec& spec, std::size_t vectors_per_state, std::uint64_t renormalize_every,
                 std::size_t n, std::size_t slots)
-      : integrator(spec), exponents(vectors_per_state, renormalize_every), k(vectors_per_state),
-        vectors(n, slots * vectors_per_state), lyapunov(slots), megno(slots), growth(slots) {}
+      : integrator(spec),
+        exponents(vectors_per_state, renormalize_every),
+        k(vectors_per_state),
+        vectors(n, slots * vectors_per_state),
+        lyapunov(slots),
+        megno(slots),
+        growth(slots) {}
 
   // Every slot at time 0: the initial vectors, orthonormalised, and zeroed sums.
   void start() {

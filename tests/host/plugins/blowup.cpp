@@ -25,10 +25,9 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/plugin_abi.h"
 
@@ -63,26 +62,58 @@ const char* metadata() {
       {"hamiltonian", "T = |p|^2/2, V = sum q_i^4/4; H_TTV = 3 sum q_i^2 p_i^2"},
       {"dimension", {{"parameter", "dimension"}}},
       {"parameters",
-       {{{"name", "dimension"}, {"type", "integer"}, {"default", 1}, {"minimum", 0}, {"maximum", 1000000},
+       {{{"name", "dimension"},
+         {"type", "integer"},
+         {"default", 1},
+         {"minimum", 0},
+         {"maximum", 1000000},
          {"description", "number of degrees of freedom (0 and huge values test the host's refusals)"}},
-        {{"name", "fail_above"}, {"type", "number"}, {"default", 1e300}, {"minimum", 0}, {"unit", "length"},
+        {{"name", "fail_above"},
+         {"type", "number"},
+         {"default", 1e300},
+         {"minimum", 0},
+         {"unit", "length"},
          {"description", "grad V fails for any |q_i| above this"}},
-        {{"name", "fail_single_above"}, {"type", "number"}, {"default", 1e300}, {"minimum", 0}, {"unit", "length"},
+        {{"name", "fail_single_above"},
+         {"type", "number"},
+         {"default", 1e300},
+         {"minimum", 0},
+         {"unit", "length"},
          {"description", "grad V fails for any |q_i| above this in a call for one state (count 1) only"}},
-        {{"name", "nan_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
+        {{"name", "nan_after"},
+         {"type", "integer"},
+         {"default", 0},
+         {"minimum", 0},
          {"description", "grad V returns NaN from its (n+1)-th call on; 0: never"}},
-        {{"name", "inf_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
+        {{"name", "inf_after"},
+         {"type", "integer"},
+         {"default", 0},
+         {"minimum", 0},
          {"description", "grad V returns +inf from its (n+1)-th call on; 0: never"}},
-        {{"name", "crash_after"}, {"type", "integer"}, {"default", 0}, {"minimum", 0},
+        {{"name", "crash_after"},
+         {"type", "integer"},
+         {"default", 0},
+         {"minimum", 0},
          {"description", "grad V crashes the process from its (n+1)-th call on; 0: never"}},
-        {{"name", "crash_how"}, {"type", "integer"}, {"default", 0}, {"minimum", 0}, {"maximum", 2},
+        {{"name", "crash_how"},
+         {"type", "integer"},
+         {"default", 0},
+         {"minimum", 0},
+         {"maximum", 2},
          {"description", "0 abort(), 1 SIGSEGV, 2 exit(3)"}},
-        {{"name", "sleep_ms"}, {"type", "integer"}, {"default", 0}, {"minimum", 0}, {"maximum", 10000},
+        {{"name", "sleep_ms"},
+         {"type", "integer"},
+         {"default", 0},
+         {"minimum", 0},
+         {"maximum", 10000},
          {"description", "each call of grad V sleeps this many milliseconds first"}}}},
       {"thread_safe", true},  // the call counters are per instance
       {"capabilities",
-       {{"value_T", BLOWUP_WITH_HESSIANS == 1}, {"value_V", BLOWUP_WITH_HESSIANS == 1},
-        {"hessian_T", BLOWUP_WITH_HESSIANS == 1}, {"hessian_V", BLOWUP_WITH_HESSIANS == 1}}}}.dump();
+       {{"value_T", BLOWUP_WITH_HESSIANS == 1},
+        {"value_V", BLOWUP_WITH_HESSIANS == 1},
+        {"hessian_T", BLOWUP_WITH_HESSIANS == 1},
+        {"hessian_V",
+         BLOWUP_WITH_HESSIANS == 1}}}}.dump();
   return text.c_str();
 }
 
@@ -165,8 +196,8 @@ nonsep_status hessian_V(nonsep_instance* instance, const double* q, double* out,
   const std::size_t n = instance->dimension;
   for (std::size_t b = 0; b < count; ++b)
     for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = 0; j < n; ++j) out[b * n * n + i * n + j] =
-            i == j ? (BLOWUP_WRONG_HESSIAN ? 2.0 : 3.0) * q[b * n + i] * q[b * n + i] : 0.0;
+      for (std::size_t j = 0; j < n; ++j)
+        out[b * n * n + i * n + j] = i == j ? (BLOWUP_WRONG_HESSIAN ? 2.0 : 3.0) * q[b * n + i] * q[b * n + i] : 0.0;
   return NONSEP_OK;
 }
 const char* last_error(const nonsep_instance* instance) { return instance->last_error.c_str(); }

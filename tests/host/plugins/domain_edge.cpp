@@ -10,9 +10,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "nonsep/plugin_abi.h"
 
@@ -26,19 +25,24 @@ namespace {
 constexpr double not_a_number = std::numeric_limits<double>::quiet_NaN();
 
 const char* metadata() {
-  static const std::string text = nlohmann::json{
-      {"name", "domain_edge"},
-      {"version", "0.0.1"},
-      {"description", "host test model: V = sum log(q_i - edge), NaN for q_i <= edge"},
-      {"hamiltonian", "T = |p|^2/2, V = sum log(q_i - edge)"},
-      {"dimension", {{"parameter", "dimension"}}},
-      {"parameters",
-       {{{"name", "dimension"}, {"type", "integer"}, {"default", 1}, {"minimum", 0}, {"maximum", 1000000000},
-         {"description", "number of degrees of freedom"}},
-        {{"name", "edge"}, {"type", "number"}, {"default", 0.0}, {"description", "V is defined for q_i > edge"}}}},
-      {"thread_safe", true},
-      {"capabilities", {{"value_T", true}, {"value_V", true}, {"hessian_T", true}, {"hessian_V", true}}}}
-                                     .dump();
+  static const std::string text =
+      nlohmann::json{
+          {"name", "domain_edge"},
+          {"version", "0.0.1"},
+          {"description", "host test model: V = sum log(q_i - edge), NaN for q_i <= edge"},
+          {"hamiltonian", "T = |p|^2/2, V = sum log(q_i - edge)"},
+          {"dimension", {{"parameter", "dimension"}}},
+          {"parameters",
+           {{{"name", "dimension"},
+             {"type", "integer"},
+             {"default", 1},
+             {"minimum", 0},
+             {"maximum", 1000000000},
+             {"description", "number of degrees of freedom"}},
+            {{"name", "edge"}, {"type", "number"}, {"default", 0.0}, {"description", "V is defined for q_i > edge"}}}},
+          {"thread_safe", true},
+          {"capabilities", {{"value_T", true}, {"value_V", true}, {"hessian_T", true}, {"hessian_V", true}}}}
+          .dump();
   return text.c_str();
 }
 
@@ -98,7 +102,8 @@ nonsep_status hessian_V(nonsep_instance* instance, const double* q, double* out,
   for (std::size_t b = 0; b < count; ++b)
     for (std::size_t i = 0; i < n; ++i) {
       const double d = q[b * n + i] - instance->edge;
-      for (std::size_t j = 0; j < n; ++j) out[b * n * n + i * n + j] = i != j ? 0.0 : d > 0 ? -1.0 / (d * d) : not_a_number;
+      for (std::size_t j = 0; j < n; ++j)
+        out[b * n * n + i * n + j] = i != j ? 0.0 : d > 0 ? -1.0 / (d * d) : not_a_number;
     }
   return NONSEP_OK;
 }

@@ -10,8 +10,9 @@ struct CreateFailing {
 
   explicit CreateFailing(const nonsep::sdk::ParameterValues& values) {
     if (values.number("inner_radius") >= values.number("outer_radius"))
-      throw nonsep::sdk::InvalidParameter("inner_radius", "parameter 'inner_radius' must be smaller than "
-                                                          "'outer_radius'");
+      throw nonsep::sdk::InvalidParameter("inner_radius",
+                                          "parameter 'inner_radius' must be smaller than "
+                                          "'outer_radius'");
   }
   template <class S>
   S T(nonsep::sdk::Vector<S> p) const {
@@ -23,4 +24,5 @@ struct CreateFailing {
   }
 };
 
-NONSEP_EXPORT_MODEL(CreateFailing, "create_failing", "0.1", "test plugin: create refuses inner >= outer", "T = p^2/2, V = q^2/2");
+NONSEP_EXPORT_MODEL(CreateFailing, "create_failing", "0.1", "test plugin: create refuses inner >= outer",
+                    "T = p^2/2, V = q^2/2");

@@ -2,9 +2,8 @@
 // with EvaluationError (a failure); the automatic Hessian of V meets log of a negative number, which the SDK returns
 // as NaN (a number: the host would report the trajectory as diverged).
 #include <cmath>
-#include <string>
-
 #include <nonsep/plugin_sdk.hpp>
+#include <string>
 
 struct EvaluationFails {
   static constexpr std::size_t dimension = 1;

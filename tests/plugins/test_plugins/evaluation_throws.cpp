@@ -4,16 +4,19 @@
 // partway, at a step that depends on its state alone (not on how many calls came before). H_TTV = p^2, whose
 // orbits are q = q0 + 2 p0 t.
 #include <cmath>
-#include <stdexcept>
-
 #include <nonsep/plugin_sdk.hpp>
+#include <stdexcept>
 
 struct EvaluationThrows {
   static constexpr std::size_t dimension = 1;
   static constexpr nonsep::sdk::Parameter parameters[] = {
-      {.name = "throw_above_p", .type = nonsep::sdk::ParameterType::number, .default_value = -1.0,
+      {.name = "throw_above_p",
+       .type = nonsep::sdk::ParameterType::number,
+       .default_value = -1.0,
        .description = "grad T throws where |p| is above this (default -1: everywhere)"},
-      {.name = "throw_above_q", .type = nonsep::sdk::ParameterType::number, .default_value = 1e300,
+      {.name = "throw_above_q",
+       .type = nonsep::sdk::ParameterType::number,
+       .default_value = 1e300,
        .description = "grad V throws where |q| is above this (default 1e300: nowhere)"}};
 
   explicit EvaluationThrows(const nonsep::sdk::ParameterValues& values)
@@ -38,5 +41,4 @@ struct EvaluationThrows {
   }
 };
 
-NONSEP_EXPORT_MODEL(EvaluationThrows, "evaluation_throws", "0.1", "test plugin: grad T throws",
-                    "T = p^2/2, V = q^2/2");
+NONSEP_EXPORT_MODEL(EvaluationThrows, "evaluation_throws", "0.1", "test plugin: grad T throws", "T = p^2/2, V = q^2/2");

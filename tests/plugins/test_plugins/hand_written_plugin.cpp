@@ -32,8 +32,9 @@ namespace {
 
 nonsep_instance the_instance = {""};
 
-#define METADATA_WITH(name, thread_safe, capabilities)                                                          \
-  "{\"name\": \"" name "\", \"version\": \"0.1\", \"description\": \"test plugin\", \"hamiltonian\": \"p q\", " \
+#define METADATA_WITH(name, thread_safe, capabilities)                                     \
+  "{\"name\": \"" name                                                                     \
+  "\", \"version\": \"0.1\", \"description\": \"test plugin\", \"hamiltonian\": \"p q\", " \
   "\"dimension\": {\"fixed\": 1}, \"parameters\": [], " thread_safe "\"capabilities\": {" capabilities "}}"
 #define METADATA_BODY(name, capabilities) METADATA_WITH(name, "\"thread_safe\": true, ", capabilities)
 
@@ -70,7 +71,6 @@ nonsep_status zero_third_derivative(nonsep_instance*, const double*, const doubl
 }
 #endif
 const char* last_error(const nonsep_instance* instance) { return instance->last_error; }
-
 
 const nonsep_plugin_api table = {
 #if NONSEP_TEST_DEFECT == 2

@@ -176,7 +176,7 @@ class ChinBasicStep {
       evaluate(model, !ttv, outer, inner_gradient_, count);  // TTV: grad T(p); VVT: grad V(q)
       flow(inner, inner_gradient_, inner_sign, coefficient);
       observe(FlowStage{!ttv, coefficient}, std::span<const double>(eps_), std::as_const(x));
-      evaluate(model, ttv, inner, outer_gradient_, count);   // TTV: grad V(q); VVT: grad T(p)
+      evaluate(model, ttv, inner, outer_gradient_, count);  // TTV: grad V(q); VVT: grad T(p)
     };
     outer_flow(c_.v2);
     inner_flow(c_.t2);
@@ -202,8 +202,7 @@ class ChinBasicStep {
   }
 
   template <Model M>
-  void evaluate(const M& model, bool potential, std::span<const double> at, std::span<double> out,
-                std::size_t count) {
+  void evaluate(const M& model, bool potential, std::span<const double> at, std::span<double> out, std::size_t count) {
     if (potential) {
       model.grad_V(at, out, count);
       evaluations_.grad_V += count;
@@ -217,7 +216,7 @@ class ChinBasicStep {
   ChinCoefficients c_;
   EvaluationCounts evaluations_;
   std::vector<double> outer_gradient_, inner_gradient_, cached_at_;
-  std::vector<double> eps_;  // cbrt(dt): one entry, or one per state
+  std::vector<double> eps_;                           // cbrt(dt): one entry, or one per state
   std::array<std::pair<double, double>, 4> roots_{};  // (dt, cbrt(dt)); dt = 0 never asked (check_step_size)
   std::size_t next_root_ = 0;
 };

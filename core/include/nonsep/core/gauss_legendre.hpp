@@ -53,10 +53,7 @@ struct GaussLegendreTableau {
       case 1:
         return {1, {0.5}, {1.0}, {0.5}};
       case 2:
-        return {2,
-                {0.25, 0.25 - r3 / 6.0, 0.25 + r3 / 6.0, 0.25},
-                {0.5, 0.5},
-                {0.5 - r3 / 6.0, 0.5 + r3 / 6.0}};
+        return {2, {0.25, 0.25 - r3 / 6.0, 0.25 + r3 / 6.0, 0.25}, {0.5, 0.5}, {0.5 - r3 / 6.0, 0.5 + r3 / 6.0}};
       case 3:
         return {3,
                 {5.0 / 36.0, 2.0 / 9.0 - r15 / 15.0, 5.0 / 36.0 - r15 / 30.0,   //
@@ -112,8 +109,10 @@ class GaussLegendre {
     d.order = order();
     d.properties = "symplectic and symmetric on (q, p), up to the round-off the fixed-point iteration leaves";
     d.grad_H_per_iteration = static_cast<std::uint64_t>(stages());
-    d.cost = std::to_string(stages()) + " grad H per state per fixed-point iteration; iterations run from Z = 0 "
-             "until the stages stop changing (at most " + std::to_string(max_iterations_) + ")";
+    d.cost = std::to_string(stages()) +
+             " grad H per state per fixed-point iteration; iterations run from Z = 0 "
+             "until the stages stop changing (at most " +
+             std::to_string(max_iterations_) + ")";
     d.parameters = {{"max_iterations", static_cast<double>(max_iterations_)}};
     return d;
   }
@@ -125,8 +124,8 @@ class GaussLegendre {
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
     const auto failures = try_step(model, x, dt);
     if (failures.empty()) return;
-    std::string message = "Gauss-Legendre collocation (order " + std::to_string(order()) + ", dt = " +
-                          std::to_string(dt) + "): the fixed-point iteration failed";
+    std::string message = "Gauss-Legendre collocation (order " + std::to_string(order()) +
+                          ", dt = " + std::to_string(dt) + "): the fixed-point iteration failed";
     if (x.count() == 1) {
       message += " (" + failures[0].reason + ")";
     } else {
@@ -194,8 +193,8 @@ class GaussLegendre {
     for (std::size_t b : active_) {
       char change[32];
       std::snprintf(change, sizeof change, "%.3g", last_change_[b]);
-      failures.push_back({b, "no convergence in " + std::to_string(max_iterations_) +
-                                 " iterations, last relative change " + change});
+      failures.push_back(
+          {b, "no convergence in " + std::to_string(max_iterations_) + " iterations, last relative change " + change});
     }
     std::sort(failures.begin(), failures.end(), [](const auto& l, const auto& r) { return l.state < r.state; });
     return failures;
@@ -245,11 +244,11 @@ class GaussLegendre {
   GaussLegendreTableau tableau_;
   HamiltonianGradient gradient_;
   int max_iterations_;
-  std::vector<double> stages_, slopes_;          // Z and f(z + Z): state b, stage i, component k at (b*s + i)*2n + k
-  std::vector<double> q_, p_, dH_dq_, dH_dp_;    // the stage points of the states still iterating
+  std::vector<double> stages_, slopes_;        // Z and f(z + Z): state b, stage i, component k at (b*s + i)*2n + k
+  std::vector<double> q_, p_, dH_dq_, dH_dp_;  // the stage points of the states still iterating
   std::vector<int> iterations_;
-  std::vector<double> last_change_;               // per state: the relative change of its last iteration
-  std::vector<std::size_t> active_, still_;       // the states iterating, and those that go on after this iteration
+  std::vector<double> last_change_;          // per state: the relative change of its last iteration
+  std::vector<std::size_t> active_, still_;  // the states iterating, and those that go on after this iteration
 };
 
 }  // namespace nonsep

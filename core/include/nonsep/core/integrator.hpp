@@ -19,12 +19,13 @@
 namespace nonsep {
 
 struct IntegratorSpec {
-  std::string scheme = "basic";  // a catalogue entry's name: "basic", "triplet", "mpe", "tao", "implicit_midpoint", "gauss"
-  Fraction order = Fraction(2, 3);  // Chin's schemes and tao
+  std::string scheme =
+      "basic";  // a catalogue entry's name: "basic", "triplet", "mpe", "tao", "implicit_midpoint", "gauss"
+  Fraction order = Fraction(2, 3);             // Chin's schemes and tao
   double t2 = ChinCoefficients::default_t2();  // Chin's schemes
   HamiltonianForm form = HamiltonianForm::TTV;
-  double omega = TaoExtendedPhaseSpace::default_omega;  // tao
-  double stages = 2;                                     // gauss (whole number 1..3)
+  double omega = TaoExtendedPhaseSpace::default_omega;            // tao
+  double stages = 2;                                              // gauss (whole number 1..3)
   double max_iterations = GaussLegendre::default_max_iterations;  // implicit_midpoint, gauss (whole number >= 1)
 };
 
@@ -58,8 +59,8 @@ class Integrator {
   // copies of those states come from `before` and are written back into this integrator's copies; the other
   // schemes hold nothing per state and step part as step() does.
   template <Model M>
-  void step_part(const M& model, PhaseSpaceBatch& part, const Integrator& before, std::size_t first,
-                 std::size_t total, double dt) {
+  void step_part(const M& model, PhaseSpaceBatch& part, const Integrator& before, std::size_t first, std::size_t total,
+                 double dt) {
     auto* tao = std::get_if<TaoExtendedPhaseSpace>(&stepper_);
     if (!tao) {
       step(model, part, dt);
@@ -88,12 +89,13 @@ class Integrator {
   }
 
   const EvaluationCounts& evaluations() const {
-    return std::visit([](const auto& stepper) -> const EvaluationCounts& { return stepper.evaluations(); },
-                      stepper_);
+    return std::visit([](const auto& stepper) -> const EvaluationCounts& { return stepper.evaluations(); }, stepper_);
   }
   // The scheme's name, order, flags and family (a comparator's t2 is 0 and basic_steps_per_step 1).
   IntegratorDescription describe() const;
-  bool is_comparator() const { return std::visit([](const auto& s) { return is_comparator_stepper<std::decay_t<decltype(s)>>; }, stepper_); }
+  bool is_comparator() const {
+    return std::visit([](const auto& s) { return is_comparator_stepper<std::decay_t<decltype(s)>>; }, stepper_);
+  }
   // Tao only: the largest |(q, p) - (x, y)| over the states and steps this integrator took (0 before a step).
   double max_copy_distance() const { return max_copy_distance_; }
   HamiltonianForm form() const { return form_; }

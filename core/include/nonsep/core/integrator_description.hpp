@@ -22,10 +22,10 @@ struct ParameterDescription {
 };
 
 struct SchemeDescription {
-  std::string name;        // the job file's integrator.scheme: "basic", "triplet", "mpe"
-  std::string method;      // human name: "Chin basic 9-stage splitting"
-  std::string equations;   // where in the paper: "eq. (expalg)"
-  std::string summary;     // one paragraph
+  std::string name;       // the job file's integrator.scheme: "basic", "triplet", "mpe"
+  std::string method;     // human name: "Chin basic 9-stage splitting"
+  std::string equations;  // where in the paper: "eq. (expalg)"
+  std::string summary;    // one paragraph
   // "chin" (the paper's schemes) or "comparator" (Tao, Gauss-Legendre: need the gradient of H, i.e. the plugin's
   // Hessians and third derivatives; no tangent map).
   std::string family = "chin";

@@ -33,11 +33,11 @@ namespace nonsep {
 struct LyapunovRecord {
   static constexpr std::size_t max_exponents = 32;  // 2n for n = 16, the largest dimension the shipped models have
 
-  std::uint64_t steps = 0;             // steps since start()
+  std::uint64_t steps = 0;  // steps since start()
   std::uint64_t steps_since_renormalization = 0;
-  double time = 0.0;                   // time at the last orthonormalisation (the exponents' denominator)
+  double time = 0.0;  // time at the last orthonormalisation (the exponents' denominator)
   double time_since_renormalization = 0.0;
-  double log_norm_first = 0.0;         // ln |v_1| now; 0 right after an orthonormalisation
+  double log_norm_first = 0.0;                      // ln |v_1| now; 0 right after an orthonormalisation
   std::array<double, max_exponents> log_stretch{};  // sum of ln R_jj, vector j at index j
 
   // lambda_j at the last orthonormalisation; 0 before the first.
@@ -115,7 +115,8 @@ class LyapunovExponents {
       const std::size_t first = b * k_ * n;
       double squared = 0.0;
       for (std::size_t i = 0; i < n; ++i)
-        squared += tangents.q()[first + i] * tangents.q()[first + i] + tangents.p()[first + i] * tangents.p()[first + i];
+        squared +=
+            tangents.q()[first + i] * tangents.q()[first + i] + tangents.p()[first + i] * tangents.p()[first + i];
       const double log_norm = 0.5 * std::log(squared);
       first_growth[b] = log_norm - r.log_norm_first;
       r.log_norm_first = log_norm;

@@ -47,8 +47,8 @@ struct MegnoRecord {
 // differ in size.
 inline void add_megno_step(std::span<MegnoRecord> records, std::span<const double> growth, double dt) {
   if (records.size() != growth.size())
-    throw InvalidArgument("MEGNO: " + std::to_string(records.size()) + " records but " +
-                          std::to_string(growth.size()) + " growth values");
+    throw InvalidArgument("MEGNO: " + std::to_string(records.size()) + " records but " + std::to_string(growth.size()) +
+                          " growth values");
   for (std::size_t b = 0; b < records.size(); ++b) records[b].add_step(growth[b], dt);
 }
 

@@ -33,22 +33,22 @@ concept Model = requires(const M& m, std::span<const double> x, std::span<double
 };
 
 template <class M>
-concept ModelWithHessians =
-    Model<M> && requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
-      m.hessian_T(x, out, count);
-      m.hessian_V(x, out, count);
-    };
+concept ModelWithHessians = Model<M> &&
+    requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
+  m.hessian_T(x, out, count);
+  m.hessian_V(x, out, count);
+};
 
 // and nonsep::ModelWithThirdDerivatives when moreover (u of size count*n, read; out of size count*n, written):
 //   m.d3T(p, u, out, count)     writes sum_ij d3T/dp_i dp_j dp_k u_i u_j, k = 0..n-1, at each of the count momenta
 //   m.d3V(q, u, out, count)     writes sum_ij d3V/dq_i dq_j dq_k u_i u_j, k = 0..n-1, at each of the count positions
 template <class M>
-concept ModelWithThirdDerivatives =
-    ModelWithHessians<M> &&
-    requires(const M& m, std::span<const double> x, std::span<const double> u, std::span<double> out, std::size_t count) {
-      m.d3T(x, u, out, count);
-      m.d3V(x, u, out, count);
-    };
+concept ModelWithThirdDerivatives = ModelWithHessians<M> &&
+    requires(const M& m, std::span<const double> x, std::span<const double> u, std::span<double> out,
+             std::size_t count) {
+  m.d3T(x, u, out, count);
+  m.d3V(x, u, out, count);
+};
 
 // Gradient evaluations performed by an integrator, counted per state: one batched call on `count` states
 // counts `count` evaluations. grad_H counts evaluations of the full gradient (dH/dq, dH/dp) of the solved

@@ -149,7 +149,8 @@ class MultiProductExpansion {
       }
       if (round == 0) {
         last_term_cache = base_.save_cache();
-        last_term_cache.at.erase(last_term_cache.at.begin(), last_term_cache.at.end() - static_cast<std::ptrdiff_t>(size));
+        last_term_cache.at.erase(last_term_cache.at.begin(),
+                                 last_term_cache.at.end() - static_cast<std::ptrdiff_t>(size));
         last_term_cache.gradient.erase(last_term_cache.gradient.begin(),
                                        last_term_cache.gradient.end() - static_cast<std::ptrdiff_t>(size));
       }
@@ -197,7 +198,9 @@ class MultiProductExpansion {
     }
   }
   template <Model M>
-  void prime(const M& model, const PhaseSpaceBatch& x) { base_.prime(model, x); }
+  void prime(const M& model, const PhaseSpaceBatch& x) {
+    base_.prime(model, x);
+  }
 
  private:
   static void accumulate(std::span<double> sum, double c, std::span<const double> y, std::span<const double> ym) {

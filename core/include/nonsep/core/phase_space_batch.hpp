@@ -20,8 +20,7 @@ class PhaseSpaceBatch {
   // One state. Throws InvalidArgument if q and p differ in length or are empty.
   static PhaseSpaceBatch single(std::span<const double> q, std::span<const double> p) {
     if (q.size() != p.size())
-      throw InvalidArgument("q has " + std::to_string(q.size()) + " components but p has " +
-                            std::to_string(p.size()));
+      throw InvalidArgument("q has " + std::to_string(q.size()) + " components but p has " + std::to_string(p.size()));
     PhaseSpaceBatch batch(q.size(), 1);
     batch.q_.assign(q.begin(), q.end());
     batch.p_.assign(p.begin(), p.end());

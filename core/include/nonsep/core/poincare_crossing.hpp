@@ -17,7 +17,6 @@
 // zero, and when s does not change sign (or vanish) over the step: "no crossing in this step, s goes from ...".
 // The model's exceptions propagate.
 #include <boost/math/tools/toms748_solve.hpp>
-
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -37,8 +36,10 @@ class SectionPlane {
     for (double x : normal_) squared += x * x;
     if (normal_.empty() || normal_.size() % 2 != 0 || squared == 0.0 || !std::isfinite(squared) ||
         !std::isfinite(offset))
-      throw InvalidArgument("a section plane needs a finite, non-zero normal of 2n numbers (n for q, then n for p) "
-                            "and a finite offset (found " + std::to_string(normal_.size()) + " numbers)");
+      throw InvalidArgument(
+          "a section plane needs a finite, non-zero normal of 2n numbers (n for q, then n for p) "
+          "and a finite offset (found " +
+          std::to_string(normal_.size()) + " numbers)");
     norm_ = std::sqrt(squared);
   }
 

@@ -25,8 +25,8 @@
 namespace nonsep {
 
 // Every stepper type a catalogue entry can build.
-using SchemeStepper = std::variant<ChinBasicStep, TripletComposition<ChinBasicStep>, MultiProductExpansion<ChinBasicStep>,
-                                   TaoExtendedPhaseSpace, GaussLegendre>;
+using SchemeStepper = std::variant<ChinBasicStep, TripletComposition<ChinBasicStep>,
+                                   MultiProductExpansion<ChinBasicStep>, TaoExtendedPhaseSpace, GaussLegendre>;
 
 // The comparator stepper types: they need ModelWithThirdDerivatives and have no tangent map.
 template <class S>

@@ -48,8 +48,8 @@ inline std::size_t check_tangents_fit(const PhaseSpaceBatch& x, const PhaseSpace
                           " but the states have dimension " + std::to_string(n));
   if (count == 0 || tangents.count() % count != 0 || tangents.count() == 0 || tangents.count() / count > 2 * n)
     throw InvalidArgument("a batch of " + std::to_string(count) + " states of dimension " + std::to_string(n) +
-                          " needs k tangent vectors per state, 1 <= k <= " + std::to_string(2 * n) +
-                          " (found " + std::to_string(tangents.count()) + " vectors in all)");
+                          " needs k tangent vectors per state, 1 <= k <= " + std::to_string(2 * n) + " (found " +
+                          std::to_string(tangents.count()) + " vectors in all)");
   return tangents.count() / count;
 }
 

@@ -67,7 +67,7 @@ class TangentMultiProductExpansion {
 
   TangentBasicStep base_;
   std::vector<double> weights_;
-  PhaseSpaceBatch start_, term_, last_;                            // states: the start, the running term, y_m
+  PhaseSpaceBatch start_, term_, last_;                             // states: the start, the running term, y_m
   PhaseSpaceBatch start_tangents_, term_tangents_, last_tangents_;  // their tangent vectors
 };
 

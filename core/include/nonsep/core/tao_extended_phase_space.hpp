@@ -78,8 +78,8 @@ class TaoExtendedPhaseSpace {
     d.order = order_;
     d.properties = "symplectic and symmetric on the extended phase space (q, p, x, y), not on (q, p) alone";
     d.grad_H_per_step = static_cast<std::uint64_t>(3 * strang);
-    d.cost = std::to_string(3 * strang) + " grad H per state per step (" + std::to_string(strang) +
-             " Strang step" + (strang > 1 ? "s" : "") + " of 3), plus 1 at the start of a run";
+    d.cost = std::to_string(3 * strang) + " grad H per state per step (" + std::to_string(strang) + " Strang step" +
+             (strang > 1 ? "s" : "") + " of 3), plus 1 at the start of a run";
     d.parameters = {{"omega", omega_}};
     return d;
   }
@@ -224,10 +224,10 @@ class TaoExtendedPhaseSpace {
   HamiltonianGradient gradient_;
   int order_;
   double omega_;
-  PhaseSpaceBatch copies_;                       // (x, y) of each state when the stepper holds them
-  std::vector<double> at_a_dq_, at_a_dp_;        // grad H at (q, y), the point the cache names
+  PhaseSpaceBatch copies_;                 // (x, y) of each state when the stepper holds them
+  std::vector<double> at_a_dq_, at_a_dp_;  // grad H at (q, y), the point the cache names
   std::vector<double> cached_q_, cached_y_;
-  std::vector<double> at_b_dq_, at_b_dp_;        // grad H at (x, p)
+  std::vector<double> at_b_dq_, at_b_dp_;  // grad H at (x, p)
 };
 
 }  // namespace nonsep

@@ -69,7 +69,9 @@ class TripletComposition {
     for_each_basic_step(levels - 1, outer, basic_step);
   }
   template <Model M>
-  void prime(const M& model, const PhaseSpaceBatch& x) { base_.prime(model, x); }
+  void prime(const M& model, const PhaseSpaceBatch& x) {
+    base_.prime(model, x);
+  }
 
  private:
   Base base_;

@@ -5,22 +5,23 @@
 // A checkpoint is taken between two steps and holds: the number of steps completed, the active states in
 // trajectory order with their energies, every trajectory's record (retired ones included: status, final state,
 // energies), the evaluation counts, every observer's state (observer.hpp: trajectory.csv's size, which a resumed
-// run cuts the file back to, the largest energy errors, the closest returns, ...), and a fingerprint of the job. Doubles are stored as shortest round-trip decimal strings
+// run cuts the file back to, the largest energy errors, the closest returns, ...), and a fingerprint of the job.
+// Doubles are stored as shortest round-trip decimal strings
 // ("0.1", "nan", "-inf"), so reading one back gives the same bits. The file is replaced atomically
 // (write_file_atomically): a crash while saving leaves the previous checkpoint.
 //
 // The fingerprint covers what determines the numbers: the plugin (name, version and its file's bytes), the model's
-// parameters, the integrator, the initial states, the time grid, output.every, output.energy_every, output.format (hdf5 only) and /analysis. It leaves out the output folder and the
-// checkpoint policy, which may change between the interrupted run and the resumed one.
+// parameters, the integrator, the initial states, the time grid, output.every, output.energy_every, output.format (hdf5
+// only) and /analysis. It leaves out the output folder and the checkpoint policy, which may change between the
+// interrupted run and the resumed one.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/core/model.hpp"
 #include "nonsep/host/job.hpp"

@@ -15,13 +15,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/plugin_loader.hpp"
@@ -49,7 +48,6 @@ class InvalidJob : public std::runtime_error {
   std::vector<JobIssue> issues_;
 };
 
-
 // The initial states, state-major as in nonsep::PhaseSpaceBatch: component i of state b at b*dimension + i.
 // `shape` says how the job wrote them: "single" (one object), "list" (an array of objects) or "grid".
 // /initial/energy and /initial/solve_for (a grid only): every state of the grid is put on the energy shell H = energy
@@ -76,10 +74,10 @@ struct InitialStates {
 // each of its step counts, and the errors at t_end are compared (study.hpp). Step counts are per integrator: the
 // study's list (/study/steps, or /study/dt turned into counts as TimeGrid does) unless the integrator gives its own.
 struct StudyIntegrator {
-  std::string label;           // /study/integrators/<i>/label, default "<scheme> <order>" ("triplet 4/3"; "basic")
-  IntegratorSpec spec;         // as /integrator of a single run, sharing /hamiltonian
+  std::string label;    // /study/integrators/<i>/label, default "<scheme> <order>" ("triplet 4/3"; "basic")
+  IntegratorSpec spec;  // as /integrator of a single run, sharing /hamiltonian
   std::vector<std::uint64_t> steps;  // distinct, in increasing order; dt = t_end / steps
-  std::string steps_from;      // where the counts came from: "study.steps", "study.dt", "integrator.steps", ...
+  std::string steps_from;            // where the counts came from: "study.steps", "study.dt", "integrator.steps", ...
 };
 struct Study {
   HamiltonianForm form = HamiltonianForm::TTV;  // /hamiltonian, shared by every integrator
@@ -98,22 +96,22 @@ struct Study {
 // (poincare.csv; observers/poincare_section.hpp).
 enum class CrossingDirection { up, down, both };  // "+": s = normal . (q, p) - offset goes from < 0 to >= 0
 struct PoincareSection {
-  std::vector<double> normal;   // 2n numbers, n for q then n for p ("component": "q1" is the unit vector of q1)
-  double offset = 0.0;          // /analysis/poincare/value (or offset)
+  std::vector<double> normal;  // 2n numbers, n for q then n for p ("component": "q1" is the unit vector of q1)
+  double offset = 0.0;         // /analysis/poincare/value (or offset)
   CrossingDirection direction = CrossingDirection::up;
   std::optional<std::uint64_t> max_crossings;  // a trajectory stops ("completed", with a message) after this many
 };
 
 // /analysis/lyapunov: Benettin's finite-time Lyapunov exponents through the tangent map of the run's integrator.
 struct LyapunovAnalysis {
-  std::size_t vectors = 1;                 // k: the k largest exponents
-  std::uint64_t renormalize_every = 1;     // steps between re-orthonormalisations
-  std::uint64_t every = 0;                 // lyapunov.csv every this many steps; 0: no time series
+  std::size_t vectors = 1;              // k: the k largest exponents
+  std::uint64_t renormalize_every = 1;  // steps between re-orthonormalisations
+  std::uint64_t every = 0;              // lyapunov.csv every this many steps; 0: no time series
 };
 
 // Per-trajectory analysis of a single run (/analysis).
 struct Analysis {
-  std::optional<PoincareSection> poincare;  // /analysis/poincare
+  std::optional<PoincareSection> poincare;   // /analysis/poincare
   std::optional<LyapunovAnalysis> lyapunov;  // /analysis/lyapunov
   bool megno = false;                        // /analysis/megno: MEGNO of the first tangent vector
   // Tangent vectors per trajectory the run must follow: lyapunov's k, or 1 for MEGNO alone; 0 for none.
@@ -143,20 +141,20 @@ enum class OutputFormat { csv, hdf5 };
 struct SingleRun {
   IntegratorSpec integrator;  // /hamiltonian and /integrator, defaults filled in from the catalogue
   TimeGrid time;
-  std::uint64_t every = 1;                 // /output/every; 0: no trajectory file
-  std::uint64_t energy_every = 0;          // /output/energy_every; 0: H only at samples, start and end
+  std::uint64_t every = 1;                  // /output/every; 0: no trajectory file
+  std::uint64_t energy_every = 0;           // /output/energy_every; 0: H only at samples, start and end
   OutputFormat format = OutputFormat::csv;  // /output/format
-  Analysis analysis;                       // /analysis
-  CheckpointPolicy checkpoint;             // /checkpoint
+  Analysis analysis;                        // /analysis
+  CheckpointPolicy checkpoint;              // /checkpoint
 };
 
 struct Job {
-  std::filesystem::path file;       // the job file as given
-  std::filesystem::path directory;  // its folder: relative paths in the job resolve against it
-  std::string plugin;               // /model/plugin: a name or a path
+  std::filesystem::path file;                            // the job file as given
+  std::filesystem::path directory;                       // its folder: relative paths in the job resolve against it
+  std::string plugin;                                    // /model/plugin: a name or a path
   nlohmann::json parameters = nlohmann::json::object();  // /model/parameters as written
-  InitialStates initial;            // a study has exactly one state
-  std::filesystem::path output_directory;  // /output/directory resolved against `directory`
+  InitialStates initial;                                 // a study has exactly one state
+  std::filesystem::path output_directory;                // /output/directory resolved against `directory`
   // What the job does: a single run, or a convergence study (/study, which has no /integrator, /analysis or
   // /checkpoint and a /time of its own).
   std::variant<SingleRun, Study> plan;

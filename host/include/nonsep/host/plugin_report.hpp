@@ -40,7 +40,7 @@ struct DerivativeCheckSettings {
 struct DerivativeCheck {
   bool passed = true;
   std::size_t comparisons = 0;  // derivative entries compared with finite differences; 0: nothing was checked
-  std::string text;  // several lines, each ending in '\n'; the last says "passed" or "FAILED"
+  std::string text;             // several lines, each ending in '\n'; the last says "passed" or "FAILED"
 };
 DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin,
                                   const DerivativeCheckSettings& settings = {});

@@ -14,12 +14,11 @@
 //     reference is given; the range of dt and steps fitted and whether the energy error changed sign in it.
 #include <cstddef>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/core/integrator_description.hpp"
 #include "nonsep/core/model.hpp"
@@ -44,7 +43,7 @@ struct StudyRun {
   std::uint64_t steps = 0;
   double dt = 0.0;
   TrajectoryStatus status = TrajectoryStatus::completed;  // completed, diverged, failed or interrupted
-  std::string error;  // why it diverged or failed; "" otherwise
+  std::string error;                                      // why it diverged or failed; "" otherwise
   std::uint64_t basic_steps = 0;
   EvaluationCounts evaluations;
   std::optional<double> relative_energy_error, phase_error;  // at t_end; completed runs only
@@ -55,7 +54,7 @@ struct StudyRun {
 // The fits of one integrator over its completed runs (summary.json "fits"). Values that cannot be fitted (fewer
 // than two usable points) are empty; the phase fit exists only with /study/reference.
 struct StudyFit {
-  std::string integrator;            // the label
+  std::string integrator;             // the label
   IntegratorDescription description;  // scheme, order (the nominal exponent), t2, symplectic
   std::string steps_from;
   std::size_t points = 0;  // runs with a finite, non-zero energy error
@@ -74,13 +73,13 @@ struct StudyFit {
 // What a study ended with: its status, its runs per integrator (in the order of /study/integrators, each in step
 // order) and their fits. summary.json is written from these.
 struct StudyOutcome {
-  ExitStatus exit_status = ExitStatus::success;  // success, run_failed or interrupted
+  ExitStatus exit_status = ExitStatus::success;           // success, run_failed or interrupted
   TrajectoryStatus status = TrajectoryStatus::completed;  // interrupted, failed, diverged or completed
   std::string error;  // why the study as a whole failed (the plugin, an output); "" otherwise
   StatusCounts run_counts;
-  std::vector<StudyFit> fits;                 // one per integrator
-  std::vector<std::vector<StudyRun>> runs;    // per integrator, as fits
-  nlohmann::ordered_json summary;             // what summary.json holds
+  std::vector<StudyFit> fits;               // one per integrator
+  std::vector<std::vector<StudyRun>> runs;  // per integrator, as fits
+  nlohmann::ordered_json summary;           // what summary.json holds
 };
 
 // The fits of `runs`, the runs of `integrator` (described by `description`); `with_reference` adds the phase fit.

@@ -36,7 +36,7 @@
 namespace nonsep {
 
 struct DerivativeCheckOptions {
-  std::size_t random_points = 16;    // sample points drawn uniformly from [-box, box]^n (same draw for p and q)
+  std::size_t random_points = 16;  // sample points drawn uniformly from [-box, box]^n (same draw for p and q)
   double box = 1.5;
   std::uint64_t seed = 12345;
   std::vector<std::vector<double>> points;  // further sample points, each with dimension() numbers
@@ -59,7 +59,7 @@ struct DerivativeMismatch {
 
 struct DerivativeCheckReport {
   std::size_t comparisons = 0;
-  double largest_error = 0.0;  // max |computed - finite difference| / max(1, |finite difference|)
+  double largest_error = 0.0;    // max |computed - finite difference| / max(1, |finite difference|)
   std::size_t not_a_number = 0;  // comparisons (included in `comparisons`) where both were NaN: agreement
   std::vector<DerivativeMismatch> mismatches;
   std::vector<std::string> skipped;  // checks not made, with the reason
@@ -79,9 +79,9 @@ struct DerivativeCheckReport {
       std::string point;
       for (double x : m.point) point += (point.empty() ? "" : ", ") + scientific(x, 6);
       const bool kinetic = m.function.back() == 'T';
-      text += "  " + m.function + "[" + std::to_string(m.component) + "] at " + (kinetic ? "p" : "q") + " = (" +
-              point + "): computed " + scientific(m.computed, 6) + ", finite difference " +
-              scientific(m.finite_difference, 6) + ", relative error " +
+      text += "  " + m.function + "[" + std::to_string(m.component) + "] at " + (kinetic ? "p" : "q") + " = (" + point +
+              "): computed " + scientific(m.computed, 6) + ", finite difference " + scientific(m.finite_difference, 6) +
+              ", relative error " +
               scientific(std::abs(m.computed - m.finite_difference) / std::max(1.0, std::abs(m.finite_difference)), 3) +
               "\n";
     }
@@ -106,19 +106,18 @@ concept ModelWithValues = requires(const M& m, std::span<const double> x, std::s
   m.value_V(x, out, count);
 };
 template <class M>
-concept ModelWithHessianFunctions =
-    requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
-      m.hessian_T(x, out, count);
-      m.hessian_V(x, out, count);
-    };
+concept ModelWithHessianFunctions = requires(const M& m, std::span<const double> x, std::span<double> out,
+                                             std::size_t count) {
+  m.hessian_T(x, out, count);
+  m.hessian_V(x, out, count);
+};
 
 template <class M>
-concept ModelWithThirdDerivativeFunctions =
-    requires(const M& m, std::span<const double> x, std::span<const double> u, std::span<double> out,
-             std::size_t count) {
-      m.d3T(x, u, out, count);
-      m.d3V(x, u, out, count);
-    };
+concept ModelWithThirdDerivativeFunctions = requires(const M& m, std::span<const double> x, std::span<const double> u,
+                                                     std::span<double> out, std::size_t count) {
+  m.d3T(x, u, out, count);
+  m.d3V(x, u, out, count);
+};
 
 // u^T H u for the row-major n x n matrix at h.
 inline double quadratic_form(const double* h, const std::vector<double>& u) {
@@ -159,8 +158,7 @@ inline void compare(DerivativeCheckReport& report, const DerivativeCheckOptions&
   }
   const double error = std::abs(computed - difference) / std::max(1.0, std::abs(difference));
   report.largest_error = std::max(report.largest_error, std::isfinite(error) ? error : INFINITY);
-  if (!(error <= options.tolerance))
-    report.mismatches.push_back({function, point, component, computed, difference});
+  if (!(error <= options.tolerance)) report.mismatches.push_back({function, point, component, computed, difference});
 }
 
 }  // namespace detail
@@ -182,7 +180,8 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
   constexpr bool has_hessians = detail::ModelWithHessianFunctions<M>;
   if (options.check_gradients && !has_values) report.skipped.push_back("gradients: the model has no value_T/value_V");
   constexpr bool has_third = detail::ModelWithThirdDerivativeFunctions<M>;
-  if (options.check_hessians && !has_hessians) report.skipped.push_back("Hessians: the model has no hessian_T/hessian_V");
+  if (options.check_hessians && !has_hessians)
+    report.skipped.push_back("Hessians: the model has no hessian_T/hessian_V");
   if (options.check_third_derivatives && !(has_third && has_hessians))
     report.skipped.push_back(has_third ? "third derivatives: differencing them needs hessian_T/hessian_V"
                                        : "third derivatives: the model has no d3T/d3V");

@@ -121,8 +121,7 @@ typedef struct nonsep_plugin_api {
  * with default visibility whatever -fvisibility says. Use it once per plugin, at file scope:
  *   static const nonsep_plugin_api table = { NONSEP_PLUGIN_ABI_VERSION, sizeof(nonsep_plugin_api), ... };
  *   NONSEP_DEFINE_PLUGIN(table); */
-#define NONSEP_DEFINE_PLUGIN(table)                                                                   \
-  NONSEP_PLUGIN_EXTERN_C __attribute__((visibility("default"))) const nonsep_plugin_api* const nonsep_plugin = \
-      &(table)
+#define NONSEP_DEFINE_PLUGIN(table) \
+  NONSEP_PLUGIN_EXTERN_C __attribute__((visibility("default"))) const nonsep_plugin_api* const nonsep_plugin = &(table)
 
 #endif /* NONSEP_PLUGIN_ABI_H */

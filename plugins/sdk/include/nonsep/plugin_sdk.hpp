@@ -28,10 +28,9 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/plugin_abi.h"
 #include "nonsep/sdk/dual.hpp"
@@ -116,28 +115,27 @@ class PluginTable {
     else
       dimension = {{"parameter", M::dimension_parameter}, {"max_dimension", M::max_dimension}};
     auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
-    const nlohmann::json metadata = {
-        {"name", id.name},
-        {"version", id.version},
-        {"description", id.description},
-        {"hamiltonian", id.hamiltonian},
-        {"dimension", dimension},
-        {"parameters", parameters_metadata(parameter_table<M>())},
-        {"thread_safe", true},
-        {"capabilities",
-         {{"value_T", true},
-          {"value_V", true},
-          {"hessian_T", true},
-          {"hessian_V", true},
-          {"d3T", true},
-          {"d3V", true}}},
-        {"derivatives",
-         {{"grad_T", kind(Adapter::analytic_grad_T)},
-          {"grad_V", kind(Adapter::analytic_grad_V)},
-          {"hessian_T", kind(Adapter::analytic_hessian_T)},
-          {"hessian_V", kind(Adapter::analytic_hessian_V)},
-          {"d3T", kind(Adapter::analytic_d3T)},
-          {"d3V", kind(Adapter::analytic_d3V)}}}};
+    const nlohmann::json metadata = {{"name", id.name},
+                                     {"version", id.version},
+                                     {"description", id.description},
+                                     {"hamiltonian", id.hamiltonian},
+                                     {"dimension", dimension},
+                                     {"parameters", parameters_metadata(parameter_table<M>())},
+                                     {"thread_safe", true},
+                                     {"capabilities",
+                                      {{"value_T", true},
+                                       {"value_V", true},
+                                       {"hessian_T", true},
+                                       {"hessian_V", true},
+                                       {"d3T", true},
+                                       {"d3V", true}}},
+                                     {"derivatives",
+                                      {{"grad_T", kind(Adapter::analytic_grad_T)},
+                                       {"grad_V", kind(Adapter::analytic_grad_V)},
+                                       {"hessian_T", kind(Adapter::analytic_hessian_T)},
+                                       {"hessian_V", kind(Adapter::analytic_hessian_V)},
+                                       {"d3T", kind(Adapter::analytic_d3T)},
+                                       {"d3V", kind(Adapter::analytic_d3V)}}}};
     return metadata.dump();
   }
 
@@ -186,33 +184,32 @@ class PluginTable {
   }
 
   // The batched functions: spans over the caller's arrays (sizes from the batch layout of plugin_abi.h).
-#define NONSEP_SDK_BATCHED(function, per_state_of)                                                              \
+#define NONSEP_SDK_BATCHED(function, per_state_of)                                                                     \
   static nonsep_status function(nonsep_instance* instance, const double* x, double* out, std::size_t count) noexcept { \
-    return guarded(instance, #function, [&](const Instance& self) {                                            \
-      const Adapter& adapter = self.adapter;                                                                   \
-      const std::size_t n = adapter.dimension();                                                               \
-      adapter.function(std::span<const double>(x, count * n), std::span<double>(out, count * (per_state_of)),  \
-                       count);                                                                                 \
-    });                                                                                                        \
+    return guarded(instance, #function, [&](const Instance& self) {                                                    \
+      const Adapter& adapter = self.adapter;                                                                           \
+      const std::size_t n = adapter.dimension();                                                                       \
+      adapter.function(std::span<const double>(x, count * n), std::span<double>(out, count * (per_state_of)), count);  \
+    });                                                                                                                \
   }
   NONSEP_SDK_BATCHED(grad_T, n)
   NONSEP_SDK_BATCHED(grad_V, n)
   NONSEP_SDK_BATCHED(value_T, 1)
   NONSEP_SDK_BATCHED(value_V, 1)
-  NONSEP_SDK_BATCHED(hessian_T, n * n)
-  NONSEP_SDK_BATCHED(hessian_V, n * n)
+  NONSEP_SDK_BATCHED(hessian_T, n* n)
+  NONSEP_SDK_BATCHED(hessian_V, n* n)
 #undef NONSEP_SDK_BATCHED
 
   // The directional third derivatives: x, u and out each hold count*n numbers.
-#define NONSEP_SDK_DIRECTIONAL(function)                                                                        \
-  static nonsep_status function(nonsep_instance* instance, const double* x, const double* u, double* out,       \
-                                std::size_t count) noexcept {                                                   \
-    return guarded(instance, #function, [&](const Instance& self) {                                            \
-      const Adapter& adapter = self.adapter;                                                                   \
-      const std::size_t size = count * adapter.dimension();                                                    \
-      adapter.function(std::span<const double>(x, size), std::span<const double>(u, size),                    \
-                       std::span<double>(out, size), count);                                                   \
-    });                                                                                                        \
+#define NONSEP_SDK_DIRECTIONAL(function)                                                                  \
+  static nonsep_status function(nonsep_instance* instance, const double* x, const double* u, double* out, \
+                                std::size_t count) noexcept {                                             \
+    return guarded(instance, #function, [&](const Instance& self) {                                       \
+      const Adapter& adapter = self.adapter;                                                              \
+      const std::size_t size = count * adapter.dimension();                                               \
+      adapter.function(std::span<const double>(x, size), std::span<const double>(u, size),                \
+                       std::span<double>(out, size), count);                                              \
+    });                                                                                                   \
   }
   NONSEP_SDK_DIRECTIONAL(d3T)
   NONSEP_SDK_DIRECTIONAL(d3V)
@@ -247,16 +244,16 @@ class PluginTable {
 // The other four arguments are string literals: `name`, which must equal the file's stem and so the CMake target
 // of nonsep_add_model (the host refuses a plugin whose metadata names another file); `version` of the model;
 // `description`, one line for `nonsep models`; `hamiltonian`, what T, V and the solved H are, in words.
-#define NONSEP_EXPORT_MODEL(Model, name, version, description, hamiltonian)                                    \
+#define NONSEP_EXPORT_MODEL(Model, name, version, description, hamiltonian)                                      \
   NONSEP_EXPORT_MODEL_WITH_DERIVATIVES(Model, ::nonsep::sdk::Derivatives::preferred, name, version, description, \
                                        hamiltonian)
 
 // As NONSEP_EXPORT_MODEL, choosing the derivative policy (::nonsep::sdk::Derivatives::automatic ignores the
 // class's analytic derivatives; used to compare the two).
-#define NONSEP_EXPORT_MODEL_WITH_DERIVATIVES(Model, policy, name, version, description, hamiltonian)       \
-  namespace {                                                                                            \
-  struct nonsep_exported_model_identity {                                                                \
-    static constexpr ::nonsep::sdk::ModelIdentity value{name, version, description, hamiltonian};        \
-  };                                                                                                     \
-  }                                                                                                      \
+#define NONSEP_EXPORT_MODEL_WITH_DERIVATIVES(Model, policy, name, version, description, hamiltonian) \
+  namespace {                                                                                        \
+  struct nonsep_exported_model_identity {                                                            \
+    static constexpr ::nonsep::sdk::ModelIdentity value{name, version, description, hamiltonian};    \
+  };                                                                                                 \
+  }                                                                                                  \
   NONSEP_DEFINE_PLUGIN((::nonsep::sdk::PluginTable<Model, policy, nonsep_exported_model_identity>::api))

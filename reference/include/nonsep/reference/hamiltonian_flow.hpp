@@ -12,8 +12,9 @@ template <class Rhs>
 std::vector<double> hamiltonian_flow(Rhs rhs, std::vector<double> x, double t_end, double tolerance = 1e-14) {
   namespace odeint = boost::numeric::odeint;
   auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<std::vector<double>>());
-  odeint::integrate_adaptive(stepper, [&](const std::vector<double>& s, std::vector<double>& d, double) { rhs(s, d); },
-                             x, 0.0, t_end, t_end / 1000);
+  odeint::integrate_adaptive(
+      stepper, [&](const std::vector<double>& s, std::vector<double>& d, double) { rhs(s, d); }, x, 0.0, t_end,
+      t_end / 1000);
   return x;
 }
 

@@ -5,8 +5,8 @@
 // |dq/dt| = |dH/dp| = 2 |p| u (1 + q^2), u = 1 + p^2/2 = sqrt(E / (1 + q^2)). The integrand has an inverse
 // square-root singularity at q0, which tanh-sinh quadrature handles; u - 1 is written without cancellation,
 // u - 1 = (q0 - q)(q0 + q) / (sqrt(1 + q^2) (sqrt(E) + sqrt(1 + q^2))), using the distance to the endpoint.
-#include <boost/math/quadrature/tanh_sinh.hpp>
 #include <algorithm>
+#include <boost/math/quadrature/tanh_sinh.hpp>
 #include <cmath>
 
 namespace nonsep::reference {

@@ -13,12 +13,11 @@
 // unit length at every sampled time and at least every `renormalize_interval`, the logarithms of the lengths
 // being summed, so long runs do not overflow.
 #include <array>
+#include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <cstddef>
-#include <vector>
-
-#include <boost/numeric/odeint.hpp>
 #include <nonsep/sdk/dual.hpp>
+#include <vector>
 
 namespace nonsep::reference {
 

@@ -8,11 +8,10 @@
 // trajectory. Rows with equal keys (two Poincare crossings in one step) come from one unit and keep their order.
 #include <cstddef>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace nonsep::host {
 
@@ -25,8 +24,7 @@ struct UnitFile {
 // (named in the header; e.g. {"step", "trajectory"}), compared in that order, then by part. Cells may be quoted
 // CSV text with commas and line breaks; the key and trajectory columns must come before any quoted cell. Throws
 // OutputError naming the file that cannot be read or does not fit.
-void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& output,
-               std::span<const std::string> keys);
+void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& output, std::span<const std::string> keys);
 
 // summary.json of the whole run from the units' summaries (in trajectory order; `first_trajectories` as above):
 // the first unit's, with what depends on the ensemble recomputed: status (the first of interrupted, failed,

@@ -77,7 +77,7 @@ class PoincareSectionObserver : public Observer {
     PoincareCrossingLocator<Integrator> locator;
     EnergyEvaluator energy;
     SectionCrossing crossing;
-    std::vector<Found> found;          // in the current chunk, in step order
+    std::vector<Found> found;  // in the current chunk, in step order
     std::vector<std::uint64_t> counts_at_chunk_start;
   };
 

@@ -28,8 +28,8 @@ class SampleWriter : public Observer {
 
   // The file at `path`, for `trajectories` states of `dimension` on `time` (which must outlive the writer): created
   // anew, or, when `resuming`, opened by restore(). Throws OutputError.
-  SampleWriter(const std::filesystem::path& path, std::size_t dimension, std::size_t trajectories,
-               std::uint64_t every, const TimeGrid& time, bool resuming);
+  SampleWriter(const std::filesystem::path& path, std::size_t dimension, std::size_t trajectories, std::uint64_t every,
+               const TimeGrid& time, bool resuming);
 
   std::uint64_t next_event(std::uint64_t step) const override { return (step / every_ + 1) * every_; }
   bool needs_energy(std::uint64_t step) const override { return step % every_ == 0; }

@@ -10,11 +10,10 @@
 // must drop it. A whole file that is produced at once goes through write_file_atomically (files.hpp) instead.
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/host/number_format.hpp"
 

@@ -20,8 +20,9 @@ class OutputError : public std::runtime_error {
 };
 
 // A file written whole and then put in place atomically: the text goes to a temporary file in the same folder
-// (".<name>.tmp-" and six random characters, created exclusively), which commit() flushes to disk and renames over `path`; readers see the old file or the
-// new one, never a part. Destroyed without commit(), the temporary file is removed and `path` left as it was.
+// (".<name>.tmp-" and six random characters, created exclusively), which commit() flushes to disk and renames over
+// `path`; readers see the old file or the new one, never a part. Destroyed without commit(), the temporary file is
+// removed and `path` left as it was.
 class AtomicFile {
  public:
   // Throws OutputError when the temporary file cannot be created.

@@ -6,11 +6,11 @@
 //
 // Every call must come from one thread at a time (Debian's HDF5 is not built thread-safe); nonsep makes them all on
 // the driver's thread.
+#include <hdf5.h>
+
 #include <filesystem>
 #include <string>
 #include <utility>
-
-#include <hdf5.h>
 
 namespace nonsep::host {
 
@@ -19,8 +19,7 @@ class Hdf5Handle {
   using Close = herr_t (*)(hid_t);
   Hdf5Handle() = default;
   Hdf5Handle(hid_t id, Close close) : id_(id), close_(close) {}
-  Hdf5Handle(Hdf5Handle&& other) noexcept
-      : id_(std::exchange(other.id_, H5I_INVALID_HID)), close_(other.close_) {}
+  Hdf5Handle(Hdf5Handle&& other) noexcept : id_(std::exchange(other.id_, H5I_INVALID_HID)), close_(other.close_) {}
   Hdf5Handle& operator=(Hdf5Handle&& other) noexcept {
     if (this != &other) {
       reset();

@@ -29,11 +29,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/core/lyapunov_exponents.hpp"
@@ -45,7 +44,7 @@
 
 namespace nonsep::host {
 
-inline constexpr std::size_t run_block_size = 256;              // trajectories per block
+inline constexpr std::size_t run_block_size = 256;               // trajectories per block
 inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chunk: state-steps of all active states
 
 // What the driver integrates.

@@ -33,12 +33,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/core/lyapunov_exponents.hpp"
 #include "nonsep/core/megno.hpp"
@@ -54,7 +53,7 @@ inline constexpr std::uint64_t no_event = std::numeric_limits<std::uint64_t>::ma
 struct StateView {
   std::size_t trajectory = 0;
   std::span<const double> q, p;
-  std::optional<double> energy;          // H at this step, when it was evaluated and finite
+  std::optional<double> energy;              // H at this step, when it was evaluated and finite
   const TrajectoryRecord* record = nullptr;  // energy_initial etc.
   // The running Lyapunov and MEGNO sums, when the run follows tangent vectors (EnsembleSetup::tangent_vectors).
   const LyapunovRecord* lyapunov = nullptr;
@@ -83,7 +82,7 @@ struct BlockView {
   std::size_t dimension = 0;
   std::span<const std::size_t> trajectories;
   std::span<const double> q, p;
-  const PluginModel* model = nullptr;  // the worker thread's plugin instance; use it on this thread only
+  const PluginModel* model = nullptr;                // the worker thread's plugin instance; use it on this thread only
   std::vector<RetirementRequest>* retire = nullptr;  // on_step only: stop these trajectories at this step
 };
 

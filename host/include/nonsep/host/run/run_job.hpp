@@ -17,11 +17,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/job.hpp"
@@ -56,10 +55,10 @@ struct RunOutcome {
   std::string error;  // why the run as a whole failed (an output could not be written, ...); "" otherwise
   std::uint64_t steps_completed = 0;  // the last step any trajectory reached
   StatusCounts counts;
-  std::vector<TrajectoryRecord> trajectories;  // one per trajectory, in job order
+  std::vector<TrajectoryRecord> trajectories;              // one per trajectory, in job order
   std::optional<LargestEnergyError> largest_energy_error;  // over the steps where H was evaluated
-  nlohmann::ordered_json summary;  // what summary.json holds
-  std::vector<std::string> notes;  // for the user, not errors (e.g. "ran on one thread: ...")
+  nlohmann::ordered_json summary;                          // what summary.json holds
+  std::vector<std::string> notes;                          // for the user, not errors (e.g. "ran on one thread: ...")
   // Spread over work units (cluster/distributed_run.hpp): `trajectories` is empty (trajectories.csv has them).
   bool distributed = false;
 };

@@ -34,7 +34,7 @@ struct TrajectoryRecord {
   // The final state: at the last step, where the run stopped, or the last finite state before it stopped early.
   std::uint64_t final_step = 0;
   double final_t = 0.0;
-  std::vector<double> final_q, final_p;  // empty while running
+  std::vector<double> final_q, final_p;                // empty while running
   std::optional<double> energy_initial, energy_final;  // H at step 0 and of the final state, when known
   // Where it stopped early: the step at which the problem was found (for "diverged" the step whose result was not
   // finite, one after final_step), and what: the first non-finite variable ("q[0]", "p[1]") or the message.

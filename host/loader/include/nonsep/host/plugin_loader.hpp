@@ -18,13 +18,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nonsep/core/error.hpp"
 
@@ -57,9 +56,9 @@ class Plugin {
   std::string version() const;
   std::string description() const;
   std::vector<PluginParameter> parameters() const;
-  bool has_hessians() const;            // both hessian_T and hessian_V
-  bool has_values() const;              // both value_T and value_V
-  bool has_third_derivatives() const;   // both d3T and d3V
+  bool has_hessians() const;           // both hessian_T and hessian_V
+  bool has_values() const;             // both value_T and value_V
+  bool has_third_derivatives() const;  // both d3T and d3V
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
   bool thread_safe() const;
 

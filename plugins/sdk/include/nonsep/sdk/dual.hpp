@@ -110,16 +110,16 @@ Dual<S, K> operator+(const Dual<S, K>& a) {
   return a;
 }
 
-#define NONSEP_SDK_DUAL_BINARY(op)                                  \
-  template <class S, std::size_t K>                                  \
-  Dual<S, K> operator op(Dual<S, K> a, const Dual<S, K>& b) {        \
-    a op## = b;                                                      \
-    return a;                                                        \
-  }                                                                  \
-  template <class S, std::size_t K>                                  \
-  Dual<S, K> operator op(Dual<S, K> a, double b) {                   \
-    a op## = b;                                                      \
-    return a;                                                        \
+#define NONSEP_SDK_DUAL_BINARY(op)                            \
+  template <class S, std::size_t K>                           \
+  Dual<S, K> operator op(Dual<S, K> a, const Dual<S, K>& b) { \
+    a op## = b;                                               \
+    return a;                                                 \
+  }                                                           \
+  template <class S, std::size_t K>                           \
+  Dual<S, K> operator op(Dual<S, K> a, double b) {            \
+    a op## = b;                                               \
+    return a;                                                 \
   }
 NONSEP_SDK_DUAL_BINARY(+)
 NONSEP_SDK_DUAL_BINARY(-)
@@ -148,18 +148,18 @@ Dual<S, K> operator/(double a, const Dual<S, K>& b) {
   return Dual<S, K>(a) / b;
 }
 
-#define NONSEP_SDK_DUAL_COMPARISON(op)                                                                   \
-  template <class S, std::size_t K>                                                                       \
-  bool operator op(const Dual<S, K>& a, const Dual<S, K>& b) {                                           \
-    return value_of(a) op value_of(b);                                                                    \
-  }                                                                                                       \
-  template <class S, std::size_t K>                                                                       \
-  bool operator op(const Dual<S, K>& a, double b) {                                                      \
-    return value_of(a) op b;                                                                              \
-  }                                                                                                       \
-  template <class S, std::size_t K>                                                                       \
-  bool operator op(double a, const Dual<S, K>& b) {                                                      \
-    return a op value_of(b);                                                                              \
+#define NONSEP_SDK_DUAL_COMPARISON(op)                         \
+  template <class S, std::size_t K>                            \
+  bool operator op(const Dual<S, K>& a, const Dual<S, K>& b) { \
+    return value_of(a) op value_of(b);                         \
+  }                                                            \
+  template <class S, std::size_t K>                            \
+  bool operator op(const Dual<S, K>& a, double b) {            \
+    return value_of(a) op b;                                   \
+  }                                                            \
+  template <class S, std::size_t K>                            \
+  bool operator op(double a, const Dual<S, K>& b) {            \
+    return a op value_of(b);                                   \
   }
 NONSEP_SDK_DUAL_COMPARISON(<)
 NONSEP_SDK_DUAL_COMPARISON(<=)
@@ -216,14 +216,14 @@ Dual<S, K> chain(const Dual<S, K>& x, const Dual<S, K>& y, const S& f, const S& 
 }  // namespace detail
 
 // The two-argument functions with one double argument: the double as a constant dual.
-#define NONSEP_SDK_DUAL_MIXED(function)                       \
-  template <class S, std::size_t K>                            \
-  Dual<S, K> function(const Dual<S, K>& x, double y) {         \
-    return function(x, Dual<S, K>(y));                         \
-  }                                                            \
-  template <class S, std::size_t K>                            \
-  Dual<S, K> function(double x, const Dual<S, K>& y) {         \
-    return function(Dual<S, K>(x), y);                         \
+#define NONSEP_SDK_DUAL_MIXED(function)                \
+  template <class S, std::size_t K>                    \
+  Dual<S, K> function(const Dual<S, K>& x, double y) { \
+    return function(x, Dual<S, K>(y));                 \
+  }                                                    \
+  template <class S, std::size_t K>                    \
+  Dual<S, K> function(double x, const Dual<S, K>& y) { \
+    return function(Dual<S, K>(x), y);                 \
   }
 
 template <class S, std::size_t K>

@@ -8,7 +8,8 @@
 // written once for any scalar S (double and the dual numbers of dual.hpp), and its dimension, either
 //   static constexpr std::size_t dimension = 2;                  fixed, or
 //   static constexpr std::size_t max_dimension = 16;             set by an integer parameter (declared in the
-//   static constexpr const char* dimension_parameter = "dimension";  table, with 1 <= minimum, maximum <= max_dimension)
+//   static constexpr const char* dimension_parameter = "dimension";  table, with 1 <= minimum, maximum <=
+//   max_dimension)
 // Optionally:
 //   static constexpr nonsep::sdk::Parameter parameters[] = {...};   (parameters.hpp)
 //   explicit M(const nonsep::sdk::ParameterValues&);                 otherwise M is default-constructed
@@ -38,8 +39,8 @@
 #include <array>
 #include <cmath>
 #include <concepts>
-#include <limits>
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -66,7 +67,9 @@ class EvaluationError : public nonsep::ModelError {
 enum class Derivatives { preferred, automatic };
 
 template <class M>
-concept HasFixedDimension = requires { std::integral_constant<std::size_t, M::dimension>{}; };
+concept HasFixedDimension = requires {
+  std::integral_constant<std::size_t, M::dimension>{};
+};
 
 template <class M>
 concept HasParameterDimension = requires {
@@ -75,7 +78,9 @@ concept HasParameterDimension = requires {
 };
 
 template <class M>
-concept HasParameterTable = requires { std::span<const Parameter>(M::parameters); };
+concept HasParameterTable = requires {
+  std::span<const Parameter>(M::parameters);
+};
 
 template <class M>
 consteval std::size_t dimension_capacity() {
@@ -88,28 +93,36 @@ consteval std::size_t dimension_capacity() {
 }
 
 template <class M>
-concept ModelClass = (HasFixedDimension<M> != HasParameterDimension<M>) && (dimension_capacity<M>() > 0) &&
+concept ModelClass = (HasFixedDimension<M> != HasParameterDimension<M>)&&(dimension_capacity<M>() > 0) &&
                      requires(const M& m, Vector<double> x, Vector<GradientDual<dimension_capacity<M>()>> d,
                               Vector<HessianDual<dimension_capacity<M>()>> dd,
                               Vector<ThirdDerivativeDual<dimension_capacity<M>()>> ddd) {
-                       { m.template T<double>(x) } -> std::convertible_to<double>;
-                       { m.template V<double>(x) } -> std::convertible_to<double>;
-                       m.template T<GradientDual<dimension_capacity<M>()>>(d);
-                       m.template V<GradientDual<dimension_capacity<M>()>>(d);
-                       m.template T<HessianDual<dimension_capacity<M>()>>(dd);
-                       m.template V<HessianDual<dimension_capacity<M>()>>(dd);
-                       m.template T<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
-                       m.template V<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
-                     };
+  { m.template T<double>(x) } -> std::convertible_to<double>;
+  { m.template V<double>(x) } -> std::convertible_to<double>;
+  m.template T<GradientDual<dimension_capacity<M>()>>(d);
+  m.template V<GradientDual<dimension_capacity<M>()>>(d);
+  m.template T<HessianDual<dimension_capacity<M>()>>(dd);
+  m.template V<HessianDual<dimension_capacity<M>()>>(dd);
+  m.template T<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
+  m.template V<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
+};
 
 template <class M>
-concept HasAnalyticGradT = requires(const M& m, Vector<double> x, std::span<double> out) { m.grad_T(x, out); };
+concept HasAnalyticGradT = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.grad_T(x, out);
+};
 template <class M>
-concept HasAnalyticGradV = requires(const M& m, Vector<double> x, std::span<double> out) { m.grad_V(x, out); };
+concept HasAnalyticGradV = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.grad_V(x, out);
+};
 template <class M>
-concept HasAnalyticHessianT = requires(const M& m, Vector<double> x, std::span<double> out) { m.hessian_T(x, out); };
+concept HasAnalyticHessianT = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.hessian_T(x, out);
+};
 template <class M>
-concept HasAnalyticHessianV = requires(const M& m, Vector<double> x, std::span<double> out) { m.hessian_V(x, out); };
+concept HasAnalyticHessianV = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.hessian_V(x, out);
+};
 template <class M>
 concept HasAnalyticD3T = requires(const M& m, Vector<double> x, Vector<double> u, std::span<double> out) {
   m.d3T(x, u, out);
@@ -174,9 +187,7 @@ class ModelAdapter {
   // parameter. Throws InvalidParameter (from M's constructor, or a dimension out of 1..max_dimension).
   explicit ModelAdapter(const ParameterValues& values) : model_(construct(values)), dimension_(dimension_of(values)) {}
   // A model object built by the caller (fixed-dimension models only).
-  explicit ModelAdapter(M model)
-    requires HasFixedDimension<M>
-      : model_(std::move(model)), dimension_(M::dimension) {}
+  explicit ModelAdapter(M model) requires HasFixedDimension<M> : model_(std::move(model)), dimension_(M::dimension) {}
   // The model with all parameters at their defaults.
   ModelAdapter() : ModelAdapter(parse_parameters(parameter_table<M>(), "{}")) {}
   // Parses and checks `parameters_json` first (parse_parameters).
@@ -253,8 +264,8 @@ class ModelAdapter {
       if constexpr (analytic_hessian_T)
         model_.hessian_T(Vector<double>(x, n), std::span<double>(h, n * n));
       else
-        detail::poison_if_not_finite(
-            detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h), h, n * n);
+        detail::poison_if_not_finite(detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h),
+                                     h, n * n);
     }
   }
   void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
@@ -266,8 +277,8 @@ class ModelAdapter {
       if constexpr (analytic_hessian_V)
         model_.hessian_V(Vector<double>(x, n), std::span<double>(h, n * n));
       else
-        detail::poison_if_not_finite(
-            detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h), h, n * n);
+        detail::poison_if_not_finite(detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h),
+                                     h, n * n);
     }
   }
 
@@ -316,9 +327,9 @@ class ModelAdapter {
     } else {
       const std::int64_t n = values.integer(M::dimension_parameter);
       if (n < 1 || static_cast<std::size_t>(n) > M::max_dimension)
-        throw InvalidParameter(M::dimension_parameter,
-                               "parameter '" + std::string(M::dimension_parameter) + "' = " + std::to_string(n) +
-                                   " is outside 1.." + std::to_string(M::max_dimension));
+        throw InvalidParameter(M::dimension_parameter, "parameter '" + std::string(M::dimension_parameter) +
+                                                           "' = " + std::to_string(n) + " is outside 1.." +
+                                                           std::to_string(M::max_dimension));
       return static_cast<std::size_t>(n);
     }
   }

@@ -20,13 +20,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
-
-#include <nlohmann/json.hpp>
 
 namespace nonsep::sdk {
 
@@ -34,9 +33,12 @@ enum class ParameterType { integer, number, boolean };
 
 inline const char* to_string(ParameterType type) {
   switch (type) {
-    case ParameterType::integer: return "integer";
-    case ParameterType::number: return "number";
-    case ParameterType::boolean: return "boolean";
+    case ParameterType::integer:
+      return "integer";
+    case ParameterType::number:
+      return "number";
+    case ParameterType::boolean:
+      return "boolean";
   }
   return "?";
 }
@@ -73,9 +75,12 @@ inline std::string format_number(double x) {
 // The default of a table row as JSON of the row's type.
 inline nlohmann::json default_as_json(const Parameter& p) {
   switch (p.type) {
-    case ParameterType::integer: return static_cast<std::int64_t>(p.default_value);
-    case ParameterType::boolean: return p.default_value != 0.0;
-    case ParameterType::number: break;
+    case ParameterType::integer:
+      return static_cast<std::int64_t>(p.default_value);
+    case ParameterType::boolean:
+      return p.default_value != 0.0;
+    case ParameterType::number:
+      break;
   }
   return p.default_value;
 }
@@ -108,15 +113,17 @@ inline ParameterFault parameter_fault(std::string_view type, std::optional<doubl
 
 // parameter_fault as a message: "" when the value is acceptable, otherwise the complete message, e.g.
 // "parameter 'dimension' = 100 is above its maximum 16".
-inline std::string check_parameter_value(std::string_view name, std::string_view type,
-                                         std::optional<double> minimum, std::optional<double> maximum,
-                                         const nlohmann::json& value) {
+inline std::string check_parameter_value(std::string_view name, std::string_view type, std::optional<double> minimum,
+                                         std::optional<double> maximum, const nlohmann::json& value) {
   const std::string quoted = "parameter '" + std::string(name) + "'";
   switch (parameter_fault(type, minimum, maximum, value)) {
-    case ParameterFault::none: return "";
+    case ParameterFault::none:
+      return "";
     case ParameterFault::wrong_type:
       return quoted + " must be " +
-             (type == "boolean" ? "true or false" : type == "integer" ? "an integer" : "a number") +
+             (type == "boolean"   ? "true or false"
+              : type == "integer" ? "an integer"
+                                  : "a number") +
              " (found " + value.dump() + ")";
     case ParameterFault::below_minimum:
       return quoted + " = " + value.dump() + " is below its minimum " + format_number(*minimum);
@@ -189,10 +196,8 @@ inline ParameterValues parse_parameters(std::span<const Parameter> table, std::s
 inline nlohmann::json parameters_metadata(std::span<const Parameter> table) {
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& p : table) {
-    nlohmann::json row = {{"name", p.name},
-                          {"type", to_string(p.type)},
-                          {"default", default_as_json(p)},
-                          {"description", p.description}};
+    nlohmann::json row = {
+        {"name", p.name}, {"type", to_string(p.type)}, {"default", default_as_json(p)}, {"description", p.description}};
     if (p.minimum) row["minimum"] = *p.minimum;
     if (p.maximum) row["maximum"] = *p.maximum;
     if (*p.unit) row["unit"] = p.unit;
