@@ -7,12 +7,15 @@
 // tests/host/test_host_job_schema.cpp holds the readers to the types written here. Other messages stay with the
 // readers.
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/time_grid.hpp"
 
 namespace nonsep::host::job_reader {
 
@@ -31,6 +34,11 @@ enum class ValueType {
   choice,       // one of the strings `choices`
   defined,      // a shape of its own, $defs/<definition> of the schema (states, axes, integrators, step lists)
 };
+
+// The integer ranges the tables share: step counts up to the time grid's limit, ensembles up to the reader's.
+inline constexpr std::int64_t steps_limit = static_cast<std::int64_t>(max_steps);
+inline constexpr std::int64_t int64_limit = std::numeric_limits<std::int64_t>::max();
+inline constexpr std::int64_t states_limit = static_cast<std::int64_t>(max_initial_states);
 
 struct KeyTable;
 
