@@ -100,6 +100,30 @@ TEST_CASE("merge_summaries: sums, the largest energy error as one process finds 
   CHECK(merged["wall_seconds"] == 2.5);
 }
 
+TEST_CASE("merge_summaries: the run's status by run_job's rule (interrupted, failed, diverged, inaccurate)") {
+  using json = nlohmann::ordered_json;
+  const auto unit = [](const char* status, std::uint64_t failed, std::uint64_t diverged, std::uint64_t inaccurate) {
+    return json{{"status", status},
+                {"time", {{"steps_completed", 10}}},
+                {"energy", json::object()},
+                {"output", {{"directory", "unit"}}},
+                {"counts", {{"completed", 1}, {"diverged", diverged}, {"failed", failed}, {"inaccurate", inaccurate}}},
+                {"evaluations", {{"grad_T", 1}}}};
+  };
+  const auto status_of = [](const std::vector<json>& units) {
+    const std::vector<std::size_t> firsts(units.size(), 0);
+    return host::merge_summaries(units, firsts, units.size(), "out", 1.0)["status"].get<std::string>();
+  };
+  CHECK(status_of({unit("completed", 0, 0, 0), unit("completed", 0, 0, 0)}) == "completed");
+  CHECK(status_of({unit("completed", 0, 0, 0), unit("inaccurate", 0, 0, 2)}) == "inaccurate");
+  CHECK(status_of({unit("inaccurate", 0, 0, 2), unit("diverged", 0, 1, 0)}) == "diverged");
+  // A unit that failed as a whole (an output it could not write) has no failed trajectory, and still fails the run.
+  CHECK(status_of({unit("diverged", 0, 1, 0), unit("failed", 0, 0, 0)}) == "failed");
+  CHECK(status_of({unit("failed", 0, 0, 0), unit("interrupted", 0, 0, 0), unit("completed", 0, 0, 0)}) ==
+        "interrupted");
+  CHECK(status_of({unit("interrupted", 0, 0, 0), unit("failed", 1, 0, 0)}) == "interrupted");
+}
+
 TEST_CASE("a distributed run on one rank writes the files of an ordinary run, byte for byte") {
   const TemporaryFolder folder;
   const auto job = std::filesystem::path(NONSEP_SOURCE_DIR) / "tests/cluster/jobs/dynamics_grid.json";

@@ -8,6 +8,9 @@
 #include <tuple>
 
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+#include "nonsep/host/run/run_job.hpp"
+#include "nonsep/host/run/trajectory.hpp"
 
 namespace nonsep::host {
 
@@ -132,13 +135,22 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-const char* const status_order[] = {"interrupted", "failed", "diverged", "inaccurate", "completed"};
+// What a unit's status says of how its driver ended; its counts say the rest (run_status).
+DriverEnd driver_end(const json& summary) {
+  const auto status = trajectory_status_from_string(summary.value("status", "failed"));
+  if (status == TrajectoryStatus::interrupted) return DriverEnd::interrupted;
+  if (!status || status == TrajectoryStatus::failed) return DriverEnd::failed;
+  return DriverEnd::completed;
+}
 
-std::size_t status_rank(const json& summary) {
-  const std::string status = summary.value("status", "failed");
-  for (std::size_t i = 0; i < std::size(status_order); ++i)
-    if (status == status_order[i]) return i;
-  return 1;
+// The counts of summary.json's "counts" object.
+StatusCounts status_counts(const json& counts) {
+  StatusCounts result;
+  for (const TrajectoryStatus status :
+       {TrajectoryStatus::completed, TrajectoryStatus::diverged, TrajectoryStatus::failed, TrajectoryStatus::inaccurate,
+        TrajectoryStatus::interrupted})
+    result[status] = counts.value(std::string(to_string(status)), std::size_t{0});
+  return result;
 }
 
 void add_counts(json& total, const json& part) {
@@ -152,11 +164,12 @@ void add_counts(json& total, const json& part) {
 json merge_summaries(std::span<const json> units, std::span<const std::size_t> first_trajectories,
                      std::size_t trajectories, const std::filesystem::path& directory, double wall_seconds) {
   json merged = units.front();
-  std::size_t status = status_rank(merged);
+  DriverEnd end = driver_end(merged);
   std::string error = merged.value("error", "");
   for (std::size_t u = 1; u < units.size(); ++u) {
     const json& unit = units[u];
-    status = std::min(status, status_rank(unit));
+    if (const DriverEnd unit_end = driver_end(unit); unit_end != DriverEnd::completed && end != DriverEnd::interrupted)
+      end = unit_end;
     if (const std::string e = unit.value("error", ""); !e.empty() && error.find(e) == std::string::npos)
       error += (error.empty() ? "" : "; ") + e;
     add_counts(merged["counts"], unit["counts"]);
@@ -181,7 +194,7 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
                  {"trajectory", candidate["trajectory"].get<std::uint64_t>() + first_trajectories[u]}};
   }
   if (merged["energy"].contains("largest_relative_error")) merged["energy"]["largest_relative_error"] = largest;
-  merged["status"] = status_order[status];
+  merged["status"] = to_string(run_status(end, status_counts(merged["counts"])));
   if (!error.empty()) {
     // "error" follows "status", as run_summary writes it.
     json ordered;

@@ -38,14 +38,6 @@ std::size_t& StatusCounts::operator[](TrajectoryStatus status) {
 
 namespace {
 
-TrajectoryStatus run_status(DriverEnd end, const StatusCounts& counts) {
-  if (end == DriverEnd::interrupted) return TrajectoryStatus::interrupted;
-  if (end == DriverEnd::failed || counts.failed > 0) return TrajectoryStatus::failed;
-  if (counts.diverged > 0) return TrajectoryStatus::diverged;
-  if (counts.inaccurate > 0) return TrajectoryStatus::inaccurate;
-  return TrajectoryStatus::completed;
-}
-
 // An earlier run's file that this run does not write would mislead.
 void remove_stale(const std::filesystem::path& path) {
   std::error_code ignored;
@@ -87,6 +79,14 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
 }
 
 }  // namespace
+
+TrajectoryStatus run_status(DriverEnd end, const StatusCounts& counts) {
+  if (end == DriverEnd::interrupted) return TrajectoryStatus::interrupted;
+  if (end == DriverEnd::failed || counts.failed > 0) return TrajectoryStatus::failed;
+  if (counts.diverged > 0) return TrajectoryStatus::diverged;
+  if (counts.inaccurate > 0) return TrajectoryStatus::inaccurate;
+  return TrajectoryStatus::completed;
+}
 
 ExitStatus exit_status_of(TrajectoryStatus status) {
   if (status == TrajectoryStatus::completed) return ExitStatus::success;

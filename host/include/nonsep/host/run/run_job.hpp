@@ -30,6 +30,8 @@
 
 namespace nonsep::host {
 
+enum class DriverEnd;  // ensemble_driver.hpp
+
 struct RunOptions {
   std::filesystem::path output_directory;  // created if missing
   bool show_progress = false;              // draw a ProgressBar on stderr (the caller checks for a terminal)
@@ -62,6 +64,11 @@ struct RunOutcome {
   // Spread over work units (cluster/distributed_run.hpp): `trajectories` is empty (trajectories.csv has them).
   bool distributed = false;
 };
+
+// The status of a run whose driver ended with `end` and whose trajectories ended as `counts` say: the first of
+// interrupted, failed (the run as a whole, or a trajectory), diverged, inaccurate, completed that applies. The
+// one rule for a run's status: run_job and the merge of a distributed run's units both use it.
+TrajectoryStatus run_status(DriverEnd end, const StatusCounts& counts);
 
 // The exit status of a run that ended with `status`: success, interrupted or run_failed.
 ExitStatus exit_status_of(TrajectoryStatus status);
