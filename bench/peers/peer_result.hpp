@@ -6,7 +6,8 @@ namespace nonsep::bench {
 
 struct RunResult {
   double q = 0.0, p = 0.0;  // the end point
-  // nonsep: gradient evaluations grad_T + grad_V (each is half of Hamilton's equations);
+  // nonsep: gradient evaluations grad_T + grad_V (each is half of Hamilton's equations), for the comparators (tao,
+  // gauss) evaluations of grad H (all of Hamilton's equations, from four model calls);
   // peers: evaluations of Hamilton's equations (dH/dp, -dH/dq) together.
   std::uint64_t evaluations = 0;
   std::uint64_t jacobian_evaluations = 0;  // GSL's implicit methods only

@@ -1,6 +1,6 @@
-// Work versus precision of nonsep's schemes against the integrators a user would otherwise pick for a
-// non-separable Hamiltonian (GSL rk2imp/rk4imp at fixed step, Odeint runge_kutta4 and runge_kutta_dopri5),
-// plus the long-time energy drift of basic, triplet 4/3 and runge_kutta4.
+// Work versus precision of nonsep's schemes (Chin's and the comparators tao 2/4/6, implicit midpoint, gauss 4/6)
+// against the integrators a user would otherwise pick for a non-separable Hamiltonian (GSL rk2imp/rk4imp at fixed step,
+// Odeint runge_kutta4 and runge_kutta_dopri5), plus the long-time energy drift of basic, triplet 4/3 and runge_kutta4.
 //
 // Usage: nonsep_bench_work_precision [--smoke] [--out DIR]
 //   --smoke   a tiny ladder (seconds; for CI)
@@ -86,7 +86,7 @@ struct Row {
   double energy_error, phase_error;
   std::uint64_t evaluations, jacobian_evaluations;
   bool succeeded;
-  bool symplectic;  // basic, triplet, GSL's Gauss methods
+  bool symplectic;  // basic, triplet, tao (on the extended phase space), implicit midpoint, gauss, GSL's Gauss methods
 };
 
 volatile double sink = 0.0;  // keeps the timed runs from being optimised away
@@ -127,7 +127,8 @@ Row make_row(const Setup& setup, std::string method, std::string family, std::st
           r.evaluations,
           r.jacobian_evaluations,
           r.succeeded,
-          method.starts_with("basic") || method.starts_with("triplet") || method.starts_with("gsl")};
+          method.starts_with("basic") || method.starts_with("triplet") || method.starts_with("gsl") ||
+              method.starts_with("tao") || method.starts_with("gauss") || method == "implicit midpoint"};
 }
 
 // Stops a ladder: after a long run, once both errors are below stop_error, or, once converging, when neither
@@ -217,6 +218,35 @@ void run_problem(const Setup& setup, const Policy& policy, std::vector<Row>& row
         rows);
   }
 
+  // The comparators, through the same Integrator; their `evaluations` count grad H (a peer's f is the same thing).
+  std::vector<std::pair<std::string, IntegratorSpec>> comparators;
+  for (const int order : {2, 4, 6}) comparators.push_back({"tao " + std::to_string(order), {"tao", Fraction(order)}});
+  for (const int stages : {1, 2, 3}) {
+    IntegratorSpec spec{"gauss"};
+    spec.stages = stages;
+    comparators.push_back({stages == 1 ? "implicit midpoint" : "gauss " + std::to_string(2 * stages), spec});
+  }
+  for (const auto& [method, spec] : comparators)
+    step_ladder(
+        policy, 2,
+        [&](std::size_t steps, double* first) -> Row {
+          const double dt = setup.t_end / static_cast<double>(steps);
+          auto run = [&] {
+            Integrator integrator(spec);
+            const double q[1] = {setup.q0}, p[1] = {setup.p0};
+            auto x = PhaseSpaceBatch::single(q, p);
+            try {
+              for (std::size_t i = 0; i < steps; ++i) integrator.step(BatchedModel<P>{}, x, dt);
+            } catch (const ModelError&) {  // a Gauss iteration that does not contract at this dt
+              return RunResult{x.q()[0], x.p()[0], integrator.evaluations().grad_H, 0, false};
+            }
+            return RunResult{x.q()[0], x.p()[0], integrator.evaluations().grad_H, 0, true};
+          };
+          const auto [result, seconds] = time_run(run, policy, first);
+          return make_row<P>(setup, method, "nonsep", "steps=" + std::to_string(steps), dt, result, seconds);
+        },
+        rows);
+
   std::cout << "[" << setup.name << "] peers" << std::endl;
   step_ladder(
       policy, 2,
@@ -299,7 +329,8 @@ void print_target_table(const std::vector<Row>& rows, const std::vector<Setup>& 
   std::printf(
       "\nTarget table%s: wall time of the cheapest run meeting each target (median of repetitions);\n"
       "ratio = nonsep time / peer time (< 1: nonsep is faster).\n\n",
-      symplectic_only ? ", symplectic methods only (nonsep basic and triplet against GSL rk2imp and rk4imp)"
+      symplectic_only ? ", symplectic methods only (nonsep basic, triplet, tao, implicit midpoint and gauss against "
+                        "GSL rk2imp and rk4imp)"
                       : ", all methods");
   std::printf("| problem | error | target | cheapest nonsep | time [s] | cheapest peer | time [s] | ratio |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");

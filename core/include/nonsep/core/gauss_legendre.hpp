@@ -9,14 +9,18 @@
 // the round-off the iteration below leaves.
 //
 // Solving the stages: fixed-point iteration Z^{m+1}_i = dt sum_j a_ij f(z + Z^m_j) from Z^0 = 0, the whole batch
-// together: each iteration evaluates f at the s stages of every state still iterating, in one batched call of
-// s x (states) points. Stopping rule, per state, with delta_m = max_k |Z^{m+1}_k - Z^m_k| / max(|z|_inf, |Z^{m+1}|_inf)
-// (the change relative to the state's size):
+// together, f in one batched model call per iteration: while more than half of the states iterate, at the s stage
+// points of every state of the batch (a state that has stopped is evaluated again at the points of its last
+// iteration and the result is discarded: model time spent, but no gathering, no new point, and loops over the whole
+// batch that vectorize); after that at the stage points of the states still iterating only, gathered. Stopping rule,
+// per state, with delta_m = max_k |Z^{m+1}_k - Z^m_k| / max(|z|_inf, |Z^{m+1}|_inf) (the change relative to the state's
+// size):
 //   converged  when delta_m <= eps (one ulp of the state's largest component: nothing left to gain), or when
 //              delta_m >= delta_{m-1} and delta_m <= 64 eps (the change stopped decreasing at round-off, GNI VIII.6);
 //   failed     when an iterate is not finite, or after max_iterations iterations without converging.
 // A converged state takes z' = z + dt sum_i b_i f(z + Z^m_i) with the evaluations of its last iteration, so a step
-// costs s grad H per state per iteration and nothing more. A state that has converged stops iterating; the others
+// costs s grad H per state per iteration and nothing more (counted so in evaluations(); the discarded evaluations
+// above are not counted). A state that has converged stops iterating; the others
 // go on. Each state's numbers therefore do not depend on the other states of the batch (batch equals single,
 // bit for bit, as long as the model's per-state results do not). The iteration contracts when dt times the
 // Lipschitz constant of f is small (about dt |Hess H| < 1); larger steps fail. Starting from the previous step's
@@ -28,7 +32,9 @@
 // retire only the states that throw. try_step() returns the failures instead of throwing. Exceptions of the model
 // propagate; the batch is then unspecified (some states may have advanced).
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <span>
@@ -95,8 +101,8 @@ class GaussLegendre {
   int max_iterations() const { return max_iterations_; }
   const GaussLegendreTableau& tableau() const { return tableau_; }
   // grad_H: s per state per iteration.
-  const EvaluationCounts& evaluations() const { return gradient_.evaluations(); }
-  void add_evaluations(const EvaluationCounts& counts) { gradient_.add_evaluations(counts); }
+  const EvaluationCounts& evaluations() const { return evaluations_; }
+  void add_evaluations(const EvaluationCounts& counts) { evaluations_ += counts; }
   // Iterations each state of the last step took (failed states: the iterations tried).
   std::span<const int> iterations() const { return iterations_; }
 
@@ -143,52 +149,56 @@ class GaussLegendre {
     check_step_size(dt);
     check_batch_fits(model, x);
     const std::size_t count = x.count(), n = x.dimension(), s = static_cast<std::size_t>(tableau_.stages);
-    const std::size_t w = 2 * n;  // one stage of one state: (q, p)
-    // Per state b: Z at stages_[(b*s + i)*w ...], f(z + Z) at slopes_ (same layout).
-    stages_.assign(count * s * w, 0.0);
-    slopes_.resize(count * s * w);
+    const std::size_t size = count * n;
+    start_q_.assign(x.q().begin(), x.q().end());
+    start_p_.assign(x.p().begin(), x.p().end());
+    for (auto* v : {&stage_q_, &stage_p_}) v->assign(s * size, 0.0);
+    for (auto* v : {&next_q_, &next_p_, &dH_dq_, &dH_dp_}) v->resize(s * size);
+    for (auto* v : {&change_, &scale_, &finite_probe_}) v->resize(size);
+    keep_points_.assign(size, 0);
     iterations_.assign(count, 0);
     last_change_.assign(count, std::numeric_limits<double>::infinity());
     active_.resize(count);
     for (std::size_t b = 0; b < count; ++b) active_[b] = b;
     std::vector<StateFailure> failures;
     const double eps = std::numeric_limits<double>::epsilon();
-    const double* a = tableau_.a.data();
     for (int m = 0; m < max_iterations_ && !active_.empty(); ++m) {
-      evaluate_slopes(model, x, active_);
+      // While most states iterate, evaluate the whole batch (no gathering; the loops run over all of it); once
+      // half of them have stopped, only those still iterating.
+      if (2 * active_.size() > count) {
+        evaluate_whole_batch(model, s, count);
+        next_iterate(0, size, size, dt);
+      } else {
+        evaluate_gathered(model, s, n, size);
+        for (std::size_t b : active_) next_iterate(b * n, b * n + n, size, dt);
+      }
+      evaluations_.grad_H += s * active_.size();
       still_.clear();
       for (std::size_t b : active_) {
         ++iterations_[b];
-        const double* q = x.q().data() + b * n;
-        const double* p = x.p().data() + b * n;
-        const double* f = slopes_.data() + b * s * w;
-        double* z = stages_.data() + b * s * w;
-        double change = 0.0, scale = 0.0;
-        bool finite = true;
-        for (std::size_t k = 0; k < n; ++k) scale = std::max(scale, std::max(std::abs(q[k]), std::abs(p[k])));
-        for (std::size_t i = 0; i < s; ++i)
-          for (std::size_t k = 0; k < w; ++k) {
-            double sum = 0.0;
-            for (std::size_t j = 0; j < s; ++j) sum += a[i * s + j] * f[j * w + k];
-            sum *= dt;
-            finite &= std::isfinite(sum);
-            change = std::max(change, std::abs(sum - z[i * w + k]));
-            scale = std::max(scale, std::abs(sum));
-            z[i * w + k] = sum;
-          }
-        if (!finite) {
-          failures.push_back({b, "an iterate is not finite after " + std::to_string(iterations_[b]) + " iterations"});
-          continue;
+        double change = 0.0, scale = 0.0, probe = 0.0;
+        for (std::size_t e = b * n; e < b * n + n; ++e) {
+          change = std::max(change, change_[e]);
+          scale = std::max(scale, scale_[e]);
+          probe += finite_probe_[e];
         }
         const double relative = scale > 0.0 ? change / scale : 0.0;
+        const bool finite = probe == 0.0;  // else NaN: an iterate is not finite
         const bool converged = relative <= eps || (relative >= last_change_[b] && relative <= 64 * eps);
-        last_change_[b] = relative;
-        if (converged)
-          advance(x, b, dt);
-        else
+        if (finite && !converged) {
+          last_change_[b] = relative;
           still_.push_back(b);
+          continue;
+        }
+        std::fill_n(keep_points_.begin() + static_cast<std::ptrdiff_t>(b * n), n, ~std::uint64_t{0});
+        if (finite)
+          advance(x, b, s, size, dt);
+        else
+          failures.push_back({b, "an iterate is not finite after " + std::to_string(iterations_[b]) + " iterations"});
       }
       active_.swap(still_);
+      stage_q_.swap(next_q_);
+      stage_p_.swap(next_p_);
     }
     for (std::size_t b : active_) {
       char change[32];
@@ -201,51 +211,142 @@ class GaussLegendre {
   }
 
  private:
-  // slopes_ = f(z + Z_i) for every stage i of the listed states, in one batched evaluation.
+  // The work arrays are stage-major, so that the loops over the batch run over contiguous memory: stage i, component
+  // k of state b at i*size + b*n + k (size = count*n) in the stages Z^m (stage_q_, stage_p_), the next iterate
+  // Z^{m+1} (next_q_, next_p_; the two swap after each iteration), the stage points z + Z^m (q_, p_; gathered: in
+  // the order of active_) and dH/dq, dH/dp there. change_, scale_ and finite_probe_ hold per component (b*n + k)
+  // what the last iteration found. The values of states that have stopped are left stale and never read. A state's
+  // numbers never mix with another's, and its sums run in the same order whichever states are evaluated with it.
+
+  // dH/dq, dH/dp at z + Z_i for every stage of every state, in one batched evaluation. A state that stopped iterating
+  // is evaluated again at the stage points of its last iteration (its stages no longer change): model time spent for
+  // nothing, but no gathering, and no point the model has not seen before.
   template <ModelWithThirdDerivatives M>
-  void evaluate_slopes(const M& model, const PhaseSpaceBatch& x, const std::vector<std::size_t>& states) {
-    const std::size_t n = x.dimension(), s = static_cast<std::size_t>(tableau_.stages), w = 2 * n;
-    const std::size_t points = states.size() * s;
-    q_.resize(points * n);
-    p_.resize(points * n);
-    dH_dq_.resize(points * n);
-    dH_dp_.resize(points * n);
-    for (std::size_t a = 0; a < states.size(); ++a)
-      for (std::size_t i = 0; i < s; ++i) {
-        const std::size_t b = states[a], point = a * s + i;
-        const double* z = stages_.data() + (b * s + i) * w;
-        for (std::size_t k = 0; k < n; ++k) {
-          q_[point * n + k] = x.q(b)[k] + z[k];
-          p_[point * n + k] = x.p(b)[k] + z[n + k];
-        }
-      }
-    gradient_.evaluate(model, q_, p_, dH_dq_, dH_dp_, points);
-    for (std::size_t a = 0; a < states.size(); ++a)
-      for (std::size_t i = 0; i < s; ++i) {
-        const std::size_t b = states[a], point = a * s + i;
-        double* f = slopes_.data() + (b * s + i) * w;
-        for (std::size_t k = 0; k < n; ++k) {
-          f[k] = dH_dp_[point * n + k];
-          f[n + k] = -dH_dq_[point * n + k];
-        }
-      }
+  void evaluate_whole_batch(const M& model, std::size_t s, std::size_t count) {
+    const std::size_t size = start_q_.size();
+    q_.resize(s * size);
+    p_.resize(s * size);
+    for (std::size_t i = 0; i < s; ++i) {
+      stage_points(start_q_.data(), stage_q_.data() + i * size, keep_points_.data(), q_.data() + i * size, size);
+      stage_points(start_p_.data(), stage_p_.data() + i * size, keep_points_.data(), p_.data() + i * size, size);
+    }
+    gradient_.evaluate(model, q_, p_, dH_dq_, dH_dp_, s * count);
   }
 
-  // z' = z + dt sum_i b_i f(z + Z_i) for state b.
-  void advance(PhaseSpaceBatch& x, std::size_t b, double dt) const {
-    const std::size_t n = x.dimension(), s = static_cast<std::size_t>(tableau_.stages), w = 2 * n;
-    for (std::size_t k = 0; k < w; ++k) {
-      double sum = 0.0;
-      for (std::size_t i = 0; i < s; ++i) sum += tableau_.b[i] * slopes_[(b * s + i) * w + k];
-      (k < n ? x.q(b)[k] : x.p(b)[k - n]) += dt * sum;
+  // points[e] = start[e] + stage[e] where keep[e] is 0; where it is all ones, points[e] stays. A select on the bits,
+  // because GCC does not vectorize a conditional on a floating-point sum under -ftrapping-math (the default).
+  static void stage_points(const double* __restrict start, const double* __restrict stage,
+                           const std::uint64_t* __restrict keep, double* __restrict points, std::size_t size) {
+    for (std::size_t e = 0; e < size; ++e) {
+      const auto fresh = std::bit_cast<std::uint64_t>(start[e] + stage[e]);
+      const auto kept = std::bit_cast<std::uint64_t>(points[e]);
+      points[e] = std::bit_cast<double>((fresh & ~keep[e]) | (kept & keep[e]));
+    }
+  }
+
+  // The same for the states still iterating only: their stage points gathered, evaluated, the gradients scattered
+  // back to their places.
+  template <ModelWithThirdDerivatives M>
+  void evaluate_gathered(const M& model, std::size_t s, std::size_t n, std::size_t size) {
+    const std::size_t points = s * active_.size();
+    q_.resize(points * n);
+    p_.resize(points * n);
+    gathered_dH_dq_.resize(points * n);
+    gathered_dH_dp_.resize(points * n);
+    for (std::size_t i = 0, g = 0; i < s; ++i)
+      for (std::size_t b : active_)
+        for (std::size_t e = b * n; e < b * n + n; ++e, ++g) {
+          q_[g] = start_q_[e] + stage_q_[i * size + e];
+          p_[g] = start_p_[e] + stage_p_[i * size + e];
+        }
+    gradient_.evaluate(model, q_, p_, gathered_dH_dq_, gathered_dH_dp_, points);
+    for (std::size_t i = 0, g = 0; i < s; ++i)
+      for (std::size_t b : active_)
+        for (std::size_t e = b * n; e < b * n + n; ++e, ++g) {
+          dH_dq_[i * size + e] = gathered_dH_dq_[g];
+          dH_dp_[i * size + e] = gathered_dH_dp_[g];
+        }
+  }
+
+  // Components [first, last) of the flat state index: Z^{m+1}_i = dt sum_j a_ij f(z + Z_j) with f = (dH/dp, -dH/dq)
+  // into next_q_, next_p_, and per component the largest change |Z^{m+1} - Z^m| and size max(|z|, |Z^{m+1}|) over
+  // the stages, and a probe that is NaN when some Z^{m+1} is not finite (0 * inf and 0 * NaN are NaN). The stage
+  // count is a template argument so that the sums unroll and the loop over components vectorizes.
+  void next_iterate(std::size_t first, std::size_t last, std::size_t size, double dt) {
+    switch (tableau_.stages) {
+      case 1:
+        return next_iterate<1>(first, last, size, dt);
+      case 2:
+        return next_iterate<2>(first, last, size, dt);
+      default:
+        return next_iterate<3>(first, last, size, dt);
+    }
+  }
+  template <std::size_t S>
+  void next_iterate(std::size_t first, std::size_t last, std::size_t size, double dt) {
+    double a[S * S];
+    std::copy_n(tableau_.a.begin(), S * S, a);
+    next_iterate_kernel<S>(a, dt, first, last, size, dH_dq_.data(), dH_dp_.data(), stage_q_.data(), stage_p_.data(),
+                           start_q_.data(), start_p_.data(), next_q_.data(), next_p_.data(), change_.data(),
+                           scale_.data(), finite_probe_.data());
+  }
+  // The arrays do not overlap (__restrict: without it GCC gives up on the many checks for overlap it would need).
+  template <std::size_t S>
+  static void next_iterate_kernel(const double* a, double dt, std::size_t first, std::size_t last, std::size_t size,
+                                  const double* __restrict dH_dq, const double* __restrict dH_dp,
+                                  const double* __restrict z_q, const double* __restrict z_p,
+                                  const double* __restrict start_q, const double* __restrict start_p,
+                                  double* __restrict next_q, double* __restrict next_p, double* __restrict change,
+                                  double* __restrict scale, double* __restrict probe) {
+    for (std::size_t e = first; e < last; ++e) {
+      double largest_change = 0.0, largest = larger(std::abs(start_q[e]), std::abs(start_p[e])), nan = 0.0;
+      for (std::size_t i = 0; i < S; ++i) {
+        double sum_q = 0.0, sum_p = 0.0;
+        for (std::size_t j = 0; j < S; ++j) {
+          sum_q += a[i * S + j] * dH_dp[j * size + e];
+          sum_p += a[i * S + j] * -dH_dq[j * size + e];
+        }
+        sum_q *= dt;
+        sum_p *= dt;
+        next_q[i * size + e] = sum_q;
+        next_p[i * size + e] = sum_p;
+        largest_change =
+            larger(largest_change, larger(std::abs(sum_q - z_q[i * size + e]), std::abs(sum_p - z_p[i * size + e])));
+        largest = larger(largest, larger(std::abs(sum_q), std::abs(sum_p)));
+        nan += 0.0 * sum_q + 0.0 * sum_p;
+      }
+      change[e] = largest_change;
+      scale[e] = largest;
+      probe[e] = nan;
+    }
+  }
+
+  // std::max by value: the same result (a < b ? b : a), but no reference to a temporary, which keeps GCC from
+  // vectorizing the loop.
+  static double larger(double a, double b) { return a < b ? b : a; }
+
+  // z' = z + dt sum_i b_i f(z + Z_i) for state b, with the gradients of its last iteration.
+  void advance(PhaseSpaceBatch& x, std::size_t b, std::size_t s, std::size_t size, double dt) const {
+    const std::size_t n = x.dimension();
+    for (std::size_t e = b * n; e < b * n + n; ++e) {
+      double sum_q = 0.0, sum_p = 0.0;
+      for (std::size_t i = 0; i < s; ++i) {
+        sum_q += tableau_.b[i] * dH_dp_[i * size + e];
+        sum_p += tableau_.b[i] * -dH_dq_[i * size + e];
+      }
+      x.q()[e] += dt * sum_q;
+      x.p()[e] += dt * sum_p;
     }
   }
 
   GaussLegendreTableau tableau_;
   HamiltonianGradient gradient_;
   int max_iterations_;
-  std::vector<double> stages_, slopes_;        // Z and f(z + Z): state b, stage i, component k at (b*s + i)*2n + k
-  std::vector<double> q_, p_, dH_dq_, dH_dp_;  // the stage points of the states still iterating
+  EvaluationCounts evaluations_;           // grad_H of the states iterating (not of those evaluated again for nothing)
+  std::vector<double> start_q_, start_p_;  // z, the states at the start of the step
+  std::vector<double> stage_q_, stage_p_, next_q_, next_p_, q_, p_, dH_dq_, dH_dp_, gathered_dH_dq_, gathered_dH_dp_;
+  std::vector<double> change_, scale_, finite_probe_;
+  std::vector<std::uint64_t> keep_points_;  // per component: 0 while its state iterates, then all ones
   std::vector<int> iterations_;
   std::vector<double> last_change_;          // per state: the relative change of its last iteration
   std::vector<std::size_t> active_, still_;  // the states iterating, and those that go on after this iteration
