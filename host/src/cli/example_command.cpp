@@ -90,6 +90,21 @@ std::string with_installed_schema(std::string text) {
   return text;
 }
 
+// "directory": "<example>.out" -> "<stem of FILE>.out": the examples name their folder as the default would for
+// their own file name, so without this `nonsep example --output orbit.json && nonsep run orbit.json` wrote to
+// quickstart.out, not orbit.out as the README says of the default, and two copies of one example shared a folder.
+std::string with_output_folder_of(std::string text, const std::string& example, const fs::path& file) {
+  const std::string stem = file.stem().string();
+  if (stem.empty() || stem == example) return text;
+  static const std::regex unsafe(R"re([^A-Za-z0-9_-])re");
+  if (std::regex_search(example, unsafe)) return text;
+  const std::regex member("\"directory\"\\s*:\\s*\"" + example + "\\.out\"");
+  std::string replacement = "\"directory\": " + nlohmann::json(stem + ".out").dump();
+  for (std::size_t at = 0; (at = replacement.find('$', at)) != std::string::npos; at += 2)
+    replacement.insert(at, "$");  // "$$": a literal $ in a regex_replace format
+  return std::regex_replace(text, member, replacement, std::regex_constants::format_first_only);
+}
+
 }  // namespace
 
 int command_example(const ExampleArguments& arguments) {
@@ -131,6 +146,7 @@ int command_example(const ExampleArguments& arguments) {
     return to_int(ExitStatus::success);
   }
   const fs::path file = arguments.output;
+  text = with_output_folder_of(text, name, file);
   // O_EXCL: created here or not at all, never an existing file and never through a symbolic link.
   const int descriptor = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (descriptor < 0 && errno == EEXIST) {

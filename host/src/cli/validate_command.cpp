@@ -6,6 +6,19 @@
 #include "nonsep/host/number_format.hpp"
 
 namespace nonsep::host::cli {
+namespace {
+
+// "grid on the energy shell H = 7, p1 solved for; 36 of its 144 states cannot reach it and are left out": without
+// it, a grid of 144 points that validates as "108 states (grid)" looks like a mistake in the grid.
+std::string initial_shell_text(const InitialStates& initial) {
+  if (!initial.shell) return "";
+  const EnergyShell& shell = *initial.shell;
+  return " on the energy shell H = " + format_number(shell.energy) + ", " + shell.solve_for + " solved for; " +
+         std::to_string(shell.left_out) + " of its " + std::to_string(initial.count + shell.left_out) +
+         " states cannot reach it and are left out";
+}
+
+}  // namespace
 
 int command_validate(const std::string& job_file) {
   try {
@@ -37,7 +50,7 @@ int command_validate(const std::string& job_file) {
               << ", t2 = " << format_number(spec.t2) << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT")
               << "\n"
               << "  initial:     " << job.initial.count << " state" << (job.initial.count == 1 ? "" : "s") << " ("
-              << job.initial.shape << ")\n"
+              << job.initial.shape << initial_shell_text(job.initial) << ")\n"
               << "  time:        " << time_text(run.time) << "\n"
               << "  output:      " << job.output_directory.string() << ", trajectory every " << run.every
               << (run.every == 0 ? " (none)" : " steps") << "\n";
