@@ -160,3 +160,65 @@ TEST_CASE("the schema's integrator options are the catalogue's, with its default
     }
   }
 }
+
+TEST_CASE("no two keys of one object of a job file look like misspellings of each other") {
+  // The reader names the key a misspelt one likely means (looks_like_misspelling): that must never be another
+  // valid key of the same object.
+  std::vector<std::vector<std::string>> objects;
+  const auto walk = [&](const auto& self, const nlohmann::ordered_json& node) -> void {
+    if (node.is_object()) {
+      if (node.contains("properties") && node["properties"].is_object()) {
+        std::vector<std::string> keys;
+        for (const auto& [key, value] : node["properties"].items()) keys.push_back(key);
+        objects.push_back(keys);
+      }
+      for (const auto& [key, value] : node.items()) self(self, value);
+    } else if (node.is_array()) {
+      for (const auto& value : node) self(self, value);
+    }
+  };
+  walk(walk, job_schema());
+  CHECK(objects.size() > 10);
+  for (const auto& keys : objects)
+    for (const auto& a : keys)
+      for (const auto& b : keys) {
+        INFO(a, " and ", b);
+        CHECK_FALSE(looks_like_misspelling(a, b));
+      }
+}
+
+TEST_CASE("looks_like_misspelling: letter case, one edit in short names, two in long ones, never short names") {
+  CHECK(looks_like_misspelling("sheme", "scheme"));
+  CHECK(looks_like_misspelling("Steps", "steps"));
+  CHECK(looks_like_misspelling("DT", "dt"));
+  CHECK(looks_like_misspelling("outptu", "output"));  // two edits, 6 letters
+  CHECK(looks_like_misspelling("paramters", "parameters"));
+  CHECK(looks_like_misspelling("step", "stop"));  // one substitution in 4 letters
+  CHECK_FALSE(looks_like_misspelling("scheme", "scheme"));
+  CHECK_FALSE(looks_like_misspelling("q", "p"));         // too short to guess
+  CHECK_FALSE(looks_like_misspelling("dt", "t"));        // too short to guess
+  CHECK_FALSE(looks_like_misspelling("every", "vary"));  // two edits, 4 letters
+  CHECK_FALSE(looks_like_misspelling("model", "output"));
+}
+
+TEST_CASE("a misspelt key is named as such, both where it is unknown and where the key it means is missing") {
+  json job = host_testing::quickstart_job();
+  job["integrator"] = {{"sheme", "basic"}};
+  const auto issues = issues_of(job);
+  const auto find = [&](const std::string& path) {
+    const auto it = std::find_if(issues.begin(), issues.end(), [&](const JobIssue& i) { return i.path == path; });
+    REQUIRE(it != issues.end());
+    return it->found;
+  };
+  CHECK(find("/integrator/sheme") == "the unknown key \"sheme\" (did you mean \"scheme\"?)");
+  CHECK(find("/integrator/scheme") == "nothing (the key is missing; \"sheme\" is there: a misspelling of it?)");
+  job = host_testing::quickstart_job();
+  job.erase("output");
+  job["outptu"] = json::object();
+  CHECK(issues_of(job).front().found == "the unknown key \"outptu\" (did you mean \"output\"?)");
+  job["output"] = json::object();
+  CHECK(issues_of(job).front().found == "the unknown key \"outptu\"");  // "output" is there: not meant
+  job.erase("outptu");
+  job["colour"] = 1;  // nothing like any key: no guess
+  CHECK(issues_of(job).front().found == "the unknown key \"colour\"");
+}

@@ -1,7 +1,46 @@
 #include "checker.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <string_view>
+#include <vector>
+
+namespace nonsep::host {
+
+namespace {
+// Edits (insertions, deletions, substitutions) that turn a into b.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({above + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string lower(std::string_view text) {
+  std::string result(text);
+  for (char& c : result) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return result;
+}
+}  // namespace
+
+bool looks_like_misspelling(std::string_view written, std::string_view meant) {
+  if (written == meant) return false;
+  if (lower(written) == lower(meant)) return true;
+  const std::size_t shorter = std::min(written.size(), meant.size());
+  if (shorter < 3) return false;
+  return edit_distance(lower(written), lower(meant)) <= (shorter >= 6 ? 2u : 1u);
+}
+
+}  // namespace nonsep::host
 
 namespace nonsep::host::job_reader {
 
@@ -58,7 +97,13 @@ void Checker::known_keys(const json& object, const std::string& path, const std:
     if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
     std::string list;
     for (const auto& name : allowed) list += (list.empty() ? "" : ", ") + name;
-    issue(child(path, key), "the unknown key \"" + key + "\"", "only the keys " + list);
+    std::string found = "the unknown key \"" + key + "\"";
+    for (const auto& name : allowed)
+      if (!object.contains(name) && looks_like_misspelling(key, name)) {
+        found += " (did you mean \"" + name + "\"?)";
+        break;
+      }
+    issue(child(path, key), found, "only the keys " + list);
   }
 }
 
@@ -66,7 +111,14 @@ const json* Checker::member(const json& object, const std::string& path, const s
                             const std::string& what) {
   const auto it = object.find(key);
   if (it != object.end()) return &*it;
-  if (required) issue(child(path, key), "nothing (the key is missing)", what);
+  if (!required) return nullptr;
+  std::string found = "nothing (the key is missing";
+  for (const auto& [name, value] : object.items())
+    if (looks_like_misspelling(name, key)) {
+      found += "; \"" + name + "\" is there: a misspelling of it?";
+      break;
+    }
+  issue(child(path, key), found + ")", what);
   return nullptr;
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "nonsep/host/job.hpp"
@@ -36,6 +37,7 @@ class Checker {
   // True for an object; otherwise an issue saying `what` is allowed.
   bool object(const json& value, const std::string& path, const std::string& what);
   // Reports every key of `object` not in `allowed`.
+  // Unknown keys are reported with the allowed key they most likely misspell, if any ("did you mean").
   void known_keys(const json& object, const std::string& path, const std::vector<std::string>& allowed);
   // The member `key` of an object, or nullptr; a missing `required` member is an issue.
   const json* member(const json& object, const std::string& path, const std::string& key, bool required,

@@ -19,6 +19,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -37,6 +38,12 @@ struct JobIssue {
 };
 // "/integrator/order: found \"5/3\"; allowed: ..."
 std::string to_string(const JobIssue& issue);
+
+// Whether the key `written` is likely a misspelling of `meant`: equal but for letter case, or (both at least 3
+// characters long) one edit away, two for names of 6 characters or more. The reader's messages name the likely
+// intended key with it; no two keys of one object of a job file are that close (a test checks it), so a
+// suggestion never names another valid key.
+bool looks_like_misspelling(std::string_view written, std::string_view meant);
 
 // Thrown by load_job with every issue of the file (never empty). what() is the full report, one issue a line.
 class InvalidJob : public std::runtime_error {
