@@ -104,7 +104,8 @@ TEST_CASE("the one-step map is symplectic for basic and triplet, and MPE is not"
 
 TEST_CASE("stepping a batch equals stepping each state alone, bit for bit") {
   for (const char* scheme : {"basic", "triplet", "mpe"}) {
-    CAPTURE(scheme);
+    const std::string scheme_name = scheme;
+    CAPTURE(scheme_name);
     const IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
     PhaseSpaceBatch batch(2, 3);
     const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};

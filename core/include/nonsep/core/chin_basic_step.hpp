@@ -71,6 +71,11 @@ struct NoStageObserver {
 
 // The checks every step makes are inline and their failures out of line, so that a step of one state does not
 // carry the frame that building the messages needs.
+// eps = cbrt(dt) as the C library computes it at run time. Not inlined, so that the compiler cannot fold a step size
+// it knows (a literal in a test or a program) into a cube root of its own, which may round differently from the
+// library's: a step must give the same numbers whether dt comes from a job file or from the source.
+[[gnu::noinline]] inline double runtime_cube_root(double dt) { return std::cbrt(dt); }
+
 [[noreturn, gnu::cold, gnu::noinline]] inline void throw_bad_step_size(double dt) {
   throw InvalidArgument("step size dt must be finite and non-zero (found " + std::to_string(dt) + ")");
 }
@@ -127,7 +132,7 @@ class ChinBasicStep {
     eps_.resize(dt.size());
     for (std::size_t b = 0; b < dt.size(); ++b) {
       check_step_size(dt[b]);
-      eps_[b] = std::cbrt(dt[b]);
+      eps_[b] = runtime_cube_root(dt[b]);
     }
     advance(model, x, observe);
   }
@@ -173,32 +178,25 @@ class ChinBasicStep {
     // The gradient is overwritten from the first inner flow on: should the model throw before the step's last
     // evaluation, the cache must not claim it belongs to any point.
     cache_valid_ = false;
-    // y += sign * coefficient * eps * gradient, state by state when the states have their own eps; with `snapshot`
-    // (the last inner flow) the new y is also written there: the point the next first-same-as-last gradient
-    // belongs to, kept without a pass of its own.
-    auto flow = [&](std::span<double> y, std::span<const double> gradient, double sign, double coefficient,
-                    double* snapshot = nullptr) {
+    // y += sign * coefficient * eps * gradient, state by state when the states have their own eps.
+    auto flow = [&](std::span<double> y, std::span<const double> gradient, double sign, double coefficient) {
       if (eps_.size() == 1) {
         const double h = sign * coefficient * eps_[0];
-        if (snapshot)
-          for (std::size_t i = 0; i < y.size(); ++i) snapshot[i] = y[i] += h * gradient[i];
-        else
-          for (std::size_t i = 0; i < y.size(); ++i) y[i] += h * gradient[i];
+        for (std::size_t i = 0; i < y.size(); ++i) y[i] += h * gradient[i];
         return;
       }
       for (std::size_t b = 0; b < count; ++b) {
         const double h = sign * coefficient * eps_[b];
         for (std::size_t i = b * n; i < (b + 1) * n; ++i) y[i] += h * gradient[i];
       }
-      if (snapshot) std::copy(y.begin(), y.end(), snapshot);
     };
     auto outer_flow = [&](double coefficient) {
       flow(outer, outer_gradient_, outer_sign, coefficient);
       observe(FlowStage{ttv, coefficient}, std::span<const double>(eps_), std::as_const(x));
     };
-    auto inner_flow = [&](double coefficient, double* snapshot = nullptr) {
+    auto inner_flow = [&](double coefficient) {
       evaluate(model, !ttv, outer, inner_gradient_, count);  // TTV: grad T(p); VVT: grad V(q)
-      flow(inner, inner_gradient_, inner_sign, coefficient, snapshot);
+      flow(inner, inner_gradient_, inner_sign, coefficient);
       observe(FlowStage{!ttv, coefficient}, std::span<const double>(eps_), std::as_const(x));
       evaluate(model, ttv, inner, outer_gradient_, count);  // TTV: grad V(q); VVT: grad T(p)
     };
@@ -209,10 +207,11 @@ class ChinBasicStep {
     outer_flow(c_.v0);
     inner_flow(c_.t1);
     outer_flow(c_.v1);
-    if (cached_at_.size() != inner.size()) cached_at_.resize(inner.size());
-    inner_flow(c_.t2, cached_at_.data());
-    cache_valid_ = true;
+    inner_flow(c_.t2);
     outer_flow(c_.v2);
+    if (cached_at_.size() != inner.size()) cached_at_.resize(inner.size());
+    std::copy(inner.begin(), inner.end(), cached_at_.begin());
+    cache_valid_ = true;
   }
 
   // a and b (of equal size) hold the same numbers bit for bit; no early exit, so that the loop vectorizes.
@@ -228,7 +227,7 @@ class ChinBasicStep {
   double cube_root(double dt) {
     for (const auto& [known, root] : roots_)
       if (known == dt) return root;
-    roots_[next_root_] = {dt, std::cbrt(dt)};
+    roots_[next_root_] = {dt, runtime_cube_root(dt)};
     const double root = roots_[next_root_].second;
     next_root_ = (next_root_ + 1) % roots_.size();
     return root;
