@@ -104,7 +104,8 @@ TEST_CASE("the one-step map is symplectic for basic and triplet, and MPE is not"
 
 TEST_CASE("stepping a batch equals stepping each state alone, bit for bit") {
   for (const char* scheme : {"basic", "triplet", "mpe"}) {
-    CAPTURE(scheme);
+    const std::string scheme_name = scheme;
+    CAPTURE(scheme_name);
     const IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
     PhaseSpaceBatch batch(2, 3);
     const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};
@@ -159,6 +160,51 @@ TEST_CASE("first-same-as-last: 4 grad T + 4 grad V per basic step, plus one at t
   CHECK(mpe.describe().basic_steps_per_step == 6);
   CHECK(mpe.evaluations().grad_T == 4 * 6 * 5);
   CHECK(mpe.evaluations().grad_V == (4 * 6 + 1) * 5);
+}
+
+// Paper1D whose gradient evaluation number `fail_at` (counting both gradients from 1) throws ModelError after
+// writing garbage into its output, as a failing plugin may leave it.
+struct FailingOnce {
+  mutable int calls = 0;
+  int fail_at = 0;
+  std::size_t dimension() const { return 1; }
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    fail_if_due(out, count);
+    Paper1D{}.grad_T(p, out, count);
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    fail_if_due(out, count);
+    Paper1D{}.grad_V(q, out, count);
+  }
+  void fail_if_due(std::span<double> out, std::size_t count) const {
+    if (++calls != fail_at) return;
+    for (std::size_t b = 0; b < count; ++b) out[b] = 1e6;
+    throw ModelError("failing on purpose");
+  }
+};
+
+TEST_CASE("first-same-as-last: a step the model fails partway leaves no stale gradient behind") {
+  // Evaluation 1 is the starting gradient, 2..9 the first step; the second step fails at each of its 8
+  // evaluations in turn. The states go back to where they were (as the host's retry does) and the same stepper
+  // steps again: it must give what a stepper that never failed gives, bit for bit.
+  for (const auto form : forms) {
+    for (int failing = 10; failing <= 17; ++failing) {
+      CAPTURE(static_cast<int>(form));
+      CAPTURE(failing);
+      FailingOnce model{0, failing};
+      ChinBasicStep stepper(form), reference(form);
+      auto x = state({0.7}, {0.3});
+      auto y = x;
+      stepper.step(model, x, 0.01);
+      reference.step(Paper1D{}, y, 0.01);
+      const auto before = x;
+      CHECK_THROWS_AS(stepper.step(model, x, 0.01), ModelError);
+      x = before;
+      stepper.step(model, x, 0.01);
+      reference.step(Paper1D{}, y, 0.01);
+      CHECK(x == y);
+    }
+  }
 }
 
 TEST_CASE("the MPE weights of eqs. (mpe43) and (mpe63)") {

@@ -31,37 +31,52 @@ const json& PluginModel::parameters() const { return instance_->parameters; }
 
 namespace {
 
+// The failures of evaluate(), out of line: a call per stage is the hot path of a single trajectory, and building
+// these messages inline would make every call pay for the frame they need.
+[[noreturn, gnu::cold, gnu::noinline]] void throw_bad_spans(const char* function_name, std::size_t count, std::size_t n,
+                                                            std::size_t out_per_state, std::size_t in_size,
+                                                            std::size_t out_size) {
+  throw nonsep::InvalidArgument(std::string(function_name) + ": a batch of " + std::to_string(count) +
+                                " states of dimension " + std::to_string(n) + " needs " + std::to_string(count * n) +
+                                " inputs and " + std::to_string(count * out_per_state) + " outputs (found " +
+                                std::to_string(in_size) + " and " + std::to_string(out_size) + ")");
+}
+[[noreturn, gnu::cold, gnu::noinline]] void throw_missing(const PluginModel& model, const char* function_name) {
+  throw nonsep::ModelError("plugin '" + model.plugin().name() + "' does not provide " + function_name +
+                           " (its capability is false)");
+}
+[[noreturn, gnu::cold, gnu::noinline]] void throw_failed(const PluginModel& model, nonsep_instance* handle,
+                                                         const nonsep_plugin_api& api, const char* function_name,
+                                                         nonsep_status status) {
+  const char* message = api.last_error(handle);
+  throw nonsep::ModelError("plugin '" + model.plugin().name() + "' failed in " + function_name + " (" +
+                           status_name(status) + "): " + (message != nullptr && *message ? message : "no message"));
+}
+
 // Checks the spans, then makes one batched call of the table, `call(handle, in, out, count)` (absent when
-// `present` is false), and turns a failure into ModelError with the plugin's message.
+// `present` is false), and turns a failure into ModelError with the plugin's message. These are the only checks
+// of a call: the SDK's side trusts the sizes the ABI's batch layout gives it.
 template <class Call>
 void evaluate(const PluginModel& model, nonsep_instance* handle, const nonsep_plugin_api& api, bool present,
-              const char* function_name, std::span<const double> in, std::span<double> out, std::size_t count,
-              std::size_t out_per_state, const Call& call) {
-  const std::size_t n = model.dimension();
-  if (in.size() < count * n || out.size() < count * out_per_state)
-    throw nonsep::InvalidArgument(std::string(function_name) + ": a batch of " + std::to_string(count) +
-                                  " states of dimension " + std::to_string(n) + " needs " + std::to_string(count * n) +
-                                  " inputs and " + std::to_string(count * out_per_state) + " outputs (found " +
-                                  std::to_string(in.size()) + " and " + std::to_string(out.size()) + ")");
-  if (!present)
-    throw nonsep::ModelError("plugin '" + model.plugin().name() + "' does not provide " + function_name +
-                             " (its capability is false)");
+              const char* function_name, std::size_t n, std::span<const double> in, std::span<double> out,
+              std::size_t count, std::size_t out_per_state, const Call& call) {
+  if (in.size() < count * n || out.size() < count * out_per_state) [[unlikely]]
+    throw_bad_spans(function_name, count, n, out_per_state, in.size(), out.size());
+  if (!present) [[unlikely]]
+    throw_missing(model, function_name);
   const nonsep_status status = call(handle, in.data(), out.data(), count);
-  if (status != NONSEP_OK) {
-    const char* message = api.last_error(handle);
-    throw nonsep::ModelError("plugin '" + model.plugin().name() + "' failed in " + function_name + " (" +
-                             status_name(status) + "): " + (message != nullptr && *message ? message : "no message"));
-  }
+  if (status != NONSEP_OK) [[unlikely]]
+    throw_failed(model, handle, api, function_name, status);
 }
 
 }  // namespace
 
-#define NONSEP_PLUGIN_MODEL_FUNCTION(function, out_per_state)                                                 \
-  void PluginModel::function(std::span<const double> x, std::span<double> out, std::size_t count) const {     \
-    const std::size_t n = instance_->dimension;                                                               \
-    const nonsep_plugin_api& api = *instance_->api;                                                           \
-    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, x, out, count, out_per_state, \
-             api.function);                                                                                   \
+#define NONSEP_PLUGIN_MODEL_FUNCTION(function, out_per_state)                                                    \
+  void PluginModel::function(std::span<const double> x, std::span<double> out, std::size_t count) const {        \
+    const std::size_t n = instance_->dimension;                                                                  \
+    const nonsep_plugin_api& api = *instance_->api;                                                              \
+    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, n, x, out, count, out_per_state, \
+             api.function);                                                                                      \
   }
 NONSEP_PLUGIN_MODEL_FUNCTION(grad_T, n)
 NONSEP_PLUGIN_MODEL_FUNCTION(grad_V, n)
@@ -80,7 +95,7 @@ NONSEP_PLUGIN_MODEL_FUNCTION(value_V, (static_cast<void>(n), 1))
                                     std::to_string(n) + " needs " + std::to_string(count * n) +                   \
                                     " direction components (found " + std::to_string(u.size()) + ")");            \
     const nonsep_plugin_api& api = *instance_->api;                                                               \
-    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, x, out, count, n,                 \
+    evaluate(*this, instance_->handle, api, api.function != nullptr, #function, n, x, out, count, n,              \
              [&](nonsep_instance* handle, const double* in, double* result, std::size_t size) {                   \
                return api.function(handle, in, u.data(), result, size);                                           \
              });                                                                                                  \

@@ -33,10 +33,13 @@ void BlockStepper::advance_block(Block& block, Worker& worker, std::uint64_t fro
   const double dt = setup.time.dt;
   bool clean = true;
   try {
-    for (std::uint64_t step = from; step < to && !block.empty(); ++step) {
-      block.step(worker.model, dt);
-      watch_step(block, worker, step + 1);
-    }
+    if (step_watchers.empty())  // the common case, without a call per step
+      for (std::uint64_t step = from; step < to; ++step) block.step(worker.model, dt);
+    else
+      for (std::uint64_t step = from; step < to && !block.empty(); ++step) {
+        block.step(worker.model, dt);
+        watch_step(block, worker, step + 1);
+      }
   } catch (const ModelError&) {
     clean = false;
   }

@@ -28,8 +28,9 @@
 // (tangent_basic_step.hpp) follows the same nine stages without a second copy of the splitting; the default
 // observer does nothing and leaves the stepping numbers as they are.
 #include <array>
+#include <bit>
 #include <cmath>
-#include <cstring>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <utility>
@@ -68,17 +69,32 @@ struct NoStageObserver {
   void operator()(const FlowStage&, std::span<const double>, const PhaseSpaceBatch&) const {}
 };
 
+// The checks every step makes are inline and their failures out of line, so that a step of one state does not
+// carry the frame that building the messages needs.
+// eps = cbrt(dt) as the C library computes it at run time. Not inlined, so that the compiler cannot fold a step size
+// it knows (a literal in a test or a program) into a cube root of its own, which may round differently from the
+// library's: a step must give the same numbers whether dt comes from a job file or from the source.
+[[gnu::noinline]] inline double runtime_cube_root(double dt) { return std::cbrt(dt); }
+
+[[noreturn, gnu::cold, gnu::noinline]] inline void throw_bad_step_size(double dt) {
+  throw InvalidArgument("step size dt must be finite and non-zero (found " + std::to_string(dt) + ")");
+}
+[[noreturn, gnu::cold, gnu::noinline]] inline void throw_batch_does_not_fit(std::size_t model, std::size_t states) {
+  throw InvalidArgument("the model has dimension " + std::to_string(model) + " but the states have dimension " +
+                        std::to_string(states));
+}
+
 // Throws InvalidArgument unless dt is finite and non-zero.
 inline void check_step_size(double dt) {
-  if (!std::isfinite(dt) || dt == 0.0)
-    throw InvalidArgument("step size dt must be finite and non-zero (found " + std::to_string(dt) + ")");
+  if (!std::isfinite(dt) || dt == 0.0) [[unlikely]]
+    throw_bad_step_size(dt);
 }
 
 template <Model M>
 void check_batch_fits(const M& model, const PhaseSpaceBatch& x) {
-  if (static_cast<std::size_t>(model.dimension()) != x.dimension())
-    throw InvalidArgument("the model has dimension " + std::to_string(model.dimension()) +
-                          " but the states have dimension " + std::to_string(x.dimension()));
+  const auto dimension = static_cast<std::size_t>(model.dimension());
+  if (dimension != x.dimension()) [[unlikely]]
+    throw_batch_does_not_fit(dimension, x.dimension());
 }
 
 class ChinBasicStep {
@@ -98,7 +114,9 @@ class ChinBasicStep {
   void step(const M& model, PhaseSpaceBatch& x, double dt, StageObserver&& observe = {}) {
     check_step_size(dt);
     check_batch_fits(model, x);
-    eps_.assign(1, cube_root(dt));
+    const double eps = cube_root(dt);
+    if (eps_.size() != 1) eps_.resize(1);
+    eps_[0] = eps;
     advance(model, x, observe);
   }
 
@@ -114,7 +132,7 @@ class ChinBasicStep {
     eps_.resize(dt.size());
     for (std::size_t b = 0; b < dt.size(); ++b) {
       check_step_size(dt[b]);
-      eps_[b] = std::cbrt(dt[b]);
+      eps_[b] = runtime_cube_root(dt[b]);
     }
     advance(model, x, observe);
   }
@@ -124,12 +142,12 @@ class ChinBasicStep {
   void prime(const M& model, const PhaseSpaceBatch& x) {
     const bool ttv = form_ == HamiltonianForm::TTV;
     std::span<const double> inner = ttv ? x.q() : x.p();
-    const bool cached = cached_at_.size() == inner.size() &&
-                        std::memcmp(cached_at_.data(), inner.data(), inner.size() * sizeof(double)) == 0;
-    if (cached) return;
+    if (cache_valid_ && cached_at_.size() == inner.size() && same_bits(cached_at_, inner)) return;
+    cache_valid_ = false;
     outer_gradient_.resize(inner.size());
     evaluate(model, ttv, inner, outer_gradient_, x.count());
     cached_at_.assign(inner.begin(), inner.end());
+    cache_valid_ = true;
   }
 
   // The first-same-as-last gradient and the point it belongs to, for wrappers that restart from a saved state
@@ -137,10 +155,11 @@ class ChinBasicStep {
   struct Cache {
     std::vector<double> at, gradient;
   };
-  Cache save_cache() const { return {cached_at_, outer_gradient_}; }
+  Cache save_cache() const { return {cache_valid_ ? cached_at_ : std::vector<double>{}, outer_gradient_}; }
   void restore_cache(const Cache& cache) {
     cached_at_ = cache.at;
     outer_gradient_ = cache.gradient;
+    cache_valid_ = true;  // an empty `at` (saved while invalid) matches no batch
   }
 
  private:
@@ -153,9 +172,12 @@ class ChinBasicStep {
     const double outer_sign = ttv ? -1.0 : 1.0;  // TTV: outer flows are kicks (p -= ...), VVT: drifts (q += ...)
     const double inner_sign = -outer_sign;
     const std::size_t count = x.count(), n = x.dimension();
-    inner_gradient_.resize(inner.size());
+    if (inner_gradient_.size() != inner.size()) inner_gradient_.resize(inner.size());
 
     prime(model, x);
+    // The gradient is overwritten from the first inner flow on: should the model throw before the step's last
+    // evaluation, the cache must not claim it belongs to any point.
+    cache_valid_ = false;
     // y += sign * coefficient * eps * gradient, state by state when the states have their own eps.
     auto flow = [&](std::span<double> y, std::span<const double> gradient, double sign, double coefficient) {
       if (eps_.size() == 1) {
@@ -187,7 +209,17 @@ class ChinBasicStep {
     outer_flow(c_.v1);
     inner_flow(c_.t2);
     outer_flow(c_.v2);
-    cached_at_.assign(inner.begin(), inner.end());
+    if (cached_at_.size() != inner.size()) cached_at_.resize(inner.size());
+    std::copy(inner.begin(), inner.end(), cached_at_.begin());
+    cache_valid_ = true;
+  }
+
+  // a and b (of equal size) hold the same numbers bit for bit; no early exit, so that the loop vectorizes.
+  static bool same_bits(std::span<const double> a, std::span<const double> b) {
+    std::uint64_t difference = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      difference |= std::bit_cast<std::uint64_t>(a[i]) ^ std::bit_cast<std::uint64_t>(b[i]);
+    return difference == 0;
   }
 
   // cbrt(dt), remembered for the last few step sizes: a run steps with one dt (basic, MPE's terms) or cycles
@@ -195,7 +227,7 @@ class ChinBasicStep {
   double cube_root(double dt) {
     for (const auto& [known, root] : roots_)
       if (known == dt) return root;
-    roots_[next_root_] = {dt, std::cbrt(dt)};
+    roots_[next_root_] = {dt, runtime_cube_root(dt)};
     const double root = roots_[next_root_].second;
     next_root_ = (next_root_ + 1) % roots_.size();
     return root;
@@ -216,6 +248,7 @@ class ChinBasicStep {
   ChinCoefficients c_;
   EvaluationCounts evaluations_;
   std::vector<double> outer_gradient_, inner_gradient_, cached_at_;
+  bool cache_valid_ = false;                          // outer_gradient_ is the outer gradient at cached_at_
   std::vector<double> eps_;                           // cbrt(dt): one entry, or one per state
   std::array<std::pair<double, double>, 4> roots_{};  // (dt, cbrt(dt)); dt = 0 never asked (check_step_size)
   std::size_t next_root_ = 0;

@@ -333,12 +333,19 @@ class ModelAdapter {
       return static_cast<std::size_t>(n);
     }
   }
+  // Inline, its failure out of line: the plugin table calls with spans of exactly count*n numbers (the ABI's batch
+  // layout), for which the comparison folds away, so a call through the ABI checks its sizes once, on the host's
+  // side.
   void check_sizes(std::span<const double> in, std::span<double> out, std::size_t count,
                    std::size_t out_per_state) const {
-    if (in.size() < count * dimension_ || out.size() < count * out_per_state)
-      throw nonsep::InvalidArgument("batch of " + std::to_string(count) + " states of dimension " +
-                                    std::to_string(dimension_) + " given spans of " + std::to_string(in.size()) +
-                                    " and " + std::to_string(out.size()) + " numbers");
+    if (in.size() < count * dimension_ || out.size() < count * out_per_state) [[unlikely]]
+      throw_bad_sizes(count, dimension_, in.size(), out.size());
+  }
+  [[noreturn, gnu::cold, gnu::noinline]] static void throw_bad_sizes(std::size_t count, std::size_t n,
+                                                                     std::size_t in_size, std::size_t out_size) {
+    throw nonsep::InvalidArgument("batch of " + std::to_string(count) + " states of dimension " + std::to_string(n) +
+                                  " given spans of " + std::to_string(in_size) + " and " + std::to_string(out_size) +
+                                  " numbers");
   }
 
   M model_;
