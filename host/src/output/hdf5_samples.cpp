@@ -191,12 +191,11 @@ void SampleDatasets::write_chunks(hid_t dataset, const char* name, const SampleS
             from, from + static_cast<std::ptrdiff_t>(trajectories * numbers_per_cell),
             chunk_values_.begin() + static_cast<std::ptrdiff_t>((s - s0) * trajectories_per_chunk * numbers_per_cell));
       }
-      const std::span<const unsigned char> bytes =
-          filter_->filter(std::span(reinterpret_cast<const unsigned char*>(chunk_values_.data()),
-                                    chunk_values_.size() * sizeof(double)),
-                          sizeof(double));
       const std::array<hsize_t, 3> offset{s0, t0, 0};
-      file_->check(H5Dwrite_chunk(dataset, H5P_DEFAULT, 0, offset.data(), bytes.size(), bytes.data()), what);
+      write_filtered_chunk(*file_, dataset, offset,
+                           std::span(reinterpret_cast<const unsigned char*>(chunk_values_.data()),
+                                     chunk_values_.size() * sizeof(double)),
+                           sizeof(double), *filter_, what);
     }
 }
 
