@@ -28,8 +28,9 @@
 namespace nonsep::host {
 
 inline constexpr const char* samples_group = "/samples";
-// deflate's level: on the benchmark's 10^5 paper2d trajectories (docs/performance.md) level 4 makes results.h5 0.9%
-// smaller than level 1 (6: 1.2%) and takes 10% longer (the shuffled exponent bytes compress, the mantissas hardly).
+// deflate's level for the planes that are deflated: on the benchmark's 10^5 paper2d trajectories (docs/performance.md)
+// level 4 makes results.h5 0.9% smaller than level 1 (6: 1.2%) and takes 10% longer (the shuffled exponent bytes
+// compress, the mantissas hardly).
 inline constexpr unsigned hdf5_deflate_level = 1;
 
 struct SampleLayout {
