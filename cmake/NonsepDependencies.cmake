@@ -30,7 +30,8 @@ if(NONSEP_WITH_MPI)
 endif()
 if(NONSEP_WITH_HDF5)
   set(HDF5_PREFER_PARALLEL ${NONSEP_WITH_MPI})
-  find_package(HDF5 1.10 REQUIRED COMPONENTS C)       # libhdf5-openmpi-dev (with MPI) or libhdf5-dev
+  find_package(HDF5 1.10.2 REQUIRED COMPONENTS C)     # libhdf5-openmpi-dev (with MPI) or libhdf5-dev; H5Dwrite_chunk
+  find_package(ZLIB REQUIRED)                         # zlib1g-dev: results.h5's /samples chunks (shuffle_deflate.hpp)
   if(NONSEP_WITH_MPI AND NOT HDF5_IS_PARALLEL)
     message(FATAL_ERROR "NONSEP_WITH_MPI needs the parallel HDF5 build (Debian: libhdf5-openmpi-dev); found a "
                         "serial one at ${HDF5_INCLUDE_DIRS}. Install it, or configure with -DNONSEP_WITH_HDF5=OFF.")

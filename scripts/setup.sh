@@ -10,6 +10,7 @@ packages=(
   libeigen3-dev libboost-dev nlohmann-json3-dev doctest-dev libcli11-dev
   python3 python3-jsonschema python3-matplotlib python3-numpy python3-h5py
   libopenmpi-dev openmpi-bin libhdf5-openmpi-dev hdf5-tools  # MPI ranks, parallel HDF5 output (docs/cluster.md)
+  zlib1g-dev  # results.h5: /samples' chunks deflated by nonsep (host/include/nonsep/host/output/shuffle_deflate.hpp)
   clang libclang-rt-14-dev valgrind  # CI: fuzzing (tests/fuzz) and memcheck (tests/ci)
   clang-format-14  # tests: the code follows .clang-format (tests/check_format.sh)
   libgsl-dev  # benchmark-only (GPL): the peer integrators of bench/peers; nothing in the product links it

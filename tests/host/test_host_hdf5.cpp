@@ -226,7 +226,10 @@ TEST_CASE(
   resumed.on_event({.step = 4, .t = 2.0, .states = other, .energy_evaluated = true});
   resumed.on_end();
   Hdf5File again = Hdf5File::open(path);
-  CHECK(read_all<double>(again, "/samples/q", H5T_NATIVE_DOUBLE, 12)[3] == 5.0);
+  const auto resumed_q = read_all<double>(again, "/samples/q", H5T_NATIVE_DOUBLE, 12);
+  CHECK(resumed_q[3] == 5.0);
+  CHECK(resumed_q[0] == 1.0);  // the row before the checkpoint, in the same chunk: read back and written again
+  CHECK(std::isnan(resumed_q[6 + 1]));
   again.close();
   Hdf5SampleWriter wrong(path, 2, 3, 4, time, true);
   CHECK_THROWS_WITH_AS(wrong.restore(checkpoint), doctest::Contains("cannot resume into"),

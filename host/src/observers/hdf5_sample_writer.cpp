@@ -24,13 +24,7 @@ std::vector<std::uint64_t> Hdf5SampleWriter::sample_steps(std::uint64_t steps, s
 
 Hdf5SampleWriter::Hdf5SampleWriter(const std::filesystem::path& path, std::size_t dimension, std::size_t trajectories,
                                    std::uint64_t every, const TimeGrid& time, bool resuming)
-    : path_(path),
-      dimension_(dimension),
-      every_(every),
-      steps_(time.steps),
-      q_(trajectories * dimension, nan),
-      p_(trajectories * dimension, nan),
-      H_(trajectories, nan) {
+    : path_(path), dimension_(dimension), every_(every), steps_(time.steps) {
   const std::vector<std::uint64_t> steps = sample_steps(time.steps, every);
   layout_ = {steps.size(), trajectories, dimension};
   if (resuming) return;
@@ -46,42 +40,60 @@ std::uint64_t Hdf5SampleWriter::row_of(std::uint64_t step) const {
   return step == steps_ ? layout_.samples - 1 : none;
 }
 
-void Hdf5SampleWriter::put(std::size_t trajectory, std::span<const double> q, std::span<const double> p,
-                           std::optional<double> H) {
-  std::copy(q.begin(), q.end(), q_.begin() + static_cast<std::ptrdiff_t>(trajectory * dimension_));
-  std::copy(p.begin(), p.end(), p_.begin() + static_cast<std::ptrdiff_t>(trajectory * dimension_));
-  H_[trajectory] = H.value_or(nan);
+std::uint64_t Hdf5SampleWriter::group_rows() const {
+  return std::min(datasets_->samples_per_chunk(), layout_.samples - group_first_);
 }
 
-void Hdf5SampleWriter::clear_row() {
-  std::fill(q_.begin(), q_.end(), nan);
-  std::fill(p_.begin(), p_.end(), nan);
-  std::fill(H_.begin(), H_.end(), nan);
+void Hdf5SampleWriter::start_group_of(std::uint64_t row) {
+  if (group_first_ != none && row >= group_first_ && row < group_first_ + group_rows()) return;
+  if (unwritten_) write_group();
+  group_first_ = row - row % datasets_->samples_per_chunk();
+  const std::size_t cells = group_rows() * layout_.trajectories;
+  q_.assign(cells * dimension_, nan);
+  p_.assign(cells * dimension_, nan);
+  H_.assign(cells, nan);
 }
 
-void Hdf5SampleWriter::on_event(const Event& event) {
-  const std::uint64_t row = row_of(event.step);
-  if (row == none || row < rows_written_) return;  // not a sample, or written before a resume
-  for (const StateView& state : event.states) put(state.trajectory, state.q, state.p, state.energy);
-  datasets_->write({.first_sample = row,
-                    .samples = 1,
+void Hdf5SampleWriter::write_group() {
+  datasets_->write({.first_sample = group_first_,
+                    .samples = group_rows(),
                     .first_trajectory = 0,
                     .trajectories = layout_.trajectories,
                     .q = q_,
                     .p = p_,
                     .H = H_});
+  unwritten_ = false;
+}
+
+void Hdf5SampleWriter::put(std::uint64_t row, std::size_t trajectory, std::span<const double> q,
+                           std::span<const double> p, std::optional<double> H) {
+  start_group_of(row);
+  const std::size_t cell = (row - group_first_) * layout_.trajectories + trajectory;
+  std::copy(q.begin(), q.end(), q_.begin() + static_cast<std::ptrdiff_t>(cell * dimension_));
+  std::copy(p.begin(), p.end(), p_.begin() + static_cast<std::ptrdiff_t>(cell * dimension_));
+  H_[cell] = H.value_or(nan);
+  unwritten_ = true;
+}
+
+void Hdf5SampleWriter::on_event(const Event& event) {
+  const std::uint64_t row = row_of(event.step);
+  if (row == none || row < rows_written_) return;  // not a sample, or written before a resume
+  start_group_of(row);
+  for (const StateView& state : event.states) put(row, state.trajectory, state.q, state.p, state.energy);
+  unwritten_ = true;
   rows_written_ = row + 1;
-  clear_row();
+  if (rows_written_ == group_first_ + group_rows()) write_group();
 }
 
 void Hdf5SampleWriter::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
   // Only a stop exactly at the next sample step, which the event there will write; a stop at a sample already
   // written was written with it (the trajectory was active there), as trajectory.csv writes no second row.
   if (const std::uint64_t row = row_of(record.final_step); row != none && row >= rows_written_)
-    put(trajectory, record.final_q, record.final_p, record.energy_final);
+    put(row, trajectory, record.final_q, record.final_p, record.energy_final);
 }
 
 void Hdf5SampleWriter::on_end() {
+  if (unwritten_) write_group();
   datasets_.reset();
   if (file_) file_->close();
   file_.reset();
@@ -89,7 +101,9 @@ void Hdf5SampleWriter::on_end() {
 
 nlohmann::json Hdf5SampleWriter::save() {
   // Checkpoints are taken after a chunk's events (checkpoint_saver.hpp), so no stopped trajectory waits in the
-  // next row: everything the run has is in the file.
+  // next row: everything the run has is in the file once the rows of an incomplete chunk are (with NaN after them,
+  // until the chunk is written again whole).
+  if (unwritten_) write_group();
   file_->flush();
   return {{"rows", rows_written_}};
 }
@@ -116,6 +130,17 @@ void Hdf5SampleWriter::restore(const nlohmann::json& state) {
            std::to_string(datasets_->layout().dimension) + ", the run " + std::to_string(layout_.samples) + " of " +
            std::to_string(layout_.trajectories) + " of dimension " + std::to_string(layout_.dimension));
   rows_written_ = state["rows"].get<std::uint64_t>();
+  if (rows_written_ == layout_.samples) return;
+  // The rows of the incomplete chunk written before the checkpoint, which its next write must carry again.
+  start_group_of(rows_written_);
+  const std::uint64_t rows = rows_written_ - group_first_;
+  const std::size_t cells = rows * layout_.trajectories;
+  try {
+    datasets_->read(group_first_, rows, std::span(q_).first(cells * dimension_),
+                    std::span(p_).first(cells * dimension_), std::span(H_).first(cells));
+  } catch (const OutputError& error) {
+    refuse(error.what());
+  }
 }
 
 }  // namespace nonsep::host

@@ -1,6 +1,9 @@
 #include "nonsep/host/output/hdf5_file.hpp"
 
+#include <bit>
+
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/shuffle_deflate.hpp"
 
 namespace nonsep::host {
 
@@ -68,5 +71,13 @@ void Hdf5File::close() {
 
 Hdf5Handle untimed_group_properties(const Hdf5File& file) { return untimed_properties(file, H5P_GROUP_CREATE); }
 Hdf5Handle untimed_dataset_properties(const Hdf5File& file) { return untimed_properties(file, H5P_DATASET_CREATE); }
+
+void write_filtered_chunk(const Hdf5File& file, hid_t dataset, std::span<const hsize_t> offset,
+                          std::span<const unsigned char> chunk, std::size_t element_size, ShuffleDeflate& filter,
+                          const std::string& what) {
+  static_assert(std::endian::native == std::endian::little, "the chunks are written in the stored (LE) byte order");
+  const std::span<const unsigned char> bytes = filter.filter(chunk, element_size);
+  file.check(H5Dwrite_chunk(dataset, H5P_DEFAULT, 0, offset.data(), bytes.size(), bytes.data()), what);
+}
 
 }  // namespace nonsep::host

@@ -10,6 +10,7 @@
 
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/shuffle_deflate.hpp"
 
 namespace nonsep::host {
 
@@ -158,15 +159,26 @@ void write_rows(const Hdf5File& file, const Column& column, hid_t memory_type, h
   file.check(H5Dwrite(column.dataset.get(), memory_type, memory.get(), space.get(), H5P_DEFAULT, values), what);
 }
 
-// Writes the block of rows `cells` ([row][column]) starting at row `first`; `changed` throws (a cell no longer of its
-// column's kind: the file changed between the two readings).
+// The numbers of a block: one chunk, whole (shuffle_deflate.hpp); zero past the last row of the last chunk.
+template <class Number>
+void write_chunk(const Hdf5File& file, const Column& column, std::vector<Number>& values, hsize_t first, hsize_t count,
+                 ShuffleDeflate& filter, const std::string& where) {
+  std::fill(values.begin() + static_cast<std::ptrdiff_t>(count), values.end(), Number{0});
+  write_filtered_chunk(file, column.dataset.get(), std::span(&first, 1),
+                       std::span(reinterpret_cast<const unsigned char*>(values.data()), values.size() * sizeof(Number)),
+                       sizeof(Number), filter, "write " + where + "/" + column.name);
+}
+
+// Writes the block of rows `cells` ([row][column]) starting at row `first`, a multiple of `chunk` (the datasets'
+// chunk: the block's size, or more for the last block); `changed` throws (a cell no longer of its column's kind: the
+// file changed between the two readings).
 template <class Changed>
-void write_block(const Hdf5File& file, std::vector<Column>& columns, hid_t string_type,
-                 std::span<const std::vector<std::string>> block, std::uint64_t first, const std::string& where,
-                 Changed&& changed) {
+void write_block(const Hdf5File& file, std::vector<Column>& columns, hid_t string_type, ShuffleDeflate& filter,
+                 std::span<const std::vector<std::string>> block, std::uint64_t first, hsize_t chunk,
+                 const std::string& where, Changed&& changed) {
   const hsize_t count = block.size();
-  std::vector<std::int64_t> integers(block.size());
-  std::vector<double> numbers(block.size());
+  std::vector<std::int64_t> integers(chunk);
+  std::vector<double> numbers(chunk);
   std::vector<const char*> texts(block.size());
   for (std::size_t k = 0; k < columns.size(); ++k) {
     const Column& column = columns[k];
@@ -185,9 +197,9 @@ void write_block(const Hdf5File& file, std::vector<Column>& columns, hid_t strin
       }
     }
     if (column.kind == Kind::integer)
-      write_rows(file, column, H5T_NATIVE_INT64, first, count, integers.data(), where);
+      write_chunk(file, column, integers, first, count, filter, where);
     else if (column.kind == Kind::number)
-      write_rows(file, column, H5T_NATIVE_DOUBLE, first, count, numbers.data(), where);
+      write_chunk(file, column, numbers, first, count, filter, where);
     else
       write_rows(file, column, string_type, first, count, texts.data(), where);
   }
@@ -230,7 +242,9 @@ void write_csv_table(const Hdf5File& file, const std::string& group, const std::
     throw OutputError(csv.string() + " changed while it was copied into " + file.path().string());
   };
   CsvRows reader(csv);
-  std::vector<std::vector<std::string>> block(std::min<std::uint64_t>(rows, rows_per_block));
+  const hsize_t chunk = std::min<std::uint64_t>(rows, rows_per_block);
+  ShuffleDeflate filter(1);
+  std::vector<std::vector<std::string>> block(chunk);
   std::vector<std::string> cells;
   reader.next(cells);  // the header
   std::uint64_t first = 0;
@@ -241,7 +255,8 @@ void write_csv_table(const Hdf5File& file, const std::string& group, const std::
       std::swap(block[used++], cells);  // the row's strings change hands; no cell is copied
     }
     if (first + used > rows) changed();
-    if (used > 0) write_block(file, columns, string_type.get(), std::span(block).first(used), first, where, changed);
+    if (used > 0)
+      write_block(file, columns, string_type.get(), filter, std::span(block).first(used), first, chunk, where, changed);
     first += used;
     more = more && used > 0;
   }

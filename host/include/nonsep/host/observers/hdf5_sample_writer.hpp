@@ -5,8 +5,12 @@
 // stopped exactly at a sample step has its final state there, as trajectory.csv has its row. Final states of
 // trajectories that stopped elsewhere are in /trajectories (added at the end of the run, run/results_file.hpp).
 //
-// Checkpoints: save() writes everything cached to the file and records the number of rows written; restore()
-// reopens the file, whose later rows the resumed run writes again with the same numbers. HDF5 1.10 keeps no journal:
+// Rows are kept until they fill a chunk of /samples (one row when the ensemble fills a chunk, several for small
+// ensembles: SampleDatasets::samples_per_chunk), so that every chunk is filtered and written once, whole.
+//
+// Checkpoints: save() writes the rows kept (an incomplete chunk, NaN after them) and everything cached to the file
+// and records the number of rows written; restore() reopens the file, reads back the rows of the incomplete chunk,
+// and the resumed run writes the later rows again with the same numbers. HDF5 1.10 keeps no journal:
 // after a hard kill (SIGKILL, a crash) between checkpoints the file can be left unreadable, and --resume then
 // refuses it, naming the file (a run stopped by SIGINT or SIGTERM closes it properly).
 #include <cstddef>
@@ -50,8 +54,13 @@ class Hdf5SampleWriter : public Observer {
   static constexpr std::uint64_t none = static_cast<std::uint64_t>(-1);
   // The row of `step` in /samples, or `none` when it is not a sample step.
   std::uint64_t row_of(std::uint64_t step) const;
-  void put(std::size_t trajectory, std::span<const double> q, std::span<const double> p, std::optional<double> H);
-  void clear_row();
+  // The rows of the group that starts at group_first_ (the samples of one chunk, fewer at the end).
+  std::uint64_t group_rows() const;
+  // Makes the group of `row` the one kept, writing the one kept before when it has unwritten rows.
+  void start_group_of(std::uint64_t row);
+  void write_group();
+  void put(std::uint64_t row, std::size_t trajectory, std::span<const double> q, std::span<const double> p,
+           std::optional<double> H);
 
   std::filesystem::path path_;
   std::size_t dimension_;
@@ -60,9 +69,12 @@ class Hdf5SampleWriter : public Observer {
   std::optional<Hdf5File> file_;
   std::optional<SampleDatasets> datasets_;
   std::uint64_t rows_written_ = 0;
-  // The next row, [N][n] for q and p and [N] for H: filled by the event at its step and by the trajectories that
-  // stopped exactly there before it (whose final states the event no longer carries).
+  // The rows of one chunk from group_first_, [rows][N][n] for q and p and [rows][N] for H, NaN where nothing was put:
+  // filled by the events at their steps and by the trajectories that stopped exactly there before them (whose final
+  // states the event no longer carries). unwritten_: put since the group was last written.
+  std::uint64_t group_first_ = none;
   std::vector<double> q_, p_, H_;
+  bool unwritten_ = false;
 };
 
 }  // namespace nonsep::host

@@ -9,6 +9,7 @@
 #include <hdf5.h>
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -85,5 +86,14 @@ class Hdf5File {
 // Object creation property lists for groups and datasets that record no times (see Hdf5File::create).
 Hdf5Handle untimed_group_properties(const Hdf5File& file);
 Hdf5Handle untimed_dataset_properties(const Hdf5File& file);
+
+class ShuffleDeflate;
+// Writes the chunk of `dataset` at `offset` (its first element's coordinates) whole: `chunk` holds all its elements
+// (the chunk's shape, padded past the dataset's end), little-endian, `element_size` bytes each, as the dataset stores
+// them; `filter` shuffles and deflates them (shuffle_deflate.hpp), which must be the dataset's declared filters, and
+// H5Dwrite_chunk writes the result. Not under MPI-IO (HDF5 1.10 refuses). Throws OutputError saying `what` failed.
+void write_filtered_chunk(const Hdf5File& file, hid_t dataset, std::span<const hsize_t> offset,
+                          std::span<const unsigned char> chunk, std::size_t element_size, ShuffleDeflate& filter,
+                          const std::string& what);
 
 }  // namespace nonsep::host

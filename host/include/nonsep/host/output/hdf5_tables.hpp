@@ -7,7 +7,8 @@
 //   - float64 when every cell is a number (an empty cell: NaN; "nan", "inf" as append_number writes them), a column
 //     of empty cells included;
 //   - otherwise variable-length UTF-8 strings, the cells' text (quotes removed).
-// Numeric datasets are chunked (at most 65536 rows a chunk) with shuffle and deflate; strings chunked and deflated.
+// Numeric datasets are chunked (at most 65536 rows a chunk) with shuffle and deflate, the chunks filtered by our code
+// (shuffle_deflate.hpp) and written whole; strings chunked and deflated by HDF5.
 // The file is read twice (types, then values, 65536 rows at a time), so tables larger than memory go through. A last
 // line without its '\n' is not a row (what a hard kill cut off; python/nonsep/tables.py drops it too).
 // Throws OutputError naming the CSV file and line (a row of another number of cells, an unclosed quote) or the HDF5
