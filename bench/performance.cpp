@@ -306,7 +306,9 @@ int main(int argc, char** argv) {
   }
   if (wanted("2")) {  // 2. 1024 trajectories, one thread
     const std::size_t count = 1024;
-    const auto steps = scaled(4000);
+    // Long enough (about 0.5 s of host time) that the run's fixed costs (plugin load, H at start and end, three
+    // fsyncs of about 10 ms each on this VM's disk) are a few percent: the figure is a cost per step.
+    const auto steps = scaled(40000);
     const auto job = make_job(folder, "ensemble", analytic, count, steps);
     const double per = 1e9 / static_cast<double>(steps * count);
     const auto [host, limit] = interleaved(
@@ -323,7 +325,7 @@ int main(int argc, char** argv) {
   }
   if (wanted("3")) {  // 3. 2 threads over 1, 8192 trajectories: idle (3), a busy core (3b), hand-written (3c)
     const std::size_t count = 8192;
-    const auto steps = scaled(2000);
+    const auto steps = scaled(10000);  // about 1 s on one thread: the run's fixed costs are serial (figure 2)
     const auto job = make_job(folder, "threads", analytic, count, steps);
     const double per = 1e9 / static_cast<double>(steps * count);
     std::vector<double> two_q;
@@ -360,7 +362,9 @@ int main(int argc, char** argv) {
   }
   if (wanted("4")) {  // 4. AD over analytic gradients, through the host
     const std::size_t count = 1024;
-    const auto steps = scaled(4000);
+    // Long enough (about 0.5 s of host time) that the run's fixed costs (plugin load, H at start and end, three
+    // fsyncs of about 10 ms each on this VM's disk) are a few percent: the figure is a cost per step.
+    const auto steps = scaled(40000);
     const auto job_automatic = make_job(folder, "automatic", automatic, count, steps);
     const auto job_analytic = make_job(folder, "analytic", analytic, count, steps);
     std::vector<double> automatic_q;
