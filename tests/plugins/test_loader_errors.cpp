@@ -119,6 +119,13 @@ TEST_CASE("a plugin of ABI version 2 (the one with integrate): expected and foun
   CHECK(contains(message, "rebuild the plugin against the installed SDK"));
 }
 
+TEST_CASE("the table itself exported under the symbol, not a pointer to it: refused before reading through it") {
+  const std::string message = load_error("table_not_pointer.so");
+  CHECK(contains(message, "the symbol 'nonsep_plugin' of plugin '" + (test_plugins / "table_not_pointer.so").string() +
+                              "' does not point to a table in a loaded library (it holds 0x"));
+  CHECK(contains(message, "not the table itself"));
+}
+
 TEST_CASE("wrong table size: expected and found") {
   const std::size_t expected = sizeof(nonsep_plugin_api), found = expected - sizeof(void*);
   const std::string message = load_error("wrong_table_size.so");

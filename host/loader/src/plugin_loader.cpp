@@ -3,11 +3,14 @@
 // Plugin and PluginModel from it is gone.
 #include "nonsep/host/plugin_loader.hpp"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <boost/dll/import.hpp>
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <boost/dll/shared_library.hpp>
 #include <boost/shared_ptr.hpp>
+#include <cstdint>
 #include <cstdlib>
 #include <set>
 #include <sstream>
@@ -201,6 +204,20 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
   const nonsep_plugin_api* api = loaded->table.get();
   if (api == nullptr)
     throw PluginError("the symbol '" NONSEP_PLUGIN_SYMBOL "' of plugin " + quoted(path) + " is a null table");
+  // A library that exports the table itself under the symbol, instead of a pointer to it, would have its first
+  // bytes (abi_version, struct_size) read as an address: refuse any pointer that is not a suitably aligned
+  // address inside a loaded library before reading through it.
+  Dl_info where{};
+  const auto address = reinterpret_cast<std::uintptr_t>(api);
+  if (address % alignof(nonsep_plugin_api) != 0 || ::dladdr(api, &where) == 0) {
+    std::ostringstream found;
+    found << std::hex << "0x" << address;
+    throw PluginError("the symbol '" NONSEP_PLUGIN_SYMBOL "' of plugin " + quoted(path) +
+                      " does not point to a table in a loaded library (it holds " + found.str() +
+                      "): it must be a pointer to a statically allocated table, 'const nonsep_plugin_api* const "
+                      "nonsep_plugin = &table;', not the table itself; define it with NONSEP_EXPORT_MODEL (see "
+                      "plugin_sdk.hpp) or NONSEP_DEFINE_PLUGIN (see plugin_abi.h)");
+  }
   if (api->abi_version != NONSEP_PLUGIN_ABI_VERSION)
     throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(api->abi_version) +
                       " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +

@@ -12,6 +12,7 @@
 //   9  the metadata lacks "thread_safe" (required since version 3)
 //  10  the metadata claims d3T but the pointer is null
 //  11  the table has d3V but the metadata does not claim it
+//  12  exports the table itself under the symbol nonsep_plugin instead of a pointer to it (a common C mistake)
 #include <cstddef>
 #include <cstring>
 
@@ -112,6 +113,8 @@ const nonsep_plugin_api table = {
 extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* const nonsep_plugin_v0 = &table;
 #elif NONSEP_TEST_DEFECT == 8
 extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api* nonsep_plugin_entry(void) { return &table; }
+#elif NONSEP_TEST_DEFECT == 12
+extern "C" __attribute__((visibility("default"))) const nonsep_plugin_api nonsep_plugin = table;
 #else
 NONSEP_DEFINE_PLUGIN(table);
 #endif

@@ -11,6 +11,8 @@
  * up by name.
  *
  * Checks the host makes, in this order, before using anything else in the table:
+ *   0. the symbol holds an aligned address inside a loaded library (refused otherwise: a library that exports
+ *      the table itself under the name, instead of a pointer to it)
  *   1. abi_version == NONSEP_PLUGIN_ABI_VERSION   (refused with "expected 3, found N")
  *   2. struct_size == sizeof(nonsep_plugin_api)  (refused with expected and found sizes)
  *   3. the required functions are non-null        (metadata_json, create, destroy, dimension, grad_T, grad_V,
