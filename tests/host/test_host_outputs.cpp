@@ -1,6 +1,9 @@
 // The output writers in-process: the number format, the CSV writer (layout, quoting, buffering on whole rows,
 // resuming) and atomic replacement.
 #include <doctest/doctest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <charconv>
 #include <cmath>
@@ -126,4 +129,34 @@ TEST_CASE("summary.json is replaced atomically, leaving no temporary file") {
   }
   CHECK(files == 1);
   CHECK_THROWS_AS(write_file_atomically(folder / "missing" / "summary.json", "{}"), OutputError);
+}
+
+TEST_CASE("a folder that is not writable is named as such, not as a temporary file that cannot be created") {
+  // Root writes anywhere, so the attempt runs in a child process that is not root (as user nobody when the
+  // suite runs as root, as CI does) on a folder without write permission.
+  const TemporaryFolder folder;
+  const auto locked = folder / "locked";
+  std::filesystem::create_directory(locked);
+  REQUIRE(::chmod(locked.c_str(), 0555) == 0);
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    if (::getuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) ::_exit(3);
+    try {
+      write_file_atomically(locked / "summary.json", "{}");
+    } catch (const OutputError& e) {
+      const std::string message = e.what();
+      const bool named = message.find("the folder " + locked.string() + " is not writable (") != std::string::npos &&
+                         message.find("summary.json cannot be written there") != std::string::npos;
+      ::_exit(named ? 0 : 1);
+    } catch (...) {
+      ::_exit(4);
+    }
+    ::_exit(2);  // written: the folder was writable after all
+  }
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  ::chmod(locked.c_str(), 0755);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
 }

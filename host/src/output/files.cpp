@@ -52,7 +52,14 @@ AtomicFile::AtomicFile(const std::filesystem::path& path) : path_(path) {
   // planted there), so that nothing else can be made to receive the text.
   std::string pattern = (path.parent_path() / ("." + path.filename().string() + ".tmp-XXXXXX")).string();
   const int descriptor = ::mkstemp(pattern.data());
-  if (descriptor < 0) throw OutputError("cannot create a temporary file for " + path.string() + ": " + system_reason());
+  if (descriptor < 0) {
+    const int error = errno;
+    const auto folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
+    if (error == EACCES || error == EROFS || error == EPERM)
+      throw OutputError("the folder " + folder.string() + " is not writable (" + std::strerror(error) + "), so " +
+                        path.filename().string() + " cannot be written there");
+    throw OutputError("cannot create a temporary file for " + path.string() + ": " + std::strerror(error));
+  }
   temporary_ = pattern;
   ::fchmod(descriptor, 0644);
   file_ = ::fdopen(descriptor, "wb");
