@@ -17,7 +17,7 @@ using json = nlohmann::json;
 
 namespace {
 
-constexpr const char* format_tag = "nonsep checkpoint 3";
+constexpr const char* format_tag = "nonsep checkpoint 4";  // 4: Tao's copies and the grad H count
 
 json encode(double value) { return format_number(value); }
 
@@ -190,7 +190,11 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
   const json document = {{"format", format_tag},
                          {"job_fingerprint", fingerprint},
                          {"step", state.step},
-                         {"evaluations", {{"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}}},
+                         {"evaluations",
+                          {{"grad_T", state.evaluations.grad_T},
+                           {"grad_V", state.evaluations.grad_V},
+                           {"grad_H", state.evaluations.grad_H}}},
+                         {"max_copy_distance", encode(state.max_copy_distance)},
                          {"active",
                           {{"trajectories", state.active},
                            {"q", encode(state.q)},
@@ -198,6 +202,8 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
                            {"energies", encode(state.energies)},
                            {"tangent_q", encode(state.tangent_q)},
                            {"tangent_p", encode(state.tangent_p)},
+                           {"copies_q", encode(state.copies_q)},
+                           {"copies_p", encode(state.copies_p)},
                            {"lyapunov", std::move(lyapunov)},
                            {"megno", std::move(megno)}}},
                          {"records", std::move(records)},
@@ -244,6 +250,8 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   const json& evaluations = read.member(document, "evaluations");
   state.evaluations.grad_T = read.unsigned_integer(read.member(evaluations, "grad_T"), "evaluations");
   state.evaluations.grad_V = read.unsigned_integer(read.member(evaluations, "grad_V"), "evaluations");
+  state.evaluations.grad_H = read.unsigned_integer(read.member(evaluations, "grad_H"), "evaluations");
+  state.max_copy_distance = read.number(read.member(document, "max_copy_distance"), "max_copy_distance");
   const json& active = read.member(document, "active");
   const json& trajectories = read.member(active, "trajectories");
   if (!trajectories.is_array()) damaged(path, "active.trajectories is not an array");
@@ -261,6 +269,9 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   const std::size_t k = job.run().analysis.tangent_vectors(), tangent_size = state.active.size() * k * n;
   state.tangent_q = read.numbers(read.member(active, "tangent_q"), tangent_size, "active.tangent_q");
   state.tangent_p = read.numbers(read.member(active, "tangent_p"), tangent_size, "active.tangent_p");
+  const std::size_t copies_size = job.run().integrator.scheme == "tao" ? state.active.size() * n : 0;
+  state.copies_q = read.numbers(read.member(active, "copies_q"), copies_size, "active.copies_q");
+  state.copies_p = read.numbers(read.member(active, "copies_p"), copies_size, "active.copies_p");
   const json& lyapunov = read.member(active, "lyapunov");
   const json& megno = read.member(active, "megno");
   if (!lyapunov.is_array() || !megno.is_array() || lyapunov.size() != (k > 0 ? state.active.size() : 0) ||

@@ -1,10 +1,12 @@
 // The comparator schemes (tao, implicit_midpoint, gauss) through the built executable: runs and studies through the
 // ensemble driver, bit for bit with the core; the family in --help, summary.json and the CSV files; the Tao copy
 // distance; a Gauss trajectory whose iteration fails retiring alone with the reason; plugins without third
-// derivatives refused; work_precision.csv.
+// derivatives refused; work_precision.csv; a Tao run killed and resumed.
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <csignal>
+#include <cstdint>
 #include <string>
 
 #include "host_run_support.hpp"
@@ -228,4 +230,44 @@ TEST_CASE("a study's reference_run: its end state is the reference of the phase 
   CHECK(a[1][phase] == b[1][phase]);
   CHECK(a[2][phase] == b[2][phase]);
   CHECK(std::stod(a[1][phase]) > 1e-6);
+}
+
+TEST_CASE("a Tao run killed and resumed continues its copies: the files and the copy distance bit for bit") {
+  json initial = json::array();
+  for (int k = 0; k < 300; ++k) initial.push_back(state(0.5 + 0.005 * k, 0.1));
+  json job = paper1d_job(initial, {{"dt", 0.001}, {"steps", 60000}}, {{"scheme", "tao"}, {"order", 2}});
+  job["output"]["every"] = 1000;
+  job["checkpoint"] = {{"every_steps", 1000}, {"every_seconds", 0}};
+  TemporaryFolder reference;
+  const json uninterrupted = run_job(reference, "out", job);
+
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", job);
+  const auto process =
+      start_nonsep({"run", "--quiet", "--output", (folder / "out").string(), file.string()}, folder.path());
+  REQUIRE(wait_until([&] {
+    try {
+      return read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>() >= 20000;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }));
+  REQUIRE(::kill(process.pid, SIGKILL) == 0);
+  finish(process, std::chrono::seconds(30));
+  const auto step = read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>();
+  INFO("killed after the checkpoint at step " << step);
+  REQUIRE(step < 60000);
+  const auto resumed =
+      run_nonsep({"run", "--quiet", "--resume", "--output", (folder / "out").string(), file.string()}, folder.path());
+  INFO("stderr: " << resumed.err);
+  REQUIRE(resumed.status == 0);
+  for (const char* name : {"trajectory.csv", "trajectories.csv"}) {
+    CAPTURE(name);
+    CHECK(read_text(folder / "out" / name) == read_text(reference / "out" / name));
+  }
+  const json summary = read_run(folder / "out");
+  CHECK(summary["comparator"]["max_copy_distance"] == uninterrupted["comparator"]["max_copy_distance"]);
+  // The resumed process evaluates one grad H per trajectory to start (the gradient the killed one had cached).
+  CHECK(summary["evaluations"]["grad_H"].get<std::uint64_t>() ==
+        uninterrupted["evaluations"]["grad_H"].get<std::uint64_t>() + 300);
 }

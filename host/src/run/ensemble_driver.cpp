@@ -280,6 +280,17 @@ void EnsembleDriver::restore(DriverState state) {
           .restore(members[b], state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
     d.blocks[b].energies = std::move(energies);
     d.blocks[b].energy_step = state.step;
+    if (!state.copies_q.empty() && !members[b].empty()) {
+      PhaseSpaceBatch copies(n, members[b].size());
+      for (std::size_t slot = 0; slot < members[b].size(); ++slot) {
+        const auto from = static_cast<std::ptrdiff_t>(members[b][slot] * n);
+        std::copy(state.copies_q.begin() + from, state.copies_q.begin() + from + static_cast<std::ptrdiff_t>(n),
+                  copies.q(slot).begin());
+        std::copy(state.copies_p.begin() + from, state.copies_p.begin() + from + static_cast<std::ptrdiff_t>(n),
+                  copies.p(slot).begin());
+      }
+      d.blocks[b].integrator.restore_copies(std::move(copies), state.max_copy_distance);
+    }
   }
   d.records = std::move(state.records);
   d.completed = state.step;
@@ -298,7 +309,15 @@ DriverState EnsembleDriver::state() const {
     for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
       state.energies.push_back(block.energy_step == d.completed ? block.energies[slot] : std::nan(""));
     if (block.tangents) block.tangents->save(state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
+    if (d.setup.integrator.scheme == "tao") {
+      // Before its first step a Tao block has no copies yet: they are its states then, as the step would set.
+      const PhaseSpaceBatch* copies = block.integrator.copies();
+      const PhaseSpaceBatch& held = copies && copies->count() == block.trajectories.size() ? *copies : block.batch;
+      state.copies_q.insert(state.copies_q.end(), held.q().begin(), held.q().end());
+      state.copies_p.insert(state.copies_p.end(), held.p().begin(), held.p().end());
+    }
   }
+  state.max_copy_distance = max_copy_distance();
   state.records = d.records;
   state.evaluations = evaluations();
   return state;

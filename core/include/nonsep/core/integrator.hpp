@@ -98,6 +98,19 @@ class Integrator {
   }
   // Tao only: the largest |(q, p) - (x, y)| over the states and steps this integrator took (0 before a step).
   double max_copy_distance() const { return max_copy_distance_; }
+  // Tao only: the extended copies of the batch's states, or nullptr (other schemes; Tao before its first step).
+  const PhaseSpaceBatch* copies() const {
+    const auto* tao = std::get_if<TaoExtendedPhaseSpace>(&stepper_);
+    return tao && tao->copies().count() > 0 ? &tao->copies() : nullptr;
+  }
+  // Tao only (nothing for the other schemes): continues from a checkpoint, with these copies of the batch's states
+  // and the largest copy distance of the steps before it, so that the run goes on as if never stopped.
+  void restore_copies(PhaseSpaceBatch copies, double max_copy_distance) {
+    if (auto* tao = std::get_if<TaoExtendedPhaseSpace>(&stepper_)) {
+      tao->restore_copies(std::move(copies));
+      max_copy_distance_ = max_copy_distance;
+    }
+  }
   HamiltonianForm form() const { return form_; }
   const IntegratorSpec& spec() const { return spec_; }
   // The stepper the catalogue entry built (TangentIntegrator maps it to its tangent map).

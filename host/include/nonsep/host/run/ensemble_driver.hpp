@@ -74,6 +74,10 @@ struct DriverState {
   std::vector<double> tangent_q, tangent_p;
   std::vector<LyapunovRecord> lyapunov;
   std::vector<MegnoRecord> megno;
+  // With Tao's scheme: the active trajectories' extended copies (x, y), state-major like q and p, and the largest
+  // copy distance so far; empty and 0 for the other schemes.
+  std::vector<double> copies_q, copies_p;
+  double max_copy_distance = 0.0;
 };
 
 // How the stepping ended.
