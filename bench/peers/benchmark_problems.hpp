@@ -20,8 +20,28 @@
 
 namespace nonsep::bench {
 
+// V = q^2/2 + q^4/12 and its derivatives (V'' = 1 + q^2): the potential of both problems below.
+struct PaperPotential {
+  template <class Real>
+  static Real V(Real q) {
+    return q * q / 2 + q * q * q * q / 12;
+  }
+  template <class Real>
+  static Real grad_V(Real q) {
+    return q + q * q * q / 3;
+  }
+  template <class Real>
+  static Real hessian_V(Real q) {
+    return 1 + q * q;
+  }
+  template <class Real>
+  static Real third_V(Real q) {
+    return 2 * q;
+  }
+};
+
 // The paper's 1D test (eq. algham): T = p + p^3/6, V = q^2/2 + q^4/12, H = (1 + p^2/2)^2 (1 + q^2).
-struct Paper1D {
+struct Paper1D : PaperPotential {
   static constexpr const char* name = "paper1d";
   template <class Real>
   static Real T(Real p) {
@@ -38,22 +58,6 @@ struct Paper1D {
   template <class Real>
   static Real third_T(Real) {
     return 1;
-  }
-  template <class Real>
-  static Real V(Real q) {
-    return q * q / 2 + q * q * q * q / 12;
-  }
-  template <class Real>
-  static Real grad_V(Real q) {
-    return q + q * q * q / 3;
-  }
-  template <class Real>
-  static Real hessian_V(Real q) {
-    return 1 + q * q;
-  }
-  template <class Real>
-  static Real third_V(Real q) {
-    return 2 * q;
   }
 
   template <class Real>
@@ -81,7 +85,7 @@ struct Paper1D {
 // A product Hamiltonian H = (q^2 + 1)(p^2 + 1)/2 in TTV form: T'(p) = sqrt((1 + p^2)/2), V''(q) = 1 + q^2,
 // so H = T'^2 V'' and Hamilton's equations are dq/dt = p (1 + q^2), dp/dt = -q (1 + p^2).
 // T = (p sqrt(1 + p^2) + asinh p) / (2 sqrt 2) is needed only to check grad_T.
-struct TaoProduct {
+struct TaoProduct : PaperPotential {
   static constexpr const char* name = "tao_product";
   template <class Real>
   static Real T(Real p) {
@@ -99,22 +103,6 @@ struct TaoProduct {
   static Real third_T(Real p) {
     const Real g = grad_T(p);
     return 1 / (2 * g) - p * p / (4 * g * g * g);
-  }
-  template <class Real>
-  static Real V(Real q) {
-    return q * q / 2 + q * q * q * q / 12;
-  }
-  template <class Real>
-  static Real grad_V(Real q) {
-    return q + q * q * q / 3;
-  }
-  template <class Real>
-  static Real hessian_V(Real q) {
-    return 1 + q * q;
-  }
-  template <class Real>
-  static Real third_V(Real q) {
-    return 2 * q;
   }
 
   template <class Real>

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -150,6 +151,28 @@ bool wait_until(Condition condition, std::chrono::seconds timeout = std::chrono:
 // Runs `nonsep args...` to completion.
 inline Result run_nonsep(const std::vector<std::string>& args, const std::filesystem::path& folder) {
   return finish(start_nonsep(args, folder));
+}
+
+// Starts `nonsep run --quiet --output OUTPUT JOB_FILE`, waits until its checkpoint.json is at step `at_least` or
+// later, kills the process with SIGKILL and returns the step of the checkpoint it left (a test then resumes it).
+// Throws (failing the test) when no such checkpoint appears within 30 s.
+inline std::uint64_t kill_after_checkpoint(const std::filesystem::path& job_file, const std::filesystem::path& output,
+                                           std::uint64_t at_least, const std::filesystem::path& folder) {
+  const auto process = start_nonsep({"run", "--quiet", "--output", output.string(), job_file.string()}, folder);
+  const auto checkpoint_step = [&] { return read_json(output / "checkpoint.json")["step"].get<std::uint64_t>(); };
+  const bool reached = wait_until([&] {
+    try {
+      return checkpoint_step() >= at_least;
+    } catch (const std::exception&) {
+      return false;
+    }
+  });
+  ::kill(process.pid, SIGKILL);
+  finish(process, std::chrono::seconds(30));
+  if (!reached)
+    throw std::runtime_error("no checkpoint at step " + std::to_string(at_least) + " or later in 30 s in " +
+                             output.string());
+  return checkpoint_step();
 }
 
 // The rows of CSV text, split at commas (no quoting in nonsep's files); row 0 is the header.

@@ -5,7 +5,6 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <csignal>
 #include <cstdint>
 #include <string>
 
@@ -243,18 +242,7 @@ TEST_CASE("a Tao run killed and resumed continues its copies: the files and the 
 
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", job);
-  const auto process =
-      start_nonsep({"run", "--quiet", "--output", (folder / "out").string(), file.string()}, folder.path());
-  REQUIRE(wait_until([&] {
-    try {
-      return read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>() >= 20000;
-    } catch (const std::exception&) {
-      return false;
-    }
-  }));
-  REQUIRE(::kill(process.pid, SIGKILL) == 0);
-  finish(process, std::chrono::seconds(30));
-  const auto step = read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>();
+  const auto step = kill_after_checkpoint(file, folder / "out", 20000, folder.path());
   INFO("killed after the checkpoint at step " << step);
   REQUIRE(step < 60000);
   const auto resumed =

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <csignal>
 #include <map>
 #include <string>
 #include <vector>
@@ -261,18 +260,7 @@ TEST_CASE("killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv b
 
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", job);
-  const auto process =
-      start_nonsep({"run", "--quiet", "--output", (folder / "out").string(), file.string()}, folder.path());
-  REQUIRE(wait_until([&] {
-    try {
-      return read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>() >= 20000;
-    } catch (const std::exception&) {
-      return false;
-    }
-  }));
-  REQUIRE(::kill(process.pid, SIGKILL) == 0);
-  finish(process, std::chrono::seconds(30));
-  const auto step = read_json(folder / "out/checkpoint.json")["step"].get<std::uint64_t>();
+  const auto step = kill_after_checkpoint(file, folder / "out", 20000, folder.path());
   INFO("killed after the checkpoint at step " << step);
   CHECK(step < 60000);
   const auto resumed =
