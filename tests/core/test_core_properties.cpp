@@ -207,6 +207,61 @@ TEST_CASE("first-same-as-last: a step the model fails partway leaves no stale gr
   }
 }
 
+TEST_CASE("step_n: n steps in one call give n calls of step bit for bit, with the same evaluation counts") {
+  for (const auto form : forms) {
+    for (std::size_t count : {std::size_t{1}, std::size_t{5}}) {  // one number takes the scalar flow
+      CAPTURE(static_cast<int>(form));
+      CAPTURE(count);
+      PhaseSpaceBatch x(1, count);
+      for (std::size_t b = 0; b < count; ++b) x.q()[b] = 0.3 + 0.2 * static_cast<double>(b), x.p()[b] = 0.1;
+      auto y = x;
+      ChinBasicStep together(form), one_by_one(form);
+      together.step_n(Paper1D{}, x, 0.01, 7);
+      together.step_n(Paper1D{}, x, -0.02, 3);  // the point carries over from one call to the next
+      together.step_n(Paper1D{}, x, 0.01, 0);   // nothing
+      for (int s = 0; s < 7; ++s) one_by_one.step(Paper1D{}, y, 0.01);
+      for (int s = 0; s < 3; ++s) one_by_one.step(Paper1D{}, y, -0.02);
+      CHECK(x == y);
+      CHECK(together.evaluations() == one_by_one.evaluations());
+      CHECK(together.evaluations().grad_T + together.evaluations().grad_V == count * (8 * 10 + 1));
+    }
+  }
+  for (const char* scheme : {"basic", "triplet", "mpe"}) {
+    const std::string scheme_name = scheme;
+    CAPTURE(scheme_name);
+    const IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
+    auto x = state({0.5, -0.2}, {0.1, 0.3});
+    auto y = x;
+    Integrator together(spec), one_by_one(spec);
+    together.step_n(Coupled2D{}, x, 0.01, 6);
+    for (int s = 0; s < 6; ++s) one_by_one.step(Coupled2D{}, y, 0.01);
+    CHECK(x == y);
+    CHECK(together.evaluations() == one_by_one.evaluations());
+  }
+}
+
+TEST_CASE("step_n: a run the model fails partway leaves no stale gradient behind") {
+  // Evaluation 1 is the starting gradient, 2..9 the first step, 10..17 the second, 18..25 the third: a run of three
+  // steps fails at each evaluation of its second and third step in turn. The states go back to where the run began
+  // and the same stepper runs again: it must give what a stepper that never failed gives, bit for bit.
+  for (const auto form : forms) {
+    for (int failing = 10; failing <= 25; ++failing) {
+      CAPTURE(static_cast<int>(form));
+      CAPTURE(failing);
+      FailingOnce model{0, failing};
+      ChinBasicStep stepper(form), reference(form);
+      auto x = state({0.7}, {0.3});
+      auto y = x;
+      const auto before = x;
+      CHECK_THROWS_AS(stepper.step_n(model, x, 0.01, 3), ModelError);
+      x = before;
+      stepper.step_n(model, x, 0.01, 3);
+      reference.step_n(Paper1D{}, y, 0.01, 3);
+      CHECK(x == y);
+    }
+  }
+}
+
 TEST_CASE("the MPE weights of eqs. (mpe43) and (mpe63)") {
   const double n = 2.0 / 3.0, a = 1, b = std::pow(2.0, n), c = std::pow(3.0, n);
   const auto w2 = MultiProductExpansion<>::weights_for(2);

@@ -124,6 +124,14 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
     else
       integrator.step(model, batch, dt);
   }
+  // `n` steps of the whole block, bit for bit n calls of step().
+  template <class M>
+  void step_n(const M& model, double dt, std::uint64_t n) {
+    if (tangents)
+      for (std::uint64_t k = 0; k < n; ++k) tangents->step(model, batch, dt);
+    else
+      integrator.step_n(model, batch, dt, n);
+  }
   EvaluationCounts evaluations() const {
     return tangents ? tangents->integrator.evaluations() : integrator.evaluations();
   }

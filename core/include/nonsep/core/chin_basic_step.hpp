@@ -18,7 +18,8 @@
 // First-same-as-last: the outer flows' gradient depends only on the variable the inner flows change (grad V
 // on q in TTV, grad T on p in VVT). The last outer gradient of a step is kept with a copy of the point it was
 // evaluated at and reused by the next step when the state still holds that point bit for bit, whatever the
-// new dt. A run of steps therefore costs 4 grad T + 4 grad V evaluations per step, plus one at the start.
+// new dt. A run of steps therefore costs 4 grad T + 4 grad V evaluations per step, plus one at the start. step_n()
+// takes n steps in one call and compares and copies the point once for all of them instead of once per step.
 //
 // Stage observers: step() takes an optional observer, called after each of the nine flows as
 //   observe(FlowStage{kick, coefficient}, eps, x)
@@ -137,6 +138,25 @@ class ChinBasicStep {
     advance(model, x, observe);
   }
 
+  // Advances every state of `x` by `n` steps of dt (finite, non-zero): bit for bit what n calls of step(model, x, dt)
+  // give, evaluations counted alike, but the per-step bookkeeping done once: the checks, cbrt(dt), and the
+  // first-same-as-last comparison and copy of the point (x is this function's alone until it returns, so the
+  // gradient of one step's last flow is the next step's first). Throws as step() does; after a model exception x
+  // holds whatever the steps reached.
+  template <Model M>
+  void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
+    if (n == 0) return;
+    check_step_size(dt);
+    check_batch_fits(model, x);
+    const double eps = cube_root(dt);
+    if (eps_.size() != 1) eps_.resize(1);
+    eps_[0] = eps;
+    begin_steps(model, x);
+    NoStageObserver none;
+    for (std::uint64_t k = 0; k < n; ++k) stages(model, x, none);
+    end_steps(x);
+  }
+
   // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached).
   template <Model M>
   void prime(const M& model, const PhaseSpaceBatch& x) {
@@ -166,22 +186,49 @@ class ChinBasicStep {
   // One basic step of every state; eps_ holds eps = cbrt(dt), one for all states or one per state.
   template <Model M, class StageObserver>
   void advance(const M& model, PhaseSpaceBatch& x, StageObserver& observe) {
+    begin_steps(model, x);
+    stages(model, x, observe);
+    end_steps(x);
+  }
+
+  // Before a run of steps: the outer gradient at x's point at hand, the work arrays sized. The gradient is
+  // overwritten from the first inner flow on: should the model throw before the run's last evaluation, the cache
+  // must not claim it belongs to any point.
+  template <Model M>
+  void begin_steps(const M& model, const PhaseSpaceBatch& x) {
+    const std::size_t size = x.size();
+    if (inner_gradient_.size() != size) inner_gradient_.resize(size);
+    prime(model, x);
+    cache_valid_ = false;
+  }
+  // After it: the outer gradient belongs to x's inner variable, for the next step's first flow.
+  void end_steps(const PhaseSpaceBatch& x) {
+    std::span<const double> inner = form_ == HamiltonianForm::TTV ? x.q() : x.p();
+    if (cached_at_.size() != inner.size()) cached_at_.resize(inner.size());
+    std::copy(inner.begin(), inner.end(), cached_at_.begin());
+    cache_valid_ = true;
+  }
+
+  // The nine flows of eq. (expalg), from outer_gradient_ at x's current point; leaves in outer_gradient_ the outer
+  // gradient at the new point.
+  template <Model M, class StageObserver>
+  void stages(const M& model, PhaseSpaceBatch& x, StageObserver& observe) {
     const bool ttv = form_ == HamiltonianForm::TTV;
     std::span<double> outer = ttv ? x.p() : x.q();
     std::span<double> inner = ttv ? x.q() : x.p();
     const double outer_sign = ttv ? -1.0 : 1.0;  // TTV: outer flows are kicks (p -= ...), VVT: drifts (q += ...)
     const double inner_sign = -outer_sign;
     const std::size_t count = x.count(), n = x.dimension();
-    if (inner_gradient_.size() != inner.size()) inner_gradient_.resize(inner.size());
-
-    prime(model, x);
-    // The gradient is overwritten from the first inner flow on: should the model throw before the step's last
-    // evaluation, the cache must not claim it belongs to any point.
-    cache_valid_ = false;
-    // y += sign * coefficient * eps * gradient, state by state when the states have their own eps.
+    // y += sign * coefficient * eps * gradient, state by state when the states have their own eps. One number (one
+    // state of dimension 1) takes a scalar statement: the vectorized loop's alias check and prologue cost more than
+    // its arithmetic.
     auto flow = [&](std::span<double> y, std::span<const double> gradient, double sign, double coefficient) {
       if (eps_.size() == 1) {
         const double h = sign * coefficient * eps_[0];
+        if (y.size() == 1) {
+          y[0] += h * gradient[0];
+          return;
+        }
         for (std::size_t i = 0; i < y.size(); ++i) y[i] += h * gradient[i];
         return;
       }
@@ -209,9 +256,6 @@ class ChinBasicStep {
     outer_flow(c_.v1);
     inner_flow(c_.t2);
     outer_flow(c_.v2);
-    if (cached_at_.size() != inner.size()) cached_at_.resize(inner.size());
-    std::copy(inner.begin(), inner.end(), cached_at_.begin());
-    cache_valid_ = true;
   }
 
   // a and b (of equal size) hold the same numbers bit for bit; no early exit, so that the loop vectorizes.

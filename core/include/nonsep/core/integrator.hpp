@@ -9,6 +9,7 @@
 // of each state: the Integrator keeps it aligned with the batch the caller steps (compact() when states leave,
 // step_part() when a step is redone state by state) and tracks the largest copy distance seen.
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -52,6 +53,17 @@ class Integrator {
           }
         },
         stepper_);
+  }
+
+  // n steps of dt: bit for bit n calls of step(model, x, dt). The basic step does its per-step bookkeeping once
+  // (ChinBasicStep::step_n); the other schemes take their steps one by one.
+  template <Model M>
+  void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
+    if (auto* basic = std::get_if<ChinBasicStep>(&stepper_)) {
+      basic->step_n(model, x, dt, n);
+      return;
+    }
+    for (std::uint64_t k = 0; k < n; ++k) step(model, x, dt);
   }
 
   // Redoes one step for part of a batch: `part` holds states first .. first + part.count() - 1 of a batch of
