@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <vector>
@@ -258,6 +259,23 @@ TEST_CASE("step_n: a run the model fails partway leaves no stale gradient behind
       stepper.step_n(model, x, 0.01, 3);
       reference.step_n(Paper1D{}, y, 0.01, 3);
       CHECK(x == y);
+    }
+  }
+}
+
+TEST_CASE("a batch's q and p start on a cache line, also when copied, moved or made from one state") {
+  const auto on_line = [](std::span<const double> values) {
+    return reinterpret_cast<std::uintptr_t>(values.data()) % cache_line_size == 0;
+  };
+  for (std::size_t count : {std::size_t{1}, std::size_t{3}, std::size_t{256}}) {
+    CAPTURE(count);
+    const PhaseSpaceBatch x(2, count);
+    const PhaseSpaceBatch copy = x;
+    PhaseSpaceBatch moved = PhaseSpaceBatch(x);
+    const auto single = PhaseSpaceBatch::single(x.q(0), x.p(0));
+    for (const PhaseSpaceBatch* batch : std::array<const PhaseSpaceBatch*, 4>{&x, &copy, &moved, &single}) {
+      CHECK(on_line(batch->q()));
+      CHECK(on_line(batch->p()));
     }
   }
 }

@@ -37,6 +37,7 @@
 #include <utility>
 #include <vector>
 
+#include "nonsep/core/aligned_allocator.hpp"
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/integrator_description.hpp"
 #include "nonsep/core/model.hpp"
@@ -175,10 +176,13 @@ class ChinBasicStep {
   struct Cache {
     std::vector<double> at, gradient;
   };
-  Cache save_cache() const { return {cache_valid_ ? cached_at_ : std::vector<double>{}, outer_gradient_}; }
+  Cache save_cache() const {
+    return {cache_valid_ ? std::vector<double>(cached_at_.begin(), cached_at_.end()) : std::vector<double>{},
+            std::vector<double>(outer_gradient_.begin(), outer_gradient_.end())};
+  }
   void restore_cache(const Cache& cache) {
-    cached_at_ = cache.at;
-    outer_gradient_ = cache.gradient;
+    cached_at_.assign(cache.at.begin(), cache.at.end());
+    outer_gradient_.assign(cache.gradient.begin(), cache.gradient.end());
     cache_valid_ = true;  // an empty `at` (saved while invalid) matches no batch
   }
 
@@ -291,10 +295,10 @@ class ChinBasicStep {
   HamiltonianForm form_;
   ChinCoefficients c_;
   EvaluationCounts evaluations_;
-  std::vector<double> outer_gradient_, inner_gradient_, cached_at_;
-  bool cache_valid_ = false;                          // outer_gradient_ is the outer gradient at cached_at_
-  std::vector<double> eps_;                           // cbrt(dt): one entry, or one per state
-  std::array<std::pair<double, double>, 4> roots_{};  // (dt, cbrt(dt)); dt = 0 never asked (check_step_size)
+  AlignedDoubles outer_gradient_, inner_gradient_, cached_at_;  // streamed through by every stage
+  bool cache_valid_ = false;                                    // outer_gradient_ is the outer gradient at cached_at_
+  std::vector<double> eps_;                                     // cbrt(dt): one entry, or one per state
+  std::array<std::pair<double, double>, 4> roots_{};            // (dt, cbrt(dt)); dt = 0 never asked (check_step_size)
   std::size_t next_root_ = 0;
 };
 

@@ -1,10 +1,12 @@
 #pragma once
 // A batch of phase-space points (q, p), the state every integrator steps. Layout as in model.hpp:
-// component i of state b at index b*n + i, in two separate contiguous arrays for q and p.
+// component i of state b at index b*n + i, in two separate contiguous arrays for q and p, each starting on a cache
+// line.
 #include <cstddef>
 #include <span>
 #include <vector>
 
+#include "nonsep/core/aligned_allocator.hpp"
 #include "nonsep/core/error.hpp"
 
 namespace nonsep {
@@ -51,8 +53,8 @@ class PhaseSpaceBatch {
  private:
   std::size_t dimension_ = 0;
   std::size_t count_ = 0;
-  std::vector<double> q_;
-  std::vector<double> p_;
+  AlignedDoubles q_;  // each on a cache line of its own (aligned_allocator.hpp)
+  AlignedDoubles p_;
 };
 
 }  // namespace nonsep
