@@ -5,12 +5,17 @@
 // compiled with the same flags as the host.
 //
 //   1. one trajectory:     ns per basic step of `nonsep run` (nonsep::host::run_job on paper1d.so, no output) over
-//                          the hand-written loop on one (q, p). 1c: the core's ChinBasicStep compiled in, over the
-//                          same hand-written loop (how much of figure 1 is the core's, not the host's).
+//                          the hand-written loop on one (q, p). 1a: the floor of an evaluation-only plugin boundary
+//                          (abi_floor.hpp: the hand-written stages calling paper1d_minimal.so, a plugin without the
+//                          SDK, for every gradient) over the same loop; 1h: the host over that floor, what the host
+//                          and the SDK add; 1r: the control, the gradients called through function pointers by value
+//                          (registers), which tells the cost of a call from that of passing numbers through memory.
+//                          1c: the core's ChinBasicStep compiled in (step_n), over the hand-written loop.
 //   2. 1024 trajectories:  ns per basic step per trajectory, run_job on 1 thread over the faster of two hand-written
 //                          loops over 1024 states (state by state; stage by stage), vectorized at the build's SIMD
-//                          width (SSE2 by default, the machine's with cmake -DNONSEP_NATIVE=ON: figure 2n).
-//                          2c: ChinBasicStep on one batch over the same limit.
+//                          width (SSE2 by default, the machine's with cmake -DNONSEP_NATIVE=ON: figure 2n). 2a, 2h:
+//                          the floor of the boundary in the host's blocks of 256, as 1a and 1h. 2c: ChinBasicStep on
+//                          one batch over the same limit.
 //   3. threads:            8192 trajectories, run_job on 1 thread over 2 threads (speed-up); 3b the same while a
 //                          child process of this program spins on one core; 3c the hand-written loop cut into the
 //                          host's blocks on std::threads, 1 over 2: what the machine itself gives two threads.
@@ -29,7 +34,8 @@
 //   --smoke         a few repetitions of short runs (< 10 s; the ctest bench.performance.smoke)
 //   --repetitions   timed repetitions per configuration (default 7; smoke 3)
 //   --scale         multiplies every run's step count (default 1; smoke 0.05)
-//   --only          one group of figures: 1, 2, 3 (3, 3b, 3c), 4, 6b or 6c (e.g. to run one under callgrind)
+//   --only          one group of figures: 1 (1, 1a, 1h, 1r, 1c), 2 (2, 2a, 2h, 2c), 3 (3, 3b, 3c), 4, 6b or
+//                   6c (e.g. to run one under callgrind)
 // Exit status 1 when a check fails; the figures' targets are reported, not enforced (timings on a shared machine
 // are not a test).
 #include <signal.h>
@@ -49,6 +55,7 @@
 #include <thread>
 #include <vector>
 
+#include "abi_floor.hpp"
 #include "hand_written.hpp"
 #include "nonsep/core/chin_basic_step.hpp"
 #include "nonsep/host/job.hpp"
@@ -63,6 +70,11 @@ using json = nlohmann::json;
 using CompiledPaper1D = nonsep::sdk::ModelAdapter<Paper1D>;
 
 constexpr double dt = 1e-4;
+
+// The references' arrays start on a cache line, as the host's do (nonsep/core/aligned_allocator.hpp): with the wide
+// vectors of a native build, arrays that straddle lines would make the limit slower than it is.
+using Doubles = nonsep::AlignedDoubles;
+Doubles copy_of(const std::vector<double>& values) { return Doubles(values.begin(), values.end()); }
 
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
@@ -110,7 +122,7 @@ double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vect
 // differently).
 double time_hand_written(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
   const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
-  std::vector<double> q(job.job.initial.q), p(job.job.initial.p), g(q.size());
+  Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p), g(q.size());
   const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
   if (q.size() == 1)
@@ -118,10 +130,10 @@ double time_hand_written(const nonsep::host::LoadedJob& job, std::vector<double>
   else
     bench::hand_written_run(c, q.data(), p.data(), g.data(), q.size(), steps);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
-  final_q = q;
+  final_q.assign(q.begin(), q.end());
   if (q.size() == 1) return elapsed.count();
   // More than one state: the stage-by-stage loop too, and the faster of the two is the limit. Both must agree.
-  std::vector<double> q2(job.job.initial.q), p2(job.job.initial.p);
+  Doubles q2 = copy_of(job.job.initial.q), p2 = copy_of(job.job.initial.p);
   const auto start2 = Clock::now();
   bench::hand_written_run_staged(c, q2.data(), p2.data(), g.data(), q2.size(), steps);
   const std::chrono::duration<double> elapsed2 = Clock::now() - start2;
@@ -139,9 +151,27 @@ double time_core(const nonsep::host::LoadedJob& job, std::vector<double>& final_
   const double step_size = job.job.run().time.dt;
   const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
-  for (std::uint64_t k = 0; k < steps; ++k) stepper.step(model, x, step_size);
+  stepper.step_n(model, x, step_size, steps);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
   final_q.assign(x.q().begin(), x.q().end());
+  return elapsed.count();
+}
+
+// Seconds for the floor of the evaluation-only boundary (abi_floor.hpp) on `job`'s states: the hand-written staged
+// loop calling paper1d_minimal.so per stage, in the host's blocks; with `by_value`, one trajectory only, the control
+// that calls the scalar gradients by value.
+double time_abi_floor(const nonsep::host::LoadedJob& job, const bench::MinimalPlugin& plugin, bool by_value,
+                      std::vector<double>& final_q) {
+  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p);
+  const std::uint64_t steps = job.job.run().time.steps;
+  const auto start = Clock::now();
+  if (by_value)
+    bench::register_call_run(c, plugin, q.at(0), p.at(0), steps);
+  else
+    bench::abi_floor_run_blocks(c, plugin, q, p, nonsep::host::run_block_size, steps);
+  const std::chrono::duration<double> elapsed = Clock::now() - start;
+  final_q.assign(q.begin(), q.end());
   return elapsed.count();
 }
 
@@ -151,7 +181,7 @@ double time_core(const nonsep::host::LoadedJob& job, std::vector<double>& final_
 // thread here against 3.7 staged, and gave an implausible 2.9x "speed-up" on two cores (25 November 2026).
 double time_hand_written_blocks(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
   const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
-  std::vector<double> q(job.job.initial.q), p(job.job.initial.p), g(q.size());
+  Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p), g(q.size());
   const std::size_t count = q.size(), block = nonsep::host::run_block_size;
   const std::size_t blocks = (count + block - 1) / block;
   const std::uint64_t steps = job.job.run().time.steps;
@@ -167,7 +197,7 @@ double time_hand_written_blocks(const nonsep::host::LoadedJob& job, unsigned thr
   run(0, blocks / threads);
   for (auto& worker : workers) worker.join();
   const std::chrono::duration<double> elapsed = Clock::now() - start;
-  final_q = q;
+  final_q.assign(q.begin(), q.end());
   return elapsed.count();
 }
 
@@ -201,17 +231,19 @@ struct Figure {
   double reference;  // median of the reference, in `unit`
 };
 
-// Runs `a` and `b` interleaved `repetitions` times (after one warm-up each); their times, in seconds.
+// Runs every configuration once (warm-up), then all of them in turn `repetitions` times; their times, in seconds,
+// one vector per configuration.
+std::vector<std::vector<double>> interleaved(int repetitions, const std::vector<std::function<double()>>& runs) {
+  for (const auto& run : runs) run();
+  std::vector<std::vector<double>> times(runs.size());
+  for (int r = 0; r < repetitions; ++r)
+    for (std::size_t k = 0; k < runs.size(); ++k) times[k].push_back(runs[k]());
+  return times;
+}
 std::pair<std::vector<double>, std::vector<double>> interleaved(int repetitions, const std::function<double()>& a,
                                                                 const std::function<double()>& b) {
-  a();
-  b();
-  std::vector<double> ta, tb;
-  for (int r = 0; r < repetitions; ++r) {
-    ta.push_back(a());
-    tb.push_back(b());
-  }
-  return {ta, tb};
+  auto times = interleaved(repetitions, {a, b});
+  return {std::move(times[0]), std::move(times[1])};
 }
 
 // The figure of times `a` (measured) over `b` (reference), `per` converting seconds into `unit`.
@@ -265,6 +297,7 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(folder);
   const std::string analytic = std::string(NONSEP_BUILD_PLUGIN_DIR) + "/paper1d.so";
   const std::string automatic = std::string(NONSEP_BENCH_PLUGIN_DIR) + "/paper1d_autodiff.so";
+  const bench::MinimalPlugin minimal(std::string(NONSEP_BENCH_PLUGIN_DIR) + "/paper1d_minimal.so");
 
   std::vector<Figure> figures;
   bool agree = true;
@@ -295,16 +328,26 @@ int main(int argc, char** argv) {
     const auto steps = scaled(4e6);
     const auto job = make_job(folder, "single", analytic, 1, steps);
     const double per = 1e9 / static_cast<double>(steps);
-    const auto [host, limit] = interleaved(
-        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_hand_written(job, reference_q); });
+    std::vector<double> floor_q, control_q;
+    const auto t = interleaved(
+        repetitions,
+        {[&] { return time_host(job, 1, host_q); }, [&] { return time_hand_written(job, reference_q); },
+         [&] { return time_abi_floor(job, minimal, false, floor_q); },
+         [&] { return time_abi_floor(job, minimal, true, control_q); }, [&] { return time_core(job, core_q); }});
     check("figure 1", host_q, reference_q);
-    figures.push_back(
-        figure("1. one trajectory: host / hand-written", "<= 1.2", "ns per basic step", host, limit, per));
-    const auto [core, limit_c] = interleaved(
-        repetitions, [&] { return time_core(job, core_q); }, [&] { return time_hand_written(job, reference_q); });
+    check("figure 1a", floor_q, reference_q);
+    check("figure 1r", control_q, reference_q);
     check("figure 1c", core_q, reference_q);
-    figures.push_back(figure("1c. one trajectory: ChinBasicStep compiled in / hand-written", "(report)",
-                             "ns per basic step", core, limit_c, per));
+    const char* unit = "ns per basic step";
+    figures.push_back(figure("1. one trajectory: host / hand-written", "<= 1.2", unit, t[0], t[1], per));
+    figures.push_back(
+        figure("1a. one trajectory: ABI floor / hand-written", "(the floor of 1)", unit, t[2], t[1], per));
+    figures.push_back(
+        figure("1h. one trajectory: host / ABI floor (what the host adds)", "(report)", unit, t[0], t[2], per));
+    figures.push_back(figure("1r. one trajectory: gradients called by value / hand-written (control)", "(report)", unit,
+                             t[3], t[1], per));
+    figures.push_back(
+        figure("1c. one trajectory: ChinBasicStep compiled in / hand-written", "(report)", unit, t[4], t[1], per));
   }
   if (wanted("2")) {  // 2. 1024 trajectories, one thread
     const std::size_t count = 1024;
@@ -313,17 +356,24 @@ int main(int argc, char** argv) {
     const auto steps = scaled(40000);
     const auto job = make_job(folder, "ensemble", analytic, count, steps);
     const double per = 1e9 / static_cast<double>(steps * count);
-    const auto [host, limit] = interleaved(
-        repetitions, [&] { return time_host(job, 1, host_q); }, [&] { return time_hand_written(job, reference_q); });
+    std::vector<double> floor_q;
+    const auto t = interleaved(
+        repetitions,
+        {[&] { return time_host(job, 1, host_q); }, [&] { return time_hand_written(job, reference_q); },
+         [&] { return time_abi_floor(job, minimal, false, floor_q); }, [&] { return time_core(job, core_q); }});
     check("figure 2", host_q, reference_q);
-    figures.push_back(figure(std::string("2") + (native ? "n" : "") + ". 1024 trajectories: host (1 thread) / " +
-                                 "hand-written over 1024 states",
-                             "<= 1.15", "ns per basic step per trajectory", host, limit, per));
-    const auto [core, limit_c] = interleaved(
-        repetitions, [&] { return time_core(job, core_q); }, [&] { return time_hand_written(job, reference_q); });
+    check("figure 2a", floor_q, reference_q);
     check("figure 2c", core_q, reference_q);
-    figures.push_back(figure("2c. 1024 trajectories: ChinBasicStep on one batch / hand-written", "(report)",
-                             "ns per basic step per trajectory", core, limit_c, per));
+    const char* unit = "ns per basic step per trajectory";
+    const std::string n = native ? "n" : "";
+    figures.push_back(figure("2" + n + ". 1024 trajectories: host (1 thread) / hand-written over 1024 states",
+                             "<= 1.15", unit, t[0], t[1], per));
+    figures.push_back(figure("2" + n + "a. 1024 trajectories: ABI floor (blocks of 256) / hand-written",
+                             "(the floor of 2)", unit, t[2], t[1], per));
+    figures.push_back(figure("2" + n + "h. 1024 trajectories: host / ABI floor (what the host adds)", "(report)", unit,
+                             t[0], t[2], per));
+    figures.push_back(figure("2" + n + "c. 1024 trajectories: ChinBasicStep on one batch / hand-written", "(report)",
+                             unit, t[3], t[1], per));
   }
   if (wanted("3")) {  // 3. 2 threads over 1, 8192 trajectories: idle (3), a busy core (3b), hand-written (3c)
     const std::size_t count = 8192;
