@@ -263,21 +263,33 @@ TEST_CASE("step_n: a run the model fails partway leaves no stale gradient behind
   }
 }
 
-TEST_CASE("a batch's q and p start on a cache line, also when copied, moved or made from one state") {
+TEST_CASE(
+    "a batch's q and p start on a cache line from 32 numbers on, also when copied, moved or made from one "
+    "state") {
   const auto on_line = [](std::span<const double> values) {
     return reinterpret_cast<std::uintptr_t>(values.data()) % cache_line_size == 0;
   };
-  for (std::size_t count : {std::size_t{1}, std::size_t{3}, std::size_t{256}}) {
+  for (std::size_t count : {std::size_t{16}, std::size_t{17}, std::size_t{256}}) {
     CAPTURE(count);
     const PhaseSpaceBatch x(2, count);
     const PhaseSpaceBatch copy = x;
     PhaseSpaceBatch moved = PhaseSpaceBatch(x);
-    const auto single = PhaseSpaceBatch::single(x.q(0), x.p(0));
-    for (const PhaseSpaceBatch* batch : std::array<const PhaseSpaceBatch*, 4>{&x, &copy, &moved, &single}) {
+    for (const PhaseSpaceBatch* batch : std::array<const PhaseSpaceBatch*, 3>{&x, &copy, &moved}) {
       CHECK(on_line(batch->q()));
       CHECK(on_line(batch->p()));
     }
   }
+  const std::vector<double> q(40, 0.5), p(40, 0.25);
+  const auto single = PhaseSpaceBatch::single(q, p);
+  CHECK(on_line(single.q()));
+  CHECK(on_line(single.p()));
+  // Smaller arrays come from the ordinary heap; what matters there is that a vector can still free them.
+  AlignedDoubles small(3, 1.0), large(64, 1.0);
+  small = large;
+  large.resize(2);
+  large.shrink_to_fit();
+  CHECK(small.size() == 64);
+  CHECK(large.size() == 2);
 }
 
 TEST_CASE("the MPE weights of eqs. (mpe43) and (mpe63)") {

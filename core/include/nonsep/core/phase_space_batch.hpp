@@ -1,7 +1,7 @@
 #pragma once
 // A batch of phase-space points (q, p), the state every integrator steps. Layout as in model.hpp:
 // component i of state b at index b*n + i, in two separate contiguous arrays for q and p, each starting on a cache
-// line.
+// line when it holds 32 numbers or more (aligned_allocator.hpp).
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -53,7 +53,7 @@ class PhaseSpaceBatch {
  private:
   std::size_t dimension_ = 0;
   std::size_t count_ = 0;
-  AlignedDoubles q_;  // each on a cache line of its own (aligned_allocator.hpp)
+  AlignedDoubles q_;
   AlignedDoubles p_;
 };
 
