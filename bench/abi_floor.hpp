@@ -110,25 +110,7 @@ inline void abi_floor_run_blocks(const HandWrittenStep& c, const MinimalPlugin& 
 // The control: one trajectory, the gradients called through function pointers by value.
 inline void register_call_run(const HandWrittenStep& c, const MinimalPlugin& plugin, double& q, double& p,
                               std::uint64_t steps) {
-  const MinimalPlugin::Scalar T = plugin.grad_T_scalar, V = plugin.grad_V_scalar;
-  double x = q, y = p, g = V(x);
-  for (std::uint64_t k = 0; k < steps; ++k) {
-    y += c.v2 * g;
-    x += c.t2 * T(y);
-    g = V(x);
-    y += c.v1 * g;
-    x += c.t1 * T(y);
-    g = V(x);
-    y += c.v0 * g;
-    x += c.t1 * T(y);
-    g = V(x);
-    y += c.v1 * g;
-    x += c.t2 * T(y);
-    g = V(x);
-    y += c.v2 * g;
-  }
-  q = x;
-  p = y;
+  hand_written_run(c, q, p, steps, plugin.grad_T_scalar, plugin.grad_V_scalar);
 }
 
 }  // namespace bench

@@ -36,8 +36,11 @@ struct HandWrittenStep {
 inline double grad_T(double p) { return 1.0 + 0.5 * p * p; }
 inline double grad_V(double q) { return q * (1.0 + q * q / 3.0); }
 
-// `steps` basic steps of one trajectory (q, p), in place.
-inline void hand_written_run(const HandWrittenStep& c, double& q, double& p, std::uint64_t steps) {
+// `steps` basic steps of one trajectory (q, p), in place. The gradients are paper1d's inline ones unless others are
+// given (abi_floor.hpp's control passes functions of a plugin, called by value).
+template <class GradT = double (*)(double), class GradV = double (*)(double)>
+inline void hand_written_run(const HandWrittenStep& c, double& q, double& p, std::uint64_t steps,
+                             GradT grad_T = bench::grad_T, GradV grad_V = bench::grad_V) {
   double x = q, y = p, g = grad_V(x);
   for (std::uint64_t k = 0; k < steps; ++k) {
     y += c.v2 * g;
