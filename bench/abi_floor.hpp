@@ -83,17 +83,7 @@ inline void abi_floor_run(const HandWrittenStep& c, const MinimalPlugin& plugin,
     evaluate(api.grad_V, q, g);
   };
   evaluate(api.grad_V, q, g);
-  for (std::uint64_t k = 0; k < steps; ++k) {
-    kick(c.v2);
-    drift(c.t2);
-    kick(c.v1);
-    drift(c.t1);
-    kick(c.v0);
-    drift(c.t1);
-    kick(c.v1);
-    drift(c.t2);
-    kick(c.v2);
-  }
+  for (std::uint64_t k = 0; k < steps; ++k) basic_step_stages(c, kick, drift);
 }
 
 // The same in the host's blocks of `block` states, each stepped to the end in turn (one thread), as the host's

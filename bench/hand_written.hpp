@@ -84,6 +84,21 @@ inline void hand_written_run(const HandWrittenStep& c, double* q, double* p, dou
     }
 }
 
+// The nine stages of one basic step, each a call: kick(h) for p += h V'(q), drift(h) for q += h T'(p) (which also
+// evaluates V' at the new q for the next kick), with the coefficients of eq. (expalg) in their order.
+template <class Kick, class Drift>
+inline void basic_step_stages(const HandWrittenStep& c, Kick&& kick, Drift&& drift) {
+  kick(c.v2);
+  drift(c.t2);
+  kick(c.v1);
+  drift(c.t1);
+  kick(c.v0);
+  drift(c.t1);
+  kick(c.v1);
+  drift(c.t2);
+  kick(c.v2);
+}
+
 // The same, written stage by stage: each of the nine stages one loop over all states (as the Integrator goes).
 // Same operations per state, so the same bits as the loop above; which of the two is faster depends on the
 // build (the loop above is latency-bound without wide SIMD, this one is throughput-bound), so the benchmark
@@ -100,17 +115,7 @@ inline void hand_written_run_staged(const HandWrittenStep& c, double* q, double*
       g[b] = grad_V(q[b]);
     }
   };
-  for (std::uint64_t k = 0; k < steps; ++k) {
-    kick(c.v2);
-    drift(c.t2);
-    kick(c.v1);
-    drift(c.t1);
-    kick(c.v0);
-    drift(c.t1);
-    kick(c.v1);
-    drift(c.t2);
-    kick(c.v2);
-  }
+  for (std::uint64_t k = 0; k < steps; ++k) basic_step_stages(c, kick, drift);
 }
 
 }  // namespace bench
