@@ -114,11 +114,8 @@ class ChinBasicStep {
   // dimension differs from the model's; propagates the model's exceptions.
   template <Model M, class StageObserver = NoStageObserver>
   void step(const M& model, PhaseSpaceBatch& x, double dt, StageObserver&& observe = {}) {
-    check_step_size(dt);
     check_batch_fits(model, x);
-    const double eps = cube_root(dt);
-    if (eps_.size() != 1) eps_.resize(1);
-    eps_[0] = eps;
+    use_step_size(dt);
     advance(model, x, observe);
   }
 
@@ -147,11 +144,8 @@ class ChinBasicStep {
   template <Model M>
   void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
     if (n == 0) return;
-    check_step_size(dt);
     check_batch_fits(model, x);
-    const double eps = cube_root(dt);
-    if (eps_.size() != 1) eps_.resize(1);
-    eps_[0] = eps;
+    use_step_size(dt);
     begin_steps(model, x);
     NoStageObserver none;
     for (std::uint64_t k = 0; k < n; ++k) stages(model, x, none);
@@ -268,6 +262,14 @@ class ChinBasicStep {
     for (std::size_t i = 0; i < a.size(); ++i)
       difference |= std::bit_cast<std::uint64_t>(a[i]) ^ std::bit_cast<std::uint64_t>(b[i]);
     return difference == 0;
+  }
+
+  // One dt for every state: eps_ = {cbrt(dt)}. Throws InvalidArgument unless dt is finite and non-zero.
+  void use_step_size(double dt) {
+    check_step_size(dt);
+    const double eps = cube_root(dt);
+    if (eps_.size() != 1) eps_.resize(1);
+    eps_[0] = eps;
   }
 
   // cbrt(dt), remembered for the last few step sizes: a run steps with one dt (basic, MPE's terms) or cycles
