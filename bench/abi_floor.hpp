@@ -11,11 +11,11 @@
 // function pointers, one number in and out by value (registers): a call that passes nothing through memory.
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "hand_written.hpp"
 #include "nonsep/core/aligned_allocator.hpp"
