@@ -89,18 +89,18 @@ typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin *
 
 /* The arguments of chin_steps (below): `steps` basic steps of eq. (expalg) of every state, in place. */
 typedef struct nonsep_chin_steps_args {
-  uint32_t form;                     /* NONSEP_FORM_TTV or NONSEP_FORM_VVT */
-  uint32_t instruction_set;          /* index into the metadata's "kernels": {"instruction_sets": [...]} */
-  double t1, t2, v0, v1, v2;         /* the coefficients of eq. (expalg) */
-  const double* eps;                 /* cbrt(dt): one number for every state (eps_count 1) or one per state */
-  size_t eps_count;                  /* 1 or count */
-  uint64_t steps;                    /* >= 1 */
-  size_t count;                      /* states, in the batch layout */
-  double* q;                         /* count*n, advanced in place */
-  double* p;                         /* count*n, advanced in place */
-  double* outer_gradient;            /* count*n: in, the outer flows' gradient at the current point (grad V(q) in
-                                        TTV, grad T(p) in VVT); out, the same at the final point */
-  double* inner_gradient;            /* count*n, scratch */
+  uint32_t form;             /* NONSEP_FORM_TTV or NONSEP_FORM_VVT */
+  uint32_t instruction_set;  /* index into the metadata's "kernels": {"instruction_sets": [...]} */
+  double t1, t2, v0, v1, v2; /* the coefficients of eq. (expalg) */
+  const double* eps;         /* cbrt(dt): one number for every state (eps_count 1) or one per state */
+  size_t eps_count;          /* 1 or count */
+  uint64_t steps;            /* >= 1 */
+  size_t count;              /* states, in the batch layout */
+  double* q;                 /* count*n, advanced in place */
+  double* p;                 /* count*n, advanced in place */
+  double* outer_gradient;    /* count*n: in, the outer flows' gradient at the current point (grad V(q) in
+                                TTV, grad T(p) in VVT); out, the same at the final point */
+  double* inner_gradient;    /* count*n, scratch */
 } nonsep_chin_steps_args;
 
 typedef struct nonsep_plugin_api {
