@@ -1,5 +1,7 @@
 #include "nonsep/core/integrator.hpp"
 
+#include <stdexcept>
+
 namespace nonsep {
 
 namespace {
@@ -26,6 +28,16 @@ IntegratorDescription description_of(const S& stepper) {
     return stepper.describe();
 }
 }  // namespace
+
+OptionField option_field(IntegratorSpec& spec, const ParameterDescription& parameter) {
+  const bool number = parameter.kind == ParameterDescription::Kind::Number;
+  if (parameter.name == "order" && parameter.kind == ParameterDescription::Kind::Order) return &spec.order;
+  if (parameter.name == "t2" && number) return &spec.t2;
+  if (parameter.name == "omega" && number) return &spec.omega;
+  if (parameter.name == "stages" && number) return &spec.stages;
+  if (parameter.name == "max_iterations" && number) return &spec.max_iterations;
+  throw std::logic_error("IntegratorSpec has no field for the catalogue option '" + parameter.name + "'");
+}
 
 Integrator::Integrator(const IntegratorSpec& spec) : spec_(spec), form_(spec.form), stepper_(build(spec)) {}
 

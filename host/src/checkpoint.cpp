@@ -3,10 +3,15 @@
 #include <bit>
 #include <charconv>
 #include <cmath>
-#include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <type_traits>
+#include <utility>
+#include <variant>
+#include <vector>
 
+#include "nonsep/core/integrator.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/files.hpp"
@@ -113,55 +118,91 @@ namespace {
 // The plugin file's bytes, hashed: another library with the same name and version is another model.
 std::uint64_t file_hash(const std::filesystem::path& path) { return file_content_hash(path).value_or(0); }
 
-// The parts of a fingerprint, "name:hash" separated by spaces, in this order.
-constexpr const char* fingerprint_parts[] = {"plugin", "parameters", "integrator", "initial",
-                                             "time",   "output",     "analysis"};
+// The integrator's part: the scheme and the form; then one part per option of the scheme's catalogue entry
+// ("integrator.omega"), read through option_field, so that every option of every scheme is in the fingerprint and a
+// changed one is named.
+void add_integrator_parts(std::vector<std::pair<std::string, std::string>>& parts, const IntegratorSpec& spec) {
+  parts.emplace_back("integrator", spec.scheme + '\n' + (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT"));
+  const Scheme* scheme = find_scheme(spec.scheme);
+  if (!scheme) return;         // the job reader refuses an unknown scheme; the name alone identifies it
+  IntegratorSpec copy = spec;  // option_field hands out fields to write; here they are only read
+  for (const ParameterDescription& option : scheme->parameters) {
+    std::string text;
+    std::visit(
+        [&](auto* field) {
+          if constexpr (std::is_same_v<decltype(field), Fraction*>)
+            text = field->to_string();
+          else
+            append_bits(text, *field);
+        },
+        option_field(copy, option));
+    parts.emplace_back("integrator." + option.name, text);
+  }
+}
+
+// "name:hash" pairs separated by spaces.
+std::map<std::string, std::string> fingerprint_parts(const std::string& fingerprint) {
+  std::map<std::string, std::string> parts;
+  std::istringstream words(fingerprint);
+  for (std::string word; words >> word;) {
+    const std::size_t colon = word.find(':');
+    parts[word.substr(0, colon)] = colon == std::string::npos ? "" : word.substr(colon + 1);
+  }
+  return parts;
+}
 
 }  // namespace
 
 std::string job_fingerprint(const LoadedJob& loaded) {
   const Job& job = loaded.job;
   const SingleRun& run = job.run();
-  std::string parts[7];
-  parts[0] =
-      loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' + content_hash_hex(file_hash(loaded.plugin.path()));
-  parts[1] = loaded.model.parameters().dump();
-  parts[2] = run.integrator.scheme + '\n' + run.integrator.order.to_string() + '\n';
-  append_bits(parts[2], run.integrator.t2);
-  parts[2] += run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
-  parts[3] = std::to_string(job.initial.dimension) + ' ' + std::to_string(job.initial.count) + '\n';
-  for (double x : job.initial.q) append_bits(parts[3], x);
-  for (double x : job.initial.p) append_bits(parts[3], x);
-  append_bits(parts[4], run.time.dt);
-  append_bits(parts[4], run.time.t_end);
-  parts[4] += std::to_string(run.time.steps);
-  parts[5] = std::to_string(run.every) + ' ' + std::to_string(run.energy_every);
-  if (run.format == OutputFormat::hdf5) parts[5] += " hdf5";  // csv adds nothing: older checkpoints stay valid
-  if (run.analysis.closest_return_after) append_bits(parts[6], *run.analysis.closest_return_after);
-  parts[6] += '|';
-  if (run.analysis.max_relative_energy_error) append_bits(parts[6], *run.analysis.max_relative_energy_error);
+  std::vector<std::pair<std::string, std::string>> parts;
+  parts.emplace_back("plugin", loaded.plugin.name() + '\n' + loaded.plugin.version() + '\n' +
+                                   content_hash_hex(file_hash(loaded.plugin.path())));
+  parts.emplace_back("parameters", loaded.model.parameters().dump());
+  add_integrator_parts(parts, run.integrator);
+  std::string initial = std::to_string(job.initial.dimension) + ' ' + std::to_string(job.initial.count) + '\n';
+  for (double x : job.initial.q) append_bits(initial, x);
+  for (double x : job.initial.p) append_bits(initial, x);
+  parts.emplace_back("initial", std::move(initial));
+  std::string time;
+  append_bits(time, run.time.dt);
+  append_bits(time, run.time.t_end);
+  time += std::to_string(run.time.steps);
+  parts.emplace_back("time", std::move(time));
+  std::string output = std::to_string(run.every) + ' ' + std::to_string(run.energy_every);
+  if (run.format == OutputFormat::hdf5) output += " hdf5";
+  parts.emplace_back("output", std::move(output));
+  std::string analysis;
+  if (run.analysis.closest_return_after) append_bits(analysis, *run.analysis.closest_return_after);
+  analysis += '|';
+  if (run.analysis.max_relative_energy_error) append_bits(analysis, *run.analysis.max_relative_energy_error);
   if (const auto& section = run.analysis.poincare) {
-    parts[6] += "|poincare ";
-    for (double x : section->normal) append_bits(parts[6], x);
-    append_bits(parts[6], section->offset);
-    parts[6] += std::to_string(static_cast<int>(section->direction)) + ' ' +
+    analysis += "|poincare ";
+    for (double x : section->normal) append_bits(analysis, x);
+    append_bits(analysis, section->offset);
+    analysis += std::to_string(static_cast<int>(section->direction)) + ' ' +
                 (section->max_crossings ? std::to_string(*section->max_crossings) : "none");
   }
   if (const auto& lyapunov = run.analysis.lyapunov)
-    parts[6] += "|lyapunov " + std::to_string(lyapunov->vectors) + ' ' + std::to_string(lyapunov->renormalize_every) +
+    analysis += "|lyapunov " + std::to_string(lyapunov->vectors) + ' ' + std::to_string(lyapunov->renormalize_every) +
                 ' ' + std::to_string(lyapunov->every);
-  if (run.analysis.megno) parts[6] += "|megno";
+  if (run.analysis.megno) analysis += "|megno";
+  parts.emplace_back("analysis", std::move(analysis));
   std::string fingerprint;
-  for (std::size_t i = 0; i < 7; ++i)
-    fingerprint += (i ? " " : "") + std::string(fingerprint_parts[i]) + ":" + content_hash_hex(content_hash(parts[i]));
+  for (const auto& [name, text] : parts)
+    fingerprint += (fingerprint.empty() ? "" : " ") + name + ":" + content_hash_hex(content_hash(text));
   return fingerprint;
 }
 
 std::string fingerprint_difference(const std::string& a, const std::string& b) {
-  std::istringstream first(a), second(b);
-  std::string x, y, differ;
-  while (first >> x && second >> y)
-    if (x != y) differ += (differ.empty() ? "" : ", ") + x.substr(0, x.find(':'));
+  const auto first = fingerprint_parts(a), second = fingerprint_parts(b);
+  std::string differ;
+  const auto add = [&](const std::string& name) { differ += (differ.empty() ? "" : ", ") + name; };
+  for (const auto& [name, hash] : first)
+    if (const auto other = second.find(name); other == second.end() || other->second != hash) add(name);
+  for (const auto& [name, hash] : second)
+    if (!first.contains(name)) add(name);
   return differ.empty() ? "the job's identity" : differ;
 }
 
@@ -217,15 +258,18 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
 
 Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded) {
   const Job& job = loaded.job;
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
+  std::optional<std::string> text;
+  try {
+    text = read_regular_file(path);
+  } catch (const OutputError& error) {
+    throw CheckpointError(error.what());
+  }
+  if (!text)
     throw CheckpointError("nothing to resume: there is no " + path.string() +
                           " (a run saves one when interrupted and as /checkpoint says; a completed run removes it)");
-  std::ostringstream text;
-  text << in.rdbuf();
   json document;
   try {
-    document = json::parse(text.str());
+    document = json::parse(*text);
   } catch (const json::exception& error) {
     damaged(path, std::string("not JSON: ") + error.what());
   }
@@ -240,8 +284,9 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)
     throw CheckpointError(
         path.string() + " belongs to a different job: its " + fingerprint_difference(fingerprint, expected) +
-        " differ (the plugin part covers the plugin file's bytes, output covers output.every, "
-        "energy_every and format); run with --force to start over, or resume with the job that wrote it");
+        " differ (the plugin part covers the plugin file's bytes, integrator.NAME is the integrator's option NAME, "
+        "output covers output.every, energy_every and format); run with --force to start over, or resume with the "
+        "job that wrote it");
   Checkpoint checkpoint;
   DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;

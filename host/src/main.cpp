@@ -9,6 +9,9 @@ int main(int argc, char** argv) {
   // A closed standard output (`nonsep models | head -1`) is a write error reported below, not a death by SIGPIPE
   // with a status outside the documented table.
   std::signal(SIGPIPE, SIG_IGN);
+  // Likewise a file size limit (`ulimit -f`): write() fails with EFBIG, which the run reports (exit 1, the file cut
+  // back to its last whole row, summary.json written), instead of a death by SIGXFSZ halfway through a row.
+  std::signal(SIGXFSZ, SIG_IGN);
   const int status = nonsep::host::run_command_line(argc, argv);
   if (!std::cout.flush()) {
     std::cerr << "nonsep: cannot write to standard output (was it closed?)\n";

@@ -8,8 +8,10 @@
      (no mpirun) ends byte for byte as an uninterrupted one; a fresh run in that folder is refused (exit 2).
   3. A plugin that cannot be loaded on rank 1 only: exit 2 on every rank, one message naming rank 1, no hang.
   4. An unreadable job under mpirun: exit 2, the message printed once.
-  5. SIGUSR1 to mpirun (passed on to the ranks): exit 143; --resume with another job's units: exit 2, "cannot
-     resume"; the run resumed on two ranks ends byte for byte as an uninterrupted one.
+  5. SIGUSR1 to mpirun (passed on to the ranks) once a unit has finished: exit 143; meanwhile a --force run into that
+     unit's folder is refused; --resume with another job's units: exit 2, "cannot resume"; a finished unit cut short,
+     and units/ replaced by a link out of the folder, are refused on two ranks (exit 2, nothing merged or written
+     through the link); the run resumed on two ranks ends byte for byte as an uninterrupted one.
   6. output.format "hdf5" on two ranks: results.h5 holds the numbers and attributes of one process's.
   7. A rank that crashes (the blowup test plugin raises SIGSEGV in grad V): mpirun ends every rank, non-zero, no hang.
 Usage: check_distributed_run.py NONSEP MPIEXEC JOB.json WORKDIR [BLOWUP_PLUGIN.so]
@@ -141,7 +143,16 @@ check(r.returncode == 2 and len(lines) == 1 and "missing.json" in lines[0],
 other = work / "long_interrupted_twice"
 process = subprocess.Popen([mpiexec, "-n", "2", nonsep, "run", "-q", "--threads", "1", str(long_job), "--output",
                             str(other)], env=signal_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-time.sleep(max(1.0, 0.15 * single_seconds))
+deadline = time.monotonic() + 300
+while not list((other / "units").glob("*/.nonsep-unit.json")) and time.monotonic() < deadline:
+    time.sleep(0.01)  # until a unit is sealed (finished), so that the resume has a finished unit to verify
+sealed = sorted(p.parent.name for p in (other / "units").glob("*/.nonsep-unit.json"))
+check(len(sealed) > 0, "a unit finished while the run goes on")
+# Another run cannot take a unit's folder over while the distributed run is active, --force or not.
+quick = Path(__file__).resolve().parents[2] / "examples" / "jobs" / "quickstart.json"
+r = run([nonsep, "run", "-q", "--force", str(quick), "--output", str(other / "units" / sealed[0])], timeout=120)
+check(r.returncode == 2 and "work unit of a distributed run" in r.stderr,
+      f"--force into a finished unit while the run is active: exit 2 ({r.returncode} {r.stderr[-300:]})")
 process.send_signal(signal.SIGUSR1)
 out, err = process.communicate(timeout=300)
 check(process.returncode == 143 and "stopped by SIGUSR1" in err,
@@ -155,6 +166,25 @@ r = mpirun(2, ["run", "-q", str(other_job), "--output", str(other), "--resume"],
 lines = [l for l in r.stderr.splitlines() if l.startswith("nonsep:")]
 check(r.returncode == 2 and len(lines) == 1 and "cannot resume" in lines[0],
       f"resuming another job's units: exit 2, one message ({r.returncode}: {lines})")
+# A finished unit cut short, or units/ replaced by a link out of the folder: the resume on two ranks refuses it, naming
+# it, and writes nothing outside.
+cut = work / "cut_unit"
+shutil.copytree(other, cut, symlinks=True)
+unit = cut / "units" / sealed[0]
+size = (unit / "trajectory.csv").stat().st_size
+os.truncate(unit / "trajectory.csv", min(50000, size // 2))
+r = mpirun(2, ["run", "-q", "--threads", "1", str(long_job), "--output", str(cut), "--resume"], timeout=300)
+check(r.returncode == 2 and f"work unit {unit}" in r.stderr and not (cut / "trajectory.csv").exists(),
+      f"a finished unit cut short: exit 2 naming it, nothing merged ({r.returncode} {r.stderr[-400:]})")
+linked = work / "linked_units"
+shutil.copytree(other, linked, symlinks=True)
+(linked / "units").rename(work / "outside_units")
+(linked / "units").symlink_to(work / "outside_units")
+before = sorted(str(p) for p in (work / "outside_units").rglob("*"))
+r = mpirun(2, ["run", "-q", "--threads", "1", str(long_job), "--output", str(linked), "--resume"], timeout=300)
+check(r.returncode == 2 and "is a symbolic link" in r.stderr,
+      f"units/ a link out of the folder: exit 2 ({r.returncode} {r.stderr[-300:]})")
+check(sorted(str(p) for p in (work / "outside_units").rglob("*")) == before, "nothing written through the link")
 r = mpirun(2, ["run", "-q", "--threads", "1", str(long_job), "--output", str(other), "--resume"], timeout=900)
 check(r.returncode == long_status, f"resumed on two ranks: exit {long_status} ({r.returncode})")
 same_results(reference, other, "interrupted on 2 ranks, resumed on 2")

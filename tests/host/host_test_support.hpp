@@ -79,8 +79,10 @@ struct Process {
   std::filesystem::path out, err;
 };
 
-// Starts the program argv[0] (a path) with arguments argv[1...], stdout and stderr going to files in `folder`.
-inline Process start_process(std::vector<std::string> argv_storage, const std::filesystem::path& folder) {
+// Starts the program argv[0] (a path) with arguments argv[1...], stdout and stderr going to files in `folder`, with
+// the signals `default_signals` at their default disposition whatever this process's is.
+inline Process start_process(std::vector<std::string> argv_storage, const std::filesystem::path& folder,
+                             const std::vector<int>& default_signals = {}) {
   use_test_plugins();
   static int serial = 0;
   Process process;
@@ -93,7 +95,15 @@ inline Process start_process(std::vector<std::string> argv_storage, const std::f
   std::vector<char*> argv;
   for (auto& arg : argv_storage) argv.push_back(arg.data());
   argv.push_back(nullptr);
-  const int error = posix_spawn(&process.pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  for (int signal : default_signals) sigaddset(&defaults, signal);
+  posix_spawnattr_setsigdefault(&attributes, &defaults);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF);
+  const int error = posix_spawn(&process.pid, argv[0], &actions, &attributes, argv.data(), environ);
+  posix_spawnattr_destroy(&attributes);
   posix_spawn_file_actions_destroy(&actions);
   if (error != 0) throw std::runtime_error("cannot start " + argv_storage[0]);
   return process;

@@ -2,7 +2,11 @@
 // The runs under mpirun are tests/cluster/check_distributed_run.py.
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "host_test_support.hpp"
@@ -11,6 +15,7 @@
 #include "nonsep/host/cluster/ranks.hpp"
 #include "nonsep/host/output/files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
+#include "nonsep/host/run/run_job.hpp"
 
 using nonsep::host_testing::read_text;
 using nonsep::host_testing::TemporaryFolder;
@@ -152,4 +157,153 @@ TEST_CASE("a distributed run on one rank writes the files of an ordinary run, by
   }
   CHECK(a == b);
   CHECK_FALSE(std::filesystem::exists(folder / "units" / host::units_folder));
+}
+
+namespace {
+
+const std::filesystem::path grid_job =
+    std::filesystem::path(NONSEP_SOURCE_DIR) / "tests/cluster/jobs/dynamics_grid.json";
+
+host::RunOptions options_for(const std::filesystem::path& out, bool resume) {
+  host::RunOptions options;
+  options.threads = 2;
+  options.output_directory = out;
+  options.resume = resume;
+  return options;
+}
+
+// `loaded` run on one rank into `out` and stopped (as by SIGTERM) once units 0 and 1 are sealed.
+void interrupt_after_two_units(const host::LoadedJob& loaded, const std::filesystem::path& out) {
+  std::atomic<bool> stop{false};
+  host::RunOptions options = options_for(out, false);
+  options.stop_requested = &stop;
+  std::thread watcher([&] {
+    nonsep::host_testing::wait_until([&] { return std::filesystem::exists(out / "units/000001/.nonsep-unit.json"); });
+    stop = true;
+  });
+  const host::Ranks one;
+  const host::RunOutcome outcome = host::run_distributed(loaded, options, one);
+  watcher.join();
+  REQUIRE(outcome.exit_status == host::ExitStatus::interrupted);
+}
+
+// The message of a resume of `out` that must be refused.
+std::string refused_resume(const host::LoadedJob& loaded, const std::filesystem::path& out) {
+  const host::Ranks one;
+  try {
+    host::run_distributed(loaded, options_for(out, true), one);
+  } catch (const host::RankFailure& failure) {
+    return failure.what();
+  }
+  FAIL("the resume was not refused");
+  return "";
+}
+
+void change_one_digit(const std::filesystem::path& path) {
+  std::string text = read_text(path);
+  const std::size_t at = text.find_first_of("123456789", text.find('\n'));
+  text[at] = text[at] == '9' ? '8' : static_cast<char>(text[at] + 1);
+  write(path, text);
+}
+
+}  // namespace
+
+TEST_CASE("a distributed resume verifies every finished unit and refuses one edited, cut, swapped or of another job") {
+  const TemporaryFolder folder;
+  const host::LoadedJob loaded = host::load_job(grid_job);
+  host::run_job(loaded, options_for(folder / "plain", false));
+  interrupt_after_two_units(loaded, folder / "stopped");
+  // The same job with another coupling: another job's units, sealed as units 0 and 1 of that job.
+  nlohmann::json other = nonsep::host_testing::read_json(grid_job);
+  other["model"]["parameters"]["coupling"] = 0.3;
+  const host::LoadedJob other_loaded = host::load_job(nonsep::host_testing::write_job(folder / "other.json", other));
+  interrupt_after_two_units(other_loaded, folder / "other");
+
+  const auto copy = [&](const std::string& name) {
+    std::filesystem::copy(folder / "stopped", folder / name, std::filesystem::copy_options::recursive);
+    return folder / name;
+  };
+  const auto unit = [](const std::filesystem::path& out, const char* number) { return out / "units" / number; };
+  {
+    const auto out = copy("cut");
+    std::filesystem::resize_file(unit(out, "000000") / "trajectory.csv",
+                                 std::filesystem::file_size(unit(out, "000000") / "trajectory.csv") / 2);
+    const std::string message = refused_resume(loaded, out);
+    CHECK(message.find("cannot resume: work unit " + unit(out, "000000").string()) != std::string::npos);
+    CHECK(message.find("trajectory.csv that is not the one it ended with") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(out / "trajectory.csv"));
+  }
+  {
+    const auto out = copy("digit");
+    change_one_digit(unit(out, "000000") / "trajectories.csv");
+    const std::string message = refused_resume(loaded, out);
+    CAPTURE(message);
+    CHECK(message.find("trajectories.csv that is not the one it ended with") != std::string::npos);
+    CHECK(message.find(", other content)") != std::string::npos);
+  }
+  {
+    const auto out = copy("swapped");
+    std::filesystem::remove_all(unit(out, "000000"));
+    std::filesystem::copy(unit(out, "000001"), unit(out, "000000"), std::filesystem::copy_options::recursive);
+    CHECK(refused_resume(loaded, out).find("is sealed as another unit") != std::string::npos);
+  }
+  {
+    const auto out = copy("foreign");
+    std::filesystem::remove_all(unit(out, "000000"));
+    std::filesystem::copy(unit(folder / "other", "000000"), unit(out, "000000"),
+                          std::filesystem::copy_options::recursive);
+    const std::string message = refused_resume(loaded, out);
+    CHECK(message.find(unit(out, "000000").string() + " (trajectories 0 to 255) was computed by another job") !=
+          std::string::npos);
+    CHECK(message.find("parameters") != std::string::npos);
+  }
+  {  // a unit that wrote its files but died before its seal is run again, not merged unverified
+    const auto out = copy("unsealed");
+    change_one_digit(unit(out, "000001") / "trajectories.csv");
+    std::filesystem::remove(unit(out, "000001") / ".nonsep-unit.json");
+    const host::Ranks one;
+    host::run_distributed(loaded, options_for(out, true), one);
+    for (const char* name : {"trajectory.csv", "trajectories.csv", "poincare.csv", "lyapunov.csv"}) {
+      CAPTURE(name);
+      CHECK(read_text(out / name) == read_text(folder / "plain" / name));
+    }
+  }
+}
+
+TEST_CASE("a distributed resume follows no link at units/ or a unit, and no other run takes a unit's folder over") {
+  const TemporaryFolder folder;
+  const host::LoadedJob loaded = host::load_job(grid_job);
+  interrupt_after_two_units(loaded, folder / "stopped");
+  const auto copy = [&](const std::string& name) {
+    std::filesystem::copy(folder / "stopped", folder / name, std::filesystem::copy_options::recursive);
+    return folder / name;
+  };
+  {
+    const auto out = copy("linked_units");
+    std::filesystem::rename(out / "units", folder / "outside_units");
+    std::filesystem::create_directory_symlink(folder / "outside_units", out / "units");
+    const auto before = std::distance(std::filesystem::recursive_directory_iterator(folder / "outside_units"), {});
+    CHECK(refused_resume(loaded, out).find((out / "units").string() + " is a symbolic link") != std::string::npos);
+    CHECK(std::distance(std::filesystem::recursive_directory_iterator(folder / "outside_units"), {}) == before);
+  }
+  {
+    const auto out = copy("linked_unit");
+    std::filesystem::create_directories(folder / "outside_unit");
+    std::filesystem::remove_all(out / "units/000003");
+    std::filesystem::create_directory_symlink(folder / "outside_unit", out / "units/000003");
+    CHECK(refused_resume(loaded, out).find("units/000003 is a symbolic link") != std::string::npos);
+    CHECK(std::filesystem::is_empty(folder / "outside_unit"));
+  }
+  {
+    const auto out = copy("taken_over");
+    const host::LoadedJob small =
+        host::load_job(std::filesystem::path(NONSEP_SOURCE_DIR) / "examples/jobs/quickstart.json");
+    host::RunOptions force = options_for(out / "units/000001", false);
+    force.force = true;
+    CHECK_THROWS_AS(host::run_job(small, force), host::FolderInUse);
+    // Without the unit's manifest the run goes ahead; the seal then refuses what it left.
+    std::filesystem::remove(out / "units/000001/.nonsep-run.json");
+    host::run_job(small, force);
+    CHECK(refused_resume(loaded, out).find("work unit " + (out / "units/000001").string()) != std::string::npos);
+  }
 }

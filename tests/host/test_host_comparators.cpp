@@ -7,8 +7,13 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
 
 #include "host_run_support.hpp"
+#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/job.hpp"
 
 using json = nlohmann::json;
 using namespace nonsep::host_testing;
@@ -258,4 +263,58 @@ TEST_CASE("a Tao run killed and resumed continues its copies: the files and the 
   // The resumed process evaluates one grad H per trajectory to start (the gradient the killed one had cached).
   CHECK(summary["evaluations"]["grad_H"].get<std::uint64_t>() ==
         uninterrupted["evaluations"]["grad_H"].get<std::uint64_t>() + 300);
+}
+
+TEST_CASE("every option of every catalogue entry is in the checkpoint's fingerprint, and a changed one is named") {
+  use_test_plugins();
+  TemporaryFolder folder;
+  for (const nonsep::Scheme& scheme : nonsep::scheme_catalogue()) {
+    CAPTURE(scheme.name);
+    const auto file = write_job(folder / (scheme.name + ".json"),
+                                paper1d_job(state(2.0, 0.0), {{"dt", 0.01}, {"steps", 4}}, {{"scheme", scheme.name}}));
+    nonsep::host::LoadedJob loaded = nonsep::host::load_job(file);
+    const std::string fingerprint = nonsep::host::job_fingerprint(loaded);
+    for (const nonsep::ParameterDescription& option : scheme.parameters) {
+      CAPTURE(option.name);
+      nonsep::host::LoadedJob changed = loaded;
+      auto& spec = std::get<nonsep::host::SingleRun>(changed.job.plan).integrator;
+      std::visit(
+          [](auto* field) {
+            if constexpr (std::is_same_v<decltype(field), nonsep::Fraction*>)
+              *field = nonsep::Fraction(99, 7);
+            else
+              *field = *field * 2 + 1;
+          },
+          nonsep::option_field(spec, option));
+      CHECK(nonsep::host::fingerprint_difference(fingerprint, nonsep::host::job_fingerprint(changed)) ==
+            "integrator." + option.name);
+    }
+  }
+}
+
+TEST_CASE(
+    "a comparator resumed with another option is refused with exit 2 naming it (Tao's omega, Gauss's iterations)") {
+  const std::pair<json, json> changes[] = {
+      {{{"scheme", "tao"}, {"order", 2}, {"omega", 20}}, {{"scheme", "tao"}, {"order", 2}, {"omega", 5}}},
+      {{{"scheme", "gauss"}, {"max_iterations", 100}}, {{"scheme", "gauss"}, {"max_iterations", 3}}}};
+  for (const auto& [before, after] : changes) {
+    CAPTURE(before);
+    json initial = json::array();
+    for (int k = 0; k < 50; ++k) initial.push_back(state(0.5 + 0.005 * k, 0.1));
+    json job = paper1d_job(initial, {{"dt", 0.001}, {"steps", 1000000}}, before);
+    job["checkpoint"] = {{"every_steps", 100}, {"every_seconds", 0}};
+    TemporaryFolder folder;
+    const auto file = write_job(folder / "job.json", job);
+    kill_after_checkpoint(file, folder / "out", 100, folder.path());
+    const std::string checkpoint = read_text(folder / "out" / "checkpoint.json");
+    job["integrator"] = after;
+    write_job(file, job);
+    const auto refused =
+        run_nonsep({"run", "--quiet", "--resume", "--output", (folder / "out").string(), file.string()}, folder.path());
+    INFO("stderr: " << refused.err);
+    CHECK(refused.status == 2);
+    const std::string option = before.contains("omega") ? "integrator.omega" : "integrator.max_iterations";
+    CHECK(refused.err.find("its " + option + " differ") != std::string::npos);
+    CHECK(read_text(folder / "out" / "checkpoint.json") == checkpoint);
+  }
 }

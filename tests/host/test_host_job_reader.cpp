@@ -155,6 +155,24 @@ TEST_CASE("time: the problems of dt, t_end and steps") {
         std::vector<std::string>{"/time/stop"});
 }
 
+TEST_CASE("an end time whose t_end / dt overflows a double is over the step limit, for a run and a study") {
+  for (const auto& [dt, t_end] : {std::pair{1e-308, 1e308}, std::pair{5e-324, 1.0}, std::pair{-5e-324, -1.0}}) {
+    CAPTURE(dt);
+    const auto issues = parse(with_time({{"dt", dt}, {"t_end", t_end}})).issues;
+    REQUIRE(paths(issues) == std::vector<std::string>{"/time/t_end"});
+    CHECK(issues[0].found.find("beyond the largest double") != std::string::npos);
+    CHECK(issues[0].allowed == "at most " + std::to_string(max_steps) + " steps");
+  }
+  json study = host_testing::quickstart_job();
+  study.erase("integrator");
+  study.erase("output");
+  study["time"] = {{"t_end", 1.0}};
+  study["study"] = {{"dt", {0.1, 5e-324}}, {"integrators", {{{"scheme", "basic"}}}}};
+  const auto issues = parse(study).issues;
+  REQUIRE(paths(issues) == std::vector<std::string>{"/study/dt/1"});
+  CHECK(issues[0].allowed == "at most " + std::to_string(max_steps) + " steps");
+}
+
 TEST_CASE("initial states: one, a list, or a grid in row-major order (last axis fastest)") {
   json document = host_testing::quickstart_job();
   document["initial"] = json::array({{{"q", {1.0}}, {"p", {0.5}}}, {{"q", {2.0}}, {"p", {-0.5}}}});

@@ -212,14 +212,16 @@ TEST_CASE("resume never follows a linked trajectory.csv: the link's target is ne
 TEST_CASE("a full disk (a file size limit) leaves trajectory.csv ending in a whole row, and says so") {
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", paper1d_job(1.0, 10'000'000, 1));
-  // 64 blocks of 512 bytes: the limit is hit partway through a buffer; SIGXFSZ ignored, so write() comes back
-  // short and then fails with EFBIG, as on a full disk.
-  const Process running =
-      start_process({"/bin/sh", "-c", "ulimit -f 64 && trap '' XFSZ && exec \"$0\" run --quiet \"$1\"",
-                     NONSEP_EXECUTABLE, file.string()},
-                    folder.path());
+  // 64 blocks of 512 bytes: the limit is hit partway through a buffer. SIGXFSZ at its default disposition, which
+  // kills a process that writes past the limit: nonsep must see write() come back short and then fail with EFBIG,
+  // as on a full disk, whatever its caller's disposition.
+  const Process running = start_process(
+      {"/bin/sh", "-c", "ulimit -f 64 && exec \"$0\" run --quiet \"$1\"", NONSEP_EXECUTABLE, file.string()},
+      folder.path(), {SIGXFSZ});
   const Result result = finish(running);
+  CHECK(!result.killed);
   CHECK(result.status == 1);
+  CHECK(read_json(folder / "out" / "summary.json")["status"] == "failed");
   CHECK(contains(result.err, "trajectory.csv"));
   const std::string text = read_text(folder / "out" / "trajectory.csv");
   REQUIRE(text.size() > 1000);

@@ -257,6 +257,39 @@ TEST_CASE("a very slow plugin: SIGINT or SIGTERM ends the run after the current 
   }
 }
 
+TEST_CASE("a signal delivered twice at once (timeout signals the process and its group) stops the run once") {
+  TemporaryFolder folder;
+  const auto file = write_job(
+      folder / "job.json", job_with("blowup", state(0.5, 0.5), {{"sleep_ms", 40}}, {{"dt", 0.001}, {"steps", 100000}}));
+  const auto process = start_nonsep({"run", "--quiet", file.string()}, folder.path());
+  wait_for_file(folder / "out/trajectory.csv", 60);
+  // Pending signals are delivered lowest number first: SIGUSR1 stops the run, the two SIGTERMs are repeats.
+  for (const int signal : {SIGTERM, SIGTERM, SIGUSR1}) REQUIRE(::kill(process.pid, signal) == 0);
+  const auto result = finish(process, std::chrono::seconds(30));
+  INFO("stderr: " << result.err);
+  CHECK(!result.killed);
+  CHECK(result.status == 143);
+  CHECK(contains(result.err, "stopped by SIG"));
+  CHECK(read_run(folder / "out")["status"] == "interrupted");
+  CHECK(std::filesystem::exists(folder / "out/checkpoint.json"));
+}
+
+TEST_CASE("a second signal well after the first is the user insisting: the process ends at once, killed by it") {
+  TemporaryFolder folder;
+  // 1.5 s per grad V call: the step the first signal lets finish outlasts the window of repeated deliveries.
+  const auto file = write_job(folder / "job.json", job_with("blowup", state(0.5, 0.5), {{"sleep_ms", 1500}},
+                                                            {{"dt", 0.001}, {"steps", 100000}}));
+  const auto process = start_nonsep({"run", "--quiet", file.string()}, folder.path());
+  wait_for_file(folder / "out/trajectory.csv", 60);
+  REQUIRE(::kill(process.pid, SIGINT) == 0);
+  // The window is the quantity under test: a repeat within 1 s is ignored, one after it is not.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  REQUIRE(::kill(process.pid, SIGINT) == 0);
+  const auto result = finish(process, std::chrono::seconds(30));
+  CHECK(result.killed);
+  CHECK(result.status == 128 + SIGINT);
+}
+
 namespace {
 
 // An ensemble whose middle state diverges at once (retired before any checkpoint) and whose others run ~1 s in a

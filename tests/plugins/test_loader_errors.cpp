@@ -2,6 +2,8 @@
 // a shared library, no entry symbol, ABI version, table size, metadata, create failing, and evaluation failing
 // with a status or by throwing inside the plugin.
 #include <doctest/doctest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -67,6 +69,19 @@ TEST_CASE("missing file: the resolved path and what it was relative to") {
         "plugin file '/jobs/run1/models/absent.so' does not exist ('models/absent.so' relative to "
         "'/jobs/run1')");
   CHECK(load_error("/nowhere/absent.so") == "plugin file '/nowhere/absent.so' does not exist");
+}
+
+TEST_CASE("a plugin path that is a folder, a FIFO or a device is named as such, not as missing") {
+  const auto folder = std::filesystem::temp_directory_path() / ("nonsep_loader_kinds_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder / "a_folder.so");
+  REQUIRE(::mkfifo((folder / "fifo.so").c_str(), 0644) == 0);
+  CHECK(load_error((folder / "a_folder.so").string()) ==
+        "plugin file '" + (folder / "a_folder.so").string() + "' is a folder, not a shared library");
+  CHECK(load_error((folder / "fifo.so").string()) ==
+        "plugin file '" + (folder / "fifo.so").string() + "' is a FIFO (named pipe), not a shared library");
+  for (const char* device : {"/dev/zero", "/dev/null"})
+    CHECK(load_error(device) == "plugin file '" + std::string(device) + "' is a device, not a shared library");
+  std::filesystem::remove_all(folder);
 }
 
 TEST_CASE("unknown name: every folder tried is listed, NONSEP_PLUGIN_PATH first") {

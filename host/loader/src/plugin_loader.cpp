@@ -157,10 +157,18 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
     const fs::path given(name_or_path);
     file = (given.is_absolute() ? given : base_directory / given).lexically_normal();
     std::error_code error;
-    if (!fs::is_regular_file(file, error))
-      throw PluginError("plugin file " + quoted(file) + " does not exist" +
+    const fs::file_status status = fs::status(file, error);
+    if (!fs::is_regular_file(status)) {
+      const std::string what = !fs::exists(status)        ? "does not exist"
+                               : fs::is_directory(status) ? "is a folder, not a shared library"
+                               : fs::is_fifo(status)      ? "is a FIFO (named pipe), not a shared library"
+                               : fs::is_character_file(status) || fs::is_block_file(status)
+                                   ? "is a device, not a shared library"
+                                   : "is not a regular file, so not a shared library";
+      throw PluginError("plugin file " + quoted(file) + " " + what +
                         (given.is_absolute() ? std::string()
                                              : " (" + quoted(given) + " relative to " + quoted(base_directory) + ")"));
+    }
   } else {
     std::string tried;
     for (const fs::path& directory : plugin_search_path()) {

@@ -1,5 +1,8 @@
+#include <time.h>
+
 #include <cmath>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -26,24 +29,52 @@ namespace {
 
 std::atomic<bool> stop_requested{false};
 std::atomic<int> stop_signal{0};
-static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free,
+std::atomic<std::int64_t> first_stop_nanoseconds{0};  // CLOCK_MONOTONIC of the first stopping signal
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free &&
+                  std::atomic<std::int64_t>::is_always_lock_free,
               "the stop flags must be lock-free to be set in a signal handler");
 
-extern "C" void request_stop(int signal) {
-  stop_signal.store(signal);
-  stop_requested.store(true);
+// A second signal this soon after the first is the same request delivered twice, not the user insisting:
+// `timeout` signals the process and then its process group (the process again), mpirun may pass a signal on more
+// than once, and a scheduler signals every process of the job.
+constexpr std::int64_t repeat_window_nanoseconds = 1'000'000'000;
+
+std::int64_t monotonic_nanoseconds() {
+  timespec now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe
+  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
 }
 
-// Catches the first SIGINT, SIGTERM or SIGUSR1 (the run finishes its step, flushes trajectory.csv and writes its
-// checkpoint and summary); SA_RESETHAND restores the default action, so a second signal of the same kind ends the
-// process at once. No SA_RESTART: a plugin sleeping or waiting in a system call sees EINTR and returns sooner.
+extern "C" void request_stop(int signal) {
+  const std::int64_t now = monotonic_nanoseconds();
+  std::int64_t first = 0;
+  if (first_stop_nanoseconds.compare_exchange_strong(first, now)) {
+    stop_signal.store(signal);
+    stop_requested.store(true);
+    return;
+  }
+  if (now - first < repeat_window_nanoseconds) return;
+  // The user insists: the signal's default action (the process ends at once, killed by it), delivered when this
+  // handler returns, the signal being blocked while it runs.
+  struct sigaction default_action = {};
+  default_action.sa_handler = SIG_DFL;
+  sigemptyset(&default_action.sa_mask);
+  ::sigaction(signal, &default_action, nullptr);
+  ::raise(signal);
+}
+
+// Catches SIGINT, SIGTERM and SIGUSR1: the first stops the run (it finishes its step, flushes trajectory.csv and
+// writes its checkpoint and summary). Any of them again, more than repeat_window_nanoseconds after the first, ends
+// the process at once; earlier it is taken for the same request delivered twice and ignored. No SA_RESTART: a
+// plugin sleeping or waiting in a system call sees EINTR and returns sooner.
 class InterruptGuard {
  public:
   InterruptGuard() {
     struct sigaction action = {};
     action.sa_handler = request_stop;
     sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;
+    for (int signal : {SIGINT, SIGTERM, SIGUSR1}) sigaddset(&action.sa_mask, signal);
+    action.sa_flags = 0;
     sigaction(SIGINT, &action, &previous_interrupt_);
     sigaction(SIGTERM, &action, &previous_terminate_);
     // mpirun passes SIGUSR1 on to every rank (SIGTERM and SIGINT it does not), and Slurm's --signal=USR1@SECONDS
@@ -299,6 +330,7 @@ int command_run(const RunArguments& arguments) {
   options.threads = arguments.threads;
   stop_requested.store(false);
   stop_signal.store(0);
+  first_stop_nanoseconds.store(0);
   // Work units over the ranks: a fresh run on several ranks, or the resume of such a run on any number.
   const bool plain_checkpoint = arguments.resume && !has_units(options.output_directory);
   if (!loaded->job.is_study() && (arguments.resume ? !plain_checkpoint : ranks->size() > 1)) {

@@ -2,10 +2,9 @@
 
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <optional>
-#include <sstream>
 
+#include "cluster/unit_seal.hpp"
 #include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/cluster/merge_outputs.hpp"
 #include "nonsep/host/cluster/merge_results_h5.hpp"
@@ -32,13 +31,6 @@ std::filesystem::path unit_folder(const std::filesystem::path& directory, std::s
   return directory / units_folder / name;
 }
 
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 struct Plan {
   std::size_t trajectories = 0, unit_size = 0, units = 0;
 
@@ -59,47 +51,6 @@ json plan_json(const Plan& plan, const std::string& fingerprint) {
           {"job_fingerprint", fingerprint}};
 }
 
-// Rank 0: takes the output folder and writes `plan` to units/plan.json (fresh) or checks it against it (resume). Throws
-// what RunFolder and the checkpoint checks throw.
-void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Plan& plan,
-                    std::optional<RunFolder>& folder) {
-  const std::filesystem::path& directory = options.output_directory;
-  folder.emplace(directory, "run", loaded.job.file, folder_use(options));
-  const std::string fingerprint = job_fingerprint(loaded);
-  const auto path = directory / units_folder / plan_name;
-  if (options.resume) {
-    json saved;
-    try {
-      saved = json::parse(read_text(path));
-    } catch (const json::exception&) {
-      throw CheckpointError(path.string() + " is missing or damaged: there is no distributed run to resume here");
-    }
-    if (saved != plan_json(plan, fingerprint))
-      throw CheckpointError(path.string() +
-                            " was written by another job, or by this job before it was changed; "
-                            "run it again without --resume (--force discards the units)");
-    return;
-  }
-  std::error_code error;
-  std::filesystem::create_directories(directory / units_folder, error);
-  if (error) throw OutputError("cannot create " + (directory / units_folder).string() + ": " + error.message());
-  write_file_atomically(path, plan_json(plan, fingerprint).dump(2) + "\n");
-}
-
-enum class UnitState { fresh, checkpointed, done };
-
-UnitState unit_state(const std::filesystem::path& folder) {
-  std::error_code error;
-  if (std::filesystem::exists(folder / checkpoint_file_name, error)) return UnitState::checkpointed;
-  if (!std::filesystem::exists(folder / "summary.json", error)) return UnitState::fresh;
-  try {
-    return json::parse(read_text(folder / "summary.json")).at("status") == "interrupted" ? UnitState::fresh
-                                                                                         : UnitState::done;
-  } catch (const json::exception&) {
-    return UnitState::fresh;  // a unit killed while writing it: run again
-  }
-}
-
 // The job restricted to `size` trajectories from `first`.
 LoadedJob unit_job(const LoadedJob& loaded, std::size_t first, std::size_t size) {
   LoadedJob unit = loaded;
@@ -113,22 +64,79 @@ LoadedJob unit_job(const LoadedJob& loaded, std::size_t first, std::size_t size)
   return unit;
 }
 
+// What unit `u`'s folder must hold (unit_seal.hpp).
+UnitIdentity unit_identity(const LoadedJob& loaded, const Plan& plan, std::size_t u) {
+  return {u, plan.first(u), plan.size(u), job_fingerprint(unit_job(loaded, plan.first(u), plan.size(u)))};
+}
+
+// Rank 0: takes the output folder and writes `plan` to units/plan.json (fresh) or checks it against it (resume): the
+// plan, that units/ and every unit folder in it are folders (no links out of the output folder), and every sealed
+// unit (unit_seal.hpp). Throws what RunFolder and the checkpoint checks throw.
+void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Plan& plan,
+                    std::optional<RunFolder>& folder) {
+  const std::filesystem::path& directory = options.output_directory;
+  folder.emplace(directory, "run", loaded.job.file, folder_use(options));
+  const std::string fingerprint = job_fingerprint(loaded);
+  const auto path = directory / units_folder / plan_name;
+  if (options.resume) {
+    check_real_folder(directory / units_folder, false);
+    json saved;
+    try {
+      saved = json::parse(read_regular_file(path, 1 << 16).value_or(""));
+    } catch (const std::exception&) {
+      throw CheckpointError(path.string() + " is missing or damaged: there is no distributed run to resume here");
+    }
+    if (saved != plan_json(plan, fingerprint))
+      throw CheckpointError(
+          path.string() + " was written by another job, or by this job before it was changed" +
+          (saved.contains("job_fingerprint") && saved["job_fingerprint"].is_string()
+               ? " (its " + fingerprint_difference(saved["job_fingerprint"].get<std::string>(), fingerprint) +
+                     " differ)"
+               : std::string()) +
+          "; run it again without --resume (--force discards the units)");
+    for (std::size_t u = 0; u < plan.units; ++u) {
+      const auto unit = unit_folder(directory, u);
+      check_real_folder(unit, true);
+      if (has_seal(unit)) verify_unit(unit, unit_identity(loaded, plan, u));
+    }
+    return;
+  }
+  std::error_code error;
+  std::filesystem::create_directories(directory / units_folder, error);
+  if (error) throw OutputError("cannot create " + (directory / units_folder).string() + ": " + error.message());
+  write_file_atomically(path, plan_json(plan, fingerprint).dump(2) + "\n");
+}
+
+enum class UnitState { fresh, checkpointed, done };
+
+// Done only when sealed (unit_seal.hpp): a unit that wrote its summary but was killed before its seal runs again.
+UnitState unit_state(const std::filesystem::path& folder) {
+  if (has_seal(folder)) return UnitState::done;
+  std::error_code error;
+  if (std::filesystem::exists(std::filesystem::symlink_status(folder / checkpoint_file_name, error)))
+    return UnitState::checkpointed;
+  return UnitState::fresh;
+}
+
 std::string failure_text(const std::exception& error) {
   if (dynamic_cast<const CheckpointError*>(&error)) return std::string("cannot resume: ") + error.what();
   return error.what();
 }
 
-// Rank 0, every unit done: the run's files from the units'.
-RunOutcome merge_units(const RunOptions& options, const Plan& plan, double wall_seconds) {
+// Rank 0, every unit done: the run's files from the units', each unit verified first (unit_seal.hpp).
+RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const Plan& plan, double wall_seconds) {
   const std::filesystem::path& directory = options.output_directory;
+  check_real_folder(directory / units_folder, false);
   std::vector<UnitFile> parts;
   std::vector<json> summaries;
   std::vector<std::size_t> firsts;
   for (std::size_t u = 0; u < plan.units; ++u) {
     parts.push_back({unit_folder(directory, u), plan.first(u)});
     firsts.push_back(plan.first(u));
+    check_real_folder(parts.back().path, false);
+    verify_unit(parts.back().path, unit_identity(loaded, plan, u));
     try {
-      summaries.push_back(json::parse(read_text(parts.back().path / "summary.json")));
+      summaries.push_back(json::parse(read_regular_file(parts.back().path / "summary.json").value_or("")));
     } catch (const json::exception& error) {
       throw OutputError((parts.back().path / "summary.json").string() + " cannot be read: " + error.what());
     }
@@ -259,16 +267,23 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
       const std::uint64_t unit = counter.next();
       if (unit >= plan.units) break;
       const auto path = unit_folder(options.output_directory, unit);
-      const UnitState state = unit_state(path);
-      if (state == UnitState::done) continue;
-      RunOptions unit_options = options;
-      unit_options.output_directory = path;
-      unit_options.show_progress = false;
-      unit_options.resume = state == UnitState::checkpointed;
-      unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over
       try {
-        const RunOutcome outcome = run_job(unit_job(loaded, plan.first(unit), plan.size(unit)), unit_options);
-        if (outcome.exit_status == ExitStatus::interrupted) interrupted = true;
+        check_real_folder(options.output_directory / units_folder, false);
+        check_real_folder(path, true);
+        const UnitState state = unit_state(path);
+        if (state == UnitState::done) continue;  // verified by rank 0 at the start and before the merge
+        RunOptions unit_options = options;
+        unit_options.output_directory = path;
+        unit_options.show_progress = false;
+        unit_options.work_unit = true;
+        unit_options.resume = state == UnitState::checkpointed;
+        unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over
+        const LoadedJob job = unit_job(loaded, plan.first(unit), plan.size(unit));
+        const RunOutcome outcome = run_job(job, unit_options);
+        if (outcome.exit_status == ExitStatus::interrupted)
+          interrupted = true;
+        else
+          seal_unit(path, {unit, plan.first(unit), plan.size(unit), job_fingerprint(job)});
       } catch (const std::exception& error) {
         local_failure = "work unit " + path.string() + " (trajectories " + std::to_string(plan.first(unit)) + " to " +
                         std::to_string(plan.first(unit) + plan.size(unit) - 1) + "): " + failure_text(error);
@@ -285,7 +300,7 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
     try {
       outcome = interrupted
                     ? interrupted_outcome(loaded, options, plan, ranks)
-                    : merge_units(options, plan,
+                    : merge_units(loaded, options, plan,
                                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     } catch (const std::exception& error) {
       local_failure = std::string(error.what()) + " (the units' results stay in " +

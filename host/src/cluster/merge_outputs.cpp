@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/held_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/run_job.hpp"
 #include "nonsep/host/run/trajectory.hpp"
@@ -64,7 +65,7 @@ void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& out
   for (const UnitFile& file : parts) {
     auto part = std::make_unique<Part>();
     part->file = &file;
-    part->in.open(file.path, std::ios::binary);
+    part->in.open(held_path(file.path), std::ios::binary);
     std::string first;
     if (!part->in || !read_record(part->in, first)) unfit(*part, "missing or empty");
     if (open.empty()) {

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <charconv>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include "nonsep/core/error.hpp"
 #include "sections.hpp"
@@ -25,21 +27,15 @@ struct OptionValue {
   Fraction order;
 };
 
-// The only place where a catalogue parameter name meets IntegratorSpec's fields. A catalogue parameter without a
-// field here is a programming error, caught by the host tests (which read every scheme's defaults).
 void set_option(IntegratorSpec& spec, const ParameterDescription& parameter, const OptionValue& value) {
-  if (parameter.name == "order" && parameter.kind == ParameterDescription::Kind::Order)
-    spec.order = value.order;
-  else if (parameter.name == "t2" && parameter.kind == ParameterDescription::Kind::Number)
-    spec.t2 = value.number;
-  else if (parameter.name == "omega" && parameter.kind == ParameterDescription::Kind::Number)
-    spec.omega = value.number;
-  else if (parameter.name == "stages" && parameter.kind == ParameterDescription::Kind::Number)
-    spec.stages = value.number;
-  else if (parameter.name == "max_iterations" && parameter.kind == ParameterDescription::Kind::Number)
-    spec.max_iterations = value.number;
-  else
-    throw std::logic_error("the host does not know the integrator parameter '" + parameter.name + "'");
+  std::visit(
+      [&](auto* field) {
+        if constexpr (std::is_same_v<decltype(field), Fraction*>)
+          *field = value.order;
+        else
+          *field = value.number;
+      },
+      option_field(spec, parameter));
 }
 
 OptionValue default_option(const ParameterDescription& parameter) {

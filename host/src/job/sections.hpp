@@ -27,7 +27,7 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
 TimeGrid read_time(Checker& check, const json& document);
 TimeGrid read_study_time(Checker& check, const json& document);
 // The step count from t_end and dt (TimeGrid's steps_to_reach) within max_steps, or an issue at `path` that shows
-// `found` and the count it would need. t_end / dt must be positive and finite.
+// `found` and the count it would need (or that t_end / dt overflows). t_end / dt must be positive.
 std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt, const std::string& path,
                                         const std::string& found);
 

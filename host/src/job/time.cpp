@@ -9,10 +9,15 @@ namespace nonsep::host::job_reader {
 
 std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt, const std::string& path,
                                         const std::string& found) {
-  const double rounded = *steps_to_reach(t_end, dt);
-  if (rounded <= static_cast<double>(max_steps)) return static_cast<std::uint64_t>(rounded);
-  check.issue(path, found + ", which needs " + format_number(rounded) + " steps",
-              "at most " + std::to_string(max_steps) + " steps");
+  const std::string limit = "at most " + std::to_string(max_steps) + " steps";
+  // t_end / dt beyond the largest double (1e308 / 1e-308, 1 / 5e-324) is no count at all: over the limit too.
+  const std::optional<double> rounded = steps_to_reach(t_end, dt);
+  if (!rounded) {
+    check.issue(path, found + ", whose t_end / dt is beyond the largest double", limit);
+    return std::nullopt;
+  }
+  if (*rounded <= static_cast<double>(max_steps)) return static_cast<std::uint64_t>(*rounded);
+  check.issue(path, found + ", which needs " + format_number(*rounded) + " steps", limit);
   return std::nullopt;
 }
 

@@ -1,6 +1,7 @@
 #include "nonsep/host/observers/checkpoint_saver.hpp"
 
 #include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
 
@@ -29,8 +30,7 @@ void CheckpointSaver::before_finish(std::uint64_t, bool interrupted) {
     save_now();
     return;
   }
-  std::error_code ignored;
-  std::filesystem::remove(path_, ignored);
+  remove_file(path_);
 }
 
 void CheckpointSaver::save_now() {

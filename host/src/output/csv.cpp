@@ -10,6 +10,7 @@
 
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/held_folder.hpp"
 
 namespace nonsep::host {
 
@@ -31,10 +32,27 @@ void append_csv_text(std::string& row, std::string_view text) {
 }
 
 void CsvAppender::open(int flags) {
-  descriptor_ = ::open(path_.c_str(), flags | O_WRONLY | O_CLOEXEC | O_NOFOLLOW, 0644);  // never through a link
-  if (descriptor_ < 0)
-    throw OutputError("cannot " + std::string(flags & O_TRUNC ? "create " : "open ") + path_.string() + ": " +
-                      std::strerror(errno));
+  // Never through a link, and never waiting: a FIFO put in the way would block the open until a reader came.
+  const std::string verb = flags & O_TRUNC ? "cannot create " : "cannot open ";
+  const FileLocation location(path_);
+  descriptor_ =
+      ::openat(location.folder(), location.name(), flags | O_WRONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+  if (descriptor_ < 0) {
+    const int error = errno;
+    struct stat status {};
+    if ((error == ENXIO || error == ELOOP) &&
+        ::fstatat(location.folder(), location.name(), &status, AT_SYMLINK_NOFOLLOW) == 0)
+      throw OutputError(verb + path_.string() + ": it is " + file_kind(status.st_mode));
+    throw OutputError(verb + path_.string() + ": " + std::strerror(error));
+  }
+  struct stat status {};
+  if (::fstat(descriptor_, &status) != 0 || !S_ISREG(status.st_mode)) {
+    const std::string what = file_kind(status.st_mode);
+    ::close(descriptor_);
+    descriptor_ = -1;
+    throw OutputError(verb + path_.string() + ": it is " + what);
+  }
+  ::fcntl(descriptor_, F_SETFL, 0);
   buffer_.reserve(buffer_capacity + 4096);
 }
 
@@ -49,7 +67,8 @@ CsvAppender::CsvAppender(const std::filesystem::path& path, std::uint64_t size, 
     : path_(path), flushed_size_(size), flushed_hash_(prefix_hash) {
   // Everything through one descriptor opened without following links: a trajectory.csv replaced by a link to a
   // file elsewhere is refused before anything is read or cut, not truncated through the link.
-  descriptor_ = ::open(path.c_str(), O_RDWR | O_APPEND | O_CLOEXEC | O_NOFOLLOW);
+  const FileLocation location(path);
+  descriptor_ = ::openat(location.folder(), location.name(), O_RDWR | O_APPEND | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
   if (descriptor_ < 0)
     throw OutputError("cannot resume " + path.string() + ": " +
                       (errno == ELOOP ? std::string("it is a symbolic link") : std::strerror(errno)));
@@ -60,7 +79,8 @@ CsvAppender::CsvAppender(const std::filesystem::path& path, std::uint64_t size, 
   };
   struct stat status {};
   if (::fstat(descriptor_, &status) != 0) refuse(std::strerror(errno));
-  if (!S_ISREG(status.st_mode)) refuse("it is not a regular file");
+  if (!S_ISREG(status.st_mode)) refuse("it is " + file_kind(status.st_mode) + ", not a regular file");
+  ::fcntl(descriptor_, F_SETFL, O_APPEND);
   if (static_cast<std::uint64_t>(status.st_size) < size)
     refuse("it has " + std::to_string(status.st_size) + " bytes, fewer than the " + std::to_string(size) +
            " the checkpoint recorded");

@@ -3,6 +3,7 @@
 #include <bit>
 
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/held_folder.hpp"
 #include "nonsep/host/output/shuffle_deflate.hpp"
 
 namespace nonsep::host {
@@ -49,15 +50,16 @@ Hdf5File Hdf5File::create(const std::filesystem::path& path, hid_t access) {
   Hdf5File file(path, H5I_INVALID_HID);
   // The root group is created with the file: its creation list (which is also a group's) must say "no times".
   const Hdf5Handle creation = untimed_properties(file, H5P_FILE_CREATE);
-  file.file_ =
-      file.own(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, creation.get(), access), H5Fclose, "create the HDF5 file");
+  file.file_ = file.own(H5Fcreate(held_path(path).c_str(), H5F_ACC_TRUNC, creation.get(), access), H5Fclose,
+                        "create the HDF5 file");
   return file;
 }
 
 Hdf5File Hdf5File::open(const std::filesystem::path& path, hid_t access) {
   silence_hdf5_error_printing();
   Hdf5File file(path, H5I_INVALID_HID);
-  file.file_ = file.own(H5Fopen(path.c_str(), H5F_ACC_RDWR, access), H5Fclose, "open the HDF5 file for writing");
+  file.file_ =
+      file.own(H5Fopen(held_path(path).c_str(), H5F_ACC_RDWR, access), H5Fclose, "open the HDF5 file for writing");
   return file;
 }
 

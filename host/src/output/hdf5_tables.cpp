@@ -10,6 +10,7 @@
 
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/held_folder.hpp"
 #include "nonsep/host/output/shuffle_deflate.hpp"
 
 namespace nonsep::host {
@@ -21,7 +22,8 @@ constexpr std::size_t rows_per_block = 65536;
 // Rows of a CSV file as csv.hpp writes them (RFC 4180 quoting, '\n' line ends), read through a buffer of 1 MiB.
 class CsvRows {
  public:
-  explicit CsvRows(const std::filesystem::path& path) : path_(path), in_(path, std::ios::binary), buffer_(1 << 20) {
+  explicit CsvRows(const std::filesystem::path& path)
+      : path_(path), in_(held_path(path), std::ios::binary), buffer_(1 << 20) {
     if (!in_) throw OutputError("cannot read " + path.string() + " to copy it into results.h5");
   }
   // The next whole row into `cells` (whose strings are reused), or false at the end (a last line without '\n' is

@@ -4,6 +4,7 @@
 
 #include "nonsep/host/output/hdf5_file.hpp"
 #include "nonsep/host/output/hdf5_tables.hpp"
+#include "nonsep/host/output/held_folder.hpp"
 
 namespace nonsep::host {
 
@@ -13,7 +14,7 @@ void write_results_file(const std::filesystem::path& path, bool has_samples, con
   write_csv_table(file, "/trajectories", directory / trajectories_file_name);
   for (const char* table : {"poincare", "lyapunov"}) {
     const std::filesystem::path csv = directory / (std::string(table) + ".csv");
-    if (std::filesystem::exists(csv)) {
+    if (std::filesystem::exists(held_path(csv))) {
       write_csv_table(file, table, csv);
     } else if (H5Lexists(file.id(), table, H5P_DEFAULT) > 0) {
       file.check(H5Ldelete(file.id(), table, H5P_DEFAULT), std::string("remove the stale group /") + table);

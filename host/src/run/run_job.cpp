@@ -39,10 +39,7 @@ std::size_t& StatusCounts::operator[](TrajectoryStatus status) {
 namespace {
 
 // An earlier run's file that this run does not write would mislead.
-void remove_stale(const std::filesystem::path& path) {
-  std::error_code ignored;
-  std::filesystem::remove(path, ignored);
-}
+void remove_stale(const std::filesystem::path& path) { remove_file(path); }
 
 nlohmann::ordered_json poincare_facts(const PoincareSection& section, const PoincareSectionObserver& observer) {
   const char* direction = section.direction == CrossingDirection::up     ? "+"
@@ -103,7 +100,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   const Job& job = loaded.job;
   const SingleRun& run = job.run();
   const std::filesystem::path& directory = options.output_directory;
-  const RunFolder folder(directory, "run", job.file, folder_use(options));
+  const RunFolder folder(directory, options.work_unit ? "unit" : "run", job.file, folder_use(options));
   std::optional<Checkpoint> checkpoint;
   if (options.resume) checkpoint = load_checkpoint(directory / checkpoint_file_name, loaded);
 

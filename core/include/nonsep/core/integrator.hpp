@@ -30,6 +30,14 @@ struct IntegratorSpec {
   double max_iterations = GaussLegendre::default_max_iterations;  // implicit_midpoint, gauss (whole number >= 1)
 };
 
+// The field of `spec` that holds the catalogue option `parameter` ("order": a Fraction; "t2", "omega", "stages",
+// "max_iterations": a double). The one place where the catalogue's option names meet IntegratorSpec's fields: the
+// job reader sets options through it and the host's checkpoint fingerprint reads every option of a scheme through
+// it, so a new option reaches both. Throws std::logic_error for an option without a field (a programming error:
+// the host's tests read every option of every catalogue entry).
+using OptionField = std::variant<Fraction*, double*>;
+OptionField option_field(IntegratorSpec& spec, const ParameterDescription& parameter);
+
 class Integrator {
  public:
   // Throws InvalidArgument naming the problem: t2 zero or not finite (Chin's schemes), unknown scheme (listing the

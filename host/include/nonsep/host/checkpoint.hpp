@@ -11,9 +11,9 @@
 // (write_file_atomically): a crash while saving leaves the previous checkpoint.
 //
 // The fingerprint covers what determines the numbers: the plugin (name, version and its file's bytes), the model's
-// parameters, the integrator, the initial states, the time grid, output.every, output.energy_every, output.format (hdf5
-// only) and /analysis. It leaves out the output folder and the checkpoint policy, which may change between the
-// interrupted run and the resumed one.
+// parameters, the integrator (its scheme, form and every option of its catalogue entry), the initial states, the time
+// grid, output.every, output.energy_every, output.format (hdf5 only) and /analysis. It leaves out the output folder and
+// the checkpoint policy, which may change between the interrupted run and the resumed one.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -43,10 +43,11 @@ struct Checkpoint {
 };
 
 // What identifies the job's numbers, as described above, in named parts, each 16 hexadecimal digits (FNV-1a, 64
-// bits): "plugin:... parameters:... integrator:... initial:... time:... output:... analysis:...". The plugin part
-// covers the plugin's name, version and the bytes of its file.
+// bits): "plugin:... parameters:... integrator:... integrator.order:... ... initial:... time:... output:...
+// analysis:...", one integrator.NAME part per option of the scheme's catalogue entry. The plugin part covers the
+// plugin's name, version and the bytes of its file.
 std::string job_fingerprint(const LoadedJob& job);
-// The names of the parts in which two fingerprints differ ("plugin, time").
+// The names of the parts in which two fingerprints differ ("plugin, integrator.omega, time").
 std::string fingerprint_difference(const std::string& a, const std::string& b);
 
 // The file name inside a run's output folder.

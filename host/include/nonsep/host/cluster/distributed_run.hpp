@@ -19,6 +19,11 @@
 // others) is the checkpoint: `nonsep run JOB.json --resume` continues it with any number of ranks, one process
 // included, and ends bit for bit as an uninterrupted run.
 //
+// Verification. A finished unit is sealed by the rank that ran it (unit_seal.hpp); only sealed units count as done.
+// Rank 0 verifies every sealed unit when a resume starts and every unit before the merge, and refuses (exit 2,
+// naming the unit) one that does not match its seal or this job; units/ and the unit folders must be folders, not
+// links. A unit's folder has the kind "unit" (run_folder.hpp), which no other run may take over.
+//
 // Failures. A unit that cannot start or write its files stops its rank's work; every rank then ends with exit
 // status 2 and rank 0 prints the message of the lowest failing rank (RankFailure). A plugin that fails on some
 // states retires them as in any run; it is not a failure of the run.

@@ -3,14 +3,15 @@
 //
 // Ownership. A folder belongs to at most one run at a time: RunFolder takes an exclusive lock (flock on
 // `.nonsep.lock`, which holds the owner's pid); a second run into the same folder is refused with that pid. The lock
-// goes with the process, however it ends. `.nonsep-run.json` records what the folder holds: the kind ("run" or
-// "study") and the job file (its absolute path) that wrote it; in a folder written before it existed,
+// goes with the process, however it ends. `.nonsep-run.json` records what the folder holds: the kind ("run",
+// "study" or "unit") and the job file (its absolute path) that wrote it; in a folder written before it existed,
 // summary.json's "job" tells.
 //
 // Earlier results. A new run refuses a folder that holds
 //   - a checkpoint (checkpoint.json): an interrupted run, which `--resume` continues and `--force` discards;
 //   - results of another job or kind, or nonsep results of unknown origin: unless `--force`.
 //   - the work units of an interrupted distributed run (`units/`, cluster/distributed_run.hpp): likewise.
+// A work unit of a distributed run (kind "unit") is refused to any run but its own, `--force` included.
 // Results of the same job (the same job file, the same kind) are the run's to replace. Starting (fresh or forced),
 // the run removes every file an earlier run left (the names in `output_files`), so a failed or killed run never
 // leaves the earlier run's summary beside its own partial files. Temporary files of dead runs (".*.tmp-*") are
@@ -20,11 +21,13 @@
 // output name to be free or a regular file (not a folder, link or device in the way), so that a run that could not
 // save its results fails at once (exit 2), not after its steps.
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/held_folder.hpp"
 
 namespace nonsep::host {
 
@@ -47,7 +50,8 @@ class FolderInUse : public std::runtime_error {
 
 class RunFolder {
  public:
-  // Creates the folder if missing, locks it and checks it as described above. `kind`: "run" or "study"; `job_file`:
+  // Creates the folder if missing, locks it and checks it as described above. `kind`: "run", "study" or "unit" (a
+  // distributed run's work unit); `job_file`:
   // the job as given on the command line. Throws FolderInUse, or OutputError when it cannot be created, locked or
   // written.
   RunFolder(const std::filesystem::path& directory, const std::string& kind, const std::filesystem::path& job_file,
@@ -63,6 +67,7 @@ class RunFolder {
 
  private:
   std::filesystem::path directory_;
+  std::unique_ptr<HeldFolder> held_;  // every file of the run resolves through it (held_folder.hpp)
   int lock_ = -1;
 };
 

@@ -38,9 +38,10 @@ struct RunOptions {
   // Checked between chunks (a fraction of a second apart); when true the run stops with status "interrupted"
   // (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;
-  bool resume = false;   // continue from output_directory/checkpoint.json (checkpoint.hpp)
-  bool force = false;    // start over in a folder holding another job's results or a checkpoint (run_folder.hpp)
-  unsigned threads = 0;  // worker threads; 0: all cores
+  bool resume = false;     // continue from output_directory/checkpoint.json (checkpoint.hpp)
+  bool force = false;      // start over in a folder holding another job's results or a checkpoint (run_folder.hpp)
+  unsigned threads = 0;    // worker threads; 0: all cores
+  bool work_unit = false;  // a distributed run's unit (its folder's kind is "unit": run_folder.hpp)
 };
 
 // How many trajectories ended with each status.
