@@ -57,7 +57,8 @@ const nonsep_plugin_api table = {
     nullptr,  // hessian_V
     &last_error,
     nullptr,  // d3T
-    nullptr,  // d3V    nullptr,  // grad_K
+    nullptr,  // d3V
+    nullptr,  // grad_K
     nullptr,  // grad_U
     nullptr,  // value_K
     nullptr,  // value_U

@@ -217,7 +217,8 @@ const nonsep_plugin_api api = {
     BLOWUP_WITH_HESSIANS ? hessian_V : nullptr,
     last_error,
     nullptr,  // d3T: absent
-    nullptr,  // d3V: absent    nullptr,  // grad_K
+    nullptr,  // d3V: absent
+    nullptr,  // grad_K
     nullptr,  // grad_U
     nullptr,  // value_K
     nullptr,  // value_U

@@ -124,7 +124,8 @@ const nonsep_plugin_api api = {
     hessian_V,
     last_error,
     nullptr,  // d3T: absent
-    nullptr,  // d3V: absent    nullptr,  // grad_K
+    nullptr,  // d3V: absent
+    nullptr,  // grad_K
     nullptr,  // grad_U
     nullptr,  // value_K
     nullptr,  // value_U
