@@ -187,9 +187,8 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
   const std::size_t k = state.active.empty() ? 0 : state.tangent_q.size() / std::max<std::size_t>(1, state.q.size());
   for (const LyapunovRecord& record : state.lyapunov) lyapunov.push_back(encode(record, k));
   for (const MegnoRecord& record : state.megno) megno.push_back(encode(record));
-  json evaluations = {{"grad_T", state.evaluations.grad_T},
-                      {"grad_V", state.evaluations.grad_V},
-                      {"grad_H", state.evaluations.grad_H}};
+  json evaluations = {
+      {"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}, {"grad_H", state.evaluations.grad_H}};
   // The separable part's counts, only for a model that has one (the checkpoints of other models are unchanged).
   if (state.evaluations.grad_K + state.evaluations.grad_U > 0) {
     evaluations["grad_K"] = state.evaluations.grad_K;

@@ -188,8 +188,9 @@ class StudyExecution {
     append_csv_text(row, options_text(integrator.spec));
     row += "," + description.order.to_string() + (description.symplectic ? ",true," : ",false,");
     append_number(row, run.dt);
-    row += "," + std::to_string(run.steps) + "," + std::to_string(e.grad_T + e.grad_V + e.grad_H + e.grad_K + e.grad_U) + "," +
-           std::to_string(e.grad_T) + "," + std::to_string(e.grad_V) + "," + std::to_string(e.grad_H) + ",";
+    row += "," + std::to_string(run.steps) + "," +
+           std::to_string(e.grad_T + e.grad_V + e.grad_H + e.grad_K + e.grad_U) + "," + std::to_string(e.grad_T) + "," +
+           std::to_string(e.grad_V) + "," + std::to_string(e.grad_H) + ",";
     append_number(row, run.wall_seconds);
     row += "," + std::to_string(run.repeats) + ",";
     if (run.relative_energy_error) append_number(row, *run.relative_energy_error);
