@@ -84,7 +84,7 @@ std::span<const Scheme> scheme_catalogue() {
               1,
               {}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
-               ChinBasicStep base(spec.form, spec.t2);
+               SeparableBasicStep base(ChinBasicStep(spec.form, spec.t2));
                chin_index(spec, 1, "basic");
                return base;
              }},
@@ -100,8 +100,9 @@ std::span<const Scheme> scheme_catalogue() {
               triplet_orders,
               {}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
-               ChinBasicStep base(spec.form, spec.t2);
-               return TripletComposition<>(std::move(base), chin_index(spec, triplet_orders, "triplet") - 1);
+               SeparableBasicStep base(ChinBasicStep(spec.form, spec.t2));
+               return TripletComposition<SeparableBasicStep>(std::move(base),
+                                                             chin_index(spec, triplet_orders, "triplet") - 1);
              }},
       Scheme{{"mpe",
               "Multi-product expansion of the basic step",
@@ -115,8 +116,8 @@ std::span<const Scheme> scheme_catalogue() {
               mpe_orders,
               {}},
              [](const IntegratorSpec& spec) -> SchemeStepper {
-               ChinBasicStep base(spec.form, spec.t2);
-               return MultiProductExpansion<>(std::move(base), chin_index(spec, mpe_orders, "mpe"));
+               SeparableBasicStep base(ChinBasicStep(spec.form, spec.t2));
+               return MultiProductExpansion<SeparableBasicStep>(std::move(base), chin_index(spec, mpe_orders, "mpe"));
              }},
       Scheme{{"tao",
               "Tao's explicit symplectic integrator in extended phase space (comparator)",

@@ -228,13 +228,17 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
   const std::size_t k = state.active.empty() ? 0 : state.tangent_q.size() / std::max<std::size_t>(1, state.q.size());
   for (const LyapunovRecord& record : state.lyapunov) lyapunov.push_back(encode(record, k));
   for (const MegnoRecord& record : state.megno) megno.push_back(encode(record));
+  json evaluations = {
+      {"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}, {"grad_H", state.evaluations.grad_H}};
+  // The separable part's counts, only for a model that has one (the checkpoints of other models are unchanged).
+  if (state.evaluations.grad_K + state.evaluations.grad_U > 0) {
+    evaluations["grad_K"] = state.evaluations.grad_K;
+    evaluations["grad_U"] = state.evaluations.grad_U;
+  }
   const json document = {{"format", format_tag},
                          {"job_fingerprint", fingerprint},
                          {"step", state.step},
-                         {"evaluations",
-                          {{"grad_T", state.evaluations.grad_T},
-                           {"grad_V", state.evaluations.grad_V},
-                           {"grad_H", state.evaluations.grad_H}}},
+                         {"evaluations", evaluations},
                          {"max_copy_distance", encode(state.max_copy_distance)},
                          {"active",
                           {{"trajectories", state.active},
@@ -296,6 +300,10 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   state.evaluations.grad_T = read.unsigned_integer(read.member(evaluations, "grad_T"), "evaluations");
   state.evaluations.grad_V = read.unsigned_integer(read.member(evaluations, "grad_V"), "evaluations");
   state.evaluations.grad_H = read.unsigned_integer(read.member(evaluations, "grad_H"), "evaluations");
+  if (evaluations.contains("grad_K") || evaluations.contains("grad_U")) {
+    state.evaluations.grad_K = read.unsigned_integer(read.member(evaluations, "grad_K"), "evaluations");
+    state.evaluations.grad_U = read.unsigned_integer(read.member(evaluations, "grad_U"), "evaluations");
+  }
   state.max_copy_distance = read.number(read.member(document, "max_copy_distance"), "max_copy_distance");
   const json& active = read.member(document, "active");
   const json& trajectories = read.member(active, "trajectories");

@@ -175,8 +175,9 @@ class StudyExecution {
     write_work_precision_row(integrator, description, run);
   }
 
-  // work_precision.csv: the cost (evaluations = grad_T + grad_V + grad_H, each counted once per state; a grad_H
-  // costs the model a gradient, two Hessians and a third-derivative contraction) and the median wall time against
+  // work_precision.csv: the cost (evaluations = grad_T + grad_V + grad_H + grad_K + grad_U, each counted once per
+  // state, the last two zero without a separable part; a grad_H costs the model a gradient, two Hessians and a
+  // third-derivative contraction) and the median wall time against
   // the errors.
   void write_work_precision_row(const StudyIntegrator& integrator, const IntegratorDescription& description,
                                 const StudyRun& run) {
@@ -187,8 +188,9 @@ class StudyExecution {
     append_csv_text(row, options_text(integrator.spec));
     row += "," + description.order.to_string() + (description.symplectic ? ",true," : ",false,");
     append_number(row, run.dt);
-    row += "," + std::to_string(run.steps) + "," + std::to_string(e.grad_T + e.grad_V + e.grad_H) + "," +
-           std::to_string(e.grad_T) + "," + std::to_string(e.grad_V) + "," + std::to_string(e.grad_H) + ",";
+    row += "," + std::to_string(run.steps) + "," +
+           std::to_string(e.grad_T + e.grad_V + e.grad_H + e.grad_K + e.grad_U) + "," + std::to_string(e.grad_T) + "," +
+           std::to_string(e.grad_V) + "," + std::to_string(e.grad_H) + ",";
     append_number(row, run.wall_seconds);
     row += "," + std::to_string(run.repeats) + ",";
     if (run.relative_energy_error) append_number(row, *run.relative_energy_error);

@@ -82,3 +82,33 @@ TEST_CASE("test models: paper2d and radial2d Hessians, and hamiltonian() as grad
   CHECK(nonsep::testing::Paper1D{}.hamiltonian(x1) ==
         doctest::Approx(nonsep::testing::Paper1D::H_TTV(0.4, -0.9)).epsilon(1e-15));
 }
+
+TEST_CASE("test models with a separable part: T, V, K and U derivatives, and a wrong grad U is found") {
+  const nonsep::testing::MathewsLakshmanan oscillator;
+  const nonsep::testing::VariableMass2D plane;
+  for (const auto& report : {check(oscillator), check(plane), nonsep::check_separable_derivatives(oscillator),
+                             nonsep::check_separable_derivatives(plane)}) {
+    INFO(report.summary());
+    CHECK(report.comparisons > 0);
+    CHECK(report.passed());
+  }
+  struct WrongGradU : nonsep::testing::VariableMass2D {
+    void grad_U(std::span<const double> q, std::span<double> out, std::size_t count) const {
+      VariableMass2D::grad_U(q, out, count);
+      for (std::size_t b = 0; b < count; ++b) out[2 * b + 1] += 1e-4;
+    }
+  };
+  const auto wrong = nonsep::check_separable_derivatives(WrongGradU{});
+  CHECK_FALSE(wrong.passed());
+  REQUIRE(!wrong.mismatches.empty());
+  CHECK(wrong.mismatches.front().function == "grad_U");
+  CHECK(wrong.mismatches.front().component == 1);
+  const double x[4] = {0.4, -0.9, 0.7, -0.3};
+  double g[2], h[4], k = 0.0, u = 0.0;
+  plane.grad_T(std::span<const double>(x + 2, 2), g, 1);
+  plane.hessian_V(std::span<const double>(x, 2), h, 1);
+  plane.value_K(std::span<const double>(x + 2, 2), std::span<double>(&k, 1), 1);
+  plane.value_U(std::span<const double>(x, 2), std::span<double>(&u, 1), 1);
+  const double product = g[0] * (h[0] * g[0] + h[1] * g[1]) + g[1] * (h[2] * g[0] + h[3] * g[1]);
+  CHECK(plane.hamiltonian(x) == doctest::Approx(product + k + u).epsilon(1e-14));
+}

@@ -41,34 +41,13 @@ std::vector<IntegratorSpec> all_specs(HamiltonianForm form) {
           {"mpe", Fraction(2), t2, form}};
 }
 
-// 2n tangent vectors forming the identity: after stepping, vector j is column j of the Jacobian M.
-PhaseSpaceBatch identity_tangents(std::size_t n) {
-  PhaseSpaceBatch t(n, 2 * n);
-  for (std::size_t j = 0; j < n; ++j) {
-    t.q(j)[j] = 1.0;
-    t.p(n + j)[j] = 1.0;
-  }
-  return t;
-}
-
-Eigen::MatrixXd as_matrix(const PhaseSpaceBatch& tangents) {
-  const auto n = static_cast<Eigen::Index>(tangents.dimension());
-  Eigen::MatrixXd m(2 * n, 2 * n);
-  for (Eigen::Index j = 0; j < 2 * n; ++j)
-    for (Eigen::Index i = 0; i < n; ++i) {
-      m(i, j) = tangents.q(static_cast<std::size_t>(j))[static_cast<std::size_t>(i)];
-      m(n + i, j) = tangents.p(static_cast<std::size_t>(j))[static_cast<std::size_t>(i)];
-    }
-  return m;
-}
-
 // `steps` steps of the tangent integrator from x: the Jacobian of the `steps`-step map.
 template <class M>
 Eigen::MatrixXd tangent_jacobian(const M& model, const IntegratorSpec& spec, PhaseSpaceBatch x, double dt, int steps) {
-  auto tangents = identity_tangents(x.dimension());
+  auto tangents = testing::identity_tangents(x.dimension());
   TangentIntegrator integrator(spec);
   for (int s = 0; s < steps; ++s) integrator.step(model, x, tangents, dt);
-  return as_matrix(tangents);
+  return testing::as_matrix(tangents);
 }
 
 // The same Jacobian by central differences of the plain integrator's map, step h (support/finite_difference.hpp).
@@ -134,11 +113,11 @@ TEST_CASE("the tangent map of a step of dt followed by one of -dt is the identit
       if (spec.scheme == "mpe") continue;
       CAPTURE(spec.scheme);
       auto x = PhaseSpaceBatch::single(std::vector{0.6, -0.4}, std::vector{0.3, 0.2});
-      auto tangents = identity_tangents(2);
+      auto tangents = testing::identity_tangents(2);
       TangentIntegrator integrator(spec);
       integrator.step(Paper2D{}, x, tangents, 0.03);
       integrator.step(Paper2D{}, x, tangents, -0.03);
-      CHECK((as_matrix(tangents) - Eigen::MatrixXd::Identity(4, 4)).cwiseAbs().maxCoeff() < 1e-12);
+      CHECK((testing::as_matrix(tangents) - Eigen::MatrixXd::Identity(4, 4)).cwiseAbs().maxCoeff() < 1e-12);
     }
 }
 
@@ -216,9 +195,9 @@ TEST_CASE("Hessian evaluations: 4 Hess T + 4 Hess V per basic step, plus one at 
     CHECK(basic.evaluations().grad_V == (ttv ? outer : inner));
   }
   // Triplet of order 2: 9 basic steps per step.
-  TangentTripletComposition triplet(TripletComposition<>(ChinBasicStep(), 2));
+  TangentTripletComposition triplet(TripletComposition<SeparableBasicStep>(SeparableBasicStep(), 2));
   auto x = PhaseSpaceBatch::single(std::vector{0.5, 0.2}, std::vector{0.1, 0.3});
-  auto tangents = identity_tangents(2);
+  auto tangents = testing::identity_tangents(2);
   for (int s = 0; s < 4; ++s) triplet.step(Paper2D{}, x, tangents, 0.01);
   CHECK(triplet.hessian_evaluations().hessian_T == 4 * 9 * 4);
   CHECK(triplet.hessian_evaluations().hessian_V == 4 * 9 * 4 + 1);

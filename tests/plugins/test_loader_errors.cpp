@@ -146,12 +146,12 @@ TEST_CASE("a plugin of ABI version 3 loads: its shorter table, none of version 4
   model.grad_V(p, out, 1);
   CHECK(out[0] == 0.5);
   // The table it was built with holds grad_K past the version-3 size: a loader reading it would refuse the plugin
-  // (a separable part, and a capability it does not claim).
+  // (a capability it does not claim, and grad_K without value_K).
 }
 
-TEST_CASE("a separable part K(p) + U(q) is refused by a host whose schemes do not solve it") {
-  const std::string message = load_error("separable_part.so");
-  CHECK(contains(message, "gives a separable part K(p) + U(q) (grad_U), which this nonsep does not solve"));
+TEST_CASE("a separable part without its value: the energy of H needs it") {
+  const std::string message = load_error("grad_U_without_value_U.so");
+  CHECK(contains(message, "gives grad_U but not value_U: the energy of H = T_i V_ij T_j + K + U needs U itself"));
 }
 
 TEST_CASE("a part's Hessian-vector product without its gradient") {

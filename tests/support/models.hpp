@@ -205,4 +205,169 @@ struct Radial2D {
   }
 };
 
+// The Mathews-Lakshmanan oscillator H = (1/2)(1 + lambda q^2) p^2 + (1/2) alpha^2 q^2 / (1 + lambda q^2), hand-written
+// twin of plugins/mathews_lakshmanan: T = p^2/2, V = q^2/4 + lambda q^4/24 (T' V'' T' = (1/2)(1 + lambda q^2) p^2),
+// the separable U = (1/2) alpha^2 q^2 / (1 + lambda q^2) and no K. Exact solution:
+// nonsep/reference/mathews_lakshmanan_exact.hpp.
+struct MathewsLakshmanan {
+  double lambda = 0.5;
+  double alpha = 1.0;
+
+  std::size_t dimension() const { return 1; }
+  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.5 * p[b] * p[b];
+  }
+  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = q[b] * q[b] / 4.0 + lambda * std::pow(q[b], 4) / 24.0;
+  }
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = p[b];
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.5 * q[b] + lambda * q[b] * q[b] * q[b] / 6.0;
+  }
+  void hessian_T(std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 1.0;
+  }
+  void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.5 * (1.0 + lambda * q[b] * q[b]);
+  }
+  void d3T(std::span<const double>, std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.0;
+  }
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = lambda * q[b] * u[b] * u[b];
+  }
+  bool has_K() const { return false; }
+  bool has_U() const { return true; }
+  void value_K(std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.0;
+  }
+  void grad_K(std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.0;
+  }
+  void hessian_K(std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.0;
+  }
+  void value_U(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.5 * alpha * alpha * q[b] * q[b] / (1.0 + lambda * q[b] * q[b]);
+  }
+  void grad_U(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double m = 1.0 + lambda * q[b] * q[b];
+      out[b] = alpha * alpha * q[b] / (m * m);
+    }
+  }
+  void hessian_U(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double m = 1.0 + lambda * q[b] * q[b];
+      out[b] = alpha * alpha * (1.0 - 3.0 * lambda * q[b] * q[b]) / (m * m * m);
+    }
+  }
+};
+
+// A 2D position-dependent inverse mass with a potential, hand-written twin of plugins/variable_mass2d:
+//   H = p . Hess V(q) p + K + U = (1/2) p . (kappa I + 2 Hess V(q)) p + U(q),   T = |p|^2/2,   V = |q|^2/4 + lambda
+//   |q|^4/24, K = kappa |p|^2/2,   U = (q1^2 + omega^2 q2^2)/2 + mu q1^2 q2^2.
+// Hess V = (1/2)(1 + lambda |q|^2/3) I + (lambda/3) q q^T is positive definite for lambda >= 0.
+struct VariableMass2D {
+  double lambda = 0.5, kappa = 0.5, omega = 1.5, mu = 0.25;
+  bool with_K = true, with_U = true;
+
+  std::size_t dimension() const { return 2; }
+  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.5 * (p[2 * b] * p[2 * b] + p[2 * b + 1] * p[2 * b + 1]);
+  }
+  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double r2 = q[2 * b] * q[2 * b] + q[2 * b + 1] * q[2 * b + 1];
+      out[b] = r2 / 4.0 + lambda * r2 * r2 / 24.0;
+    }
+  }
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t i = 0; i < 2 * count; ++i) out[i] = p[i];
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double r2 = q[2 * b] * q[2 * b] + q[2 * b + 1] * q[2 * b + 1], factor = 0.5 + lambda * r2 / 6.0;
+      out[2 * b] = factor * q[2 * b];
+      out[2 * b + 1] = factor * q[2 * b + 1];
+    }
+  }
+  void hessian_T(std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      double* h = out.data() + 4 * b;
+      h[0] = h[3] = 1.0;
+      h[1] = h[2] = 0.0;
+    }
+  }
+  void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = q[2 * b], y = q[2 * b + 1], diagonal = 0.5 + lambda * (x * x + y * y) / 6.0;
+      double* h = out.data() + 4 * b;
+      h[0] = diagonal + lambda * x * x / 3.0;
+      h[1] = h[2] = lambda * x * y / 3.0;
+      h[3] = diagonal + lambda * y * y / 3.0;
+    }
+  }
+  // d3T = 0; V_ijk = (lambda/3)(delta_ij q_k + delta_ik q_j + delta_jk q_i), so out_k = (lambda/3)(|u|^2 q_k + 2 (u.q)
+  // u_k).
+  void d3T(std::span<const double>, std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t i = 0; i < 2 * count; ++i) out[i] = 0.0;
+  }
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double u0 = u[2 * b], u1 = u[2 * b + 1], uu = u0 * u0 + u1 * u1, uq = u0 * q[2 * b] + u1 * q[2 * b + 1];
+      out[2 * b] = lambda / 3.0 * (uu * q[2 * b] + 2.0 * uq * u0);
+      out[2 * b + 1] = lambda / 3.0 * (uu * q[2 * b + 1] + 2.0 * uq * u1);
+    }
+  }
+  bool has_K() const { return with_K; }
+  bool has_U() const { return with_U; }
+  void value_K(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = 0.5 * kappa * (p[2 * b] * p[2 * b] + p[2 * b + 1] * p[2 * b + 1]);
+  }
+  void grad_K(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    for (std::size_t i = 0; i < 2 * count; ++i) out[i] = kappa * p[i];
+  }
+  void hessian_K(std::span<const double>, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      double* h = out.data() + 4 * b;
+      h[0] = h[3] = kappa;
+      h[1] = h[2] = 0.0;
+    }
+  }
+  void value_U(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = q[2 * b], y = q[2 * b + 1];
+      out[b] = 0.5 * (x * x + omega * omega * y * y) + mu * x * x * y * y;
+    }
+  }
+  void grad_U(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = q[2 * b], y = q[2 * b + 1];
+      out[2 * b] = x + 2.0 * mu * x * y * y;
+      out[2 * b + 1] = omega * omega * y + 2.0 * mu * x * x * y;
+    }
+  }
+  void hessian_U(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) {
+      const double x = q[2 * b], y = q[2 * b + 1];
+      double* h = out.data() + 4 * b;
+      h[0] = 1.0 + 2.0 * mu * y * y;
+      h[1] = h[2] = 4.0 * mu * x * y;
+      h[3] = omega * omega + 2.0 * mu * x * x;
+    }
+  }
+  // The full H for any scalar type, x = (q1, q2, p1, p2).
+  template <class S>
+  S hamiltonian(const S* x) const {
+    const S r2 = x[0] * x[0] + x[1] * x[1], pp = x[2] * x[2] + x[3] * x[3], qp = x[0] * x[2] + x[1] * x[3];
+    S h = (0.5 + lambda * r2 / 6.0) * pp + lambda / 3.0 * qp * qp;
+    if (with_K) h = h + 0.5 * kappa * pp;
+    if (with_U) h = h + 0.5 * (x[0] * x[0] + omega * omega * x[1] * x[1]) + mu * x[0] * x[0] * x[1] * x[1];
+    return h;
+  }
+};
+
 }  // namespace nonsep::testing

@@ -72,4 +72,25 @@ auto integrator_map(const M& model, const IntegratorSpec& spec, double dt, int s
   };
 }
 
+// 2n tangent vectors forming the identity: after stepping, vector j is column j of the Jacobian M.
+inline PhaseSpaceBatch identity_tangents(std::size_t n) {
+  PhaseSpaceBatch t(n, 2 * n);
+  for (std::size_t j = 0; j < n; ++j) {
+    t.q(j)[j] = 1.0;
+    t.p(n + j)[j] = 1.0;
+  }
+  return t;
+}
+
+inline Eigen::MatrixXd as_matrix(const PhaseSpaceBatch& tangents) {
+  const auto n = static_cast<Eigen::Index>(tangents.dimension());
+  Eigen::MatrixXd m(2 * n, 2 * n);
+  for (Eigen::Index j = 0; j < 2 * n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      m(i, j) = tangents.q(static_cast<std::size_t>(j))[static_cast<std::size_t>(i)];
+      m(n + i, j) = tangents.p(static_cast<std::size_t>(j))[static_cast<std::size_t>(i)];
+    }
+  return m;
+}
+
 }  // namespace nonsep::testing

@@ -68,7 +68,13 @@ const json& Plugin::metadata() const { return loaded_->metadata; }
 std::string Plugin::name() const { return loaded_->metadata["name"].get<std::string>(); }
 std::string Plugin::version() const { return loaded_->metadata["version"].get<std::string>(); }
 std::string Plugin::description() const { return loaded_->metadata["description"].get<std::string>(); }
-bool Plugin::has_hessians() const { return loaded_->api->hessian_T != nullptr && loaded_->api->hessian_V != nullptr; }
+bool Plugin::has_hessians() const {
+  const nonsep_plugin_api& api = *loaded_->api;
+  return api.hessian_T != nullptr && api.hessian_V != nullptr && (api.grad_K == nullptr || api.hessian_K != nullptr) &&
+         (api.grad_U == nullptr || api.hessian_U != nullptr);
+}
+bool Plugin::has_K() const { return loaded_->api->grad_K != nullptr; }
+bool Plugin::has_U() const { return loaded_->api->grad_U != nullptr; }
 bool Plugin::has_third_derivatives() const { return loaded_->api->d3T != nullptr && loaded_->api->d3V != nullptr; }
 unsigned Plugin::abi_version() const { return loaded_->abi_version; }
 bool Plugin::thread_safe() const { return loaded_->metadata["thread_safe"].get<bool>(); }

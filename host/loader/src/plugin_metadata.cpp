@@ -106,9 +106,13 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
     if (part.others && !part.gradient)
       fail("gives the value, Hessian or Hessian-vector product of " + std::string(part.name) + " but not grad_" +
            part.name + " (a separable part is made by its gradient)");
-  if (api.grad_K != nullptr || api.grad_U != nullptr)
-    fail("gives a separable part K(p) + U(q) (grad_" + std::string(api.grad_K != nullptr ? "K" : "U") +
-         "), which this nonsep does not solve: its schemes integrate T_i V_ij T_j and V_i T_ij V_j alone");
+  // The energy of H = T_i V_ij T_j + K + U needs the values of the parts the plugin has.
+  const Part values[] = {{"K", api.grad_K != nullptr, api.value_K != nullptr},
+                         {"U", api.grad_U != nullptr, api.value_U != nullptr}};
+  for (const Part& part : values)
+    if (part.gradient && !part.others)
+      fail("gives grad_" + std::string(part.name) + " but not value_" + part.name +
+           ": the energy of H = T_i V_ij T_j + K + U needs " + part.name + " itself");
 }
 
 }  // namespace nonsep::host

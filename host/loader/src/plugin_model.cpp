@@ -26,6 +26,8 @@ const char* status_name(nonsep_status status) {
 }
 
 std::size_t PluginModel::dimension() const { return instance_->dimension; }
+bool PluginModel::has_K() const { return instance_->api->grad_K != nullptr; }
+bool PluginModel::has_U() const { return instance_->api->grad_U != nullptr; }
 const Plugin& PluginModel::plugin() const { return instance_->plugin; }
 const json& PluginModel::parameters() const { return instance_->parameters; }
 
@@ -84,6 +86,12 @@ NONSEP_PLUGIN_MODEL_FUNCTION(hessian_T, n* n)
 NONSEP_PLUGIN_MODEL_FUNCTION(hessian_V, n* n)
 NONSEP_PLUGIN_MODEL_FUNCTION(value_T, (static_cast<void>(n), 1))
 NONSEP_PLUGIN_MODEL_FUNCTION(value_V, (static_cast<void>(n), 1))
+NONSEP_PLUGIN_MODEL_FUNCTION(grad_K, n)
+NONSEP_PLUGIN_MODEL_FUNCTION(grad_U, n)
+NONSEP_PLUGIN_MODEL_FUNCTION(hessian_K, n* n)
+NONSEP_PLUGIN_MODEL_FUNCTION(hessian_U, n* n)
+NONSEP_PLUGIN_MODEL_FUNCTION(value_K, (static_cast<void>(n), 1))
+NONSEP_PLUGIN_MODEL_FUNCTION(value_U, (static_cast<void>(n), 1))
 #undef NONSEP_PLUGIN_MODEL_FUNCTION
 
 #define NONSEP_PLUGIN_MODEL_DIRECTIONAL(function)                                                                 \

@@ -89,6 +89,10 @@ json run_summary(const RunFacts& facts) {
   const auto evaluations = facts.driver.evaluations();
   summary["evaluations"] = {
       {"grad_T", evaluations.grad_T}, {"grad_V", evaluations.grad_V}, {"grad_H", evaluations.grad_H}};
+  if (evaluations.grad_K + evaluations.grad_U > 0) {  // a model with a separable part K(p) + U(q)
+    summary["evaluations"]["grad_K"] = evaluations.grad_K;
+    summary["evaluations"]["grad_U"] = evaluations.grad_U;
+  }
   if (run.integrator.scheme == "tao")
     summary["comparator"] = {{"omega", run.integrator.omega},
                              {"max_copy_distance", facts.driver.max_copy_distance()},

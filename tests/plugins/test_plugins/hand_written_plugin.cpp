@@ -14,7 +14,7 @@
 //  11  the table has d3V but the metadata does not claim it
 //  12  exports the table itself under the symbol nonsep_plugin instead of a pointer to it (a common C mistake)
 //  13  none: a valid plugin of ABI version 3 (its shorter table; the entries of version 4 past it are not read)
-//  14  a separable part (grad_U), which the host does not solve
+//  14  a separable part grad_U without value_U, which the energy of H needs
 //  15  hvp_K without grad_K
 #include <cstddef>
 #include <cstring>

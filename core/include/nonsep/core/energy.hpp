@@ -1,7 +1,9 @@
 #pragma once
 // The energy of the Hamiltonian the integrators solve (paper, eq. (httv) and section III):
 //   H_TTV = grad T(p) . (Hess V(q) grad T(p))      H_VVT = grad V(q) . (Hess T(p) grad V(q))
-// Needs a model with Hessians (model.hpp). Not part of stepping: used for reporting and testing.
+// plus K(p) + U(q) when the model has a separable part (model.hpp, ModelWithSeparablePart; added after the product
+// term, so a model without one gets the numbers of the product term alone). Needs a model with Hessians (model.hpp).
+// Not part of stepping: used for reporting and testing.
 #include <algorithm>
 #include <span>
 #include <vector>
@@ -49,6 +51,7 @@ class EnergyEvaluator {
         }
         energies[first + b] = sum;
       }
+      add_separable_part(model, q, p, energies.subspan(first, count), count);
     }
   }
 
@@ -60,9 +63,25 @@ class EnergyEvaluator {
   }
 
  private:
+  template <class M>
+  void add_separable_part(const M& model, std::span<const double> q, std::span<const double> p,
+                          std::span<double> energies, std::size_t count) {
+    if constexpr (ModelWithSeparablePart<M>) {
+      separable_.resize(count);
+      if (model.has_K()) {
+        model.value_K(p, std::span<double>(separable_), count);
+        for (std::size_t b = 0; b < count; ++b) energies[b] += separable_[b];
+      }
+      if (model.has_U()) {
+        model.value_U(q, std::span<double>(separable_), count);
+        for (std::size_t b = 0; b < count; ++b) energies[b] += separable_[b];
+      }
+    }
+  }
+
   static constexpr std::size_t hessian_values_per_call = std::size_t{1} << 20;
   HamiltonianForm form_;
-  std::vector<double> gradient_, hessian_;
+  std::vector<double> gradient_, hessian_, separable_;
 };
 
 }  // namespace nonsep

@@ -5,6 +5,8 @@
 //   TTV: H = T_i(p) V_ij(q) T_j(p)    dH/dq = d3V(q, grad T(p))        dH/dp = 2 Hess T(p) Hess V(q) grad T(p)
 //   VVT: H = V_i(q) T_ij(p) V_j(q)    dH/dq = 2 Hess V(q) Hess T(p) grad V(q)    dH/dp = d3T(p, grad V(q))
 //
+// plus, for a model with a separable part (model.hpp), dH/dq += grad U(q) and dH/dp += grad K(p), added last so that
+// a model without one gets the numbers of the product term alone;
 // where d3V(q, u)_k = sum_ij d3V/dq_i dq_j dq_k u_i u_j (model.hpp, ModelWithThirdDerivatives). One evaluation
 // costs the model one gradient, two Hessians and one third-derivative contraction per state, in four batched
 // calls, and counts one grad_H per state (EvaluationCounts).
@@ -63,10 +65,26 @@ class HamiltonianGradient {
     }
     multiply(inner_hessian_, gradient_, product_, n, count, 1.0);
     multiply(outer_hessian_, product_, ttv ? dH_dp : dH_dq, n, count, 2.0);
+    add_separable_part(model, q, p, dH_dq, dH_dp, size, count);
     evaluations_.grad_H += count;
   }
 
  private:
+  template <class M>
+  void add_separable_part(const M& model, std::span<const double> q, std::span<const double> p, std::span<double> dH_dq,
+                          std::span<double> dH_dp, std::size_t size, std::size_t count) {
+    if constexpr (ModelWithSeparablePart<M>) {
+      if (model.has_U()) {
+        model.grad_U(q, std::span<double>(product_), count);
+        for (std::size_t i = 0; i < size; ++i) dH_dq[i] += product_[i];
+      }
+      if (model.has_K()) {
+        model.grad_K(p, std::span<double>(product_), count);
+        for (std::size_t i = 0; i < size; ++i) dH_dp[i] += product_[i];
+      }
+    }
+  }
+
   // out_b = factor * A_b u_b for each state b (A row-major n x n per state).
   static void multiply(std::span<const double> a, std::span<const double> u, std::span<double> out, std::size_t n,
                        std::size_t count, double factor) {

@@ -64,10 +64,10 @@ class Integrator {
   }
 
   // n steps of dt: bit for bit n calls of step(model, x, dt). The basic step does its per-step bookkeeping once
-  // (ChinBasicStep::step_n); the other schemes take their steps one by one.
+  // (ChinBasicStep::step_n, through SeparableComposition::step_n); the other schemes take their steps one by one.
   template <Model M>
   void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
-    if (auto* basic = std::get_if<ChinBasicStep>(&stepper_)) {
+    if (auto* basic = std::get_if<SeparableBasicStep>(&stepper_)) {
       basic->step_n(model, x, dt, n);
       return;
     }

@@ -50,6 +50,52 @@ concept ModelWithThirdDerivatives = ModelWithHessians<M> &&
   m.d3V(x, u, out, count);
 };
 
+// The optional separable part. A model may add K(p) + U(q) to the product form, so that the solved Hamiltonian is
+//   H = T_i V_ij T_j + K(p) + U(q)   (TTV)      H = V_i T_ij V_j + K(p) + U(q)   (VVT)
+// (separable_composition.hpp integrates it). M models nonsep::ModelWithSeparablePart when moreover
+// (x, out as above; Hessians in the Hessian layout, values one number per state):
+//   m.has_K(), m.has_U()        -> bool, whether this model has K (resp. U); a model without one of them has it zero
+//                                  and is never asked for it. Constant for the model's lifetime.
+//   m.grad_K(p, out, count)     writes dK/dp_i            m.grad_U(q, out, count)     writes dU/dq_i
+//   m.value_K(p, out, count)    writes K (one per state)  m.value_U(q, out, count)    writes U (one per state)
+//   m.hessian_K(p, out, count)  writes d2K/dp_i dp_j      m.hessian_U(q, out, count)  writes d2U/dq_i dq_j
+// Whether a model has a separable part is known at compile time (the concept) and at run time (has_K, has_U: one
+// plugin type serves models with and without). Stepping needs the gradients, the energy the values, the tangent
+// map and the comparators' grad H the Hessians and gradients. A model without the concept, or with has_K() and
+// has_U() false, is the pure product form and every integrator gives it bit for bit the numbers it gives it alone.
+template <class M>
+concept ModelWithSeparablePart = Model<M> &&
+    requires(const M& m, std::span<const double> x, std::span<double> out, std::size_t count) {
+  { m.has_K() } -> std::convertible_to<bool>;
+  { m.has_U() } -> std::convertible_to<bool>;
+  m.grad_K(x, out, count);
+  m.grad_U(x, out, count);
+  m.value_K(x, out, count);
+  m.value_U(x, out, count);
+  m.hessian_K(x, out, count);
+  m.hessian_U(x, out, count);
+};
+
+// Whether `model` has K(p) (resp. U(q)): false for every model without the separable concept.
+template <class M>
+bool has_K(const M& model) {
+  if constexpr (ModelWithSeparablePart<M>)
+    return static_cast<bool>(model.has_K());
+  else
+    return false;
+}
+template <class M>
+bool has_U(const M& model) {
+  if constexpr (ModelWithSeparablePart<M>)
+    return static_cast<bool>(model.has_U());
+  else
+    return false;
+}
+template <class M>
+bool has_separable_part(const M& model) {
+  return has_K(model) || has_U(model);
+}
+
 // Gradient evaluations performed by an integrator, counted per state: one batched call on `count` states
 // counts `count` evaluations. grad_H counts evaluations of the full gradient (dH/dq, dH/dp) of the solved
 // Hamiltonian by the comparator schemes (hamiltonian_gradient.hpp), each one gradient, two Hessians and one
@@ -58,11 +104,15 @@ struct EvaluationCounts {
   std::uint64_t grad_T = 0;
   std::uint64_t grad_V = 0;
   std::uint64_t grad_H = 0;
+  std::uint64_t grad_K = 0;  // the separable part's flows (separable_composition.hpp)
+  std::uint64_t grad_U = 0;
 
   EvaluationCounts& operator+=(const EvaluationCounts& other) {
     grad_T += other.grad_T;
     grad_V += other.grad_V;
     grad_H += other.grad_H;
+    grad_K += other.grad_K;
+    grad_U += other.grad_U;
     return *this;
   }
   friend bool operator==(const EvaluationCounts&, const EvaluationCounts&) = default;

@@ -19,14 +19,17 @@
 #include "nonsep/core/gauss_legendre.hpp"
 #include "nonsep/core/integrator_description.hpp"
 #include "nonsep/core/multi_product_expansion.hpp"
+#include "nonsep/core/separable_composition.hpp"
 #include "nonsep/core/tao_extended_phase_space.hpp"
 #include "nonsep/core/triplet_composition.hpp"
 
 namespace nonsep {
 
 // Every stepper type a catalogue entry can build.
-using SchemeStepper = std::variant<ChinBasicStep, TripletComposition<ChinBasicStep>,
-                                   MultiProductExpansion<ChinBasicStep>, TaoExtendedPhaseSpace, GaussLegendre>;
+// Chin's schemes are built over the basic step with the separable flows of K(p) + U(q) around it
+// (separable_composition.hpp), which is the basic step itself for a model without them.
+using SchemeStepper = std::variant<SeparableBasicStep, TripletComposition<SeparableBasicStep>,
+                                   MultiProductExpansion<SeparableBasicStep>, TaoExtendedPhaseSpace, GaussLegendre>;
 
 // The comparator stepper types: they need ModelWithThirdDerivatives and have no tangent map.
 template <class S>

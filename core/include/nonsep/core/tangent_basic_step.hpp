@@ -36,6 +36,8 @@ namespace nonsep {
 struct HessianCounts {
   std::uint64_t hessian_T = 0;
   std::uint64_t hessian_V = 0;
+  std::uint64_t hessian_K = 0;  // the separable part's flows (tangent_separable_composition.hpp)
+  std::uint64_t hessian_U = 0;
   friend bool operator==(const HessianCounts&, const HessianCounts&) = default;
 };
 

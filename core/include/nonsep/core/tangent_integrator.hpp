@@ -7,19 +7,21 @@
 #include <variant>
 
 #include "nonsep/core/integrator.hpp"
-#include "nonsep/core/tangent_basic_step.hpp"
 #include "nonsep/core/tangent_multi_product_expansion.hpp"
+#include "nonsep/core/tangent_separable_composition.hpp"
 #include "nonsep/core/tangent_triplet_composition.hpp"
 
 namespace nonsep {
 
 // The tangent map of each stepper type a catalogue entry builds (SchemeStepper): the states stepped bit for bit as
 // the stepper steps them.
-inline TangentBasicStep tangent_map_of(const ChinBasicStep& stepper) { return TangentBasicStep(stepper); }
-inline TangentTripletComposition tangent_map_of(const TripletComposition<ChinBasicStep>& stepper) {
+inline TangentSeparableComposition tangent_map_of(const SeparableBasicStep& stepper) {
+  return TangentSeparableComposition(stepper);
+}
+inline TangentTripletComposition tangent_map_of(const TripletComposition<SeparableBasicStep>& stepper) {
   return TangentTripletComposition(stepper);
 }
-inline TangentMultiProductExpansion tangent_map_of(const MultiProductExpansion<ChinBasicStep>& stepper) {
+inline TangentMultiProductExpansion tangent_map_of(const MultiProductExpansion<SeparableBasicStep>& stepper) {
   return TangentMultiProductExpansion(stepper);
 }
 
@@ -45,7 +47,7 @@ class TangentIntegrator {
   }
 
  private:
-  using Stepper = std::variant<TangentBasicStep, TangentTripletComposition, TangentMultiProductExpansion>;
+  using Stepper = std::variant<TangentSeparableComposition, TangentTripletComposition, TangentMultiProductExpansion>;
   // Built by the catalogue, through Integrator, and mapped to its tangent map.
   static Stepper make(const IntegratorSpec& spec) {
     return std::visit(

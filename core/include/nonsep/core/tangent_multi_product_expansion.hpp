@@ -13,15 +13,15 @@
 #include <vector>
 
 #include "nonsep/core/multi_product_expansion.hpp"
-#include "nonsep/core/tangent_basic_step.hpp"
+#include "nonsep/core/tangent_separable_composition.hpp"
 
 namespace nonsep {
 
 class TangentMultiProductExpansion {
  public:
   // The tangent map of `stepper`: its base's form and t2, its weights c_i.
-  explicit TangentMultiProductExpansion(const MultiProductExpansion<ChinBasicStep>& stepper)
-      : base_(ChinBasicStep(stepper.base().form(), stepper.base().coefficients().t2)), weights_(stepper.weights()) {}
+  explicit TangentMultiProductExpansion(const MultiProductExpansion<SeparableBasicStep>& stepper)
+      : base_(stepper.base()), weights_(stepper.weights()) {}
 
   int terms() const { return static_cast<int>(weights_.size()); }
   HamiltonianForm form() const { return base_.form(); }
@@ -65,7 +65,7 @@ class TangentMultiProductExpansion {
     for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += c * (y[i] - ym[i]);
   }
 
-  TangentBasicStep base_;
+  TangentSeparableComposition base_;
   std::vector<double> weights_;
   PhaseSpaceBatch start_, term_, last_;                             // states: the start, the running term, y_m
   PhaseSpaceBatch start_tangents_, term_tangents_, last_tangents_;  // their tangent vectors

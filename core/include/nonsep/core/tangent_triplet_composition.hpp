@@ -1,10 +1,10 @@
 #pragma once
 // The tangent map of the triplet composition, eqs. (sym43) and (sym63): the chain rule through the 3^levels basic
-// steps of a step, which is the product of their tangent maps (tangent_basic_step.hpp) taken in the order the
-// composition runs them. The schedule of step sizes is TripletComposition::for_each_basic_step, the one the
-// plain composition runs, so the states get bit for bit the numbers of TripletComposition::step, and the tangent
-// map is symplectic (a product of symplectic maps). Tangent layout as in tangent_basic_step.hpp.
-#include "nonsep/core/tangent_basic_step.hpp"
+// steps of a step, which is the product of their tangent maps (tangent_separable_composition.hpp) taken in the order
+// the composition runs them. The schedule of step sizes is TripletComposition::for_each_basic_step, the one the plain
+// composition runs, so the states get bit for bit the numbers of TripletComposition::step, and the tangent map is
+// symplectic (a product of symplectic maps). Tangent layout as in tangent_basic_step.hpp.
+#include "nonsep/core/tangent_separable_composition.hpp"
 #include "nonsep/core/triplet_composition.hpp"
 
 namespace nonsep {
@@ -12,8 +12,8 @@ namespace nonsep {
 class TangentTripletComposition {
  public:
   // The tangent map of `stepper`: its base's form and t2, its number of levels.
-  explicit TangentTripletComposition(const TripletComposition<ChinBasicStep>& stepper)
-      : base_(ChinBasicStep(stepper.base().form(), stepper.base().coefficients().t2)), levels_(stepper.levels()) {}
+  explicit TangentTripletComposition(const TripletComposition<SeparableBasicStep>& stepper)
+      : base_(stepper.base()), levels_(stepper.levels()) {}
 
   int levels() const { return levels_; }
   HamiltonianForm form() const { return base_.form(); }
@@ -24,12 +24,12 @@ class TangentTripletComposition {
   template <ModelWithHessians M>
   void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, double dt) {
     check_step_size(dt);
-    TripletComposition<ChinBasicStep>::for_each_basic_step(
+    TripletComposition<SeparableBasicStep>::for_each_basic_step(
         levels_, dt, [&](double basic_dt) { base_.step(model, x, tangents, basic_dt); });
   }
 
  private:
-  TangentBasicStep base_;
+  TangentSeparableComposition base_;
   int levels_;
 };
 

@@ -50,8 +50,8 @@ struct DerivativeCheckOptions {
 };
 
 struct DerivativeMismatch {
-  std::string function;       // "grad_T", "grad_V", "hessian_T", "hessian_V", "d3T" or "d3V"
-  std::vector<double> point;  // p for *_T, q for *_V
+  std::string function;       // "grad_T", "grad_V", "hessian_T", "hessian_V", "d3T", "d3V" (or _K, _U)
+  std::vector<double> point;  // p for *_T and *_K, q for *_V and *_U
   std::size_t component;      // index into the gradient or third derivative (i) or row-major Hessian (i*n + j)
   double computed;
   double finite_difference;
@@ -78,7 +78,7 @@ struct DerivativeCheckReport {
       const auto& m = mismatches[k];
       std::string point;
       for (double x : m.point) point += (point.empty() ? "" : ", ") + scientific(x, 6);
-      const bool kinetic = m.function.back() == 'T';
+      const bool kinetic = m.function.back() == 'T' || m.function.back() == 'K';
       text += "  " + m.function + "[" + std::to_string(m.component) + "] at " + (kinetic ? "p" : "q") + " = (" + point +
               "): computed " + scientific(m.computed, 6) + ", finite difference " + scientific(m.finite_difference, 6) +
               ", relative error " +
@@ -253,6 +253,48 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
       }
     }
   }
+  return report;
+}
+
+namespace detail {
+// A model's separable part seen as a product-form model: K in the place of T, U in the place of V, so that
+// check_derivatives checks it as it checks T and V.
+template <class M>
+struct SeparablePartView {
+  const M& model;
+  std::size_t dimension() const { return model.dimension(); }
+  void value_T(std::span<const double> x, std::span<double> out, std::size_t count) const {
+    model.value_K(x, out, count);
+  }
+  void value_V(std::span<const double> x, std::span<double> out, std::size_t count) const {
+    model.value_U(x, out, count);
+  }
+  void grad_T(std::span<const double> x, std::span<double> out, std::size_t count) const {
+    model.grad_K(x, out, count);
+  }
+  void grad_V(std::span<const double> x, std::span<double> out, std::size_t count) const {
+    model.grad_U(x, out, count);
+  }
+  void hessian_T(std::span<const double> x, std::span<double> out, std::size_t count) const {
+    model.hessian_K(x, out, count);
+  }
+  void hessian_V(std::span<const double> x, std::span<double> out, std::size_t count) const {
+    model.hessian_U(x, out, count);
+  }
+};
+}  // namespace detail
+
+// The separable part K(p) + U(q) of a model (nonsep/core/model.hpp, ModelWithSeparablePart: value_K, value_U,
+// grad_K, grad_U, hessian_K, hessian_U) checked as check_derivatives checks T and V: grad K and grad U against
+// differences of K and U, their Hessians against differences of the gradients, only the parts the model has
+// (has_K(), has_U()). Mismatches name grad_K, grad_U, hessian_K, hessian_U.
+template <class M>
+DerivativeCheckReport check_separable_derivatives(const M& model, DerivativeCheckOptions options = {}) {
+  options.check_third_derivatives = false;
+  options.check_kinetic = options.check_kinetic && model.has_K();
+  options.check_potential = options.check_potential && model.has_U();
+  DerivativeCheckReport report = check_derivatives(detail::SeparablePartView<M>{model}, options);
+  for (auto& mismatch : report.mismatches) mismatch.function.back() = mismatch.function.back() == 'T' ? 'K' : 'U';
   return report;
 }
 

@@ -142,7 +142,8 @@ typedef struct nonsep_plugin_api {
 
   /* The separable part: the solved Hamiltonian is H = T_i V_ij T_j + K(p) + U(q) (VVT: V_i T_ij V_j + K + U).
    * grad_K or grad_U, or both, make a model's separable part (an absent one is zero); values and Hessians as for
-   * T and V, each present only with its gradient. */
+   * T and V, each present only with its gradient, and the value required with it (the energy of H needs it). The
+   * host's schemes compose the exact flows of K and U with the basic step (core separable_composition.hpp). */
   nonsep_status (*grad_K)(nonsep_instance* instance, const double* p, double* out, size_t count);
   nonsep_status (*grad_U)(nonsep_instance* instance, const double* q, double* out, size_t count);
   nonsep_status (*value_K)(nonsep_instance* instance, const double* p, double* out, size_t count);

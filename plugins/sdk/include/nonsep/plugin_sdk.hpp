@@ -15,6 +15,8 @@
 // metadata name differs from its file name. Every SDK plugin provides all optional functions of plugin_abi.h
 // (values, Hessians and directional third derivatives of T and V); its metadata adds a "derivatives" object
 // saying, for grad_T, grad_V, hessian_T, hessian_V, d3T and d3V, whether it is "analytic" or "automatic".
+// A model class with K(p) or U(q) (model_adapter.hpp) also fills grad_K, value_K, hessian_K (resp. the U ones) of
+// ABI version 4, announces them as capabilities and adds them to "derivatives"; the absent part's entries are null.
 //
 // Thread safety (as plugin_abi.h promises): metadata_json and create may be called concurrently; an instance
 // holds its model and its last error message, so one instance is for one thread at a time. The metadata says
@@ -115,27 +117,37 @@ class PluginTable {
     else
       dimension = {{"parameter", M::dimension_parameter}, {"max_dimension", M::max_dimension}};
     auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
-    const nlohmann::json metadata = {{"name", id.name},
-                                     {"version", id.version},
-                                     {"description", id.description},
-                                     {"hamiltonian", id.hamiltonian},
-                                     {"dimension", dimension},
-                                     {"parameters", parameters_metadata(parameter_table<M>())},
-                                     {"thread_safe", true},
-                                     {"capabilities",
-                                      {{"value_T", true},
-                                       {"value_V", true},
-                                       {"hessian_T", true},
-                                       {"hessian_V", true},
-                                       {"d3T", true},
-                                       {"d3V", true}}},
-                                     {"derivatives",
-                                      {{"grad_T", kind(Adapter::analytic_grad_T)},
-                                       {"grad_V", kind(Adapter::analytic_grad_V)},
-                                       {"hessian_T", kind(Adapter::analytic_hessian_T)},
-                                       {"hessian_V", kind(Adapter::analytic_hessian_V)},
-                                       {"d3T", kind(Adapter::analytic_d3T)},
-                                       {"d3V", kind(Adapter::analytic_d3V)}}}};
+    nlohmann::json metadata = {{"name", id.name},
+                               {"version", id.version},
+                               {"description", id.description},
+                               {"hamiltonian", id.hamiltonian},
+                               {"dimension", dimension},
+                               {"parameters", parameters_metadata(parameter_table<M>())},
+                               {"thread_safe", true},
+                               {"capabilities",
+                                {{"value_T", true},
+                                 {"value_V", true},
+                                 {"hessian_T", true},
+                                 {"hessian_V", true},
+                                 {"d3T", true},
+                                 {"d3V", true}}},
+                               {"derivatives",
+                                {{"grad_T", kind(Adapter::analytic_grad_T)},
+                                 {"grad_V", kind(Adapter::analytic_grad_V)},
+                                 {"hessian_T", kind(Adapter::analytic_hessian_T)},
+                                 {"hessian_V", kind(Adapter::analytic_hessian_V)},
+                                 {"d3T", kind(Adapter::analytic_d3T)},
+                                 {"d3V", kind(Adapter::analytic_d3V)}}}};
+    for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
+    for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
+    if constexpr (HasK<M>) {
+      metadata["derivatives"]["grad_K"] = kind(Adapter::analytic_grad_K);
+      metadata["derivatives"]["hessian_K"] = kind(Adapter::analytic_hessian_K);
+    }
+    if constexpr (HasU<M>) {
+      metadata["derivatives"]["grad_U"] = kind(Adapter::analytic_grad_U);
+      metadata["derivatives"]["hessian_U"] = kind(Adapter::analytic_hessian_U);
+    }
     return metadata.dump();
   }
 
@@ -200,6 +212,30 @@ class PluginTable {
   NONSEP_SDK_BATCHED(hessian_V, n* n)
 #undef NONSEP_SDK_BATCHED
 
+  // The separable part's functions: compiled for every model, in the table only for a model with that part (the
+  // body of the absent one is never reached; it answers NONSEP_UNSUPPORTED).
+#define NONSEP_SDK_SEPARABLE(function, present, per_state_of)                                                          \
+  static nonsep_status function(nonsep_instance* instance, const double* x, double* out, std::size_t count) noexcept { \
+    if constexpr (present) {                                                                                           \
+      return guarded(instance, #function, [&](const Instance& self) {                                                  \
+        const Adapter& adapter = self.adapter;                                                                         \
+        const std::size_t n = adapter.dimension();                                                                     \
+        adapter.function(std::span<const double>(x, count * n), std::span<double>(out, count * (per_state_of)),        \
+                         count);                                                                                       \
+      });                                                                                                              \
+    } else {                                                                                                           \
+      static_cast<void>(instance), static_cast<void>(x), static_cast<void>(out), static_cast<void>(count);             \
+      return NONSEP_UNSUPPORTED;                                                                                       \
+    }                                                                                                                  \
+  }
+  NONSEP_SDK_SEPARABLE(grad_K, HasK<M>, n)
+  NONSEP_SDK_SEPARABLE(grad_U, HasU<M>, n)
+  NONSEP_SDK_SEPARABLE(value_K, HasK<M>, 1)
+  NONSEP_SDK_SEPARABLE(value_U, HasU<M>, 1)
+  NONSEP_SDK_SEPARABLE(hessian_K, HasK<M>, n* n)
+  NONSEP_SDK_SEPARABLE(hessian_U, HasU<M>, n* n)
+#undef NONSEP_SDK_SEPARABLE
+
   // The directional third derivatives: x, u and out each hold count*n numbers.
 #define NONSEP_SDK_DIRECTIONAL(function)                                                                  \
   static nonsep_status function(nonsep_instance* instance, const double* x, const double* u, double* out, \
@@ -232,12 +268,12 @@ class PluginTable {
       &last_error,
       &d3T,
       &d3V,
-      nullptr,  // grad_K
-      nullptr,  // grad_U
-      nullptr,  // value_K
-      nullptr,  // value_U
-      nullptr,  // hessian_K
-      nullptr,  // hessian_U
+      HasK<M> ? &grad_K : nullptr,
+      HasU<M> ? &grad_U : nullptr,
+      HasK<M> ? &value_K : nullptr,
+      HasU<M> ? &value_U : nullptr,
+      HasK<M> ? &hessian_K : nullptr,
+      HasU<M> ? &hessian_U : nullptr,
       nullptr,  // hvp_T
       nullptr,  // hvp_V
       nullptr,  // hvp_K

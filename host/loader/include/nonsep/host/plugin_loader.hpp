@@ -56,9 +56,15 @@ class Plugin {
   std::string version() const;
   std::string description() const;
   std::vector<PluginParameter> parameters() const;
-  bool has_hessians() const;           // both hessian_T and hessian_V
+  // hessian_T and hessian_V, and the Hessians of the separable parts the plugin has (hessian_K with grad_K,
+  // hessian_U with grad_U): what the energy and the tangent maps need.
+  bool has_hessians() const;
   bool has_values() const;             // both value_T and value_V
   bool has_third_derivatives() const;  // both d3T and d3V
+  // The separable part K(p) + U(q) of the solved H (plugin_abi.h version 4): grad_K (resp. grad_U) present. The
+  // loader has checked that its value is too.
+  bool has_K() const;
+  bool has_U() const;
   // The plugin ABI version its table was built for (4, or 3 for a table without version 4's entries).
   unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
@@ -92,7 +98,9 @@ struct DiscoveredPlugin {
 };
 std::vector<DiscoveredPlugin> discover_plugins();
 
-// A plugin instance as a nonsep::ModelWithThirdDerivatives. One instance must be used by one thread at a time.
+// A plugin instance as a nonsep::ModelWithThirdDerivatives and a nonsep::ModelWithSeparablePart (has_K() and
+// has_U() say whether the plugin has K and U; a model without them is the pure product form). One instance must
+// be used by one thread at a time.
 class PluginModel {
  public:
   std::size_t dimension() const;
@@ -108,6 +116,16 @@ class PluginModel {
   // Throw nonsep::ModelError when the plugin lacks the function, or it fails.
   void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const;
   void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const;
+
+  // The separable part (model.hpp). Throw nonsep::ModelError when the plugin lacks the function, or it fails.
+  bool has_K() const;
+  bool has_U() const;
+  void grad_K(std::span<const double> p, std::span<double> out, std::size_t count) const;
+  void grad_U(std::span<const double> q, std::span<double> out, std::size_t count) const;
+  void value_K(std::span<const double> p, std::span<double> out, std::size_t count) const;
+  void value_U(std::span<const double> q, std::span<double> out, std::size_t count) const;
+  void hessian_K(std::span<const double> p, std::span<double> out, std::size_t count) const;
+  void hessian_U(std::span<const double> q, std::span<double> out, std::size_t count) const;
 
   const Plugin& plugin() const;
   // The parameters in effect: the metadata's defaults overlaid with those given to create().

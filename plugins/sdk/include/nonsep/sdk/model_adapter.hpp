@@ -20,6 +20,13 @@
 //   void d3T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> u, std::span<double> out) const;
 //   void d3V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> u, std::span<double> out) const;
 //                                     directional third derivatives, out[k] = sum_ij T_ijk u_i u_j (n entries).
+//   template <class S> S K(nonsep::sdk::Vector<S> p) const;      a separable part: H = T_i V_ij T_j + K(p) + U(q)
+//   template <class S> S U(nonsep::sdk::Vector<S> q) const;      (either or both; the other is zero)
+//   void grad_K(...), grad_U(...), hessian_K(...), hessian_U(...)  analytic derivatives of K and U, as for T and V
+// K and U are differentiated automatically like T and V (gradients and Hessians: they must compile for double and
+// the gradient and Hessian duals). A model with K or U makes the adapter a nonsep::ModelWithSeparablePart
+// (has_K(), has_U(), grad_K, grad_U, value_K, value_U, hessian_K, hessian_U; the absent one's functions write
+// zeros); a model with neither leaves the adapter as it was, without those functions.
 // Model code signals a point where it cannot be evaluated by throwing EvaluationError; the plugin returns
 // NONSEP_EVALUATION_FAILED with that message. Any other exception becomes NONSEP_INTERNAL_ERROR.
 //
@@ -36,6 +43,7 @@
 // x, as in log(-1), whose dual "derivative" -1 is finite) are the derivatives set to NaN, so that such a point
 // diverges too instead of silently continuing with a wrong number. Failures are what model code throws
 // (EvaluationError and other exceptions).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <concepts>
@@ -105,6 +113,38 @@ concept ModelClass = (HasFixedDimension<M> != HasParameterDimension<M>)&&(dimens
   m.template V<HessianDual<dimension_capacity<M>()>>(dd);
   m.template T<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
   m.template V<ThirdDerivativeDual<dimension_capacity<M>()>>(ddd);
+};
+
+// The optional separable part K(p), U(q), with what automatic differentiation needs (gradients and Hessians).
+template <class M>
+concept HasK = requires(const M& m, Vector<double> x, Vector<GradientDual<dimension_capacity<M>()>> d,
+                        Vector<HessianDual<dimension_capacity<M>()>> dd) {
+  { m.template K<double>(x) } -> std::convertible_to<double>;
+  m.template K<GradientDual<dimension_capacity<M>()>>(d);
+  m.template K<HessianDual<dimension_capacity<M>()>>(dd);
+};
+template <class M>
+concept HasU = requires(const M& m, Vector<double> x, Vector<GradientDual<dimension_capacity<M>()>> d,
+                        Vector<HessianDual<dimension_capacity<M>()>> dd) {
+  { m.template U<double>(x) } -> std::convertible_to<double>;
+  m.template U<GradientDual<dimension_capacity<M>()>>(d);
+  m.template U<HessianDual<dimension_capacity<M>()>>(dd);
+};
+template <class M>
+concept HasAnalyticGradK = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.grad_K(x, out);
+};
+template <class M>
+concept HasAnalyticGradU = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.grad_U(x, out);
+};
+template <class M>
+concept HasAnalyticHessianK = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.hessian_K(x, out);
+};
+template <class M>
+concept HasAnalyticHessianU = requires(const M& m, Vector<double> x, std::span<double> out) {
+  m.hessian_U(x, out);
 };
 
 template <class M>
@@ -205,20 +245,10 @@ class ModelAdapter {
   static constexpr bool analytic_d3T = policy == Derivatives::preferred && HasAnalyticD3T<M>;
   static constexpr bool analytic_d3V = policy == Derivatives::preferred && HasAnalyticD3V<M>;
 
-  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
-    check_sizes(p, out, count, 1);
-    const std::size_t n = dimension_;
-    for (std::size_t b = 0; b < count; ++b) {
-      out[b] = model_.template T<double>(Vector<double>(p.data() + b * n, n));
-    }
-  }
-  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
-    check_sizes(q, out, count, 1);
-    const std::size_t n = dimension_;
-    for (std::size_t b = 0; b < count; ++b) {
-      out[b] = model_.template V<double>(Vector<double>(q.data() + b * n, n));
-    }
-  }
+  static constexpr bool analytic_grad_K = policy == Derivatives::preferred && HasAnalyticGradK<M>;
+  static constexpr bool analytic_grad_U = policy == Derivatives::preferred && HasAnalyticGradU<M>;
+  static constexpr bool analytic_hessian_K = policy == Derivatives::preferred && HasAnalyticHessianK<M>;
+  static constexpr bool analytic_hessian_U = policy == Derivatives::preferred && HasAnalyticHessianU<M>;
 
   // The dimension of the states, a compile-time constant for a model of fixed dimension, so that the loops over a
   // batch unroll and vectorize.
@@ -229,57 +259,97 @@ class ModelAdapter {
       return dimension_;
   }
 
+  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    values(p, out, count, [this](auto v) { return model_.T(v); });
+  }
+  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    values(q, out, count, [this](auto v) { return model_.V(v); });
+  }
   void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
-    check_sizes(p, out, count, dimension_);
-    const std::size_t n = batch_dimension();
-    for (std::size_t b = 0; b < count; ++b) {
-      const double* x = p.data() + b * n;
-      double* g = out.data() + b * n;
-      if constexpr (analytic_grad_T)
-        model_.grad_T(Vector<double>(x, n), std::span<double>(g, n));
-      else
-        detail::poison_if_not_finite(
-            detail::gradient_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, g), g, n);
-    }
+    gradients<analytic_grad_T>(
+        p, out, count, [this](auto v) { return model_.T(v); },
+        [this](Vector<double> x, std::span<double> g) {
+          if constexpr (HasAnalyticGradT<M>) model_.grad_T(x, g);
+        });
   }
   void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
-    check_sizes(q, out, count, dimension_);
-    const std::size_t n = batch_dimension();
-    for (std::size_t b = 0; b < count; ++b) {
-      const double* x = q.data() + b * n;
-      double* g = out.data() + b * n;
-      if constexpr (analytic_grad_V)
-        model_.grad_V(Vector<double>(x, n), std::span<double>(g, n));
-      else
-        detail::poison_if_not_finite(
-            detail::gradient_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, g), g, n);
-    }
+    gradients<analytic_grad_V>(
+        q, out, count, [this](auto v) { return model_.V(v); },
+        [this](Vector<double> x, std::span<double> g) {
+          if constexpr (HasAnalyticGradV<M>) model_.grad_V(x, g);
+        });
   }
   void hessian_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
-    check_sizes(p, out, count, dimension_ * dimension_);
-    const std::size_t n = dimension_;
-    for (std::size_t b = 0; b < count; ++b) {
-      const double* x = p.data() + b * n;
-      double* h = out.data() + b * n * n;
-      if constexpr (analytic_hessian_T)
-        model_.hessian_T(Vector<double>(x, n), std::span<double>(h, n * n));
-      else
-        detail::poison_if_not_finite(detail::hessian_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, n, h),
-                                     h, n * n);
-    }
+    hessians<analytic_hessian_T>(
+        p, out, count, [this](auto v) { return model_.T(v); },
+        [this](Vector<double> x, std::span<double> h) {
+          if constexpr (HasAnalyticHessianT<M>) model_.hessian_T(x, h);
+        });
   }
   void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
-    check_sizes(q, out, count, dimension_ * dimension_);
-    const std::size_t n = dimension_;
-    for (std::size_t b = 0; b < count; ++b) {
-      const double* x = q.data() + b * n;
-      double* h = out.data() + b * n * n;
-      if constexpr (analytic_hessian_V)
-        model_.hessian_V(Vector<double>(x, n), std::span<double>(h, n * n));
-      else
-        detail::poison_if_not_finite(detail::hessian_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, n, h),
-                                     h, n * n);
-    }
+    hessians<analytic_hessian_V>(
+        q, out, count, [this](auto v) { return model_.V(v); },
+        [this](Vector<double> x, std::span<double> h) {
+          if constexpr (HasAnalyticHessianV<M>) model_.hessian_V(x, h);
+        });
+  }
+
+  // The separable part (nonsep::ModelWithSeparablePart), present when M has K or U; the absent one is zero.
+  bool has_K() const requires(HasK<M> || HasU<M>) { return HasK<M>; }
+  bool has_U() const requires(HasK<M> || HasU<M>) { return HasU<M>; }
+  void value_K(std::span<const double> p, std::span<double> out, std::size_t count) const requires(HasK<M> || HasU<M>) {
+    if constexpr (HasK<M>)
+      values(p, out, count, [this](auto v) { return model_.K(v); });
+    else
+      zeros(p, out, count, 1);
+  }
+  void value_U(std::span<const double> q, std::span<double> out, std::size_t count) const requires(HasK<M> || HasU<M>) {
+    if constexpr (HasU<M>)
+      values(q, out, count, [this](auto v) { return model_.U(v); });
+    else
+      zeros(q, out, count, 1);
+  }
+  void grad_K(std::span<const double> p, std::span<double> out, std::size_t count) const requires(HasK<M> || HasU<M>) {
+    if constexpr (HasK<M>)
+      gradients<analytic_grad_K>(
+          p, out, count, [this](auto v) { return model_.K(v); },
+          [this](Vector<double> x, std::span<double> g) {
+            if constexpr (HasAnalyticGradK<M>) model_.grad_K(x, g);
+          });
+    else
+      zeros(p, out, count, dimension_);
+  }
+  void grad_U(std::span<const double> q, std::span<double> out, std::size_t count) const requires(HasK<M> || HasU<M>) {
+    if constexpr (HasU<M>)
+      gradients<analytic_grad_U>(
+          q, out, count, [this](auto v) { return model_.U(v); },
+          [this](Vector<double> x, std::span<double> g) {
+            if constexpr (HasAnalyticGradU<M>) model_.grad_U(x, g);
+          });
+    else
+      zeros(q, out, count, dimension_);
+  }
+  void hessian_K(std::span<const double> p, std::span<double> out, std::size_t count) const
+      requires(HasK<M> || HasU<M>) {
+    if constexpr (HasK<M>)
+      hessians<analytic_hessian_K>(
+          p, out, count, [this](auto v) { return model_.K(v); },
+          [this](Vector<double> x, std::span<double> h) {
+            if constexpr (HasAnalyticHessianK<M>) model_.hessian_K(x, h);
+          });
+    else
+      zeros(p, out, count, dimension_ * dimension_);
+  }
+  void hessian_U(std::span<const double> q, std::span<double> out, std::size_t count) const
+      requires(HasK<M> || HasU<M>) {
+    if constexpr (HasU<M>)
+      hessians<analytic_hessian_U>(
+          q, out, count, [this](auto v) { return model_.U(v); },
+          [this](Vector<double> x, std::span<double> h) {
+            if constexpr (HasAnalyticHessianU<M>) model_.hessian_U(x, h);
+          });
+    else
+      zeros(q, out, count, dimension_ * dimension_);
   }
 
   // out[b*n + k] = sum_ij T_ijk(p_b) u_bi u_bj (d3T), the same for V in q (d3V); u has the layout of p.
@@ -315,6 +385,50 @@ class ModelAdapter {
   }
 
  private:
+  // f (T, V, K or U) at each state of x, one number per state.
+  template <class F>
+  void values(std::span<const double> x, std::span<double> out, std::size_t count, const F& f) const {
+    check_sizes(x, out, count, 1);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) out[b] = f(Vector<double>(x.data() + b * n, n));
+  }
+  // grad f at each state: the author's `analytic_gradient(x, out)` when `analytic`, automatic differentiation of f
+  // otherwise.
+  template <bool analytic, class F, class A>
+  void gradients(std::span<const double> x, std::span<double> out, std::size_t count, const F& f,
+                 const A& analytic_gradient) const {
+    check_sizes(x, out, count, dimension_);
+    const std::size_t n = batch_dimension();
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* at = x.data() + b * n;
+      double* g = out.data() + b * n;
+      if constexpr (analytic)
+        analytic_gradient(Vector<double>(at, n), std::span<double>(g, n));
+      else
+        detail::poison_if_not_finite(detail::gradient_by_dual<capacity>(f, at, n, g), g, n);
+    }
+  }
+  // The Hessian of f at each state, row-major n x n: analytic or automatic as gradients().
+  template <bool analytic, class F, class A>
+  void hessians(std::span<const double> x, std::span<double> out, std::size_t count, const F& f,
+                const A& analytic_hessian) const {
+    check_sizes(x, out, count, dimension_ * dimension_);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* at = x.data() + b * n;
+      double* h = out.data() + b * n * n;
+      if constexpr (analytic)
+        analytic_hessian(Vector<double>(at, n), std::span<double>(h, n * n));
+      else
+        detail::poison_if_not_finite(detail::hessian_by_dual<capacity>(f, at, n, h), h, n * n);
+    }
+  }
+  // The absent part of K + U: zero, with the sizes checked as for the present one.
+  void zeros(std::span<const double> x, std::span<double> out, std::size_t count, std::size_t per_state) const {
+    check_sizes(x, out, count, per_state);
+    std::fill_n(out.begin(), count * per_state, 0.0);
+  }
+
   static M construct(const ParameterValues& values) {
     if constexpr (std::is_constructible_v<M, const ParameterValues&>)
       return M(values);
