@@ -28,6 +28,7 @@ const char* status_name(nonsep_status status) {
 std::size_t PluginModel::dimension() const { return instance_->dimension; }
 const Plugin& PluginModel::plugin() const { return instance_->plugin; }
 const json& PluginModel::parameters() const { return instance_->parameters; }
+bool PluginModel::has_hessian_vector_products() const { return instance_->plugin.has_hessian_vector_products(); }
 
 namespace {
 
@@ -102,6 +103,8 @@ NONSEP_PLUGIN_MODEL_FUNCTION(value_V, (static_cast<void>(n), 1))
   }
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3T)
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3V)
+NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_T)
+NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_V)
 #undef NONSEP_PLUGIN_MODEL_DIRECTIONAL
 
 }  // namespace nonsep::host

@@ -13,8 +13,10 @@
 //
 // The plugin's file must be named <name>.so (nonsep_add_model() in CMake does that): the host refuses a file whose
 // metadata name differs from its file name. Every SDK plugin provides all optional functions of plugin_abi.h
-// (values, Hessians and directional third derivatives of T and V); its metadata adds a "derivatives" object
-// saying, for grad_T, grad_V, hessian_T, hessian_V, d3T and d3V, whether it is "analytic" or "automatic".
+// (values, Hessians, directional third derivatives and Hessian-vector products of T and V); its metadata adds a
+// "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T and hvp_V, whether it is
+// "analytic" or "automatic" (the products are always automatic: of the gradient templates where the model has
+// them, else of T and V).
 //
 // Thread safety (as plugin_abi.h promises): metadata_json and create may be called concurrently; an instance
 // holds its model and its last error message, so one instance is for one thread at a time. The metadata says
@@ -128,14 +130,18 @@ class PluginTable {
                                        {"hessian_T", true},
                                        {"hessian_V", true},
                                        {"d3T", true},
-                                       {"d3V", true}}},
+                                       {"d3V", true},
+                                       {"hvp_T", true},
+                                       {"hvp_V", true}}},
                                      {"derivatives",
                                       {{"grad_T", kind(Adapter::analytic_grad_T)},
                                        {"grad_V", kind(Adapter::analytic_grad_V)},
                                        {"hessian_T", kind(Adapter::analytic_hessian_T)},
                                        {"hessian_V", kind(Adapter::analytic_hessian_V)},
                                        {"d3T", kind(Adapter::analytic_d3T)},
-                                       {"d3V", kind(Adapter::analytic_d3V)}}}};
+                                       {"d3V", kind(Adapter::analytic_d3V)},
+                                       {"hvp_T", "automatic"},
+                                       {"hvp_V", "automatic"}}}};
     return metadata.dump();
   }
 
@@ -200,7 +206,7 @@ class PluginTable {
   NONSEP_SDK_BATCHED(hessian_V, n* n)
 #undef NONSEP_SDK_BATCHED
 
-  // The directional third derivatives: x, u and out each hold count*n numbers.
+  // The directional third derivatives and the Hessian-vector products: x, u and out each hold count*n numbers.
 #define NONSEP_SDK_DIRECTIONAL(function)                                                                  \
   static nonsep_status function(nonsep_instance* instance, const double* x, const double* u, double* out, \
                                 std::size_t count) noexcept {                                             \
@@ -213,6 +219,8 @@ class PluginTable {
   }
   NONSEP_SDK_DIRECTIONAL(d3T)
   NONSEP_SDK_DIRECTIONAL(d3V)
+  NONSEP_SDK_DIRECTIONAL(hvp_T)
+  NONSEP_SDK_DIRECTIONAL(hvp_V)
 #undef NONSEP_SDK_DIRECTIONAL
 
  public:
@@ -238,8 +246,8 @@ class PluginTable {
       nullptr,  // value_U
       nullptr,  // hessian_K
       nullptr,  // hessian_U
-      nullptr,  // hvp_T
-      nullptr,  // hvp_V
+      &hvp_T,
+      &hvp_V,
       nullptr,  // hvp_K
       nullptr,  // hvp_U
       nullptr,  // chin_steps

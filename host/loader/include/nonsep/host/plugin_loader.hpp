@@ -59,6 +59,8 @@ class Plugin {
   bool has_hessians() const;           // both hessian_T and hessian_V
   bool has_values() const;             // both value_T and value_V
   bool has_third_derivatives() const;  // both d3T and d3V
+  // Both hvp_T and hvp_V.
+  bool has_hessian_vector_products() const;
   // The plugin ABI version its table was built for (4, or 3 for a table without version 4's entries).
   unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
@@ -108,6 +110,12 @@ class PluginModel {
   // Throw nonsep::ModelError when the plugin lacks the function, or it fails.
   void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const;
   void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const;
+  // Hessian-vector products (plugin_abi.h hvp_T, hvp_V): out[b*n+i] = sum_j X_ij(x_b) v[b*n+j]. Throw
+  // nonsep::ModelError when the plugin lacks the function, or it fails.
+  void hvp_T(std::span<const double> p, std::span<const double> v, std::span<double> out, std::size_t count) const;
+  void hvp_V(std::span<const double> q, std::span<const double> v, std::span<double> out, std::size_t count) const;
+  // Whether the plugin has both products (the core's energy and gradient of H use them then: hessian_products.hpp).
+  bool has_hessian_vector_products() const;
 
   const Plugin& plugin() const;
   // The parameters in effect: the metadata's defaults overlaid with those given to create().
