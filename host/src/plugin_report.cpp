@@ -156,6 +156,10 @@ std::vector<EvaluationFunction> evaluation_functions(const Plugin& plugin, std::
     functions.push_back({"d3T", "p", n, [](M m, X x, X u, Out out, C c) { m.d3T(x, u, out, c); }});
     functions.push_back({"d3V", "q", n, [](M m, X x, X u, Out out, C c) { m.d3V(x, u, out, c); }});
   }
+  if (plugin.has_hessian_vector_products()) {
+    functions.push_back({"hvp_T", "p", n, [](M m, X x, X v, Out out, C c) { m.hvp_T(x, v, out, c); }});
+    functions.push_back({"hvp_V", "q", n, [](M m, X x, X v, Out out, C c) { m.hvp_V(x, v, out, c); }});
+  }
   return functions;
 }
 
@@ -270,6 +274,7 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
   options.check_gradients = plugin.has_values();
   options.check_hessians = plugin.has_hessians();
   options.check_third_derivatives = plugin.has_third_derivatives() && plugin.has_hessians();
+  options.check_hessian_vector_products = plugin.has_hessian_vector_products();
   options.tolerance = settings.tolerance;
   options.random_points = 0;
   const Samples samples(n, settings);
@@ -307,6 +312,8 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
     result.text += plugin.has_third_derivatives()
                        ? "  skipped: third derivatives: differencing them needs hessian_T/hessian_V\n"
                        : "  skipped: third derivatives: the plugin has no d3T/d3V\n";
+  if (!options.check_hessian_vector_products)
+    result.text += "  skipped: Hessian-vector products: the plugin has no hvp_T/hvp_V\n";
   const std::string difference = batch_difference(model, plugin, samples);
   result.text += difference.empty() ? "batch consistency: one call on all points equals one call per point\n"
                                     : "batch consistency FAILED: " + difference + "\n";

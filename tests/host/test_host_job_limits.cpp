@@ -169,7 +169,7 @@ TEST_CASE("max_initial_values applies to every kind of initial state, not only g
   CHECK(job.initial.count == 1);
 }
 
-TEST_CASE("the model's size: dimension 0 is refused, and so is a Hessian too large to hold, before any step") {
+TEST_CASE("the model's size: dimension 0 is refused, and so is a dense Hessian too large to hold, before any step") {
   nonsep::host_testing::TemporaryFolder folder;
   const auto job_of = [](const std::string& plugin, std::size_t dimension) {
     return json{{"model", {{"plugin", plugin}, {"parameters", {{"dimension", dimension}}}}},
@@ -197,4 +197,15 @@ TEST_CASE("the model's size: dimension 0 is refused, and so is a Hessian too lar
   const auto gradients_only =
       nonsep::host_testing::write_job(folder / "gradients.json", job_of("blowup_gradients_only", 20000));
   CHECK(nonsep::host_testing::run_nonsep({"run", "--quiet", gradients_only.string()}, folder.path()).status == 0);
+  // A plugin with Hessian-vector products forms no matrix: the energy every step and a Lyapunov vector at n =
+  // 20000.
+  json lattice = job_of("lattice_chain", 20000);
+  lattice["model"]["parameters"] = {{"sites", 20000}};
+  lattice["output"] = {{"directory", "lattice"}, {"every", 0}, {"energy_every", 1}};
+  lattice["analysis"] = {{"lyapunov", json::object()}};
+  const auto products = nonsep::host_testing::write_job(folder / "lattice.json", lattice);
+  const auto ran = nonsep::host_testing::run_nonsep({"run", "--quiet", products.string()}, folder.path());
+  INFO(ran.err);
+  CHECK(ran.status == 0);
+  CHECK(std::filesystem::exists(folder / "lattice" / "summary.json"));
 }

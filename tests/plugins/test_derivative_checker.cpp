@@ -48,21 +48,22 @@ TEST_CASE("correct analytic and automatic derivatives pass") {
   const auto report = nonsep::check_derivatives(with(Anharmonic2D::Wrong::nothing));
   INFO(report.summary());
   CHECK(report.passed());
-  CHECK(report.comparisons == 16 * (2 + 2 + 4 + 4 + 2 + 2));
+  CHECK(report.comparisons == 16 * (2 + 2 + 4 + 4 + 2 + 2 + 2 + 2));
   CHECK(report.largest_error < 1e-9);
   CHECK(report.skipped.empty());
 }
 
 TEST_CASE("a gradient off by 0.1 percent is caught and located") {
-  // grad_V[1] disagrees with the differences of V, and (correct, automatic) Hess V[1][1] with the differences of
-  // the wrong grad_V[1]; nothing else is flagged.
+  // grad_V[1] disagrees with the differences of V, and (correct, automatic) Hess V[1][1] and hvp_V[1] with the
+  // differences of the wrong grad_V[1]; nothing else is flagged.
   const auto report = nonsep::check_derivatives(with(Anharmonic2D::Wrong::grad_V));
   REQUIRE_FALSE(report.passed());
   std::size_t gradient_mismatches = 0;
   for (const auto& mismatch : report.mismatches) {
     CAPTURE(mismatch.function);
     CHECK(((mismatch.function == "grad_V" && mismatch.component == 1) ||
-           (mismatch.function == "hessian_V" && mismatch.component == 3)));
+           (mismatch.function == "hessian_V" && mismatch.component == 3) ||
+           (mismatch.function == "hvp_V" && mismatch.component == 1)));
     gradient_mismatches += mismatch.function == "grad_V";
   }
   CHECK(gradient_mismatches == 16);
@@ -102,6 +103,7 @@ TEST_CASE("a model without values has its Hessians checked and the gradient chec
   INFO(report.summary());
   CHECK(report.passed());
   CHECK(report.comparisons == 3 * (4 + 4 + 2 + 2));
-  REQUIRE(report.skipped.size() == 1);
+  REQUIRE(report.skipped.size() == 2);
   CHECK(report.skipped[0] == "gradients: the model has no value_T/value_V");
+  CHECK(report.skipped[1] == "Hessian-vector products: the model has no hvp_T/hvp_V");
 }

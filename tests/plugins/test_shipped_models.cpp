@@ -131,7 +131,7 @@ TEST_CASE("every shipped plugin passes the derivative checker") {
 }
 
 TEST_CASE("each shipped model documents T, V and the Hamiltonian it solves") {
-  for (const char* name : {"paper1d", "radial", "quadratic_kinetic", "tao_product", "paper2d"}) {
+  for (const char* name : {"paper1d", "radial", "quadratic_kinetic", "tao_product", "paper2d", "lattice_chain"}) {
     CAPTURE(std::string(name));
     const auto plugin = load_plugin(name, "");
     CHECK(plugin.name() == name);

@@ -76,6 +76,9 @@ bool Plugin::has_hessians() const {
 bool Plugin::has_K() const { return loaded_->api->grad_K != nullptr; }
 bool Plugin::has_U() const { return loaded_->api->grad_U != nullptr; }
 bool Plugin::has_third_derivatives() const { return loaded_->api->d3T != nullptr && loaded_->api->d3V != nullptr; }
+bool Plugin::has_hessian_vector_products() const {
+  return loaded_->api->hvp_T != nullptr && loaded_->api->hvp_V != nullptr;
+}
 unsigned Plugin::abi_version() const { return loaded_->abi_version; }
 bool Plugin::thread_safe() const { return loaded_->metadata["thread_safe"].get<bool>(); }
 bool Plugin::has_values() const { return loaded_->api->value_T != nullptr && loaded_->api->value_V != nullptr; }

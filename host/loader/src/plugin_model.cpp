@@ -30,6 +30,7 @@ bool PluginModel::has_K() const { return instance_->api->grad_K != nullptr; }
 bool PluginModel::has_U() const { return instance_->api->grad_U != nullptr; }
 const Plugin& PluginModel::plugin() const { return instance_->plugin; }
 const json& PluginModel::parameters() const { return instance_->parameters; }
+bool PluginModel::has_hessian_vector_products() const { return instance_->plugin.has_hessian_vector_products(); }
 
 namespace {
 
@@ -110,6 +111,8 @@ NONSEP_PLUGIN_MODEL_FUNCTION(value_U, (static_cast<void>(n), 1))
   }
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3T)
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3V)
+NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_T)
+NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_V)
 #undef NONSEP_PLUGIN_MODEL_DIRECTIONAL
 
 }  // namespace nonsep::host

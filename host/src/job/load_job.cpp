@@ -102,11 +102,14 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
     return std::nullopt;
   }
   check_dimension(checked.initial, loaded.model.dimension(), issues);
-  if (const std::size_t n = loaded.model.dimension(); loaded.plugin.has_hessians() && n > max_hessian_values / n)
+  // Only the dense path forms n x n Hessians: with Hessian-vector products every evaluation is O(n).
+  if (const std::size_t n = loaded.model.dimension();
+      loaded.plugin.has_hessians() && !loaded.plugin.has_hessian_vector_products() && n > max_hessian_values / n)
     issues.push_back({"/model",
                       "a model of dimension " + std::to_string(n) + ", whose Hessian (for H) would take " +
                           gibibytes(n * n * sizeof(double)) + " GiB",
-                      "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians"});
+                      "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians and no "
+                      "Hessian-vector products (hvp_T, hvp_V)"});
   if (issues.size() == before) place_on_energy_shell(loaded, issues);
   if (!checked.is_study())
     if (const Analysis& analysis = checked.run().analysis;

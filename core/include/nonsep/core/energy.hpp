@@ -2,13 +2,16 @@
 // The energy of the Hamiltonian the integrators solve (paper, eq. (httv) and section III):
 //   H_TTV = grad T(p) . (Hess V(q) grad T(p))      H_VVT = grad V(q) . (Hess T(p) grad V(q))
 // plus K(p) + U(q) when the model has a separable part (model.hpp, ModelWithSeparablePart; added after the product
-// term, so a model without one gets the numbers of the product term alone). Needs a model with Hessians (model.hpp).
-// Not part of stepping: used for reporting and testing.
+// term, so a model without one gets the numbers of the product term alone).
+// Needs a model with Hessians (model.hpp); one with Hessian-vector products is evaluated through them instead
+// (hessian_products.hpp: one gradient and one product per state, O(n) numbers). Not part of stepping: used for
+// reporting and testing.
 #include <algorithm>
 #include <span>
 #include <vector>
 
 #include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/hessian_products.hpp"
 
 namespace nonsep {
 
@@ -23,6 +26,12 @@ class EnergyEvaluator {
     if (energies.size() != x.count())
       throw InvalidArgument("energy output has " + std::to_string(energies.size()) + " entries for " +
                             std::to_string(x.count()) + " states");
+    if constexpr (ModelWithHessianProducts<M>)
+      if (has_hessian_products(model)) {
+        energy_by_products(model, form_, x.q(), x.p(), energies, x.count(), products_);
+        add_separable_part(model, x.q(), x.p(), energies, x.count());
+        return;
+      }
     const std::size_t n = x.dimension();
     // A few states at a time, so that the Hessians take at most about hessian_values_per_call numbers (8 MiB)
     // whatever the batch: each state's H depends on that state alone, so the numbers are the same.
@@ -82,6 +91,7 @@ class EnergyEvaluator {
   static constexpr std::size_t hessian_values_per_call = std::size_t{1} << 20;
   HamiltonianForm form_;
   std::vector<double> gradient_, hessian_, separable_;
+  HessianProductScratch products_;
 };
 
 }  // namespace nonsep

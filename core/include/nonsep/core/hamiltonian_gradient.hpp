@@ -9,7 +9,9 @@
 // a model without one gets the numbers of the product term alone;
 // where d3V(q, u)_k = sum_ij d3V/dq_i dq_j dq_k u_i u_j (model.hpp, ModelWithThirdDerivatives). One evaluation
 // costs the model one gradient, two Hessians and one third-derivative contraction per state, in four batched
-// calls, and counts one grad_H per state (EvaluationCounts).
+// calls, and counts one grad_H per state (EvaluationCounts). A model with Hessian-vector products is evaluated
+// through them instead (hessian_products.hpp): one gradient, two products and one third-derivative contraction,
+// O(n) numbers per state.
 //
 // Layout: q, p, dH/dq and dH/dp are batches of `count` states of dimension n (component i of state b at b*n + i).
 // Model exceptions propagate; the outputs are then unspecified.
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "nonsep/core/error.hpp"
+#include "nonsep/core/hessian_products.hpp"
 #include "nonsep/core/model.hpp"
 
 namespace nonsep {
@@ -45,6 +48,15 @@ class HamiltonianGradient {
     p = p.first(size);
     dH_dq = dH_dq.first(size);
     dH_dp = dH_dp.first(size);
+    if constexpr (ModelWithHessianProducts<M>) {
+      if (has_hessian_products(model)) {
+        hamiltonian_gradient_by_products(model, form_, q, p, dH_dq, dH_dp, count, products_);
+        product_.resize(size);
+        add_separable_part(model, q, p, dH_dq, dH_dp, size, count);
+        evaluations_.grad_H += count;
+        return;
+      }
+    }
     gradient_.resize(size);
     product_.resize(size);
     outer_hessian_.resize(size * n);
@@ -106,6 +118,7 @@ class HamiltonianGradient {
   HamiltonianForm form_;
   EvaluationCounts evaluations_;
   std::vector<double> gradient_, product_, outer_hessian_, inner_hessian_;
+  HessianProductScratch products_;
 };
 
 }  // namespace nonsep

@@ -21,7 +21,9 @@
 // model call per stage), plus one at the start: the Hessian of the outer flows is cached with the point it
 // belongs to and reused while the state still holds that point bit for bit, as the basic step does with its
 // gradient. Counted per state in hessian_evaluations(). Scratch storage grows to the largest batch seen and is
-// reused: steady stepping does not allocate.
+// reused: steady stepping does not allocate. A model with Hessian-vector products (hessian_products.hpp) is used
+// through them instead: one batched product per stage for all k vectors, O(k n) numbers per state, no matrix
+// formed and none counted in hessian_evaluations().
 #include <cstdint>
 #include <cstring>
 #include <span>
@@ -29,6 +31,7 @@
 #include <vector>
 
 #include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/hessian_products.hpp"
 
 namespace nonsep {
 
@@ -87,11 +90,22 @@ class TangentBasicStep {
              PhaseSpaceBatch& tangents, std::size_t k) {
     const std::size_t count = x.count(), n = x.dimension();
     const std::span<const double> point = stage.kick ? x.q() : x.p();
-    const double* hessian = hessian_at(model, stage.kick, point, count).data();
     // kick: dp += h Hess V(q) dq with h = -c eps; drift: dq += h Hess T(p) dp with h = c eps.
     double* changed = (stage.kick ? tangents.p() : tangents.q()).data();
     const double* driver = (stage.kick ? std::as_const(tangents).q() : std::as_const(tangents).p()).data();
     const double sign = stage.kick ? -1.0 : 1.0;
+    if constexpr (ModelWithHessianProducts<M>) {
+      if (has_hessian_products(model)) {
+        const std::span<const double> products = tangent_hessian_products(
+            model, stage.kick, point, count, k, std::span<const double>(driver, count * k * n), products_);
+        for (std::size_t b = 0; b < count; ++b) {
+          const double h = sign * stage.coefficient * eps[eps.size() == 1 ? 0 : b];
+          for (std::size_t i = b * k * n; i < (b + 1) * k * n; ++i) changed[i] += h * products[i];
+        }
+        return;
+      }
+    }
+    const double* hessian = hessian_at(model, stage.kick, point, count).data();
     for (std::size_t b = 0; b < count; ++b) {
       const double h = sign * stage.coefficient * eps[eps.size() == 1 ? 0 : b];
       const double* matrix = hessian + b * n * n;
@@ -132,6 +146,7 @@ class TangentBasicStep {
   ChinBasicStep base_;
   HessianCounts hessians_;
   CachedHessian potential_, kinetic_;
+  HessianProductScratch products_;
 };
 
 }  // namespace nonsep

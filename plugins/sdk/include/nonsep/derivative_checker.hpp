@@ -8,15 +8,18 @@
 //   dimension(), grad_T, grad_V                     always,
 //   value_T(x, out, count), value_V(x, out, count)  (one value per state) when options.check_gradients,
 //   hessian_T, hessian_V                            when options.check_hessians or check_third_derivatives,
-//   d3T(x, u, out, count), d3V(x, u, out, count)    when options.check_third_derivatives.
-// A model whose type lacks value_T/value_V, the Hessians or d3T/d3V is checked on what it has (those checks are
-// skipped and listed in report.skipped).
+//   d3T(x, u, out, count), d3V(x, u, out, count)    when options.check_third_derivatives,
+//   hvp_T(x, v, out, count), hvp_V(x, v, out, count) when options.check_hessian_vector_products.
+// A model whose type lacks value_T/value_V, the Hessians, d3T/d3V or hvp_T/hvp_V is checked on what it has (those
+// checks are skipped and listed in report.skipped).
 //
 // Method: 5-point central differences, f'(x) ~ [f(x-2h) - 8 f(x-h) + 8 f(x+h) - f(x+2h)] / (12 h) with
 // h = options.step * max(1, |x_i|); truncation error O(h^4), rounding error O(eps/h), about 1e-12 relative for
 // smooth models at the default step. Gradients are differenced from the values, Hessians from the gradients,
 // and d3T(x, u)_k = sum_ij T_ijk u_i u_j, the derivative of u^T H(x) u along e_k, from the Hessians, with one
-// direction u per sample point drawn uniformly from [-1, 1]^n (seeded).
+// direction u per sample point drawn uniformly from [-1, 1]^n (seeded). Hessian-vector products H(x) v are
+// differenced from the gradients along v (another seeded direction), g(x + s v) at s = -2h, -h, h, 2h with
+// h = options.step * max(1, max_i |x_i|): 4 gradient evaluations, so products are checked without any Hessian.
 // Every stencil of one check is one batched call, so a plugin is crossed once per function and sample point.
 //
 // Output: a DerivativeCheckReport. A comparison fails when |analytic - finite difference| >
@@ -24,6 +27,7 @@
 // point outside the model's domain, such as log(q) at q < 0) agrees: it is counted in report.not_a_number, not
 // as a mismatch. Evaluation failures of the model propagate (ModelError).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -39,18 +43,19 @@ struct DerivativeCheckOptions {
   std::size_t random_points = 16;  // sample points drawn uniformly from [-box, box]^n (same draw for p and q)
   double box = 1.5;
   std::uint64_t seed = 12345;
-  std::vector<std::vector<double>> points;  // further sample points, each with dimension() numbers
-  double step = 1e-3;                       // relative finite-difference step
-  double tolerance = 1e-6;                  // allowed error, relative to max(1, |finite difference|)
-  bool check_gradients = true;              // grad T, grad V against differences of T, V (needs values)
-  bool check_hessians = true;               // Hessians against differences of the gradients
-  bool check_third_derivatives = true;      // d3T, d3V against differences of u^T H u (needs Hessians)
-  bool check_kinetic = true;                // the T functions, with each sample point as p
-  bool check_potential = true;              // the V functions, with each sample point as q
+  std::vector<std::vector<double>> points;    // further sample points, each with dimension() numbers
+  double step = 1e-3;                         // relative finite-difference step
+  double tolerance = 1e-6;                    // allowed error, relative to max(1, |finite difference|)
+  bool check_gradients = true;                // grad T, grad V against differences of T, V (needs values)
+  bool check_hessians = true;                 // Hessians against differences of the gradients
+  bool check_third_derivatives = true;        // d3T, d3V against differences of u^T H u (needs Hessians)
+  bool check_hessian_vector_products = true;  // hvp_T, hvp_V against differences of the gradients along v
+  bool check_kinetic = true;                  // the T functions, with each sample point as p
+  bool check_potential = true;                // the V functions, with each sample point as q
 };
 
 struct DerivativeMismatch {
-  std::string function;       // "grad_T", "grad_V", "hessian_T", "hessian_V", "d3T", "d3V" (or _K, _U)
+  std::string function;       // "grad_T", "grad_V", "hessian_T", "hessian_V", "d3T", "d3V", "hvp_T", "hvp_V" (or _K, _U)
   std::vector<double> point;  // p for *_T and *_K, q for *_V and *_U
   std::size_t component;      // index into the gradient or third derivative (i) or row-major Hessian (i*n + j)
   double computed;
@@ -119,6 +124,13 @@ concept ModelWithThirdDerivativeFunctions = requires(const M& m, std::span<const
   m.d3V(x, u, out, count);
 };
 
+template <class M>
+concept ModelWithHessianVectorProducts = requires(const M& m, std::span<const double> x, std::span<const double> v,
+                                                  std::span<double> out, std::size_t count) {
+  m.hvp_T(x, v, out, count);
+  m.hvp_V(x, v, out, count);
+};
+
 // u^T H u for the row-major n x n matrix at h.
 inline double quadratic_form(const double* h, const std::vector<double>& u) {
   const std::size_t n = u.size();
@@ -185,6 +197,11 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
   if (options.check_third_derivatives && !(has_third && has_hessians))
     report.skipped.push_back(has_third ? "third derivatives: differencing them needs hessian_T/hessian_V"
                                        : "third derivatives: the model has no d3T/d3V");
+  constexpr bool has_products = detail::ModelWithHessianVectorProducts<M>;
+  if (options.check_hessian_vector_products && !has_products)
+    report.skipped.push_back("Hessian-vector products: the model has no hvp_T/hvp_V");
+  std::mt19937_64 product_engine(options.seed + 2);
+  std::vector<double> product_direction(n), product(n), along, along_gradients;
   std::mt19937_64 direction_engine(options.seed + 1);
   std::uniform_real_distribution<double> direction_component(-1.0, 1.0);
   std::vector<double> direction(n), third(n), stencil_hessians, quadratic_forms;
@@ -249,6 +266,29 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
           for (std::size_t k = 0; k < n; ++k)
             detail::compare(report, options, kinetic ? "d3T" : "d3V", x, k, third[k],
                             detail::five_point(quadratic_forms.data() + 4 * k, 1, steps[k]));
+        }
+      }
+      if constexpr (has_products) {
+        if (options.check_hessian_vector_products) {
+          for (double& v : product_direction) v = direction_component(product_engine);
+          double largest = 1.0;
+          for (double xi : x) largest = std::max(largest, std::abs(xi));
+          const double h = options.step * largest;
+          along.resize(4 * n);
+          along_gradients.resize(4 * n);
+          for (std::size_t s = 0; s < 4; ++s)
+            for (std::size_t i = 0; i < n; ++i)
+              along[s * n + i] = x[i] + std::array{-2.0, -1.0, 1.0, 2.0}[s] * h * product_direction[i];
+          if (kinetic) {
+            model.hvp_T(x, product_direction, product, 1);
+            model.grad_T(along, along_gradients, 4);
+          } else {
+            model.hvp_V(x, product_direction, product, 1);
+            model.grad_V(along, along_gradients, 4);
+          }
+          for (std::size_t i = 0; i < n; ++i)
+            detail::compare(report, options, kinetic ? "hvp_T" : "hvp_V", x, i, product[i],
+                            detail::five_point(along_gradients.data() + i, n, h));
         }
       }
     }

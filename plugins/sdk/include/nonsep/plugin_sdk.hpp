@@ -13,8 +13,10 @@
 //
 // The plugin's file must be named <name>.so (nonsep_add_model() in CMake does that): the host refuses a file whose
 // metadata name differs from its file name. Every SDK plugin provides all optional functions of plugin_abi.h
-// (values, Hessians and directional third derivatives of T and V); its metadata adds a "derivatives" object
-// saying, for grad_T, grad_V, hessian_T, hessian_V, d3T and d3V, whether it is "analytic" or "automatic".
+// (values, Hessians, directional third derivatives and Hessian-vector products of T and V); its metadata adds a
+// "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T and hvp_V, whether it is
+// "analytic" or "automatic" (the products are always automatic: of the gradient templates where the model has
+// them, else of T and V).
 // A model class with K(p) or U(q) (model_adapter.hpp) also fills grad_K, value_K, hessian_K (resp. the U ones) of
 // ABI version 4, announces them as capabilities and adds them to "derivatives"; the absent part's entries are null.
 //
@@ -130,14 +132,18 @@ class PluginTable {
                                  {"hessian_T", true},
                                  {"hessian_V", true},
                                  {"d3T", true},
-                                 {"d3V", true}}},
+                                 {"d3V", true},
+                                 {"hvp_T", true},
+                                 {"hvp_V", true}}},
                                {"derivatives",
                                 {{"grad_T", kind(Adapter::analytic_grad_T)},
                                  {"grad_V", kind(Adapter::analytic_grad_V)},
                                  {"hessian_T", kind(Adapter::analytic_hessian_T)},
                                  {"hessian_V", kind(Adapter::analytic_hessian_V)},
                                  {"d3T", kind(Adapter::analytic_d3T)},
-                                 {"d3V", kind(Adapter::analytic_d3V)}}}};
+                                 {"d3V", kind(Adapter::analytic_d3V)},
+                                 {"hvp_T", "automatic"},
+                                 {"hvp_V", "automatic"}}}};
     for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
     for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
     if constexpr (HasK<M>) {
@@ -237,6 +243,7 @@ class PluginTable {
 #undef NONSEP_SDK_SEPARABLE
 
   // The directional third derivatives: x, u and out each hold count*n numbers.
+  // The directional third derivatives and the Hessian-vector products: x, u and out each hold count*n numbers.
 #define NONSEP_SDK_DIRECTIONAL(function)                                                                  \
   static nonsep_status function(nonsep_instance* instance, const double* x, const double* u, double* out, \
                                 std::size_t count) noexcept {                                             \
@@ -249,6 +256,8 @@ class PluginTable {
   }
   NONSEP_SDK_DIRECTIONAL(d3T)
   NONSEP_SDK_DIRECTIONAL(d3V)
+  NONSEP_SDK_DIRECTIONAL(hvp_T)
+  NONSEP_SDK_DIRECTIONAL(hvp_V)
 #undef NONSEP_SDK_DIRECTIONAL
 
  public:
@@ -274,8 +283,8 @@ class PluginTable {
       HasU<M> ? &value_U : nullptr,
       HasK<M> ? &hessian_K : nullptr,
       HasU<M> ? &hessian_U : nullptr,
-      nullptr,  // hvp_T
-      nullptr,  // hvp_V
+      &hvp_T,
+      &hvp_V,
       nullptr,  // hvp_K
       nullptr,  // hvp_U
       nullptr,  // chin_steps

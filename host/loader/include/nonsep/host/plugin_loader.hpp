@@ -65,6 +65,8 @@ class Plugin {
   // loader has checked that its value is too.
   bool has_K() const;
   bool has_U() const;
+  // Both hvp_T and hvp_V.
+  bool has_hessian_vector_products() const;
   // The plugin ABI version its table was built for (4, or 3 for a table without version 4's entries).
   unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
@@ -116,6 +118,12 @@ class PluginModel {
   // Throw nonsep::ModelError when the plugin lacks the function, or it fails.
   void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const;
   void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const;
+  // Hessian-vector products (plugin_abi.h hvp_T, hvp_V): out[b*n+i] = sum_j X_ij(x_b) v[b*n+j]. Throw
+  // nonsep::ModelError when the plugin lacks the function, or it fails.
+  void hvp_T(std::span<const double> p, std::span<const double> v, std::span<double> out, std::size_t count) const;
+  void hvp_V(std::span<const double> q, std::span<const double> v, std::span<double> out, std::size_t count) const;
+  // Whether the plugin has both products (the core's energy and gradient of H use them then: hessian_products.hpp).
+  bool has_hessian_vector_products() const;
 
   // The separable part (model.hpp). Throw nonsep::ModelError when the plugin lacks the function, or it fails.
   bool has_K() const;

@@ -11,12 +11,24 @@
 //                               e1 e2 part is d^2/ds dt f(x + (s + t) u) with its gradient in x inside. 4 (K+1)
 //                               doubles per number: cheaper than differencing n Hessian passes, and no Hessian
 //                               is formed.
+//   hessian_vector_by_dual      out = H(x) v, one column pass of hessian_by_dual with the outer slot seeded with v
+//                               instead of e_j: the cost of a single Hessian column.
 // Each returns f(x) (the value computed alongside), which poison_if_not_finite uses.
+//
+// For a model whose gradient g is written as a template over the number type (model_adapter.hpp), the
+// derivatives of g need no capacity K, and their storage is a per-thread buffer of n numbers that grows once:
+//   hessian_vector_by_gradient      out = H(x) v, one pass of g on Dual<double, 1> seeded with v: a few gradients'
+//                                   cost
+//   hessian_by_gradient             the n x n Hessian, row-major: n such passes (column j along e_j)
+//   directional_third_by_gradient   out_k = sum_ij f_kij u_i u_j, one pass of g on Dual<Dual<double, 1>, 1> with
+//                                   both slots seeded with u
+// These return nothing (g gives no value); the callers poison their results by the value of f where they need to.
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <span>
+#include <vector>
 
 #include "nonsep/sdk/dual.hpp"
 
@@ -84,6 +96,64 @@ double directional_third_by_dual(const F& f, const double* x, const double* u, s
   const D y = f(Vector<D>(xs.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[k];
   return y.value.value.value;
+}
+
+template <std::size_t K, class F>
+double hessian_vector_by_dual(const F& f, const double* x, const double* v, std::size_t n, double* out) {
+  using Inner = Dual<double, K>;
+  using D = HessianDual<K>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i].value = Inner::variable(x[i], i);
+    xs[i].derivative[0] = Inner(v[i]);
+  }
+  const D y = f(Vector<D>(xs.data(), n));
+  for (std::size_t i = 0; i < n; ++i) out[i] = y.derivative[0].derivative[i];
+  return y.value.value;
+}
+
+// Two per-thread buffers of n numbers of type D (the point and the gradient), reused by every call on the thread.
+template <class D>
+struct GradientScratch {
+  std::vector<D> x, g;
+  static GradientScratch& of_size(std::size_t n) {
+    thread_local GradientScratch scratch;
+    if (scratch.x.size() < n) {
+      scratch.x.resize(n);
+      scratch.g.resize(n);
+    }
+    return scratch;
+  }
+};
+
+template <class G>
+void hessian_vector_by_gradient(const G& gradient, const double* x, const double* v, std::size_t n, double* out) {
+  using D = Dual<double, 1>;
+  auto& scratch = GradientScratch<D>::of_size(n);
+  for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(x[i], {v[i]});
+  gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
+  for (std::size_t i = 0; i < n; ++i) out[i] = scratch.g[i].derivative[0];
+}
+
+template <class G>
+void hessian_by_gradient(const G& gradient, const double* x, std::size_t n, double* out) {
+  using D = Dual<double, 1>;
+  auto& scratch = GradientScratch<D>::of_size(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(x[i], {i == j ? 1.0 : 0.0});
+    gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
+    for (std::size_t i = 0; i < n; ++i) out[i * n + j] = scratch.g[i].derivative[0];
+  }
+}
+
+template <class G>
+void directional_third_by_gradient(const G& gradient, const double* x, const double* u, std::size_t n, double* out) {
+  using Inner = Dual<double, 1>;
+  using D = Dual<Inner, 1>;
+  auto& scratch = GradientScratch<D>::of_size(n);
+  for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(Inner(x[i], {u[i]}), {Inner(u[i])});
+  gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
+  for (std::size_t k = 0; k < n; ++k) out[k] = scratch.g[k].derivative[0].derivative[0];
 }
 
 }  // namespace detail

@@ -27,15 +27,22 @@
 // the gradient and Hessian duals). A model with K or U makes the adapter a nonsep::ModelWithSeparablePart
 // (has_K(), has_U(), grad_K, grad_U, value_K, value_U, hessian_K, hessian_U; the absent one's functions write
 // zeros); a model with neither leaves the adapter as it was, without those functions.
+// The gradients may be written as templates over the number type, like T and V,
+//   template <class S> void grad_T(nonsep::sdk::Vector<S> p, std::span<S> out) const;   (and grad_V)
+// instantiated for double, Dual<double, 1> and Dual<Dual<double, 1>, 1>. Then every higher derivative not written
+// by hand is automatic differentiation of the gradient, not of T: the Hessian-vector products hvp_T, hvp_V in one
+// pass (a few gradients' cost, whatever n), the directional third derivatives in one second-order pass along u,
+// Hessians in n passes; no capacity-sized dual is used, so max_dimension may be large (a lattice of 10^6 sites),
+// and T and V need only compile for double. Their scratch is a per-thread buffer of 2n numbers that grows once.
 // Model code signals a point where it cannot be evaluated by throwing EvaluationError; the plugin returns
 // NONSEP_EVALUATION_FAILED with that message. Any other exception becomes NONSEP_INTERNAL_ERROR.
 //
-// Automatic differentiation (automatic_derivatives.hpp) uses Dual<double, K> for gradients (one pass),
+// Otherwise automatic differentiation (automatic_derivatives.hpp) uses Dual<double, K> for gradients (one pass),
 // Dual<Dual<double, K>, 1> for Hessians (one pass per column) and Dual<Dual<Dual<double, K>, 1>, 1> for directional
-// third derivatives (one pass), with K = dimension or max_dimension: T and V must compile for these three types
-// and double. All AD storage is on the stack (std::array of K duals), so there is no heap allocation while
-// evaluating; max_dimension bounds that stack use (about 32 (K+1) K bytes for a third-derivative pass, 8.7 KB at
-// K = 16).
+// third derivatives (one pass) and Hessian-vector products (one pass), with K = dimension or max_dimension: T and V
+// must compile for these three types and double. All AD storage is on the stack (std::array of K duals), so there is no
+// heap allocation while evaluating; max_dimension bounds that stack use (about 32 (K+1) K bytes for a third-derivative
+// pass, 8.7 KB at K = 16).
 //
 // Non-finite results are numbers, not failures: a gradient, Hessian or value that overflows or is NaN is returned
 // as computed, and the host sees the state become non-finite and reports the trajectory as diverged (where, when
@@ -100,13 +107,23 @@ consteval std::size_t dimension_capacity() {
     return 0;
 }
 
+// The number types a gradient template is instantiated with for Hessian-vector products and third derivatives.
+using DirectionalDual = Dual<double, 1>;
+using SecondDirectionalDual = Dual<DirectionalDual, 1>;
+
 template <class M>
-concept ModelClass = (HasFixedDimension<M> != HasParameterDimension<M>)&&(dimension_capacity<M>() > 0) &&
-                     requires(const M& m, Vector<double> x, Vector<GradientDual<dimension_capacity<M>()>> d,
-                              Vector<HessianDual<dimension_capacity<M>()>> dd,
-                              Vector<ThirdDerivativeDual<dimension_capacity<M>()>> ddd) {
-  { m.template T<double>(x) } -> std::convertible_to<double>;
-  { m.template V<double>(x) } -> std::convertible_to<double>;
+concept HasGradientTemplates = requires(const M& m, Vector<DirectionalDual> d, std::span<DirectionalDual> d_out,
+                                        Vector<SecondDirectionalDual> dd, std::span<SecondDirectionalDual> dd_out) {
+  m.template grad_T<DirectionalDual>(d, d_out);
+  m.template grad_V<DirectionalDual>(d, d_out);
+  m.template grad_T<SecondDirectionalDual>(dd, dd_out);
+  m.template grad_V<SecondDirectionalDual>(dd, dd_out);
+};
+
+template <class M>
+concept HasDualTV = requires(const M& m, Vector<GradientDual<dimension_capacity<M>()>> d,
+                             Vector<HessianDual<dimension_capacity<M>()>> dd,
+                             Vector<ThirdDerivativeDual<dimension_capacity<M>()>> ddd) {
   m.template T<GradientDual<dimension_capacity<M>()>>(d);
   m.template V<GradientDual<dimension_capacity<M>()>>(d);
   m.template T<HessianDual<dimension_capacity<M>()>>(dd);
@@ -146,6 +163,14 @@ template <class M>
 concept HasAnalyticHessianU = requires(const M& m, Vector<double> x, std::span<double> out) {
   m.hessian_U(x, out);
 };
+
+template <class M>
+concept ModelClass = (HasFixedDimension<M> != HasParameterDimension<M>)&&(dimension_capacity<M>() > 0) &&
+                     requires(const M& m, Vector<double> x) {
+  { m.template T<double>(x) } -> std::convertible_to<double>;
+  { m.template V<double>(x) } -> std::convertible_to<double>;
+}
+&&(HasGradientTemplates<M> || HasDualTV<M>);
 
 template <class M>
 concept HasAnalyticGradT = requires(const M& m, Vector<double> x, std::span<double> out) {
@@ -212,11 +237,10 @@ consteval bool dimension_parameter_is_bounded() {
 }
 
 // A model class behind the batched interface of nonsep/core/model.hpp (it models
-// nonsep::ModelWithThirdDerivatives), plus value_T / value_V. Batch layout as in model.hpp. Spans must hold at
-// least count*n (count*n*n for Hessians, count for values) entries; shorter spans are a caller bug and throw
-// nonsep::InvalidArgument.
-// Evaluation failures throw EvaluationError. ModelAdapter keeps no mutable state: concurrent calls are as safe
-// as M's const member functions.
+// nonsep::ModelWithThirdDerivatives), plus value_T / value_V and hvp_T / hvp_V. Batch layout as in model.hpp. Spans
+// must hold at least count*n (count*n*n for Hessians, count for values) entries; shorter spans are a caller bug and
+// throw nonsep::InvalidArgument. Evaluation failures throw EvaluationError. ModelAdapter keeps no mutable state:
+// concurrent calls are as safe as M's const member functions.
 template <ModelClass M, Derivatives policy = Derivatives::preferred>
 class ModelAdapter {
  public:
@@ -244,6 +268,10 @@ class ModelAdapter {
   static constexpr bool analytic_hessian_V = policy == Derivatives::preferred && HasAnalyticHessianV<M>;
   static constexpr bool analytic_d3T = policy == Derivatives::preferred && HasAnalyticD3T<M>;
   static constexpr bool analytic_d3V = policy == Derivatives::preferred && HasAnalyticD3V<M>;
+  // Higher derivatives by automatic differentiation of the gradient templates (else of T and V).
+  static constexpr bool differentiates_gradients = policy == Derivatives::preferred && HasGradientTemplates<M>;
+  static_assert(differentiates_gradients || HasDualTV<M>,
+                "Derivatives::automatic needs T and V that compile for the dual numbers of automatic_derivatives.hpp");
 
   static constexpr bool analytic_grad_K = policy == Derivatives::preferred && HasAnalyticGradK<M>;
   static constexpr bool analytic_grad_U = policy == Derivatives::preferred && HasAnalyticGradU<M>;
@@ -280,18 +308,24 @@ class ModelAdapter {
         });
   }
   void hessian_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
-    hessians<analytic_hessian_T>(
-        p, out, count, [this](auto v) { return model_.T(v); },
-        [this](Vector<double> x, std::span<double> h) {
-          if constexpr (HasAnalyticHessianT<M>) model_.hessian_T(x, h);
-        });
+    if constexpr (!analytic_hessian_T && differentiates_gradients)
+      hessians_by_gradient(p, out, count, [this](auto y, auto g) { model_.grad_T(y, g); });
+    else
+      hessians<analytic_hessian_T>(
+          p, out, count, [this](auto w) { return model_.T(w); },
+          [this](Vector<double> x, std::span<double> h) {
+            if constexpr (HasAnalyticHessianT<M>) model_.hessian_T(x, h);
+          });
   }
   void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
-    hessians<analytic_hessian_V>(
-        q, out, count, [this](auto v) { return model_.V(v); },
-        [this](Vector<double> x, std::span<double> h) {
-          if constexpr (HasAnalyticHessianV<M>) model_.hessian_V(x, h);
-        });
+    if constexpr (!analytic_hessian_V && differentiates_gradients)
+      hessians_by_gradient(q, out, count, [this](auto y, auto g) { model_.grad_V(y, g); });
+    else
+      hessians<analytic_hessian_V>(
+          q, out, count, [this](auto w) { return model_.V(w); },
+          [this](Vector<double> x, std::span<double> h) {
+            if constexpr (HasAnalyticHessianV<M>) model_.hessian_V(x, h);
+          });
   }
 
   // The separable part (nonsep::ModelWithSeparablePart), present when M has K or U; the absent one is zero.
@@ -363,6 +397,8 @@ class ModelAdapter {
       double* d = out.data() + b * n;
       if constexpr (analytic_d3T)
         model_.d3T(Vector<double>(x, n), Vector<double>(v, n), std::span<double>(d, n));
+      else if constexpr (differentiates_gradients)
+        detail::directional_third_by_gradient([this](auto y, auto g) { model_.grad_T(y, g); }, x, v, n, d);
       else
         detail::poison_if_not_finite(
             detail::directional_third_by_dual<capacity>([this](auto w) { return model_.T(w); }, x, v, n, d), d, n);
@@ -378,10 +414,23 @@ class ModelAdapter {
       double* d = out.data() + b * n;
       if constexpr (analytic_d3V)
         model_.d3V(Vector<double>(x, n), Vector<double>(v, n), std::span<double>(d, n));
+      else if constexpr (differentiates_gradients)
+        detail::directional_third_by_gradient([this](auto y, auto g) { model_.grad_V(y, g); }, x, v, n, d);
       else
         detail::poison_if_not_finite(
             detail::directional_third_by_dual<capacity>([this](auto w) { return model_.V(w); }, x, v, n, d), d, n);
     }
+  }
+
+  // Hessian-vector products, out[b*n + i] = sum_j T_ij(p_b) v[b*n + j] (hvp_T), the same for V in q (hvp_V); v has
+  // the layout of p. One directional pass over the gradient template, or one Hessian-column pass over T or V.
+  void hvp_T(std::span<const double> p, std::span<const double> v, std::span<double> out, std::size_t count) const {
+    hessian_vector([](const auto& m, auto y, auto g) { m.grad_T(y, g); }, [](const auto& m, auto w) { return m.T(w); },
+                   p, v, out, count);
+  }
+  void hvp_V(std::span<const double> q, std::span<const double> v, std::span<double> out, std::size_t count) const {
+    hessian_vector([](const auto& m, auto y, auto g) { m.grad_V(y, g); }, [](const auto& m, auto w) { return m.V(w); },
+                   q, v, out, count);
   }
 
  private:
@@ -421,6 +470,34 @@ class ModelAdapter {
         analytic_hessian(Vector<double>(at, n), std::span<double>(h, n * n));
       else
         detail::poison_if_not_finite(detail::hessian_by_dual<capacity>(f, at, n, h), h, n * n);
+    }
+  }
+  // The Hessian of the function whose gradient template is `gradient(y, g)`, column by column (n passes).
+  template <class G>
+  void hessians_by_gradient(std::span<const double> x, std::span<double> out, std::size_t count,
+                            const G& gradient) const {
+    check_sizes(x, out, count, dimension_ * dimension_);
+    const std::size_t n = dimension_;
+    for (std::size_t b = 0; b < count; ++b)
+      detail::hessian_by_gradient(gradient, x.data() + b * n, n, out.data() + b * n * n);
+  }
+  // Hessian-vector products of T or V: one directional pass over the gradient template `gradient(model, y, g)`, or
+  // one Hessian-column pass over `function(model, w)`.
+  template <class Gradient, class Function>
+  void hessian_vector(const Gradient& gradient, const Function& function, std::span<const double> x,
+                      std::span<const double> v, std::span<double> out, std::size_t count) const {
+    check_sizes(x, out, count, dimension_);
+    check_sizes(v, out, count, dimension_);
+    const std::size_t n = batch_dimension();
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* xb = x.data() + b * n;
+      const double* vb = v.data() + b * n;
+      double* d = out.data() + b * n;
+      if constexpr (differentiates_gradients)
+        detail::hessian_vector_by_gradient([&](auto y, auto g) { gradient(model_, y, g); }, xb, vb, n, d);
+      else
+        detail::poison_if_not_finite(
+            detail::hessian_vector_by_dual<capacity>([&](auto w) { return function(model_, w); }, xb, vb, n, d), d, n);
     }
   }
   // The absent part of K + U: zero, with the sizes checked as for the present one.
