@@ -57,7 +57,17 @@ const nonsep_plugin_api table = {
     nullptr,  // hessian_V
     &last_error,
     nullptr,  // d3T
-    nullptr,  // d3V
+    nullptr,  // d3V    nullptr,  // grad_K
+    nullptr,  // grad_U
+    nullptr,  // value_K
+    nullptr,  // value_U
+    nullptr,  // hessian_K
+    nullptr,  // hessian_U
+    nullptr,  // hvp_T
+    nullptr,  // hvp_V
+    nullptr,  // hvp_K
+    nullptr,  // hvp_U
+    nullptr,  // chin_steps
 };
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/plugin_abi.h"
 
 namespace nonsep::host {
 
@@ -47,6 +48,11 @@ std::string describe_plugin(const Plugin& plugin) {
   out += "  description: " + plugin.description() + "\n";
   if (metadata.contains("hamiltonian")) out += "  hamiltonian: " + text_of(metadata["hamiltonian"]) + "\n";
   out += "  dimension:   " + dimension_text(metadata) + "\n";
+  out += "  plugin ABI:  version " + std::to_string(plugin.abi_version()) +
+         (plugin.abi_version() < NONSEP_PLUGIN_ABI_VERSION ? " (still loaded; rebuild it for the entries of version " +
+                                                                 std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ")"
+                                                           : "") +
+         "\n";
   std::string capabilities;
   const json capabilities_object = metadata.value("capabilities", json::object());
   for (const auto& [name, present] : capabilities_object.items())

@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
     expect(parameters.size() == 1 && parameters[0].name == "g" && parameters[0].unit == "1/time^2",
            "parameter g with its unit");
     expect(plugin.has_values() && plugin.has_hessians() && plugin.has_third_derivatives(),
-           "values, Hessians and third derivatives (ABI version 3, filled in by the SDK)");
+           "values, Hessians and third derivatives (filled in by the SDK)");
     expect(plugin.thread_safe(), "thread_safe, as the SDK declares");
     const auto model = plugin.create({{"g", 2.0}});
     const auto report = nonsep::check_derivatives(model);

@@ -109,14 +109,39 @@ TEST_CASE("a plugin of ABI version 1 (its entry function, no plugin symbol): exp
   CHECK(load_error("version_1_entry.so") ==
         "plugin '" + file +
             "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
-            "version 3 (expected 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) and "
+            "version 4 (expected 4 or 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) "
+            "and "
             "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
 }
 
 TEST_CASE("a plugin of ABI version 2 (the one with integrate): expected and found, and how to rebuild") {
   const std::string message = load_error("wrong_abi_version.so");
-  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 3 (expected 3, found 2)"));
+  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 4 (expected 4 or 3, found 2)"));
   CHECK(contains(message, "rebuild the plugin against the installed SDK"));
+}
+
+TEST_CASE("a plugin of ABI version 3 loads: its shorter table, none of version 4's entries read past its end") {
+  const Plugin plugin = load_plugin("version_3_table.so", test_plugins);
+  CHECK(plugin.name() == "version_3_table");
+  CHECK(plugin.abi_version() == 3);
+  CHECK(load_plugin("hand_written.so", test_plugins).abi_version() == 4);
+  const PluginModel model = plugin.create(nlohmann::json::object());
+  const double p[] = {0.5};
+  double out[1] = {0.0};
+  model.grad_V(p, out, 1);
+  CHECK(out[0] == 0.5);
+  // The table it was built with holds grad_K past the version-3 size: a loader reading it would refuse the plugin
+  // (a separable part, and a capability it does not claim).
+}
+
+TEST_CASE("a separable part K(p) + U(q) is refused by a host whose schemes do not solve it") {
+  const std::string message = load_error("separable_part.so");
+  CHECK(contains(message, "gives a separable part K(p) + U(q) (grad_U), which this nonsep does not solve"));
+}
+
+TEST_CASE("a part's Hessian-vector product without its gradient") {
+  const std::string message = load_error("hvp_K_without_grad_K.so");
+  CHECK(contains(message, "gives the value, Hessian or Hessian-vector product of K but not grad_K"));
 }
 
 TEST_CASE("the table itself exported under the symbol, not a pointer to it: refused before reading through it") {
@@ -263,7 +288,7 @@ TEST_CASE("discovery lists good plugins and the failures with their errors, firs
   CHECK(entry("paper1d")->plugin.has_value());
   REQUIRE(entry("wrong_abi_version") != nullptr);
   CHECK_FALSE(entry("wrong_abi_version")->plugin.has_value());
-  CHECK(contains(entry("wrong_abi_version")->error, "(expected 3, found 2)"));
+  CHECK(contains(entry("wrong_abi_version")->error, "(expected 4 or 3, found 2)"));
   REQUIRE(entry("not_a_library") != nullptr);
   CHECK(contains(entry("not_a_library")->error, "invalid ELF header"));
   CHECK(entry("hand_written")->path == test_plugins / "hand_written.so");

@@ -15,7 +15,10 @@ namespace nonsep::host {
 struct Plugin::Loaded {
   boost::shared_ptr<const nonsep_plugin_api> table;  // from import_alias: owns the loaded library
   std::filesystem::path path;
-  const nonsep_plugin_api* api = nullptr;  // table.get()
+  // The plugin's table as a version-4 one: a version-3 table copied, with the entries it lacks null.
+  nonsep_plugin_api entries{};
+  unsigned abi_version = NONSEP_PLUGIN_ABI_VERSION;  // the plugin's own
+  const nonsep_plugin_api* api = nullptr;            // &entries
   nlohmann::json metadata;
 };
 

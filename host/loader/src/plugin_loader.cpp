@@ -12,6 +12,7 @@
 #include <boost/shared_ptr.hpp>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <set>
 #include <sstream>
 #include <system_error>
@@ -69,6 +70,7 @@ std::string Plugin::version() const { return loaded_->metadata["version"].get<st
 std::string Plugin::description() const { return loaded_->metadata["description"].get<std::string>(); }
 bool Plugin::has_hessians() const { return loaded_->api->hessian_T != nullptr && loaded_->api->hessian_V != nullptr; }
 bool Plugin::has_third_derivatives() const { return loaded_->api->d3T != nullptr && loaded_->api->d3V != nullptr; }
+unsigned Plugin::abi_version() const { return loaded_->abi_version; }
 bool Plugin::thread_safe() const { return loaded_->metadata["thread_safe"].get<bool>(); }
 bool Plugin::has_values() const { return loaded_->api->value_T != nullptr && loaded_->api->value_V != nullptr; }
 
@@ -192,7 +194,7 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                         " uses plugin ABI version 1 (it exports '" NONSEP_PLUGIN_V1_ENTRY_SYMBOL
                         "') but this host uses version " +
                         std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
-                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found 1); " + rebuild_hint);
+                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " or 3, found 1); " + rebuild_hint);
     throw PluginError(
         quoted(path) +
         " is a shared library but not a nonsep plugin: it does not export the symbol '" NONSEP_PLUGIN_SYMBOL
@@ -218,17 +220,21 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                       "nonsep_plugin = &table;', not the table itself; define it with NONSEP_EXPORT_MODEL (see "
                       "plugin_sdk.hpp) or NONSEP_DEFINE_PLUGIN (see plugin_abi.h)");
   }
-  if (api->abi_version != NONSEP_PLUGIN_ABI_VERSION)
-    throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(api->abi_version) +
+  const std::uint32_t version = api->abi_version;
+  if (version != NONSEP_PLUGIN_ABI_VERSION && version != 3)
+    throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(version) +
                       " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
-                      std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", found " + std::to_string(api->abi_version) +
-                      "); " + rebuild_hint);
-  if (api->struct_size != sizeof(nonsep_plugin_api))
+                      std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " or 3, found " + std::to_string(version) + "); " +
+                      rebuild_hint);
+  const std::size_t size = version == 3 ? NONSEP_PLUGIN_V3_STRUCT_SIZE : sizeof(nonsep_plugin_api);
+  if (api->struct_size != size)
     throw PluginError("plugin " + quoted(path) + " has a function table of " + std::to_string(api->struct_size) +
-                      " bytes but ABI version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " defines " +
-                      std::to_string(sizeof(nonsep_plugin_api)) + " (expected " +
-                      std::to_string(sizeof(nonsep_plugin_api)) + ", found " + std::to_string(api->struct_size) +
+                      " bytes but ABI version " + std::to_string(version) + " defines " + std::to_string(size) +
+                      " (expected " + std::to_string(size) + ", found " + std::to_string(api->struct_size) +
                       "); the plugin was built against a different plugin_abi.h");
+  std::memcpy(&loaded->entries, api, size);  // a version-3 table leaves the version-4 entries null
+  loaded->abi_version = version;
+  api = &loaded->entries;
   const std::pair<const char*, bool> required[] = {{"metadata_json", api->metadata_json != nullptr},
                                                    {"create", api->create != nullptr},
                                                    {"destroy", api->destroy != nullptr},
@@ -250,7 +256,7 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                       " (metadata begins: \"" + shown + "\")");
   }
   check_metadata(loaded->metadata, *api, path);
-  loaded->api = api;
+  loaded->api = &loaded->entries;
   Plugin plugin;
   plugin.loaded_ = std::move(loaded);
   return plugin;

@@ -76,7 +76,18 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
                                                   {"hessian_T", api.hessian_T != nullptr},
                                                   {"hessian_V", api.hessian_V != nullptr},
                                                   {"d3T", api.d3T != nullptr},
-                                                  {"d3V", api.d3V != nullptr}};
+                                                  {"d3V", api.d3V != nullptr},
+                                                  {"grad_K", api.grad_K != nullptr},
+                                                  {"grad_U", api.grad_U != nullptr},
+                                                  {"value_K", api.value_K != nullptr},
+                                                  {"value_U", api.value_U != nullptr},
+                                                  {"hessian_K", api.hessian_K != nullptr},
+                                                  {"hessian_U", api.hessian_U != nullptr},
+                                                  {"hvp_T", api.hvp_T != nullptr},
+                                                  {"hvp_V", api.hvp_V != nullptr},
+                                                  {"hvp_K", api.hvp_K != nullptr},
+                                                  {"hvp_U", api.hvp_U != nullptr},
+                                                  {"chin_steps", api.chin_steps != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
@@ -84,6 +95,20 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
       fail("says capability \"" + std::string(capability) + "\" is " + (claimed.get<bool>() ? "true" : "false") +
            " but the table's " + capability + " pointer is " + (in_table ? "set" : "null"));
   }
+  // A part's value, Hessian and Hessian-vector product describe a part that its gradient makes.
+  struct Part {
+    const char* name;
+    bool gradient, others;
+  };
+  const Part parts[] = {{"K", api.grad_K != nullptr, api.value_K || api.hessian_K || api.hvp_K},
+                        {"U", api.grad_U != nullptr, api.value_U || api.hessian_U || api.hvp_U}};
+  for (const Part& part : parts)
+    if (part.others && !part.gradient)
+      fail("gives the value, Hessian or Hessian-vector product of " + std::string(part.name) + " but not grad_" +
+           part.name + " (a separable part is made by its gradient)");
+  if (api.grad_K != nullptr || api.grad_U != nullptr)
+    fail("gives a separable part K(p) + U(q) (grad_" + std::string(api.grad_K != nullptr ? "K" : "U") +
+         "), which this nonsep does not solve: its schemes integrate T_i V_ij T_j and V_i T_ij V_j alone");
 }
 
 }  // namespace nonsep::host

@@ -217,7 +217,17 @@ const nonsep_plugin_api api = {
     BLOWUP_WITH_HESSIANS ? hessian_V : nullptr,
     last_error,
     nullptr,  // d3T: absent
-    nullptr,  // d3V: absent
+    nullptr,  // d3V: absent    nullptr,  // grad_K
+    nullptr,  // grad_U
+    nullptr,  // value_K
+    nullptr,  // value_U
+    nullptr,  // hessian_K
+    nullptr,  // hessian_U
+    nullptr,  // hvp_T
+    nullptr,  // hvp_V
+    nullptr,  // hvp_K
+    nullptr,  // hvp_U
+    nullptr,  // chin_steps
 };
 
 }  // namespace

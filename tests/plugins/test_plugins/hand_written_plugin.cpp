@@ -13,6 +13,9 @@
 //  10  the metadata claims d3T but the pointer is null
 //  11  the table has d3V but the metadata does not claim it
 //  12  exports the table itself under the symbol nonsep_plugin instead of a pointer to it (a common C mistake)
+//  13  none: a valid plugin of ABI version 3 (its shorter table; the entries of version 4 past it are not read)
+//  14  a separable part (grad_U), which the host does not solve
+//  15  hvp_K without grad_K
 #include <cstddef>
 #include <cstring>
 
@@ -50,6 +53,10 @@ const char* metadata_json() {
   return METADATA_WITH(NONSEP_TEST_NAME, "", "");
 #elif NONSEP_TEST_DEFECT == 10
   return METADATA_BODY(NONSEP_TEST_NAME, "\"d3T\": true, \"d3V\": false");
+#elif NONSEP_TEST_DEFECT == 14
+  return METADATA_BODY(NONSEP_TEST_NAME, "\"grad_U\": true");
+#elif NONSEP_TEST_DEFECT == 15
+  return METADATA_BODY(NONSEP_TEST_NAME, "\"hvp_K\": true");
 #else
   return METADATA_BODY(NONSEP_TEST_NAME, "");
 #endif
@@ -65,7 +72,7 @@ nonsep_status identity(nonsep_instance*, const double* x, double* out, size_t co
   std::memcpy(out, x, count * sizeof(double));
   return NONSEP_OK;
 }
-#if NONSEP_TEST_DEFECT == 11
+#if NONSEP_TEST_DEFECT == 11 || NONSEP_TEST_DEFECT == 15
 nonsep_status zero_third_derivative(nonsep_instance*, const double*, const double*, double* out, size_t count) {
   for (size_t b = 0; b < count; ++b) out[b] = 0.0;  // V = q^2/2 has no third derivative
   return NONSEP_OK;
@@ -76,11 +83,15 @@ const char* last_error(const nonsep_instance* instance) { return instance->last_
 const nonsep_plugin_api table = {
 #if NONSEP_TEST_DEFECT == 2
     2u,
+#elif NONSEP_TEST_DEFECT == 13
+    3u,
 #else
     NONSEP_PLUGIN_ABI_VERSION,
 #endif
 #if NONSEP_TEST_DEFECT == 3
     static_cast<uint32_t>(sizeof(nonsep_plugin_api) - sizeof(void*)),
+#elif NONSEP_TEST_DEFECT == 13
+    static_cast<uint32_t>(NONSEP_PLUGIN_V3_STRUCT_SIZE),
 #else
     static_cast<uint32_t>(sizeof(nonsep_plugin_api)),
 #endif
@@ -105,6 +116,29 @@ const nonsep_plugin_api table = {
 #else
     nullptr,  // d3V: optional, absent
 #endif
+#if NONSEP_TEST_DEFECT == 13
+    &identity,  // past a version-3 table's end: never read
+#else
+    nullptr,  // grad_K
+#endif
+#if NONSEP_TEST_DEFECT == 14
+    &identity,
+#else
+    nullptr,  // grad_U
+#endif
+    nullptr,  // value_K
+    nullptr,  // value_U
+    nullptr,  // hessian_K
+    nullptr,  // hessian_U
+    nullptr,  // hvp_T
+    nullptr,  // hvp_V
+#if NONSEP_TEST_DEFECT == 15
+    &zero_third_derivative,  // a directional function of the same signature
+#else
+    nullptr,  // hvp_K
+#endif
+    nullptr,  // hvp_U
+    nullptr,  // chin_steps
 };
 
 }  // namespace

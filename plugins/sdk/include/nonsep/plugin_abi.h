@@ -1,8 +1,12 @@
-/* nonsep plugin ABI, version 3. The boundary evaluates; it does not integrate: the host owns every stepper and
- * crosses the boundary once per batch of states for a gradient (or a Hessian, a value, a third derivative).
- * Version 2 had a fused stepping function integrate() (the plugin ran the core's integrator itself); version 1
- * exported a function, nonsep_plugin_entry, returning the table instead of the pointer below. Plugins of either
- * are refused: rebuild them against the installed SDK.
+/* nonsep plugin ABI, version 4. The boundary evaluates: the host owns every scheme and crosses the boundary once
+ * per batch of states for a gradient (or a Hessian, a value, a third derivative, a Hessian-vector product).
+ * Version 4 adds three optional groups at the end of version 3's table: the separable part K(p) + U(q) of the
+ * solved Hamiltonian, Hessian-vector products, and a stepping kernel (n basic steps of the core's own splitting,
+ * compiled into the plugin with its model inlined, the coefficients given by the host). A version-3 table is
+ * the prefix of a version-4 one: such plugins are still loaded, without the new groups. Version 2 had a fused
+ * stepping function integrate() with a stepper of its own; version 1 exported a function, nonsep_plugin_entry,
+ * returning the table instead of the pointer below. Plugins of either are refused: rebuild them against the
+ * installed SDK.
  *
  * A plugin is a shared library that exports one C symbol, NONSEP_PLUGIN_SYMBOL ("nonsep_plugin"): a constant
  * pointer to a constant, statically allocated function table (nonsep_plugin_api) that stays valid while the
@@ -13,8 +17,9 @@
  * Checks the host makes, in this order, before using anything else in the table:
  *   0. the symbol holds an aligned address inside a loaded library (refused otherwise: a library that exports
  *      the table itself under the name, instead of a pointer to it)
- *   1. abi_version == NONSEP_PLUGIN_ABI_VERSION   (refused with "expected 3, found N")
- *   2. struct_size == sizeof(nonsep_plugin_api)  (refused with expected and found sizes)
+ *   1. abi_version is 4 (NONSEP_PLUGIN_ABI_VERSION) or 3   (refused with "expected 4 or 3, found N")
+ *   2. struct_size == sizeof(nonsep_plugin_api) for 4, NONSEP_PLUGIN_V3_STRUCT_SIZE for 3
+ *                                                 (refused with expected and found sizes)
  *   3. the required functions are non-null        (metadata_json, create, destroy, dimension, grad_T, grad_V,
  *                                                   last_error)
  *   4. metadata_json() returns valid JSON of the shape below, whose capabilities match the table.
@@ -22,7 +27,8 @@
  * Batch layout (same as nonsep/core/model.hpp): `count` states of dimension n, state-major and contiguous.
  * Component i of state b is at x[b*n + i]; gradient outputs have the same layout; Hessian outputs hold count
  * row-major n x n matrices, entry (i, j) of state b at out[b*n*n + i*n + j]. Value outputs hold one double
- * per state. Third-derivative inputs u (one direction per state) and outputs have the gradient layout.
+ * per state. Directions (u of the third derivatives, v of the Hessian-vector products; one per state) and their
+ * outputs have the gradient layout.
  * Input and output arrays never overlap. The host crosses this boundary once per batch.
  *
  * Errors: every function that can fail returns a nonsep_status and never lets a C++ exception (or a longjmp)
@@ -46,10 +52,11 @@
  *                       "default": 2, "minimum": 1, "maximum": 64, "unit": "", "description": "..." } ],
  *     "thread_safe": true,
  *     "capabilities": { "value_T": true, "value_V": true, "hessian_T": true, "hessian_V": true,
- *                       "d3T": true, "d3V": true }
+ *                       "d3T": true, "d3V": true, "grad_K": false, "grad_U": true, "value_U": true, ...,
+ *                       "hvp_T": true, "hvp_V": true, "chin_steps": true }
  *   }
  * "minimum", "maximum" and "unit" may be absent; "thread_safe" is required. Each capability is true exactly
- * when the table's pointer is non-null (an absent capability counts as false).
+ * when the table's pointer of that name is non-null (an absent capability counts as false).
  */
 #ifndef NONSEP_PLUGIN_ABI_H
 #define NONSEP_PLUGIN_ABI_H
@@ -61,7 +68,7 @@
 extern "C" {
 #endif
 
-#define NONSEP_PLUGIN_ABI_VERSION 3u
+#define NONSEP_PLUGIN_ABI_VERSION 4u
 #define NONSEP_PLUGIN_SYMBOL "nonsep_plugin"
 /* The symbol of ABI version 1 (a function returning the table); the host names it when refusing such a plugin. */
 #define NONSEP_PLUGIN_V1_ENTRY_SYMBOL "nonsep_plugin_entry"
@@ -75,6 +82,26 @@ typedef enum nonsep_status {
 } nonsep_status;
 
 typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin */
+
+/* The forms of the solved Hamiltonian (nonsep/core/integrator_description.hpp's HamiltonianForm). */
+#define NONSEP_FORM_TTV 0u /* H = T_i V_ij T_j (+ K + U) */
+#define NONSEP_FORM_VVT 1u /* H = V_i T_ij V_j (+ K + U) */
+
+/* The arguments of chin_steps (below): `steps` basic steps of eq. (expalg) of every state, in place. */
+typedef struct nonsep_chin_steps_args {
+  uint32_t form;             /* NONSEP_FORM_TTV or NONSEP_FORM_VVT */
+  uint32_t instruction_set;  /* index into the metadata's "kernels": {"instruction_sets": [...]} */
+  double t1, t2, v0, v1, v2; /* the coefficients of eq. (expalg) */
+  const double* eps;         /* cbrt(dt): one number for every state (eps_count 1) or one per state */
+  size_t eps_count;          /* 1 or count */
+  uint64_t steps;            /* >= 1 */
+  size_t count;              /* states, in the batch layout */
+  double* q;                 /* count*n, advanced in place */
+  double* p;                 /* count*n, advanced in place */
+  double* outer_gradient;    /* count*n: in, the outer flows' gradient at the current point (grad V(q) in
+                                TTV, grad T(p) in VVT); out, the same at the final point */
+  double* inner_gradient;    /* count*n, scratch */
+} nonsep_chin_steps_args;
 
 typedef struct nonsep_plugin_api {
   uint32_t abi_version; /* NONSEP_PLUGIN_ABI_VERSION */
@@ -110,7 +137,37 @@ typedef struct nonsep_plugin_api {
    * and d3V the same in q. */
   nonsep_status (*d3T)(nonsep_instance* instance, const double* p, const double* u, double* out, size_t count);
   nonsep_status (*d3V)(nonsep_instance* instance, const double* q, const double* u, double* out, size_t count);
+
+  /* ---- Version 4. Every entry below is optional (NULL when absent). ---- */
+
+  /* The separable part: the solved Hamiltonian is H = T_i V_ij T_j + K(p) + U(q) (VVT: V_i T_ij V_j + K + U).
+   * grad_K or grad_U, or both, make a model's separable part (an absent one is zero); values and Hessians as for
+   * T and V, each present only with its gradient. */
+  nonsep_status (*grad_K)(nonsep_instance* instance, const double* p, double* out, size_t count);
+  nonsep_status (*grad_U)(nonsep_instance* instance, const double* q, double* out, size_t count);
+  nonsep_status (*value_K)(nonsep_instance* instance, const double* p, double* out, size_t count);
+  nonsep_status (*value_U)(nonsep_instance* instance, const double* q, double* out, size_t count);
+  nonsep_status (*hessian_K)(nonsep_instance* instance, const double* p, double* out, size_t count);
+  nonsep_status (*hessian_U)(nonsep_instance* instance, const double* q, double* out, size_t count);
+
+  /* Hessian-vector products: out[b*n + i] = sum_j T_ij(p_b) v[b*n + j], and so for V (at q), K and U (the last
+   * two only with their gradients). O(n) memory per state where the Hessians take n^2. */
+  nonsep_status (*hvp_T)(nonsep_instance* instance, const double* p, const double* v, double* out, size_t count);
+  nonsep_status (*hvp_V)(nonsep_instance* instance, const double* q, const double* v, double* out, size_t count);
+  nonsep_status (*hvp_K)(nonsep_instance* instance, const double* p, const double* v, double* out, size_t count);
+  nonsep_status (*hvp_U)(nonsep_instance* instance, const double* q, const double* v, double* out, size_t count);
+
+  /* The stepping kernel: args->steps basic steps of eq. (expalg) of args->count states, the stages those of the
+   * core's own template with this model's gradients inlined, so that with the baseline instruction set the
+   * numbers are bit for bit those of the host stepping through grad_T and grad_V. Announced with the metadata
+   * object "kernels": {"version": K, "instruction_sets": [...]}, K the core's kernel version it was compiled
+   * from (the host uses only its own). A failed evaluation returns its status (message by last_error) with q, p
+   * and outer_gradient undefined: the host then redoes the steps through grad_T and grad_V. */
+  nonsep_status (*chin_steps)(nonsep_instance* instance, const nonsep_chin_steps_args* args);
 } nonsep_plugin_api;
+
+/* The size of a version-3 table: version 4's without the entries from grad_K on. */
+#define NONSEP_PLUGIN_V3_STRUCT_SIZE offsetof(nonsep_plugin_api, grad_K)
 
 #ifdef __cplusplus
 }

@@ -232,6 +232,17 @@ class PluginTable {
       &last_error,
       &d3T,
       &d3V,
+      nullptr,  // grad_K
+      nullptr,  // grad_U
+      nullptr,  // value_K
+      nullptr,  // value_U
+      nullptr,  // hessian_K
+      nullptr,  // hessian_U
+      nullptr,  // hvp_T
+      nullptr,  // hvp_V
+      nullptr,  // hvp_K
+      nullptr,  // hvp_U
+      nullptr,  // chin_steps
   };
 };
 

@@ -59,6 +59,8 @@ class Plugin {
   bool has_hessians() const;           // both hessian_T and hessian_V
   bool has_values() const;             // both value_T and value_V
   bool has_third_derivatives() const;  // both d3T and d3V
+  // The plugin ABI version its table was built for (4, or 3 for a table without version 4's entries).
+  unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
   bool thread_safe() const;
 
@@ -74,7 +76,7 @@ class Plugin {
 };
 
 // Throws PluginError: file not found (listing every place tried), not a shared library, no plugin symbol,
-// ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 3, found N"
+// ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 4 or 3, found N"
 // and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
 // (including capabilities that disagree with the table and a missing "thread_safe").
 Plugin load_plugin(const std::string& name_or_path, const std::filesystem::path& base_directory);
