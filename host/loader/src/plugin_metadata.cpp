@@ -1,4 +1,5 @@
 // The metadata checks of plugin_abi.h (plugin_internals.hpp), after the JSON has parsed.
+#include <algorithm>
 #include <set>
 #include <string>
 
@@ -109,6 +110,20 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
   if (api.grad_K != nullptr || api.grad_U != nullptr)
     fail("gives a separable part K(p) + U(q) (grad_" + std::string(api.grad_K != nullptr ? "K" : "U") +
          "), which this nonsep does not solve: its schemes integrate T_i V_ij T_j and V_i T_ij V_j alone");
+
+  // "kernels": {"version": K, "instruction_sets": ["x86-64", ...]}, exactly when the table has chin_steps.
+  if (m.contains("kernels") != (api.chin_steps != nullptr))
+    fail(api.chin_steps != nullptr ? "lacks the object \"kernels\" that its chin_steps needs"
+                                   : "has \"kernels\" but the table's chin_steps pointer is null");
+  if (api.chin_steps != nullptr) {
+    const json& kernels = m["kernels"];
+    if (!kernels.is_object() || !kernels.contains("version") || !kernels["version"].is_number_unsigned())
+      fail("gives \"kernels\" no unsigned integer \"version\"");
+    const json sets = kernels.value("instruction_sets", json());
+    if (!sets.is_array() || sets.empty() ||
+        std::any_of(sets.begin(), sets.end(), [](const json& s) { return !s.is_string(); }))
+      fail("gives \"kernels\" no non-empty array of strings \"instruction_sets\" (found " + sets.dump() + ")");
+  }
 }
 
 }  // namespace nonsep::host
