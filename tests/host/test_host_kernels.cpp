@@ -94,12 +94,12 @@ TEST_CASE("kernel path: states that fail or diverge partway are reported as the 
   use_test_plugins();
   // evaluation_fails: grad V refuses |q| >= 1 (a failure inside the kernel, then the evaluation path's replay).
   json failing = json::array();
-  for (int i = 0; i < 40; ++i) failing.push_back(state(0.5 + 0.0125 * i, 0.8));
+  for (int i = 0; i < 40; ++i) failing.push_back(state(0.3 + 0.0175 * i, 0.05));
   json job = {{"model", {{"plugin", std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/evaluation_fails.so"}}},
               {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}}},
               {"initial", failing},
               {"time", {{"dt", 0.01}, {"steps", 60}}},
-              {"output", {{"every", 0}}}};
+              {"output", {{"every", 10}}}};
   auto file = write_job(folder / "failing.json", job);
   const auto kernel = run_with("baseline", folder, "failing-kernel", file, "2");
   check_same_files(kernel, run_with("evaluation", folder, "failing-evaluation", file, "2"));
