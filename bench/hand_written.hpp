@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace bench {
 
@@ -36,26 +37,75 @@ struct HandWrittenStep {
 inline double grad_T(double p) { return 1.0 + 0.5 * p * p; }
 inline double grad_V(double q) { return q * (1.0 + q * q / 3.0); }
 
+// One basic step of (x, y) with g = V'(x) on entry and on exit.
+template <class GradT, class GradV>
+inline void hand_written_step(const HandWrittenStep& c, double& x, double& y, double& g, GradT grad_T, GradV grad_V) {
+  y += c.v2 * g;
+  x += c.t2 * grad_T(y);
+  g = grad_V(x);
+  y += c.v1 * g;
+  x += c.t1 * grad_T(y);
+  g = grad_V(x);
+  y += c.v0 * g;
+  x += c.t1 * grad_T(y);
+  g = grad_V(x);
+  y += c.v1 * g;
+  x += c.t2 * grad_T(y);
+  g = grad_V(x);
+  y += c.v2 * g;
+}
+
 // `steps` basic steps of one trajectory (q, p), in place. The gradients are paper1d's inline ones unless others are
 // given (abi_floor.hpp's control passes functions of a plugin, called by value).
 template <class GradT = double (*)(double), class GradV = double (*)(double)>
 inline void hand_written_run(const HandWrittenStep& c, double& q, double& p, std::uint64_t steps,
                              GradT grad_T = bench::grad_T, GradV grad_V = bench::grad_V) {
   double x = q, y = p, g = grad_V(x);
+  for (std::uint64_t k = 0; k < steps; ++k) hand_written_step(c, x, y, g, grad_T, grad_V);
+  q = x;
+  p = y;
+}
+
+// Triplet composition 4/3 (eq. sym43) of the hand-written step, one trajectory: each step the basic steps of
+// dt/(2-s), -s dt/(2-s), dt/(2-s), s = 2^(3/5), with V' carried from one to the next.
+inline void hand_written_triplet_run(double dt, double t2, double& q, double& p, std::uint64_t steps) {
+  const double s = std::pow(2.0, 3.0 / 5.0), outer_dt = dt / (2.0 - s);
+  const HandWrittenStep outer(outer_dt, t2), inner(-s * outer_dt, t2);
+  double x = q, y = p, g = grad_V(x);
   for (std::uint64_t k = 0; k < steps; ++k) {
-    y += c.v2 * g;
-    x += c.t2 * grad_T(y);
+    hand_written_step(outer, x, y, g, bench::grad_T, bench::grad_V);
+    hand_written_step(inner, x, y, g, bench::grad_T, bench::grad_V);
+    hand_written_step(outer, x, y, g, bench::grad_T, bench::grad_V);
+  }
+  q = x;
+  p = y;
+}
+
+// Multi-product expansion of m terms (eqs. mpe43, mpe63), one trajectory: each step, term k = m..1 takes k basic
+// steps of dt/k from the step's start (V' at the start shared), and the result is y_m + sum_k c_k (y_k - y_m);
+// V' at the combined point is evaluated anew. `weights` are c_1..c_m.
+inline void hand_written_mpe_run(double dt, double t2, const std::vector<double>& weights, double& q, double& p,
+                                 std::uint64_t steps) {
+  const std::size_t m = weights.size();
+  std::vector<HandWrittenStep> term;
+  for (std::size_t k = 1; k <= m; ++k) term.emplace_back(dt / static_cast<double>(k), t2);
+  double x = q, y = p, g = grad_V(x);
+  for (std::uint64_t n = 0; n < steps; ++n) {
+    double sum_x = 0, sum_y = 0, last_x = 0, last_y = 0;
+    for (std::size_t k = m; k >= 1; --k) {
+      double tx = x, ty = y, tg = g;
+      for (std::size_t r = 0; r < k; ++r) hand_written_step(term[k - 1], tx, ty, tg, bench::grad_T, bench::grad_V);
+      if (k == m) {
+        sum_x = last_x = tx;
+        sum_y = last_y = ty;
+        continue;
+      }
+      sum_x += weights[k - 1] * (tx - last_x);
+      sum_y += weights[k - 1] * (ty - last_y);
+    }
+    x = sum_x;
+    y = sum_y;
     g = grad_V(x);
-    y += c.v1 * g;
-    x += c.t1 * grad_T(y);
-    g = grad_V(x);
-    y += c.v0 * g;
-    x += c.t1 * grad_T(y);
-    g = grad_V(x);
-    y += c.v1 * g;
-    x += c.t2 * grad_T(y);
-    g = grad_V(x);
-    y += c.v2 * g;
   }
   q = x;
   p = y;

@@ -68,6 +68,14 @@ std::string describe_plugin(const Plugin& plugin) {
          std::string(plugin.thread_safe() ? "thread-safe (one instance per thread)"
                                           : "not thread-safe (\"thread_safe\": false: one instance on one thread)") +
          "\n";
+  const KernelChoice& kernels = plugin.kernels();
+  std::string sets;
+  for (const auto& name : kernels.instruction_sets) sets += (sets.empty() ? "" : ", ") + name;
+  out += "  kernels:     " +
+         (kernels.present ? "version " + std::to_string(kernels.version) + " for " + sets + "; runs use " +
+                                (kernels.chosen ? kernels.chosen_name() + " (" + kernels.note + ")" : kernels.note)
+                          : std::string("none (the evaluation path)")) +
+         "\n";
   out += "  energy:      " +
          std::string(plugin.has_hessians() ? "available (the plugin has both Hessians)"
                                            : "not available: the plugin lacks hessian_T or hessian_V") +
@@ -329,7 +337,10 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
         "threads: skipped: the plugin declares \"thread_safe\": false (the host runs it as one instance on "
         "one thread)\n";
   }
-  result.passed = report.passed() && difference.empty() && threads.empty();
+  const std::size_t states = std::min(samples.p.count, samples.q.count);
+  const KernelCheck kernels = check_kernels(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
+  result.text += kernels.text;
+  result.passed = report.passed() && difference.empty() && threads.empty() && kernels.passed;
   if (!result.passed)
     result.text += "derivative check FAILED\n";
   else if (report.comparisons == 0)

@@ -3,6 +3,7 @@
 // (plugin_loader.cpp), the metadata checks (plugin_metadata.cpp) and the evaluations (plugin_model.cpp).
 #include <boost/shared_ptr.hpp>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -20,6 +21,7 @@ struct Plugin::Loaded {
   unsigned abi_version = NONSEP_PLUGIN_ABI_VERSION;  // the plugin's own
   const nonsep_plugin_api* api = nullptr;            // &entries
   nlohmann::json metadata;
+  KernelChoice kernels;
 };
 
 struct PluginModel::Instance {
@@ -28,6 +30,7 @@ struct PluginModel::Instance {
   nonsep_instance* handle = nullptr;
   std::size_t dimension = 0;
   nlohmann::json parameters;
+  std::uint64_t kernel_calls = 0;
 
   Instance() = default;
   Instance(const Instance&) = delete;
@@ -44,6 +47,10 @@ inline std::string quoted(const std::filesystem::path& path) {
 
 // "ok", "invalid parameters", ...: a status of plugin_abi.h as words.
 const char* status_name(nonsep_status status);
+
+// The kernel this process uses of the plugin with checked metadata `metadata` and table `api` (kernel_choice.cpp).
+// Throws PluginError when NONSEP_INSTRUCTION_SET asks for one it cannot have.
+KernelChoice choose_kernel(const nlohmann::json& metadata, const nonsep_plugin_api& api);
 
 // The metadata checks of plugin_abi.h on the parsed metadata `m` of the plugin at `path` whose table is `api`.
 // Throws PluginError naming the field.

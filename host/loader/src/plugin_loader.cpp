@@ -80,6 +80,7 @@ bool Plugin::has_hessian_vector_products() const {
   return loaded_->api->hvp_T != nullptr && loaded_->api->hvp_V != nullptr;
 }
 unsigned Plugin::abi_version() const { return loaded_->abi_version; }
+const KernelChoice& Plugin::kernels() const { return loaded_->kernels; }
 bool Plugin::thread_safe() const { return loaded_->metadata["thread_safe"].get<bool>(); }
 bool Plugin::has_values() const { return loaded_->api->value_T != nullptr && loaded_->api->value_V != nullptr; }
 
@@ -274,6 +275,7 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
   }
   check_metadata(loaded->metadata, *api, path);
   loaded->api = &loaded->entries;
+  loaded->kernels = choose_kernel(loaded->metadata, *loaded->api);
   Plugin plugin;
   plugin.loaded_ = std::move(loaded);
   return plugin;

@@ -1,4 +1,5 @@
 // The metadata checks of plugin_abi.h (plugin_internals.hpp), after the JSON has parsed.
+#include <algorithm>
 #include <set>
 #include <string>
 
@@ -113,6 +114,20 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
     if (part.gradient && !part.others)
       fail("gives grad_" + std::string(part.name) + " but not value_" + part.name +
            ": the energy of H = T_i V_ij T_j + K + U needs " + part.name + " itself");
+
+  // "kernels": {"version": K, "instruction_sets": ["x86-64", ...]}, exactly when the table has chin_steps.
+  if (m.contains("kernels") != (api.chin_steps != nullptr))
+    fail(api.chin_steps != nullptr ? "lacks the object \"kernels\" that its chin_steps needs"
+                                   : "has \"kernels\" but the table's chin_steps pointer is null");
+  if (api.chin_steps != nullptr) {
+    const json& kernels = m["kernels"];
+    if (!kernels.is_object() || !kernels.contains("version") || !kernels["version"].is_number_unsigned())
+      fail("gives \"kernels\" no unsigned integer \"version\"");
+    const json sets = kernels.value("instruction_sets", json());
+    if (!sets.is_array() || sets.empty() ||
+        std::any_of(sets.begin(), sets.end(), [](const json& s) { return !s.is_string(); }))
+      fail("gives \"kernels\" no non-empty array of strings \"instruction_sets\" (found " + sets.dump() + ")");
+  }
 }
 
 }  // namespace nonsep::host

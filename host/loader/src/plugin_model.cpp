@@ -115,4 +115,49 @@ NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_T)
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_V)
 #undef NONSEP_PLUGIN_MODEL_DIRECTIONAL
 
+PluginModel PluginModel::with_kernel() const {
+  const auto chosen = plugin().kernels().chosen;
+  return chosen ? with_kernel(*chosen) : *this;
+}
+
+PluginModel PluginModel::with_kernel(std::size_t instruction_set) const {
+  PluginModel model = *this;
+  const auto& usable = plugin().kernels().usable;
+  model.kernel_.reset();
+  if (instruction_set < usable.size() && usable[instruction_set])
+    model.kernel_ = static_cast<std::uint32_t>(instruction_set);
+  return model;
+}
+
+std::uint64_t PluginModel::kernel_calls() const { return instance_->kernel_calls; }
+
+bool PluginModel::chin_steps(const ChinStepsCall& call) const {
+  if (!kernel_) return false;
+  const std::size_t size = call.count * instance_->dimension;
+  if (call.q.size() != size || call.p.size() != size || call.outer_gradient.size() != size ||
+      call.inner_gradient.size() != size || (call.eps.size() != 1 && call.eps.size() != call.count)) [[unlikely]]
+    throw_bad_spans("chin_steps", call.count, instance_->dimension, instance_->dimension, call.q.size(), call.p.size());
+  const nonsep_plugin_api& api = *instance_->api;
+  const nonsep_chin_steps_args args{call.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT,
+                                    *kernel_,
+                                    call.coefficients.t1,
+                                    call.coefficients.t2,
+                                    call.coefficients.v0,
+                                    call.coefficients.v1,
+                                    call.coefficients.v2,
+                                    call.eps.data(),
+                                    call.eps.size(),
+                                    call.steps,
+                                    call.count,
+                                    call.q.data(),
+                                    call.p.data(),
+                                    call.outer_gradient.data(),
+                                    call.inner_gradient.data()};
+  const nonsep_status status = api.chin_steps(instance_->handle, &args);
+  if (status != NONSEP_OK) [[unlikely]]
+    throw_failed(*this, instance_->handle, api, "chin_steps", status);
+  ++instance_->kernel_calls;
+  return true;
+}
+
 }  // namespace nonsep::host

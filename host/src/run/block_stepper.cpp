@@ -33,8 +33,8 @@ void BlockStepper::advance_block(Block& block, Worker& worker, std::uint64_t fro
   const double dt = setup.time.dt;
   bool clean = true;
   try {
-    if (step_watchers.empty())  // the common case: the whole chunk in one call
-      block.step_n(worker.model, dt, to - from);
+    if (step_watchers.empty())  // the common case: the whole chunk in one call, through the kernel when there is one
+      block.step_n(worker.stepping, dt, to - from);
     else
       for (std::uint64_t step = from; step < to && !block.empty(); ++step) {
         block.step(worker.model, dt);

@@ -18,10 +18,12 @@
 
 namespace nonsep::host {
 
-// What one thread owns: a plugin instance and an energy evaluator's workspace.
+// What one thread owns: a plugin instance (as the evaluation path's model, and as the model whose chin_steps runs
+// the plugin's kernel when it has one) and an energy evaluator's workspace.
 struct alignas(64) Worker {
   PluginModel model;
   EnergyEvaluator energy;
+  PluginModel stepping = model.with_kernel();
 };
 
 // Retirement requests in trajectory order, the order a step-by-step run applies them.

@@ -334,6 +334,11 @@ double EnsembleDriver::max_copy_distance() const {
   for (const Block& block : impl_->blocks) distance = std::max(distance, block.integrator.max_copy_distance());
   return distance;
 }
+std::uint64_t EnsembleDriver::kernel_calls() const {
+  std::uint64_t calls = 0;
+  for (const Worker& worker : impl_->workers) calls += worker.stepping.kernel_calls();
+  return calls;
+}
 std::uint64_t EnsembleDriver::steps_completed() const { return impl_->completed; }
 std::size_t EnsembleDriver::active_count() const { return impl_->active_count(); }
 const std::string& EnsembleDriver::error() const { return impl_->error; }

@@ -42,6 +42,19 @@ json energy_facts(const RunFacts& facts) {
           {"max_relative_error_bound", optional_number(run.analysis.max_relative_energy_error)}};
 }
 
+// Which path stepped the run: the plugin's kernel (and its instruction set) or the evaluation path.
+json stepping_facts(const RunFacts& facts) {
+  const KernelChoice& kernels = facts.loaded.plugin.kernels();
+  const bool kernel = facts.driver.kernel_calls() > 0;
+  return {{"path", kernel ? "kernel" : "evaluation"},
+          {"instruction_set", kernel ? json(kernels.chosen_name()) : json(nullptr)},
+          {"kernel_calls", facts.driver.kernel_calls()},
+          {"plugin_kernels", kernels.instruction_sets},
+          {"note", kernels.chosen && !kernel ? "every step needed the evaluation path (an every-step observer, tangent "
+                                               "vectors, or a scheme without basic steps)"
+                                             : kernels.note}};
+}
+
 }  // namespace
 
 json run_summary(const RunFacts& facts) {
@@ -93,6 +106,7 @@ json run_summary(const RunFacts& facts) {
     summary["evaluations"]["grad_K"] = evaluations.grad_K;
     summary["evaluations"]["grad_U"] = evaluations.grad_U;
   }
+  summary["stepping"] = stepping_facts(facts);
   if (run.integrator.scheme == "tao")
     summary["comparator"] = {{"omega", run.integrator.omega},
                              {"max_copy_distance", facts.driver.max_copy_distance()},

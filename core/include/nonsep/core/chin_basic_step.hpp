@@ -28,44 +28,29 @@
 // point the flow's gradient was evaluated at (q for a kick, p for a drift). This is how the tangent map
 // (tangent_basic_step.hpp) follows the same nine stages without a second copy of the splitting; the default
 // observer does nothing and leaves the stepping numbers as they are.
+//
+// The nine flows themselves are chin_stages (chin_stages.hpp), shared with the stepping kernels that plugins carry:
+// for a model offering chin_steps (ModelWithChinSteps: a plugin with a kernel, as the host presents it), the steps
+// no stage observer watches are handed to the model whole, coefficients, eps and the first-same-as-last gradient
+// included, and come back with the same numbers and the same evaluation counts.
 #include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "nonsep/core/aligned_allocator.hpp"
+#include "nonsep/core/chin_stages.hpp"
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/integrator_description.hpp"
 #include "nonsep/core/model.hpp"
 #include "nonsep/core/phase_space_batch.hpp"
 
 namespace nonsep {
-
-// The coefficients of eq. (expalg) as functions of the free parameter t2.
-struct ChinCoefficients {
-  double t1, t2, v0, v1, v2;
-
-  static double default_t2() { return -std::cbrt(6.0); }
-  // Throws InvalidArgument when t2 is zero or not finite.
-  static ChinCoefficients from_t2(double t2) {
-    if (!std::isfinite(t2) || t2 == 0.0)
-      throw InvalidArgument("t2 must be a finite non-zero number (found " + std::to_string(t2) +
-                            "); the default is -6^(1/3) = -1.8171205928321397");
-    const double v1 = 1.0 / (t2 * t2);
-    const double v2 = -v1 / 2.0;
-    return ChinCoefficients{-t2, t2, -2.0 * (v1 + v2), v1, v2};
-  }
-};
-
-// One flow of the splitting, as seen by a stage observer (above).
-struct FlowStage {
-  bool kick;           // p <- p - coefficient eps grad V(q); otherwise the drift q <- q + coefficient eps grad T(p)
-  double coefficient;  // the splitting coefficient of this flow (v0, v1, v2, t1 or t2)
-};
 
 struct NoStageObserver {
   void operator()(const FlowStage&, std::span<const double>, const PhaseSpaceBatch&) const {}
@@ -148,7 +133,7 @@ class ChinBasicStep {
     use_step_size(dt);
     begin_steps(model, x);
     NoStageObserver none;
-    for (std::uint64_t k = 0; k < n; ++k) stages(model, x, none);
+    stages(model, x, none, n);
     end_steps(x);
   }
 
@@ -185,7 +170,7 @@ class ChinBasicStep {
   template <Model M, class StageObserver>
   void advance(const M& model, PhaseSpaceBatch& x, StageObserver& observe) {
     begin_steps(model, x);
-    stages(model, x, observe);
+    stages(model, x, observe, 1);
     end_steps(x);
   }
 
@@ -207,54 +192,40 @@ class ChinBasicStep {
     cache_valid_ = true;
   }
 
-  // The nine flows of eq. (expalg), from outer_gradient_ at x's current point; leaves in outer_gradient_ the outer
-  // gradient at the new point.
+  // `steps` times the nine flows of eq. (expalg) (chin_stages.hpp), from outer_gradient_ at x's current point;
+  // leaves in outer_gradient_ the outer gradient at the new point. Steps that no observer watches go to the model's
+  // kernel when it offers one (ModelWithChinSteps), the same numbers and evaluation counts.
   template <Model M, class StageObserver>
-  void stages(const M& model, PhaseSpaceBatch& x, StageObserver& observe) {
-    const bool ttv = form_ == HamiltonianForm::TTV;
-    std::span<double> outer = ttv ? x.p() : x.q();
-    std::span<double> inner = ttv ? x.q() : x.p();
-    const double outer_sign = ttv ? -1.0 : 1.0;  // TTV: outer flows are kicks (p -= ...), VVT: drifts (q += ...)
-    const double inner_sign = -outer_sign;
-    const std::size_t count = x.count(), n = x.dimension();
-    // y += sign * coefficient * eps * gradient, state by state when the states have their own eps. One number (one
-    // state of dimension 1) takes a scalar statement: the vectorized loop's alias check and prologue cost more than
-    // its arithmetic.
-    auto flow = [&](std::span<double> y, std::span<const double> gradient, double sign, double coefficient) {
-      if (eps_.size() == 1) {
-        const double h = sign * coefficient * eps_[0];
-        if (y.size() == 1) {
-          y[0] += h * gradient[0];
-          return;
-        }
-        for (std::size_t i = 0; i < y.size(); ++i) y[i] += h * gradient[i];
+  void stages(const M& model, PhaseSpaceBatch& x, StageObserver& observe, std::uint64_t steps) {
+    const std::size_t count = x.count();
+    if constexpr (ModelWithChinSteps<M> && std::is_same_v<std::decay_t<StageObserver>, NoStageObserver>) {
+      const ChinStepsCall call{form_, c_, eps_, steps, count, x.q(), x.p(), outer_gradient_, inner_gradient_};
+      if (model.chin_steps(call)) {
+        evaluations_.grad_T += 4 * steps * count;
+        evaluations_.grad_V += 4 * steps * count;
         return;
       }
-      for (std::size_t b = 0; b < count; ++b) {
-        const double h = sign * coefficient * eps_[b];
-        for (std::size_t i = b * n; i < (b + 1) * n; ++i) y[i] += h * gradient[i];
-      }
-    };
-    auto outer_flow = [&](double coefficient) {
-      flow(outer, outer_gradient_, outer_sign, coefficient);
-      observe(FlowStage{ttv, coefficient}, std::span<const double>(eps_), std::as_const(x));
-    };
-    auto inner_flow = [&](double coefficient) {
-      evaluate(model, !ttv, outer, inner_gradient_, count);  // TTV: grad T(p); VVT: grad V(q)
-      flow(inner, inner_gradient_, inner_sign, coefficient);
-      observe(FlowStage{!ttv, coefficient}, std::span<const double>(eps_), std::as_const(x));
-      evaluate(model, ttv, inner, outer_gradient_, count);  // TTV: grad V(q); VVT: grad T(p)
-    };
-    outer_flow(c_.v2);
-    inner_flow(c_.t2);
-    outer_flow(c_.v1);
-    inner_flow(c_.t1);
-    outer_flow(c_.v0);
-    inner_flow(c_.t1);
-    outer_flow(c_.v1);
-    inner_flow(c_.t2);
-    outer_flow(c_.v2);
+    }
+    const CountedModel<M> counted{model, evaluations_};
+    chin_stages(counted, form_, c_, eps_, steps, count, x.q(), x.p(), outer_gradient_, inner_gradient_,
+                [&](const FlowStage& stage) { observe(stage, std::span<const double>(eps_), std::as_const(x)); });
   }
+
+  // The model with its gradient evaluations counted in `counts`, per state.
+  template <Model M>
+  struct CountedModel {
+    const M& model;
+    EvaluationCounts& counts;
+    std::size_t dimension() const { return model.dimension(); }
+    void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+      model.grad_T(p, out, count);
+      counts.grad_T += count;
+    }
+    void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+      model.grad_V(q, out, count);
+      counts.grad_V += count;
+    }
+  };
 
   // a and b (of equal size) hold the same numbers bit for bit; no early exit, so that the loop vectorizes.
   static bool same_bits(std::span<const double> a, std::span<const double> b) {
@@ -285,13 +256,7 @@ class ChinBasicStep {
 
   template <Model M>
   void evaluate(const M& model, bool potential, std::span<const double> at, std::span<double> out, std::size_t count) {
-    if (potential) {
-      model.grad_V(at, out, count);
-      evaluations_.grad_V += count;
-    } else {
-      model.grad_T(at, out, count);
-      evaluations_.grad_T += count;
-    }
+    chin_gradient(CountedModel<M>{model, evaluations_}, potential, at, out, count);
   }
 
   HamiltonianForm form_;

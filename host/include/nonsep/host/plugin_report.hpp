@@ -1,6 +1,7 @@
 #pragma once
 // What `nonsep inspect` and `nonsep models` print, and the derivative check of `nonsep inspect --check`.
 #include <cstddef>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,7 +24,8 @@ std::string describe_discovered(const DiscoveredPlugin& discovered);
 // same numbers, bit for bit, as one call per point (the runner relies on it to retire states from an ensemble
 // without changing the others; NaN in both agrees); plus, for a plugin declaring "thread_safe": true, two
 // instances used at once on two threads give the numbers of one instance on one thread (the runner gives each
-// worker thread its own instance; reported as skipped for "thread_safe": false).
+// worker thread its own instance; reported as skipped for "thread_safe": false); plus check_kernels (below) on
+// the sample points.
 //
 // Sample points: `random_points` seeded points in [box_low, box_high]^n, each used as p for the T functions and
 // as q for the V functions; then `p_points` for the T functions only and `q_points` for the V functions only (a
@@ -44,6 +46,20 @@ struct DerivativeCheck {
 };
 DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin,
                                   const DerivativeCheckSettings& settings = {});
+
+// The kernel part of the check: each of the plugin's kernels this processor runs against the evaluation path on
+// `count` states (q, p: count*n numbers each), a few steps of the basic step and of MPE 4/3 in both forms. Bit for
+// bit equal for a plugin built with the host's flags; a plugin built with other flags (-march=native, -ffast-math)
+// or a wider instruction set (fused multiply-add) may round differently: the largest difference, relative to
+// max(1, |x|), is reported, and above `tolerance` (or non-finite on one side only) the check fails. A model
+// failing at the points is reported, not a failure.
+struct KernelCheck {
+  bool passed = true;
+  double largest_difference = 0.0;
+  std::string text;  // lines ending in '\n'
+};
+KernelCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                          std::span<const double> p, std::size_t count, double tolerance);
 
 // The number of bytes the check of a model of dimension n with these settings holds at its largest (an estimate
 // within a small factor, computed without overflow: saturates at the largest double).

@@ -13,10 +13,12 @@
 //
 // The plugin's file must be named <name>.so (nonsep_add_model() in CMake does that): the host refuses a file whose
 // metadata name differs from its file name. Every SDK plugin provides all optional functions of plugin_abi.h
-// (values, Hessians, directional third derivatives and Hessian-vector products of T and V); its metadata adds a
-// "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T and hvp_V, whether it is
-// "analytic" or "automatic" (the products are always automatic: of the gradient templates where the model has
-// them, else of T and V).
+// for T and V (values, Hessians, directional third derivatives, Hessian-vector products) and the stepping kernel
+// chin_steps: the core's chin_kernel_steps with the model inlined, compiled for the instruction sets of
+// kernels.hpp (metadata "kernels": {"version", "instruction_sets"}); no stepping code is written here. Its
+// metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T and
+// hvp_V, whether it is "analytic" or "automatic" (the products are always automatic: of the gradient templates
+// where the model has them, else of T and V).
 // A model class with K(p) or U(q) (model_adapter.hpp) also fills grad_K, value_K, hessian_K (resp. the U ones) of
 // ABI version 4, announces them as capabilities and adds them to "derivatives"; the absent part's entries are null.
 //
@@ -34,10 +36,12 @@
 #include <exception>
 #include <nlohmann/json.hpp>
 #include <span>
+#include <stdexcept>
 #include <string>
 
 #include "nonsep/plugin_abi.h"
 #include "nonsep/sdk/dual.hpp"
+#include "nonsep/sdk/kernels.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 #include "nonsep/sdk/parameters.hpp"
 
@@ -119,6 +123,8 @@ class PluginTable {
     else
       dimension = {{"parameter", M::dimension_parameter}, {"max_dimension", M::max_dimension}};
     auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
+    nlohmann::json kernel_sets = nlohmann::json::array();
+    for (const auto name : kernel_instruction_sets) kernel_sets.push_back(std::string(name));
     nlohmann::json metadata = {{"name", id.name},
                                {"version", id.version},
                                {"description", id.description},
@@ -134,7 +140,8 @@ class PluginTable {
                                  {"d3T", true},
                                  {"d3V", true},
                                  {"hvp_T", true},
-                                 {"hvp_V", true}}},
+                                 {"hvp_V", true},
+                                 {"chin_steps", true}}},
                                {"derivatives",
                                 {{"grad_T", kind(Adapter::analytic_grad_T)},
                                  {"grad_V", kind(Adapter::analytic_grad_V)},
@@ -143,7 +150,8 @@ class PluginTable {
                                  {"d3T", kind(Adapter::analytic_d3T)},
                                  {"d3V", kind(Adapter::analytic_d3V)},
                                  {"hvp_T", "automatic"},
-                                 {"hvp_V", "automatic"}}}};
+                                 {"hvp_V", "automatic"}}},
+                               {"kernels", {{"version", chin_kernel_version}, {"instruction_sets", kernel_sets}}}};
     for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
     for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
     if constexpr (HasK<M>) {
@@ -260,6 +268,34 @@ class PluginTable {
   NONSEP_SDK_DIRECTIONAL(hvp_V)
 #undef NONSEP_SDK_DIRECTIONAL
 
+  // The stepping kernel (plugin_abi.h chin_steps): the core's chin_kernel_steps with this model inlined, for the
+  // instruction set the host asks for (kernels.hpp).
+  static nonsep_status chin_steps(nonsep_instance* instance, const nonsep_chin_steps_args* args) noexcept {
+    return guarded(instance, "chin_steps", [&](const Instance& self) {
+      if (args == nullptr) throw std::invalid_argument("chin_steps: no arguments");
+      const Adapter& adapter = self.adapter;
+      const std::size_t size = args->count * adapter.dimension();
+      if (args->form != NONSEP_FORM_TTV && args->form != NONSEP_FORM_VVT)
+        throw std::invalid_argument("chin_steps: form " + std::to_string(args->form) +
+                                    " is neither TTV (0) nor VVT (1)");
+      if (args->eps_count != 1 && args->eps_count != args->count)
+        throw std::invalid_argument("chin_steps: " + std::to_string(args->eps_count) + " step sizes for " +
+                                    std::to_string(args->count) + " states (expected 1 or one per state)");
+      const ChinStepsCall call{args->form == NONSEP_FORM_VVT ? HamiltonianForm::VVT : HamiltonianForm::TTV,
+                               ChinCoefficients{args->t1, args->t2, args->v0, args->v1, args->v2},
+                               std::span<const double>(args->eps, args->eps_count),
+                               args->steps,
+                               args->count,
+                               std::span<double>(args->q, size),
+                               std::span<double>(args->p, size),
+                               std::span<double>(args->outer_gradient, size),
+                               std::span<double>(args->inner_gradient, size)};
+      if (!ChinKernels<Adapter>::run(args->instruction_set, adapter, call))
+        throw std::invalid_argument("chin_steps: instruction set " + std::to_string(args->instruction_set) +
+                                    " is not among this plugin's kernels (its metadata lists them)");
+    });
+  }
+
  public:
   static constexpr nonsep_plugin_api api = {
       NONSEP_PLUGIN_ABI_VERSION,
@@ -287,7 +323,7 @@ class PluginTable {
       &hvp_V,
       nullptr,  // hvp_K
       nullptr,  // hvp_U
-      nullptr,  // chin_steps
+      &chin_steps,
   };
 };
 

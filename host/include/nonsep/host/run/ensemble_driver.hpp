@@ -112,6 +112,10 @@ class EnsembleDriver {
   // Tao's scheme: the largest distance between a state and its extended copy over every block and step of this
   // process (a resumed run restarts the copies from the states and counts from there); 0 for the other schemes.
   double max_copy_distance() const;
+  // Calls of the plugin's stepping kernel in this process (0: every step went through the evaluation path). The
+  // kernel takes the chunks no every-step observer watches, without tangent vectors; replays after a failure and
+  // every other step go through the evaluations.
+  std::uint64_t kernel_calls() const;
   std::uint64_t steps_completed() const;
   std::size_t active_count() const;
   const std::string& error() const;  // why the run failed (DriverEnd::failed)

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "nonsep/core/chin_stages.hpp"
 #include "nonsep/core/error.hpp"
 
 struct nonsep_plugin_api;
@@ -46,6 +47,21 @@ struct PluginParameter {
 };
 
 class PluginModel;
+
+// A plugin's stepping kernels (plugin_abi.h chin_steps) and the one this process uses. Chosen when the plugin is
+// loaded: none when the plugin has none or was built against another kernel version (with a note saying so);
+// otherwise the instruction set NONSEP_INSTRUCTION_SET names ("baseline" for x86-64; "evaluation" for none), or
+// without it the widest of the plugin's that this processor runs.
+struct KernelChoice {
+  bool present = false;                       // the plugin carries kernels
+  std::uint64_t version = 0;                  // the kernel version it was built with
+  std::vector<std::string> instruction_sets;  // as the metadata lists them (index 0 the baseline)
+  std::vector<bool> usable;                   // per instruction set: right kernel version, and this processor runs it
+  std::optional<std::size_t> chosen;          // the index used; empty: the evaluation path
+  std::string note;                           // how the choice was made, or why none is used
+  // The chosen instruction set's name, or "" for the evaluation path.
+  std::string chosen_name() const { return chosen ? instruction_sets[*chosen] : ""; }
+};
 
 class Plugin {
  public:
@@ -71,6 +87,7 @@ class Plugin {
   unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
   bool thread_safe() const;
+  const KernelChoice& kernels() const;
 
   // Creates an instance. `parameters` must be a JSON object; unknown names, wrong types and values out of range
   // are refused with a PluginError naming the parameter (checked by the host against the metadata first, then by
@@ -83,7 +100,8 @@ class Plugin {
   std::shared_ptr<const Loaded> loaded_;
 };
 
-// Throws PluginError: file not found (listing every place tried), not a shared library, no plugin symbol,
+// Throws PluginError: NONSEP_INSTRUCTION_SET naming an instruction set the plugin lacks or this processor cannot
+// run; file not found (listing every place tried), not a shared library, no plugin symbol,
 // ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 4 or 3, found N"
 // and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
 // (including capabilities that disagree with the table and a missing "thread_safe").
@@ -135,6 +153,19 @@ class PluginModel {
   void hessian_K(std::span<const double> p, std::span<double> out, std::size_t count) const;
   void hessian_U(std::span<const double> q, std::span<double> out, std::size_t count) const;
 
+  // The same instance, whose chin_steps uses the plugin's chosen kernel (Plugin::kernels()); the evaluation path's
+  // model (this one, and every PluginModel from create()) answers chin_steps with false. As a core model it is a
+  // nonsep::ModelWithChinSteps (chin_stages.hpp): ChinBasicStep hands it the steps no stage observer watches.
+  // With an instruction set's index: that kernel instead (none when it is not usable, KernelChoice::usable).
+  PluginModel with_kernel() const;
+  PluginModel with_kernel(std::size_t instruction_set) const;
+  bool has_kernel() const { return kernel_.has_value(); }
+  // Advances `call` through the plugin's kernel and returns true, or returns false without a kernel at hand.
+  // Throws nonsep::ModelError with the plugin's message when the kernel fails.
+  bool chin_steps(const ChinStepsCall& call) const;
+  // Calls of chin_steps that ran the kernel, on this instance (every PluginModel sharing it).
+  std::uint64_t kernel_calls() const;
+
   const Plugin& plugin() const;
   // The parameters in effect: the metadata's defaults overlaid with those given to create().
   const nlohmann::json& parameters() const;
@@ -143,6 +174,7 @@ class PluginModel {
   friend class Plugin;
   struct Instance;
   std::shared_ptr<Instance> instance_;
+  std::optional<std::uint32_t> kernel_;  // the instruction set chin_steps uses; empty: the evaluation path
 };
 
 }  // namespace nonsep::host

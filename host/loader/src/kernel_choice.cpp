@@ -1,0 +1,82 @@
+// Which of a plugin's stepping kernels this process uses (plugin_loader.hpp, KernelChoice): the metadata's
+// "kernels" object checked against the core's kernel version, and an instruction set chosen from the processor's
+// features or pinned by NONSEP_INSTRUCTION_SET.
+#include <cstdlib>
+#include <string>
+
+#include "nonsep/core/chin_kernel.hpp"
+#include "plugin_internals.hpp"
+
+namespace nonsep::host {
+
+using nlohmann::json;
+
+namespace {
+
+// Whether this processor runs code compiled for `name` (an x86-64 micro-architecture level).
+bool processor_runs(const std::string& name) {
+  if (name == "x86-64") return true;
+#if defined(__x86_64__) && defined(__GNUC__)
+  __builtin_cpu_init();
+  if (name == "x86-64-v3") return __builtin_cpu_supports("x86-64-v3");
+  if (name == "x86-64-v4") return __builtin_cpu_supports("x86-64-v4");
+#endif
+  return false;
+}
+
+}  // namespace
+
+std::string instruction_set_pin() {
+  const char* pin = std::getenv("NONSEP_INSTRUCTION_SET");
+  if (pin == nullptr || *pin == '\0') return "";
+  const std::string name = pin;
+  return name == "baseline" ? "x86-64" : name;
+}
+
+KernelChoice choose_kernel(const json& metadata, const nonsep_plugin_api& api) {
+  KernelChoice choice;
+  if (api.chin_steps == nullptr) {
+    choice.note = "no stepping kernels: the evaluation path";
+    return choice;
+  }
+  choice.present = true;
+  const json& kernels = metadata["kernels"];
+  choice.version = kernels["version"].get<std::uint64_t>();
+  for (const json& name : kernels["instruction_sets"]) {
+    choice.instruction_sets.push_back(name.get<std::string>());
+    choice.usable.push_back(choice.version == chin_kernel_version && processor_runs(choice.instruction_sets.back()));
+  }
+  if (choice.version != chin_kernel_version) {
+    choice.note = "kernel version " + std::to_string(choice.version) + ", this nonsep's is " +
+                  std::to_string(chin_kernel_version) + ": the evaluation path (rebuild the plugin to use its kernels)";
+    return choice;
+  }
+  const std::string pin = instruction_set_pin();
+  if (pin == "evaluation") {
+    choice.note = "NONSEP_INSTRUCTION_SET=evaluation: the evaluation path";
+    return choice;
+  }
+  for (std::size_t i = choice.instruction_sets.size(); i-- > 0;) {
+    const std::string& name = choice.instruction_sets[i];
+    if (!pin.empty() && name != pin) continue;
+    if (!choice.usable[i]) {
+      if (!pin.empty())
+        throw PluginError("NONSEP_INSTRUCTION_SET=" + pin + " but this processor cannot run it (unset it, or use " +
+                          "x86-64, the baseline every x86-64 runs)");
+      continue;
+    }
+    choice.chosen = i;
+    choice.note = pin.empty() ? "the widest this processor runs" : "pinned by NONSEP_INSTRUCTION_SET";
+    return choice;
+  }
+  if (pin.empty()) {
+    choice.note = "no kernel this processor runs: the evaluation path";
+    return choice;
+  }
+  std::string known;
+  for (const auto& name : choice.instruction_sets) known += (known.empty() ? "" : ", ") + name;
+  throw PluginError("NONSEP_INSTRUCTION_SET=" + pin + " names no kernel of this plugin (it has " + known +
+                    "; \"baseline\" means x86-64, \"evaluation\" the evaluation path)");
+}
+
+}  // namespace nonsep::host

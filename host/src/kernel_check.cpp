@@ -1,0 +1,103 @@
+// The kernel part of `nonsep inspect --check` (plugin_report.hpp, check_kernels): each kernel this processor runs
+// against the evaluation path, on a few steps of the basic step (one dt for all states) and of MPE 4/3 (a step
+// size per state), both forms.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/host/plugin_report.hpp"
+
+namespace nonsep::host {
+
+namespace {
+
+// The numbers of `count` states (q, p) after `steps` steps of `spec` through `model`.
+PhaseSpaceBatch run(const PluginModel& model, const IntegratorSpec& spec, std::span<const double> q,
+                    std::span<const double> p, std::size_t count, double dt, std::uint64_t steps) {
+  PhaseSpaceBatch x(model.dimension(), count);
+  std::copy_n(q.begin(), x.size(), x.q().begin());
+  std::copy_n(p.begin(), x.size(), x.p().begin());
+  Integrator integrator(spec);
+  integrator.step_n(model, x, dt, steps);
+  return x;
+}
+
+}  // namespace
+
+KernelCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                          std::span<const double> p, std::size_t count, double tolerance) {
+  KernelCheck result;
+  const KernelChoice& kernels = plugin.kernels();
+  if (!kernels.present) {
+    result.text = "kernels: none (the evaluation path steps this plugin)\n";
+    return result;
+  }
+  if (!kernels.chosen && kernels.version != chin_kernel_version) {
+    result.text = "kernels: not checked: " + kernels.note + "\n";
+    return result;
+  }
+  constexpr double dt = 1e-3;
+  constexpr std::uint64_t steps = 8;
+  for (std::size_t index = 0; index < kernels.instruction_sets.size(); ++index) {
+    const std::string& name = kernels.instruction_sets[index];
+    const PluginModel kernel = model.with_kernel(index);
+    if (!kernel.has_kernel()) {
+      result.text += "kernel " + name + ": not checked (this processor does not run it)\n";
+      continue;
+    }
+    double largest = 0.0;  // relative to max(1, |number|)
+    bool identical = true, comparable = true;
+    std::string failure;
+    for (const char* scheme : {"basic", "mpe"})
+      for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT}) {
+        IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
+        spec.form = form;
+        try {
+          const PhaseSpaceBatch expected = run(model, spec, q, p, count, dt, steps);
+          const PhaseSpaceBatch found = run(kernel, spec, q, p, count, dt, steps);
+          for (std::size_t i = 0; i < expected.size(); ++i)
+            for (const auto& [a, b] :
+                 {std::pair{expected.q()[i], found.q()[i]}, std::pair{expected.p()[i], found.p()[i]}}) {
+              if (std::memcmp(&a, &b, sizeof a) == 0) continue;
+              identical = false;
+              if (!std::isfinite(a) || !std::isfinite(b)) {
+                comparable = false;
+                continue;
+              }
+              largest = std::max(largest, std::abs(a - b) / std::max(1.0, std::abs(a)));
+            }
+        } catch (const ModelError& error) {
+          failure = error.what();
+        }
+      }
+    std::string line = "kernel " + name + ": ";
+    if (!failure.empty()) {
+      line += "not compared: the model failed at the sample points (" + failure + ")";
+    } else if (identical) {
+      line += "identical to the evaluation path bit for bit";
+    } else if (!comparable) {
+      line += "FAILED: non-finite where the evaluation path is finite (or the reverse)";
+      result.passed = false;
+    } else {
+      char text[64];
+      std::snprintf(text, sizeof text, "%.3g", largest);
+      line += std::string("largest difference from the evaluation path ") + text +
+              " (relative to max(1, |x|); fused multiply-add or other compiler flags round differently)";
+      if (largest > tolerance) {
+        line += ": FAILED, above the tolerance";
+        result.passed = false;
+      }
+    }
+    result.largest_difference = std::max(result.largest_difference, largest);
+    result.text += line + (index == kernels.chosen ? " [used by runs]" : "") + "\n";
+  }
+  result.text = "kernels (" + std::to_string(steps) + " steps of basic and mpe 4/3, dt " +
+                std::to_string(dt).substr(0, 5) + ", TTV and VVT, " + std::to_string(count) + " states):\n" +
+                result.text;
+  return result;
+}
+
+}  // namespace nonsep::host

@@ -1,0 +1,72 @@
+#pragma once
+// The stepping kernels an SDK plugin carries (plugin_abi.h, chin_steps): nonsep::chin_kernel_steps, the core's own
+// template (nonsep/core/chin_kernel.hpp), instantiated with the plugin's model adapter inlined. No stepping code is
+// written here: this header only compiles that template once per instruction set and picks one by index.
+//
+// Instruction sets, in the order of the metadata's "kernels": {"instruction_sets": [...]} (index 0 first):
+//   "x86-64"     the baseline every x86-64 runs, compiled with the plugin's own flags: bit for bit the evaluation
+//                path of a host built with the same flags
+//   "x86-64-v3"  AVX2 and FMA (GCC's target attribute "arch=x86-64-v3")
+//   "x86-64-v4"  AVX-512 (F, BW, CD, DQ, VL)
+// The wider sets run more numbers per instruction and fuse multiplications and additions (one rounding instead of
+// two), so their numbers may differ from the baseline's in the last bits (docs/performance.md measures by how
+// much). The host chooses the set from the processor's features, or the one NONSEP_INSTRUCTION_SET names.
+// Each wider instantiation is flattened (every call inside inlined), so that the model's code is compiled for the
+// wider set too and not called in its baseline copy. Other processors (and compilers without the attribute) get
+// the baseline alone.
+#include <cstddef>
+#include <span>
+#include <string_view>
+
+#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/sdk/model_adapter.hpp"
+
+namespace nonsep::sdk {
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define NONSEP_SDK_WIDE_KERNELS 1
+inline constexpr std::string_view kernel_instruction_sets[] = {"x86-64", "x86-64-v3", "x86-64-v4"};
+#else
+#define NONSEP_SDK_WIDE_KERNELS 0
+inline constexpr std::string_view kernel_instruction_sets[] = {"x86-64"};
+#endif
+
+// The kernels of one adapter type: run(index, adapter, call) advances call by the kernel of instruction set
+// `index` (an index into kernel_instruction_sets; false when out of range). Throws what the model throws.
+template <class Adapter>
+struct ChinKernels {
+  static constexpr std::size_t fixed_dimension =
+      HasFixedDimension<typename Adapter::Model> ? dimension_capacity<typename Adapter::Model>() : 0;
+
+  [[gnu::flatten]] static void baseline(const Adapter& adapter, const ChinStepsCall& call) {
+    chin_kernel_steps<fixed_dimension>(adapter, call);
+  }
+#if NONSEP_SDK_WIDE_KERNELS
+  [[gnu::target("arch=x86-64-v3"), gnu::flatten]] static void v3(const Adapter& adapter, const ChinStepsCall& call) {
+    chin_kernel_steps<fixed_dimension>(adapter, call);
+  }
+  [[gnu::target("arch=x86-64-v4"), gnu::flatten]] static void v4(const Adapter& adapter, const ChinStepsCall& call) {
+    chin_kernel_steps<fixed_dimension>(adapter, call);
+  }
+#endif
+
+  static bool run(std::size_t index, const Adapter& adapter, const ChinStepsCall& call) {
+    switch (index) {
+      case 0:
+        baseline(adapter, call);
+        return true;
+#if NONSEP_SDK_WIDE_KERNELS
+      case 1:
+        v3(adapter, call);
+        return true;
+      case 2:
+        v4(adapter, call);
+        return true;
+#endif
+      default:
+        return false;
+    }
+  }
+};
+
+}  // namespace nonsep::sdk

@@ -1,0 +1,128 @@
+// The stepping kernel (chin_kernel.hpp) against the evaluation path: a model offering chin_steps gets bit for bit
+// the numbers and evaluation counts of the same model without it, through every Chin scheme (basic, triplet, mpe),
+// both forms, 1, 5 and 300 states, fixed and run-time dimensions; and a kernel that fails leaves nothing stale.
+#include <doctest/doctest.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "nonsep/core.hpp"
+#include "nonsep/core/chin_kernel.hpp"
+#include "support/models.hpp"
+
+using namespace nonsep;
+using nonsep::testing::Coupled2D;
+using nonsep::testing::Paper1D;
+
+namespace {
+
+// Model M with a kernel: chin_kernel_steps<FixedDimension> when `available`, counting the calls that used it.
+// `fail_at_call`: that call (1-based) throws ModelError instead, as a plugin's kernel failing partway does.
+template <class M, std::size_t FixedDimension>
+struct WithKernel : M {
+  bool available = true;
+  int fail_at_call = 0;
+  mutable int calls = 0;
+  bool chin_steps(const ChinStepsCall& call) const {
+    if (!available) return false;
+    if (++calls == fail_at_call) throw ModelError("the kernel failed");
+    chin_kernel_steps<FixedDimension>(static_cast<const M&>(*this), call);
+    return true;
+  }
+};
+static_assert(ModelWithChinSteps<WithKernel<Paper1D, 1>>);
+static_assert(!ModelWithChinSteps<Paper1D>);
+
+const std::array<HamiltonianForm, 2> forms{HamiltonianForm::TTV, HamiltonianForm::VVT};
+
+PhaseSpaceBatch spread_states(std::size_t n, std::size_t count) {
+  PhaseSpaceBatch x(n, count);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    x.q()[i] = 0.4 + 0.7 * static_cast<double>((i * 37) % 101) / 101.0;
+    x.p()[i] = -0.3 + 0.5 * static_cast<double>((i * 53) % 97) / 97.0;
+  }
+  return x;
+}
+
+// Runs `scheme` for 2 chunks of 4 steps and 1 chunk of 3 (the host's step_n) with and without the kernel.
+template <class M, std::size_t FixedDimension>
+void check_scheme(const std::string& scheme, HamiltonianForm form, std::size_t count) {
+  CAPTURE(scheme);
+  CAPTURE(static_cast<int>(form));
+  CAPTURE(count);
+  CAPTURE(FixedDimension);
+  const M plain{};
+  WithKernel<M, FixedDimension> kernel{};
+  IntegratorSpec spec{scheme, Fraction(scheme == "basic" ? 2 : 4, 3)};
+  spec.form = form;
+  Integrator with(spec), without(spec);
+  auto x = spread_states(plain.dimension(), count);
+  auto y = x;
+  for (std::uint64_t steps : {4, 4, 3}) {
+    with.step_n(kernel, x, 0.01, steps);
+    without.step_n(plain, y, 0.01, steps);
+  }
+  CHECK(x == y);
+  CHECK(with.evaluations() == without.evaluations());
+  CHECK(kernel.calls > 0);
+}
+
+}  // namespace
+
+TEST_CASE("kernel path: every Chin scheme and form gives the evaluation path's numbers and counts bit for bit") {
+  for (const char* scheme : {"basic", "triplet", "mpe"})
+    for (const auto form : forms)
+      for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{300}}) {
+        check_scheme<Paper1D, 1>(scheme, form, count);    // blocks of 16 states in local arrays, then one by one
+        check_scheme<Coupled2D, 2>(scheme, form, count);  // blocks of 8
+        check_scheme<Coupled2D, 0>(scheme, form, count);  // the dimension known at run time: the caller's arrays
+      }
+}
+
+TEST_CASE("kernel path: a model whose kernel is not at hand is stepped through its evaluations") {
+  WithKernel<Paper1D, 1> kernel{};
+  kernel.available = false;
+  ChinBasicStep with, without;
+  auto x = spread_states(1, 5);
+  auto y = x;
+  with.step_n(kernel, x, 0.01, 5);
+  without.step_n(Paper1D{}, y, 0.01, 5);
+  CHECK(x == y);
+  CHECK(with.evaluations() == without.evaluations());
+  CHECK(kernel.calls == 0);
+}
+
+TEST_CASE("kernel path: steps a stage observer watches go through the evaluations") {
+  WithKernel<Paper1D, 1> kernel{};
+  ChinBasicStep with, without;
+  auto x = spread_states(1, 3);
+  auto y = x;
+  int flows = 0;
+  with.step(kernel, x, 0.01, [&](const FlowStage&, std::span<const double>, const PhaseSpaceBatch&) { ++flows; });
+  without.step(Paper1D{}, y, 0.01);
+  CHECK(x == y);
+  CHECK(flows == 9);
+  CHECK(kernel.calls == 0);
+}
+
+TEST_CASE("kernel path: a kernel that fails leaves no stale first-same-as-last gradient behind") {
+  for (const auto form : forms) {
+    CAPTURE(static_cast<int>(form));
+    WithKernel<Paper1D, 1> kernel{};
+    kernel.fail_at_call = 2;
+    ChinBasicStep stepper(form), reference(form);
+    auto x = spread_states(1, 5);
+    auto y = x;
+    stepper.step_n(kernel, x, 0.01, 3);
+    reference.step_n(Paper1D{}, y, 0.01, 3);
+    const auto before = x;
+    CHECK_THROWS_AS(stepper.step_n(kernel, x, 0.01, 3), ModelError);
+    x = before;
+    stepper.step_n(kernel, x, 0.01, 3);
+    reference.step_n(Paper1D{}, y, 0.01, 3);
+    CHECK(x == y);
+  }
+}

@@ -1,0 +1,176 @@
+// The plugins' stepping kernels in the `nonsep` executable: runs through the kernel (NONSEP_INSTRUCTION_SET=
+// baseline) write byte for byte the files of runs through the evaluation path (NONSEP_INSTRUCTION_SET=evaluation),
+// for every Chin scheme and form, 1, 5 and 300 states, 1 and 2 threads, states that fail or diverge partway, and a
+// run killed and resumed; summary.json says which path ran; inspect shows and checks the kernels; a plugin of
+// another kernel version, and one without kernels, run through the evaluation path.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "host_run_support.hpp"
+
+using nlohmann::json;
+using namespace nonsep::host_testing;
+
+namespace {
+
+// Sets NONSEP_INSTRUCTION_SET for the runs started in its lifetime, then puts the tests' pin back.
+struct InstructionSet {
+  explicit InstructionSet(const char* name) { ::setenv("NONSEP_INSTRUCTION_SET", name, 1); }
+  ~InstructionSet() { ::setenv("NONSEP_INSTRUCTION_SET", "baseline", 1); }
+  InstructionSet(const InstructionSet&) = delete;
+  InstructionSet& operator=(const InstructionSet&) = delete;
+};
+
+struct RunFiles {
+  int status = -1;
+  std::string trajectories, trajectory, err;
+  json summary;
+};
+
+RunFiles run_with(const char* instruction_set, const TemporaryFolder& folder, const std::string& name,
+                  const std::filesystem::path& file, const char* threads = "1") {
+  InstructionSet pin(instruction_set);
+  const auto out = folder / name;
+  const auto result =
+      run_nonsep({"run", "--quiet", "--threads", threads, "--output", out.string(), file.string()}, folder.path());
+  RunFiles files{result.status, read_text(out / "trajectories.csv"), "", result.err,
+                 comparable(read_json(out / "summary.json"))};
+  if (std::filesystem::exists(out / "trajectory.csv")) files.trajectory = read_text(out / "trajectory.csv");
+  return files;
+}
+
+// The two runs agree byte for byte, but for the summary's "stepping", which says which path ran.
+void check_same_files(RunFiles kernel, RunFiles evaluation) {
+  INFO("stderr (kernel): " << kernel.err);
+  INFO("stderr (evaluation): " << evaluation.err);
+  CHECK(kernel.status == evaluation.status);
+  CHECK(kernel.trajectories == evaluation.trajectories);
+  CHECK(kernel.trajectory == evaluation.trajectory);
+  CHECK(kernel.summary["stepping"]["path"] == "kernel");
+  CHECK(kernel.summary["stepping"]["instruction_set"] == "x86-64");
+  CHECK(kernel.summary["stepping"]["kernel_calls"].get<std::uint64_t>() > 0);
+  CHECK(evaluation.summary["stepping"]["path"] == "evaluation");
+  CHECK(evaluation.summary["stepping"]["kernel_calls"] == 0);
+  kernel.summary.erase("stepping");
+  evaluation.summary.erase("stepping");
+  CHECK(kernel.summary == evaluation.summary);
+}
+
+json states(std::size_t count) {
+  json list = json::array();
+  for (std::size_t i = 0; i < count; ++i) list.push_back(state(0.3 + 0.002 * double(i), 0.2 - 0.001 * double(i)));
+  return list;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "kernel path: every Chin scheme and form, 1, 5 and 300 states, 1 and 2 threads, the evaluation path's files") {
+  TemporaryFolder folder;
+  for (const json& integrator : {json{{"scheme", "basic"}}, json{{"scheme", "triplet"}, {"order", "4/3"}},
+                                 json{{"scheme", "mpe"}, {"order", "4/3"}}})
+    for (const char* form : {"TTV", "VVT"})
+      for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{300}}) {
+        json job = paper1d_job(states(count), {{"dt", 0.01}, {"steps", 40}}, integrator);
+        job["hamiltonian"] = form;
+        job["output"] = {{"every", 10}};
+        const std::string name = integrator["scheme"].get<std::string>() + "-" + form + "-" + std::to_string(count);
+        CAPTURE(name);
+        const auto file = write_job(folder / (name + ".json"), job);
+        for (const char* threads : {"1", "2"}) {
+          if (count < 300 && std::string(threads) == "2") continue;  // one block: the threads have nothing to share
+          CAPTURE(threads);
+          check_same_files(run_with("baseline", folder, name + "-kernel-" + threads, file, threads),
+                           run_with("evaluation", folder, name + "-evaluation-" + threads, file, threads));
+        }
+      }
+}
+
+TEST_CASE("kernel path: states that fail or diverge partway are reported as the evaluation path reports them") {
+  TemporaryFolder folder;
+  use_test_plugins();
+  // evaluation_fails: grad V refuses |q| >= 1 (a failure inside the kernel, then the evaluation path's replay).
+  json failing = json::array();
+  for (int i = 0; i < 40; ++i) failing.push_back(state(0.3 + 0.0175 * i, 0.05));
+  json job = {{"model", {{"plugin", std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/evaluation_fails.so"}}},
+              {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}}},
+              {"initial", failing},
+              {"time", {{"dt", 0.01}, {"steps", 60}}},
+              {"output", {{"every", 10}}}};
+  auto file = write_job(folder / "failing.json", job);
+  const auto kernel = run_with("baseline", folder, "failing-kernel", file, "2");
+  check_same_files(kernel, run_with("evaluation", folder, "failing-evaluation", file, "2"));
+  CHECK(kernel.trajectories.find("failed") != std::string::npos);
+  CHECK(kernel.trajectories.find("completed") != std::string::npos);
+  // paper1d: a state whose gradient overflows diverges in its first step, among states that go on.
+  json diverging = states(20);
+  diverging[7] = state(0.5, 1e200);
+  file = write_job(folder / "diverging.json",
+                   paper1d_job(diverging, {{"dt", 0.01}, {"steps", 30}}, {{"scheme", "mpe"}, {"order", "4/3"}}));
+  const auto diverged = run_with("baseline", folder, "diverging-kernel", file);
+  check_same_files(diverged, run_with("evaluation", folder, "diverging-evaluation", file));
+  CHECK(diverged.trajectories.find("diverged") != std::string::npos);
+}
+
+TEST_CASE("kernel path: a run killed and resumed gives the uninterrupted evaluation path's files") {
+  TemporaryFolder folder;
+  json job = paper1d_job(states(2000), {{"dt", 0.0001}, {"steps", 200000}}, {{"scheme", "basic"}});
+  job["output"] = {{"every", 0}};
+  job["checkpoint"] = {{"every_steps", 10000}, {"every_seconds", 0}};
+  const auto file = write_job(folder / "job.json", job);
+  const auto reference = run_with("evaluation", folder, "reference", file);
+  REQUIRE(reference.status == 0);
+  InstructionSet pin("baseline");
+  const auto step = kill_after_checkpoint(file, folder / "out", 20000, folder.path());
+  INFO("killed after the checkpoint at step " << step);
+  CHECK(step < 200000);
+  const auto resumed =
+      run_nonsep({"run", "--quiet", "--resume", "--output", (folder / "out").string(), file.string()}, folder.path());
+  INFO("stderr: " << resumed.err);
+  REQUIRE(resumed.status == 0);
+  CHECK(read_text(folder / "out/trajectories.csv") == reference.trajectories);
+  CHECK(read_json(folder / "out/summary.json")["stepping"]["path"] == "kernel");
+}
+
+TEST_CASE("kernel path: a plugin without kernels, or of another kernel version, runs through the evaluation path") {
+  TemporaryFolder folder;
+  use_test_plugins();
+  for (const auto& [plugin, note] : {std::pair{std::string("blowup"), std::string("no stepping kernels")},
+                                     std::pair{std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/kernel_other_version.so",
+                                               std::string("kernel version 999")}}) {
+    CAPTURE(plugin);
+    json job = blowup_job(json::array({state(0.5, 0.25), state(0.7, 0.1)}), json::object(), plugin);
+    const auto file = write_job(folder / "job.json", job);
+    const auto run = run_with("baseline", folder, "out-" + std::to_string(note.size()), file);
+    CHECK(run.status == 0);
+    CHECK(run.summary["stepping"]["path"] == "evaluation");
+    CHECK(run.summary["stepping"]["note"].get<std::string>().find(note) != std::string::npos);
+  }
+}
+
+TEST_CASE("inspect shows a plugin's kernels and --check compares them with the evaluation path") {
+  TemporaryFolder folder;
+  const auto shown = run_nonsep({"inspect", "paper1d"}, folder.path());
+  CHECK(shown.status == 0);
+  CHECK(shown.out.find("kernels:     version 1 for x86-64") != std::string::npos);
+  CHECK(shown.out.find("runs use x86-64 (pinned by NONSEP_INSTRUCTION_SET)") != std::string::npos);
+  const auto checked = run_nonsep({"inspect", "paper1d", "--check"}, folder.path());
+  INFO(checked.out);
+  CHECK(checked.status == 0);
+  CHECK(checked.out.find("kernel x86-64: identical to the evaluation path bit for bit [used by runs]") !=
+        std::string::npos);
+  const auto none = run_nonsep({"inspect", "blowup", "--check"}, folder.path());
+  CHECK(none.out.find("kernels: none (the evaluation path steps this plugin)") != std::string::npos);
+}
+
+TEST_CASE("NONSEP_INSTRUCTION_SET naming a set the plugin lacks is refused with the sets it has") {
+  TemporaryFolder folder;
+  InstructionSet pin("x86-64-v9");
+  const auto result = run_nonsep({"inspect", "paper1d"}, folder.path());
+  CHECK(result.status == 2);
+  CHECK(result.err.find("NONSEP_INSTRUCTION_SET=x86-64-v9 names no kernel of this plugin (it has x86-64") !=
+        std::string::npos);
+}
