@@ -296,11 +296,18 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
     for (std::size_t k = 0; k < sample.count; ++k)
       options.points.emplace_back(sample.at.begin() + static_cast<std::ptrdiff_t>(k * n),
                                   sample.at.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
-    const DerivativeCheckReport part = nonsep::check_derivatives(model, options);
-    report.comparisons += part.comparisons;
-    report.not_a_number += part.not_a_number;
-    report.largest_error = std::max(report.largest_error, part.largest_error);
-    report.mismatches.insert(report.mismatches.end(), part.mismatches.begin(), part.mismatches.end());
+    // The separable part K(p) + U(q), where the plugin has one, at the same points (K at p, U at q).
+    DerivativeCheckOptions separable = options;
+    separable.check_hessian_vector_products = false;
+    for (const DerivativeCheckReport& part :
+         {nonsep::check_derivatives(model, options), plugin.has_K() || plugin.has_U()
+                                                         ? nonsep::check_separable_derivatives(model, separable)
+                                                         : DerivativeCheckReport{}}) {
+      report.comparisons += part.comparisons;
+      report.not_a_number += part.not_a_number;
+      report.largest_error = std::max(report.largest_error, part.largest_error);
+      report.mismatches.insert(report.mismatches.end(), part.mismatches.begin(), part.mismatches.end());
+    }
   }
   DerivativeCheck result;
   result.comparisons = report.comparisons;

@@ -133,6 +133,13 @@ TEST_CASE("inspect shows the metadata, --json the raw metadata, --check the deri
   CHECK(result.status == 1);
   CHECK(result.out.find("derivative check FAILED") != std::string::npos);
   CHECK(result.out.find("  hessian_V[0] at q = (") != std::string::npos);
+  // The separable part K(p) + U(q) is checked too: a wrong grad U is named, a right one passes.
+  result = run_nonsep({"inspect", "wrong_grad_U", "--check"}, folder.path());
+  CHECK(result.status == 1);
+  CHECK(result.out.find("  grad_U[0] at q = (") != std::string::npos);
+  result = run_nonsep({"inspect", "mathews_lakshmanan", "--check"}, folder.path());
+  CHECK(result.status == 0);
+  CHECK(result.out.find("derivative check passed") != std::string::npos);
 
   result = run_nonsep({"inspect", "no_such_plugin"}, folder.path());
   CHECK(result.status == 2);
