@@ -266,6 +266,7 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
       unit_options.show_progress = false;
       unit_options.resume = state == UnitState::checkpointed;
       unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over
+      unit_options.whole_ensemble = loaded.job.initial.count;
       try {
         const RunOutcome outcome = run_job(unit_job(loaded, plan.first(unit), plan.size(unit)), unit_options);
         if (outcome.exit_status == ExitStatus::interrupted) interrupted = true;
