@@ -125,8 +125,8 @@ TEST_CASE("blocks are sized from the ensemble, so that 71 trajectories are block
   CHECK(run_block_size_for(600) == 64);
   CHECK(run_block_size_for(2048) == 256);
   CHECK(run_block_size_for(100000) == 256);
-  CHECK(run_block_size_for(3) == 1);
-  CHECK(run_block_size_for(1) == 1);
+  CHECK(run_block_size_for(3) == 2);
+  CHECK(run_block_size_for(1) == 2);
   const auto plugin = nonsep::host::load_plugin(std::string(NONSEP_SHIPPED_PLUGIN_DIR) + "/paper1d.so", "");
   const auto model = plugin.create(json::object());
   std::vector<double> q(71), p(71, 0.25);

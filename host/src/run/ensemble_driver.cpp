@@ -219,7 +219,7 @@ struct EnsembleDriver::Impl {
 
 std::size_t run_block_size_for(std::size_t trajectories) {
   std::size_t size = run_block_size;
-  while (size > 1 && (trajectories + size - 1) / size < run_min_blocks) size /= 2;
+  while (size > 2 && (trajectories + size - 1) / size < run_min_blocks) size /= 2;
   return size;
 }
 

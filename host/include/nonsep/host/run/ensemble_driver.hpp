@@ -50,8 +50,9 @@ inline constexpr std::size_t run_block_size = 256;               // the most tra
 inline constexpr std::size_t run_min_blocks = 8;                 // the fewest blocks, when there are enough states
 inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chunk: state-steps of all active states
 
-// Trajectories per block for an ensemble of `trajectories`: the largest power of two up to run_block_size that
-// still cuts it into at least run_min_blocks blocks (1 for fewer states): 71 trajectories are 9 blocks of 8,
+// Trajectories per block for an ensemble of `trajectories`: the largest power of two from 2 up to run_block_size
+// that still cuts it into at least run_min_blocks blocks (2 for fewer states: states stepped together stay in one
+// plugin call, as plugins that tell batches from single states expect): 71 trajectories are 9 blocks of 8,
 // 600 are 10 of 64, 2048 and more are blocks of 256. A power of two divides run_block_size, so the work units of a
 // distributed run (multiples of run_block_size) cut no block.
 std::size_t run_block_size_for(std::size_t trajectories);
