@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # Installs what nonsep needs from Debian 12 packages (as root; quick when everything is already there),
 # then configures and builds the project in ./build with 2 parallel jobs.
+# What is built: when ./build is configured for the first time, only what a user runs: the nonsep executable, the
+# shipped plugins, the SDK and CMake package, the Python package and the example programs (BUILD_TESTING and
+# NONSEP_BUILD_BENCHMARKS off). scripts/test.sh passes -DBUILD_TESTING=ON -DNONSEP_BUILD_BENCHMARKS=ON to build the
+# test suites and benchmarks too. An existing ./build keeps its choice; options given here win over both.
 # Usage: bash scripts/setup.sh [extra cmake -D options...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,6 +13,7 @@ packages=(
   ca-certificates cmake g++ make pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev doctest-dev libcli11-dev
   python3 python3-jsonschema python3-matplotlib python3-numpy python3-h5py
+  jupyter-nbconvert python3-nbconvert python3-nbformat python3-ipykernel  # examples/tutorial.ipynb, run headless
   libopenmpi-dev openmpi-bin libhdf5-openmpi-dev hdf5-tools  # MPI ranks, parallel HDF5 output (docs/cluster.md)
   zlib1g-dev  # results.h5: /samples' chunks deflated by nonsep (host/include/nonsep/host/output/shuffle_deflate.hpp)
   clang libclang-rt-14-dev valgrind  # CI: fuzzing (tests/fuzz) and memcheck (tests/ci)
@@ -27,5 +32,7 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+product_only=()
+[ -f build/CMakeCache.txt ] || product_only=(-DBUILD_TESTING=OFF -DNONSEP_BUILD_BENCHMARKS=OFF)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${product_only[@]}" "$@" >/dev/null
 cmake --build build -j2

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, exactly as CI runs it (.ci/run) and README.md shows it, from a fresh Debian 12 machine:
-#   1. setup    scripts/setup.sh: the Debian packages, configure and build build/ (Release);
+#   1. setup    scripts/setup.sh: the Debian packages, configure and build build/ (Release) with the test suites
+#               and benchmarks (-DBUILD_TESTING=ON -DNONSEP_BUILD_BENCHMARKS=ON);
 #   2. ctest    every ctest test of build/ (labels core, plugins, host, examples, python, slow);
 #   3. sanitize the suite again built with ASan + UBSan in build-sanitize/ (tests/ci/run_sanitized_suite.sh);
 #   4. fuzz     30 s of libFuzzer on job-file reading from the kept corpus, clang build in build/fuzz
@@ -14,7 +15,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.." || exit 1
 root=$PWD
 
-if ! bash scripts/setup.sh; then
+if ! bash scripts/setup.sh -DBUILD_TESTING=ON -DNONSEP_BUILD_BENCHMARKS=ON; then
   echo "test.sh: setup failed"
   echo "0 passed, 1 failed"
   exit 1

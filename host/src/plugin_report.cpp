@@ -307,6 +307,7 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
       report.not_a_number += part.not_a_number;
       report.largest_error = std::max(report.largest_error, part.largest_error);
       report.mismatches.insert(report.mismatches.end(), part.mismatches.begin(), part.mismatches.end());
+      report.culprits.insert(report.culprits.end(), part.culprits.begin(), part.culprits.end());
     }
   }
   DerivativeCheck result;

@@ -55,15 +55,51 @@ json or_null(const std::optional<T>& value) {
   return value ? json(*value) : json(nullptr);
 }
 
+bool usable_error(double e) { return std::isfinite(e) && e != 0.0; }
+
 }  // namespace
+
+std::size_t round_off_floor_start(std::span<const double> dt, std::span<const double> error, double order) {
+  std::vector<std::size_t> usable;
+  for (std::size_t i = 0; i < dt.size() && i < error.size(); ++i)
+    if (usable_error(error[i])) usable.push_back(i);
+  const auto slope_below_half = [&](std::size_t a, std::size_t b) {
+    const double slope = std::log(std::abs(error[a] / error[b])) / std::log(std::abs(dt[a] / dt[b]));
+    return !(slope >= order / 2);
+  };
+  for (std::size_t k = 0; k < usable.size(); ++k) {
+    const double e = std::abs(error[usable[k]]);
+    if (e < round_off_energy_error) return usable[k];
+    if (e < round_off_at_most && ((k > 0 && slope_below_half(usable[k - 1], usable[k])) ||
+                                  (k + 1 < usable.size() && slope_below_half(usable[k], usable[k + 1]))))
+      return usable[k];
+  }
+  return dt.size();
+}
 
 StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescription& description,
                    const std::vector<StudyRun>& runs, bool with_reference) {
+  std::vector<double> all_dts, all_energy_errors;
+  for (const auto& run : runs)
+    if (run.status == TrajectoryStatus::completed) {
+      all_dts.push_back(run.dt);
+      all_energy_errors.push_back(run.relative_energy_error.value_or(std::nan("")));
+    }
+  const std::size_t floor = round_off_floor_start(all_dts, all_energy_errors, description.order.value());
+  StudyFit fit;
   std::vector<double> dts, energy_errors, phase_errors;
   std::vector<std::uint64_t> steps;
   int positive = 0, negative = 0;
+  std::size_t completed = 0;
   for (const auto& run : runs) {
     if (run.status != TrajectoryStatus::completed) continue;
+    if (completed++ >= floor) {
+      ++fit.points_at_round_off;
+      fit.round_off_dt_max = fit.round_off_dt_max.value_or(run.dt);
+      const double e = std::abs(run.relative_energy_error.value_or(INFINITY));
+      fit.round_off_error_smallest = std::min(fit.round_off_error_smallest.value_or(INFINITY), e);
+      continue;
+    }
     dts.push_back(run.dt);
     steps.push_back(run.steps);
     const double e = run.relative_energy_error.value_or(std::nan(""));
@@ -72,7 +108,6 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
     if (e < 0) ++negative;
     phase_errors.push_back(run.phase_error.value_or(std::nan("")));
   }
-  StudyFit fit;
   fit.integrator = integrator.label;
   fit.description = description;
   fit.steps_from = integrator.steps_from;
@@ -137,6 +172,8 @@ json to_json(const StudyFit& fit) {
   entry["energy_error_changes_sign"] = fit.energy_error_changes_sign;
   entry["energy_error_smallest"] = or_null(fit.energy_error_smallest);
   entry["energy_error_excess_at_smallest_dt"] = or_null(fit.energy_error_excess_at_smallest_dt);
+  entry["n_points_at_round_off"] = fit.points_at_round_off;
+  entry["round_off_dt_max"] = or_null(fit.round_off_dt_max);
   if (fit.dt_min) {
     entry["dt_min"] = *fit.dt_min;
     entry["dt_max"] = or_null(fit.dt_max);

@@ -6,8 +6,21 @@
     orbit = result.orbit(0)                            # orbit.t, orbit.q [n, d], orbit.p, orbit.H, ...
 
 run(), validate() and the executable: nonsep.process; load() and Result: nonsep.results; figures: nonsep.plot
-(imported on its own, as it needs matplotlib).
+(imported on its own, as it needs matplotlib); nonsep.work_precision plots a study's work_precision.csv
+(`python3 -m nonsep.work_precision`).
+
+The package needs numpy (and matplotlib, h5py where used): Debian's python3-numpy serves Debian's /usr/bin/python3.
 """
+import sys
+
+try:
+    import numpy  # noqa: F401
+except ImportError as missing:
+    raise ImportError(
+        f"nonsep needs numpy, which this Python ({sys.executable}) cannot import. Debian's python3-numpy (installed "
+        "by scripts/setup.sh) serves /usr/bin/python3: run /usr/bin/python3, or install numpy (and matplotlib, "
+        "h5py) for this interpreter") from missing
+
 from .process import (ExecutableNotFound, Problem, RunError, RunInterrupted, executable, parse_problems, run,
                       validate)
 from .results import Crossings, LyapunovSeries, Orbit, Result, Samples, load

@@ -182,8 +182,13 @@ class Result:
 
     def initial_states(self):
         """(q, p), each [trajectories, dimension]: every trajectory's state at step 0, from trajectory.csv (the host
-        writes step 0 whatever output.every). Raises FileNotFoundError when the run wrote no trajectory.csv, and
-        ValueError when it has no step-0 row of some trajectory."""
+        writes step 0 whatever output.every > 0). Raises FileNotFoundError saying what to set when the run had
+        output.every 0 (no samples), and ValueError when it has no step-0 row of some trajectory."""
+        if self.summary.get("output", {}).get("every") == 0:
+            raise FileNotFoundError(
+                f"{self.directory} has no samples, so no initial states: the run had output.every = 0. The initial "
+                "states are the step-0 samples: run the job with output.every > 0 (its number of steps writes step "
+                "0 and the last step only)")
         samples = self.samples()
         first = samples[samples["step"] == 0]
         first = first[np.argsort(first["trajectory"], kind="stable")]

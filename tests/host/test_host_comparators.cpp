@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include "host_run_support.hpp"
 #include "nonsep/host/checkpoint.hpp"
@@ -194,6 +195,35 @@ TEST_CASE("a study of Chin's schemes and comparators writes work_precision.csv w
   const double ratio = std::stod(rows[3][column(h, "phase_error")]) / std::stod(rows[4][column(h, "phase_error")]);
   CHECK(ratio > 12.0);
   CHECK(ratio < 20.0);
+}
+
+TEST_CASE("a study's default labels name each integrator's order as summary.json reports it") {
+  TemporaryFolder folder;
+  const json job = {{"model", {{"plugin", "paper1d"}}},
+                    {"initial", state(2.0, 0.0)},
+                    {"time", {{"t_end", quarter_period}}},
+                    {"study",
+                     {{"steps", {16, 32}},
+                      {"integrators",
+                       {{{"scheme", "gauss"}, {"stages", 2}},
+                        {{"scheme", "gauss"}, {"stages", 3}},
+                        {{"scheme", "implicit_midpoint"}},
+                        {{"scheme", "tao"}, {"order", 4}},
+                        {{"scheme", "mpe"}, {"order", "8/3"}},
+                        {{"scheme", "basic"}}}}}}};
+  const auto file = write_job(folder / "labels.json", job);
+  const auto result =
+      run_nonsep({"run", "--quiet", "--output", (folder / "labels").string(), file.string()}, folder.path());
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  const json fits = read_json(folder / "labels" / "summary.json")["fits"];
+  REQUIRE(fits.size() == 6);
+  const std::vector<std::string> labels{"gauss 4", "gauss 6", "implicit_midpoint 2", "tao 4", "mpe 8/3", "basic"};
+  for (std::size_t i = 0; i < fits.size(); ++i) {
+    CHECK(fits[i]["integrator"] == labels[i]);
+    if (i + 1 < fits.size())
+      CHECK(fits[i]["integrator"] == fits[i]["scheme"].get<std::string>() + " " + fits[i]["order"].get<std::string>());
+  }
 }
 
 TEST_CASE("a study's reference_run: its end state is the reference of the phase errors, as a given reference") {

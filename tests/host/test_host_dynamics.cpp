@@ -123,6 +123,9 @@ TEST_CASE("a general normal, direction both, and max_crossings stopping a trajec
       last_step = cell(row, "step");
     }
     CHECK(cell(rows[t], "step") == last_step);  // it stopped at the step of its second crossing
+    // Without samples H is evaluated at step 0 and at that last state: the largest |dH/H0| includes it.
+    CHECK(std::abs(cell(rows[t], "relative_energy_error")) > 0.0);
+    CHECK(cell(rows[t], "max_abs_relative_energy_error") == std::abs(cell(rows[t], "relative_energy_error")));
   }
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "host_run_support.hpp"
+#include "nonsep/host/number_format.hpp"
 #include "support/nan_aware.hpp"
 
 using nlohmann::json;
@@ -121,4 +122,27 @@ TEST_CASE("the completion line names the largest relative energy error, and a wa
   result = run_nonsep({"run", "--quiet", "--output", (folder / "coarse").string(), file.string()}, folder.path());
   CHECK(result.status == 0);
   CHECK(result.err.find("nonsep: warning: the relative energy error |dH/H0| reached 0.312") != std::string::npos);
+}
+
+TEST_CASE("the largest |dH/H0| includes the last state of a trajectory that diverged, between two samples") {
+  TemporaryFolder folder;
+  // Triplet 8/3 with 16 steps over the quarter period overflows after a few steps (the SDK passes the non-finite
+  // gradient on); without samples, H is evaluated at step 0 and at the last finite state only.
+  json job = paper1d_job(state(2.0, 0.0), {{"t_end", quarter_period}, {"dt", quarter_period / 16}},
+                         {{"scheme", "triplet"}, {"order", "8/3"}, {"t2", -2.0}});
+  job["output"] = {{"every", 0}};
+  const auto file = write_job(folder / "diverging.json", job);
+  const auto result = run_nonsep({"run", "--output", (folder / "diverging").string(), file.string()}, folder.path());
+  REQUIRE(result.status == 1);
+  const json summary = read_run(folder / "diverging");
+  const json& trajectory = summary["trajectories"][0];
+  REQUIRE(trajectory["status"] == "diverged");
+  REQUIRE(trajectory["final"]["step"].get<std::uint64_t>() >= 1);
+  const double final_error = std::abs(number(trajectory["energy"]["relative_error_final"]));
+  CHECK(final_error > 0.0);
+  CHECK(number(trajectory["energy"]["relative_error_max_abs"]) == final_error);
+  CHECK(number(summary["energy"]["largest_relative_error"]["value"]) == final_error);
+  CHECK((result.out + result.err)
+            .find("largest |dH/H0| " + nonsep::host::format_number(final_error) + " (trajectory 0)") !=
+        std::string::npos);
 }

@@ -19,7 +19,7 @@ namespace {
 // The names of the source tree's example job files, which the build tree's share/nonsep links to.
 std::set<std::string> source_examples() {
   std::set<std::string> names;
-  for (const char* folder : {"examples/jobs", "examples/paper"})
+  for (const char* folder : {"examples/jobs", "examples/paper", "examples/dynamics"})
     for (const auto& entry : fs::directory_iterator(fs::path(NONSEP_SOURCE_DIR) / folder))
       if (entry.path().extension() == ".json") names.insert(entry.path().stem().string());
   return names;

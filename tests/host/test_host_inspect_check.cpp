@@ -186,3 +186,36 @@ TEST_CASE("inspect --check too large for memory is invalid input with a clear me
   CHECK(err.find("unexpected error") == std::string::npos);
 #endif
 }
+
+TEST_CASE(
+    "a wrong gradient: run and validate refuse it at /model/plugin, and inspect --check names it as the culprit") {
+  TemporaryFolder folder;
+  // blowup_wrong_gradient: grad V = 2 q^3 where V = q^4 / 4; its Hessian 3 q^2 is right.
+  json job = {{"model", {{"plugin", "blowup_wrong_gradient"}}},
+              {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}}},
+              {"initial", json::array({{{"q", {1.0}}, {"p", {0.5}}}, {{"q", {0.5}}, {"p", {0.25}}}})},
+              {"time", {{"dt", 0.001}, {"steps", 10}}}};
+  const auto file = write_job(folder / "wrong.json", job);
+  for (const char* command : {"run", "validate"}) {
+    CAPTURE(command);
+    const auto result = run_nonsep({command, file.string()}, folder.path());
+    CHECK(result.status == 2);
+    CHECK(result.err.find("/model/plugin: found the plugin 'blowup_wrong_gradient', whose grad_V[0] at initial state 0 "
+                          "(q = (1.000000e+00)) is 2.000000e+00 where the finite difference of value_V gives "
+                          "1.000000e+00") != std::string::npos);
+    CHECK(result.err.find("--check --points-from " + file.string() + "` lists every mismatch") != std::string::npos);
+  }
+  CHECK_FALSE(std::filesystem::exists(folder / "wrong.out" / "summary.json"));  // nothing was run
+  job["model"]["plugin"] = "blowup";                                            // the right gradient: the same job runs
+  write_job(file, job);
+  CHECK(run_nonsep({"run", "--quiet", file.string()}, folder.path()).status == 0);
+
+  auto result = run_nonsep({"inspect", "blowup_wrong_gradient", "--check"}, folder.path());
+  CHECK(result.status == 1);
+  CHECK(result.out.find("  hessian_V[0] at q = (") != std::string::npos);  // differenced from the wrong gradient
+  CHECK(result.out.find("likely culprit: grad_V, which disagrees with the differences of value_V; hessian_V agrees "
+                        "with the second differences of value_V") != std::string::npos);
+  result = run_nonsep({"inspect", "blowup_wrong_hessian", "--check"}, folder.path());
+  CHECK(result.status == 1);
+  CHECK(result.out.find("likely culprit") == std::string::npos);  // its gradient is right: the Hessian is wrong
+}

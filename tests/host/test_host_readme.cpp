@@ -1,5 +1,5 @@
 // README.md's examples of the `nonsep` executable are what it does: the worked example (job, command line,
-// summary.json, rows) and the example of errors in a job file.
+// summary.json, rows), the example of errors in a job file, and the tables that list the schemes.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host_test_support.hpp"
+#include "nonsep/core/scheme_catalogue.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 using nlohmann::json;
@@ -140,5 +141,17 @@ TEST_CASE("README and --help: exit status 1 names every status with which a traj
     CAPTURE(name);
     CHECK(readme_row.find(name) != std::string::npos);
     CHECK(help_entry.find(name) != std::string::npos);
+  }
+}
+
+TEST_CASE("README: the job-key table and the schemes table name every scheme of the catalogue") {
+  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / "README.md");
+  const auto row = readme.find("\n| `integrator.scheme` | ");
+  REQUIRE(row != std::string::npos);
+  const std::string key_row = readme.substr(row + 1, readme.find('\n', row + 1) - row - 1);
+  for (const auto& scheme : nonsep::scheme_catalogue()) {
+    CAPTURE(scheme.name);
+    CHECK(key_row.find("`\"" + scheme.name + "\"`") != std::string::npos);
+    CHECK(readme.find("\n| `" + scheme.name + "` ") != std::string::npos);  // a row of the schemes table
   }
 }

@@ -93,6 +93,27 @@ TEST_CASE("fit_power_law recovers c dt^n, skips zero and non-finite errors, and 
   CHECK_FALSE(nonsep::host::fit_power_law(std::vector<double>{0.1, 0.1}, std::vector<double>{1e-3, 2e-3}));
 }
 
+TEST_CASE("round_off_floor_start: where the errors stop falling as the order says, below 1e-8, or below 5e-14") {
+  using nonsep::host::round_off_floor_start;
+  std::vector<double> dt, clean, floored;
+  for (int k = 0; k < 7; ++k) {
+    dt.push_back(0.1 / std::pow(2.0, k));
+    clean.push_back(-3e-3 * std::pow(dt.back() / 0.1, 4.0));  // 3e-3 down to 1.8e-10, slope 4 throughout
+    floored.push_back(-std::max(3e-3 * std::pow(dt.back() / 0.1, 4.0), 1e-9 * (k % 2 ? 1.3 : 1.0)));
+  }
+  CHECK(round_off_floor_start(dt, clean, 4.0) == dt.size());
+  // 3e-3 ... 2.9e-9 with slope 4, then the floor 1e-9 at k = 6 (1.8e-10 without it): the local slope from k = 5 to
+  // k = 6 is 1.5 < 4 / 2, so k = 5, only 2.9 times the floor, is left out too.
+  CHECK(round_off_floor_start(dt, floored, 4.0) == 5);
+  const std::vector<double> last_only{dt[0], dt[1], dt[2]}, errors{1e-9, 6.25e-11, 5e-11};
+  CHECK(round_off_floor_start(last_only, errors, 4.0) == 1);  // 6.25e-11 -> 5e-11: slope 0.3
+  floored[4] = 4e-14;                                         // below 5e-14: round-off whatever the slope
+  CHECK(round_off_floor_start(dt, floored, 4.0) == 4);
+  // Above 1e-8 a slow fall is the method's (pre-asymptotic), not round-off.
+  const std::vector<double> large{1e-2, 9e-3, 8e-3};
+  CHECK(round_off_floor_start(std::vector<double>{0.1, 0.05, 0.025}, large, 4.0) == 3);
+}
+
 TEST_CASE("a study's rows are the core's runs bit for bit, and its fit is the slope through them") {
   TemporaryFolder folder;
   const json integrators = {{{"scheme", "basic"}, {"t2", -2.0}},
@@ -210,10 +231,11 @@ TEST_CASE("closest_return is the minimum distance to the start over every step f
   CHECK_FALSE(read_run(folder / "plain")["trajectories"][0].contains("closest_return"));
 }
 
-TEST_CASE("the study's report: exponents to 4 significant digits, and a warning for a fit that reaches round-off") {
+TEST_CASE("the study's report: exponents to 4 significant digits, and the round-off floor left out with a warning") {
   TemporaryFolder folder;
-  // MPE 4 to 4096 steps reaches the round-off of paper1d (about 1e-11, of random sign); triplet 4/3 on these step
-  // counts stays in its asymptotic range (the control: no warning).
+  // MPE 4 to 4096 steps reaches the round-off of paper1d (about 1e-11, of random sign) from 512 steps on: those four
+  // runs are left out and the fit over 64 .. 256 steps finds the order; triplet 4/3 on these step counts stays in its
+  // asymptotic range (the control: no warning).
   json job =
       study_job({{{"scheme", "mpe"}, {"order", "4"}, {"t2", -2.5}, {"steps", {64, 128, 256, 512, 1024, 2048, 4096}}},
                  {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}, {"steps", {256, 512, 1024, 2048}}}},
@@ -227,18 +249,25 @@ TEST_CASE("the study's report: exponents to 4 significant digits, and a warning 
       result.out, std::regex(R"(  mpe 4: energy error exponent \d\.\d{3} \(nominal 4 = 4\.000\) \(see warning\)\n)")));
   CHECK(std::regex_search(result.out,
                           std::regex(R"(  triplet 4/3: energy error exponent 1\.\d{3} \(nominal 4/3 = 1\.333\)\n)")));
-  CHECK(result.err.find("nonsep: warning: mpe 4: the energy error reaches round-off") != std::string::npos);
-  CHECK(result.err.find("move its step range to larger dt (fewer steps)") != std::string::npos);
-  CHECK(result.err.find("nonsep: warning: mpe 4: the energy error changes sign") != std::string::npos);
-  CHECK(result.err.find("triplet 4/3: the energy") == std::string::npos);
+  CHECK(result.err.find("nonsep: warning: mpe 4: 4 runs at the round-off floor of the energy error (dt <= ") !=
+        std::string::npos);
+  CHECK(result.err.find("left out of the fit, which has 3 points; move its step range to larger dt (fewer steps)") !=
+        std::string::npos);
+  CHECK(result.err.find("mpe 4: the energy error changes sign") == std::string::npos);  // the floor's signs: left out
+  CHECK(result.err.find("triplet 4/3:") == std::string::npos);
   const json summary = read_json(folder / "out" / "summary.json");
-  CHECK(summary["fits"][0]["energy_error_excess_at_smallest_dt"].get<double>() > 10.0);
-  CHECK(summary["fits"][0]["energy_error_smallest"].get<double>() < 1e-11);
+  CHECK(summary["fits"][0]["n_points"] == 3);
+  CHECK(summary["fits"][0]["n_points_at_round_off"] == 4);
+  CHECK(summary["fits"][0]["steps_max"] == 256);
+  CHECK(std::abs(summary["fits"][0]["exponent"].get<double>() - 4.0) < 0.1);
+  CHECK(std::abs(summary["fits"][0]["energy_error_excess_at_smallest_dt"].get<double>() - 1.0) < 0.2);
+  CHECK(summary["fits"][1]["n_points_at_round_off"] == 0);
+  CHECK(summary["fits"][1]["round_off_dt_max"].is_null());
   CHECK(std::abs(summary["fits"][1]["energy_error_excess_at_smallest_dt"].get<double>() - 1.0) < 0.2);
 
   // --quiet keeps the warnings (on stderr) and drops the report.
   const auto quiet =
       run_nonsep({"run", "--quiet", "--force", "--output", (folder / "out").string(), file.string()}, folder.path());
   CHECK(quiet.out.empty());
-  CHECK(quiet.err.find("nonsep: warning: mpe 4: the energy error reaches round-off") != std::string::npos);
+  CHECK(quiet.err.find("nonsep: warning: mpe 4: 4 runs at the round-off floor") != std::string::npos);
 }

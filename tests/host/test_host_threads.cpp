@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "host_run_support.hpp"
+#include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host_testing;
@@ -16,8 +18,8 @@ TEST_CASE(
     "wall_seconds)") {
   TemporaryFolder folder;
   use_test_plugins();
-  // 600 trajectories: three blocks of run_block_size = 256. A diverging state in the first block and, in the
-  // second job, a failing state in the last block make blocks replay their chunk step by step.
+  // 600 trajectories: ten blocks of 64 (run_block_size_for), whatever the threads. A diverging state in the second
+  // block and, in the second job, a failing state in the ninth make blocks replay their chunk step by step.
   json diverging = json::array(), failing = json::array(), completing = json::array();
   for (int i = 0; i < 600; ++i) {
     const double q = 0.5 + 0.001 * i;
@@ -104,4 +106,45 @@ TEST_CASE(
     CHECK(chunked["trajectories"][i]["final"] == sampled["trajectories"][i]["final"]);
   }
   CHECK(chunked["trajectories"][1]["closest_return"] == sampled["trajectories"][1]["closest_return"]);
+}
+
+namespace {
+
+// Counts the blocks a driver steps (Observer::prepare_blocks) and the trajectories it retires.
+struct BlockCounter : nonsep::host::Observer {
+  std::size_t blocks = 0, retired = 0;
+  void prepare_blocks(std::size_t count) override { blocks = count; }
+  void on_retire(std::size_t, const nonsep::host::TrajectoryRecord&) override { ++retired; }
+};
+
+}  // namespace
+
+TEST_CASE("blocks are sized from the ensemble, so that 71 trajectories are blocks that two threads share out") {
+  using nonsep::host::run_block_size_for;
+  CHECK(run_block_size_for(71) == 8);  // 9 blocks
+  CHECK(run_block_size_for(600) == 64);
+  CHECK(run_block_size_for(2048) == 256);
+  CHECK(run_block_size_for(100000) == 256);
+  CHECK(run_block_size_for(3) == 2);
+  CHECK(run_block_size_for(1) == 2);
+  const auto plugin = nonsep::host::load_plugin(std::string(NONSEP_SHIPPED_PLUGIN_DIR) + "/paper1d.so", "");
+  const auto model = plugin.create(json::object());
+  std::vector<double> q(71), p(71, 0.25);
+  for (std::size_t i = 0; i < q.size(); ++i) q[i] = 0.5 + 0.01 * static_cast<double>(i);
+  for (const unsigned threads : {1u, 2u}) {
+    CAPTURE(threads);
+    nonsep::host::EnsembleSetup setup;
+    setup.integrator = triplet_43();
+    setup.time = nonsep::host::TimeGrid::of_steps(4, 0.01);
+    setup.dimension = 1;
+    setup.q = q;
+    setup.p = p;
+    setup.threads = threads;
+    nonsep::host::EnsembleDriver driver(plugin, model, setup);
+    BlockCounter counter;
+    driver.add_observer(counter);
+    CHECK(driver.run() == nonsep::host::DriverEnd::completed);
+    CHECK(counter.blocks == 9);
+    CHECK(counter.retired == 71);
+  }
 }

@@ -180,6 +180,16 @@ class DynamicsPlotTest(SharedRun):
             self.assertIn(label, ax.figure.axes[-1].get_ylabel())
             ax.figure.savefig(self.folder / f"chaos_map_{value}.png", dpi=60)
 
+    def test_a_chaos_map_without_samples_says_to_set_output_every(self):
+        job = paper2d_job(q_count=3, p_count=3, t_end=0.5, poincare=False)
+        job["output"] = {"every": 0}
+        result = nonsep.run(job, output="no_samples")
+        with self.assertRaisesRegex(FileNotFoundError, r"output.every = 0.*run the job with output.every > 0"):
+            nonsep.plot.chaos_map(result)
+        job["output"] = {"every": 100}  # the number of steps: step 0 and the last only
+        ax = nonsep.plot.chaos_map(nonsep.run(job, output="first_and_last"))
+        self.assertEqual(len(ax.images), 1)
+
     def test_without_a_section_there_is_no_poincare_plot(self):
         result = nonsep.run(paper2d_job(q_count=3, p_count=3, t_end=0.5, poincare=False), output="plain")
         self.assertIsNone(result.poincare)

@@ -1,7 +1,8 @@
 """The installed package runs the installed executable: `cmake --install` of the build ($NONSEP_BUILD_DIR, with
 $CMAKE_COMMAND) into a temporary prefix, then a fresh Python whose only nonsep is that prefix's: PYTHONPATH is
 <prefix>/lib/python3/dist-packages, NONSEP_EXECUTABLE and NONSEP_PLUGIN_PATH are unset, and PATH has no nonsep.
-The installed host finds the installed paper1d plugin by itself."""
+The installed host finds the installed paper1d plugin by itself; the installed package plots work-precision studies
+(nonsep.work_precision) and the dynamics examples are installed."""
 import json
 import os
 import shutil
@@ -43,6 +44,11 @@ class InstallTest(unittest.TestCase):
             self.assertEqual(found["executable"], str(prefix / "bin" / "nonsep"))
             self.assertEqual(ran, {"status": "completed", "steps": 20,
                                    "plugin": str(prefix / "lib" / "nonsep" / "plugins" / "paper1d.so")})
+            plotter = subprocess.run(["/usr/bin/python3", "-m", "nonsep.work_precision", "--help"], env=environment,
+                                     cwd=folder, capture_output=True, text=True)
+            self.assertEqual(plotter.returncode, 0, plotter.stderr)
+            self.assertIn("work_precision.csv", plotter.stdout)
+            self.assertTrue((prefix / "share" / "nonsep" / "examples" / "dynamics" / "chaos_map.json").exists())
 
 
 if __name__ == "__main__":

@@ -1,5 +1,9 @@
 """nonsep.plot: each function returns labelled axes whose lines hold exactly the loaded data, with a legend when
-there are several series; headless (Agg)."""
+there are several series; headless (Agg). `python3 -m nonsep.work_precision` on a study; the package's message when
+numpy is missing."""
+import os
+import subprocess
+import sys
 import unittest
 
 import matplotlib
@@ -78,6 +82,26 @@ class PlotTest(FolderTestCase):
         self.assertTrue(labels[0].startswith("basic: $") and f"{result.exponents['basic']:.3f}" in labels[0])
         with self.assertRaises(ValueError):
             nonsep.plot.convergence(nonsep.run(paper1d_job(state(1.0, 0.0), steps=3), output="run"))
+
+
+class WorkPrecisionTest(FolderTestCase):
+    def test_the_module_plots_a_studys_work_precision_csv(self):
+        job = {"model": {"plugin": "paper1d"}, "initial": state(2.0, 0.0), "time": {"t_end": 0.3863765573361232},
+               "study": {"reference": {"q": [0.0], "p": [-1.5723027555148466]},
+                         "integrators": [{"scheme": "triplet", "order": 2, "steps": [32, 64]},
+                                         {"scheme": "gauss", "stages": 2, "steps": [8, 16]}]}}
+        nonsep.run(job, output="study")
+        done = subprocess.run([sys.executable, "-m", "nonsep.work_precision", str(self.folder / "study"), "--out",
+                               str(self.folder / "wp.png")], capture_output=True, text=True, env=os.environ)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertGreater((self.folder / "wp.png").stat().st_size, 1000)
+
+    def test_without_numpy_the_package_names_the_interpreter_to_use(self):
+        done = subprocess.run([sys.executable, "-c", "import sys; sys.modules['numpy'] = None; import nonsep"],
+                              capture_output=True, text=True, env=os.environ)
+        self.assertNotEqual(done.returncode, 0)
+        self.assertIn(f"nonsep needs numpy, which this Python ({sys.executable}) cannot import", done.stderr)
+        self.assertIn("run /usr/bin/python3", done.stderr)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 // `nonsep example [NAME] [--output FILE] [--list]`: a starting job file. The examples are the job files of
-// share/nonsep/examples/{jobs,paper} beside the executable (installation.hpp); the quickstart job is also compiled
-// in (examples/jobs/quickstart.json, embedded_examples.cpp), so it is there even when the executable was copied
-// alone. The written file is the example's text unchanged but for "$schema", which is made to point at the
+// share/nonsep/examples/{jobs,paper,dynamics} beside the executable (installation.hpp); the quickstart job is also
+// compiled in (examples/jobs/quickstart.json, embedded_examples.cpp), so it is there even when the executable was
+// copied alone. The written file is the example's text unchanged but for "$schema", which is made to point at the
 // schema of this installation (the examples' own value is relative to their folder).
 #include <fcntl.h>
 #include <unistd.h>
@@ -31,12 +31,12 @@ namespace {
 
 constexpr const char* default_example = "quickstart";
 
-// Name -> file, over share/nonsep/examples/jobs then examples/paper (the first of a name wins).
+// Name -> file, over share/nonsep/examples/jobs, examples/paper, then examples/dynamics (the first of a name wins).
 std::map<std::string, fs::path> installed_examples() {
   std::map<std::string, fs::path> examples;
   const auto data = data_directory();
   if (!data) return examples;
-  for (const char* folder : {"jobs", "paper"}) {
+  for (const char* folder : {"jobs", "paper", "dynamics"}) {
     std::error_code error;
     for (fs::directory_iterator entry(*data / "examples" / folder, error), end; !error && entry != end;
          entry.increment(error))

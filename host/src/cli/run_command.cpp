@@ -116,13 +116,10 @@ class OnlyRankZeroSpeaks {
   std::streambuf* err_ = nullptr;
 };
 
-// Below this |relative energy error| a study's errors are at the round-off of double precision (about 500 units
-// of 1.1e-16: H is a sum of products, and its error accumulates over the steps).
-constexpr double round_off_energy_error = 5e-14;
 // Round-off also shows as errors at the smallest dt this many times above the nominal power law through the
-// largest dt (StudyFit::energy_error_excess_at_smallest_dt), when they are small enough to be round-off at all.
+// largest dt (StudyFit::energy_error_excess_at_smallest_dt), when they are small enough to be round-off at all
+// (round_off_at_most, study.hpp).
 constexpr double flattened_excess = 10.0;
-constexpr double round_off_at_most = 1e-8;
 
 std::string four_digits(double x) {
   char text[32];
@@ -130,10 +127,18 @@ std::string four_digits(double x) {
   return text;
 }
 
-// What makes a study's fit unreliable, with what to do: an energy error that changes sign in the range, one that
-// reaches round-off or flattens at the smallest dt. One sentence each; none for a clean fit.
+// What makes a study's fit unreliable, with what to do: runs left out at the round-off floor, an energy error that
+// changes sign in the range, one that reaches round-off or flattens at the smallest dt. One sentence each; none for
+// a clean fit.
 std::vector<std::string> fit_warnings(const StudyFit& fit) {
   std::vector<std::string> warnings;
+  if (fit.points_at_round_off > 0)
+    warnings.push_back(fit.integrator + ": " + std::to_string(fit.points_at_round_off) +
+                       (fit.points_at_round_off == 1 ? " run" : " runs") +
+                       " at the round-off floor of the energy error (dt <= " + four_digits(*fit.round_off_dt_max) +
+                       ", |dH/H0| down to " + four_digits(*fit.round_off_error_smallest) +
+                       ") left out of the fit, which has " + std::to_string(fit.points) +
+                       " points; move its step range to larger dt (fewer steps) to fit on all of them");
   const auto& smallest = fit.energy_error_smallest;
   const auto& excess = fit.energy_error_excess_at_smallest_dt;
   std::string round_off;
@@ -231,7 +236,8 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
     std::cerr << "nonsep: warning: the relative energy error |dH/H0| reached " << format_number(largest->value)
               << " (trajectory " << largest->trajectory << "), above " << format_number(warn_relative_energy_error)
               << ": the results are not accurate; use a smaller dt or a higher order "
-                 "(analysis.max_relative_energy_error stops trajectories past a bound)\n";
+                 "(analysis.max_relative_energy_error stops trajectories past a bound), or, if it does not shrink "
+                 "with dt, check the plugin's derivatives with `nonsep inspect PLUGIN --check`\n";
 }
 
 // Runs `run` (run_job or run_study) with SIGINT and SIGTERM caught. Nothing, after saying why on stderr, when it

@@ -14,8 +14,9 @@ std::string exit_status_text() {
          "  1    the run started but failed: a trajectory diverged, the plugin failed mid-run, or a trajectory\n"
          "       was retired as inaccurate (its |dH/H0| passed analysis.max_relative_energy_error; summary.json\n"
          "       says which and where); an output could not be written; `inspect --check` found wrong derivatives\n"
-         "  2    invalid input, nothing was run: usage, job file, parameters, a plugin that cannot be loaded,\n"
-         "       an output folder that cannot be created\n"
+         "  2    invalid input, nothing was run: usage, job file, parameters, a plugin that cannot be loaded\n"
+         "       or whose gradients disagree with its values at the initial states, an output folder that\n"
+         "       cannot be created\n"
          "  130  interrupted (SIGINT): the current step was finished, outputs written with status \"interrupted\",\n"
          "       and a checkpoint: `nonsep run JOB --resume` continues the run\n"
          "  143  terminated (SIGTERM, or SIGUSR1 as mpirun passes it on): the same as 130\n";

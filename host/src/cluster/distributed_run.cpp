@@ -278,6 +278,7 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
         unit_options.work_unit = true;
         unit_options.resume = state == UnitState::checkpointed;
         unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over
+        unit_options.whole_ensemble = loaded.job.initial.count;
         const LoadedJob job = unit_job(loaded, plan.first(unit), plan.size(unit));
         const RunOutcome outcome = run_job(job, unit_options);
         if (outcome.exit_status == ExitStatus::interrupted)

@@ -111,6 +111,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
                       "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians and no "
                       "Hessian-vector products (hvp_T, hvp_V)"});
   if (issues.size() == before) place_on_energy_shell(loaded, issues);
+  if (issues.size() == before) check_gradients_at_initial_states(loaded, issues);
   if (!checked.is_study())
     if (const Analysis& analysis = checked.run().analysis;
         analysis.tangent_vectors() > 0 && !loaded.plugin.has_hessians())

@@ -2,6 +2,8 @@
 // turned into counts by step_count), and the optional exact reference state at t_end.
 #include <algorithm>
 
+#include "nonsep/core/error.hpp"
+#include "nonsep/core/integrator.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -80,8 +82,17 @@ std::optional<std::vector<std::uint64_t>> read_steps_or_dt(Checker& check, const
   return read_step_list(check, object[key], child(path, key), key, t_end);
 }
 
+// The label of an integrator without "label": the scheme alone for basic (it has one order), else the scheme and
+// the order of what the catalogue's factory builds from the spec, as summary.json reports it ("gauss 6" for 3
+// stages, "implicit_midpoint 2"); the spec's order when the factory refuses the spec (the reader reports why).
 std::string default_label(const IntegratorSpec& spec) {
-  return spec.scheme == "basic" ? spec.scheme : spec.scheme + " " + spec.order.to_string();
+  if (spec.scheme == "basic") return spec.scheme;
+  Fraction order = spec.order;
+  try {
+    order = Integrator(spec).describe().order;
+  } catch (const InvalidArgument&) {
+  }
+  return spec.scheme + " " + order.to_string();
 }
 
 }  // namespace

@@ -16,20 +16,31 @@ std::uint64_t EnergyErrorObserver::next_event(std::uint64_t step) const {
   return energy_every_ > 0 ? (step / energy_every_ + 1) * energy_every_ : no_event;
 }
 
+std::optional<double> EnergyErrorObserver::include(std::size_t trajectory, std::optional<double> energy,
+                                                   std::optional<double> energy_initial) {
+  const auto error = relative_energy_error(energy, energy_initial);
+  if (!error) return std::nullopt;
+  auto& max = max_abs_[trajectory];
+  max = std::max(max.value_or(0.0), std::abs(*error));
+  return error;
+}
+
 void EnergyErrorObserver::on_event(const Event& event) {
   if (!event.energy_evaluated) return;
   for (const StateView& state : event.states) {
     if (!state.energy) continue;
-    const auto error = relative_energy_error(state.energy, state.record->energy_initial);
+    const auto error = include(state.trajectory, state.energy, state.record->energy_initial);
     if (!error) continue;
-    auto& max = max_abs_[state.trajectory];
-    max = std::max(max.value_or(0.0), std::abs(*error));
     if (bound_ && !(std::abs(*error) <= *bound_))
       event.retire->push_back({state.trajectory, TrajectoryStatus::inaccurate,
                                "the relative energy error " + format_number(*error) + " at step " +
                                    std::to_string(event.step) +
                                    " exceeds analysis.max_relative_energy_error = " + format_number(*bound_)});
   }
+}
+
+void EnergyErrorObserver::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
+  include(trajectory, record.energy_final, record.energy_initial);
 }
 
 std::optional<LargestEnergyError> EnergyErrorObserver::largest() const {

@@ -24,6 +24,7 @@ struct EnsembleDriver::Impl {
   bool energy_available;
   std::vector<TrajectoryRecord> records;
   std::vector<Block> blocks;
+  std::size_t block_size = run_block_size;  // trajectories per block (the last may have fewer)
   std::vector<Worker> workers;
   std::vector<Observer*> observers;
   std::vector<Observer*> step_watchers;
@@ -37,8 +38,13 @@ struct EnsembleDriver::Impl {
   Impl(const Plugin& p, const PluginModel& model, EnsembleSetup s)
       : plugin(p), setup(std::move(s)), energy_available(p.has_hessians()), records(setup.q.size() / setup.dimension) {
     const std::size_t n = setup.dimension, count = records.size();
-    for (std::size_t first = 0; first < count; first += run_block_size) {
-      const std::size_t size = std::min(run_block_size, count - first);
+    // A plugin that is not thread-safe ("thread_safe": false, plugin_abi.h) gets one instance on one thread.
+    const unsigned requested = !plugin.thread_safe() ? 1u
+                               : setup.threads > 0   ? setup.threads
+                                                     : static_cast<unsigned>(omp_get_max_threads());
+    block_size = setup.block_size > 0 ? setup.block_size : run_block_size_for(count);
+    for (std::size_t first = 0; first < count; first += block_size) {
+      const std::size_t size = std::min(block_size, count - first);
       std::vector<std::size_t> members(size);
       std::iota(members.begin(), members.end(), first);
       blocks.emplace_back(setup.integrator, n, members, setup.q.subspan(first * n, size * n),
@@ -48,10 +54,6 @@ struct EnsembleDriver::Impl {
         blocks.back().tangents->start();
       }
     }
-    // A plugin that is not thread-safe ("thread_safe": false, plugin_abi.h) gets one instance on one thread.
-    const unsigned requested = !plugin.thread_safe() ? 1u
-                               : setup.threads > 0   ? setup.threads
-                                                     : static_cast<unsigned>(omp_get_max_threads());
     const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(requested, blocks.size()));
     workers.push_back(Worker{model, EnergyEvaluator(setup.integrator.form)});
     for (std::size_t t = 1; t < threads; ++t)
@@ -215,6 +217,12 @@ struct EnsembleDriver::Impl {
   }
 };
 
+std::size_t run_block_size_for(std::size_t trajectories) {
+  std::size_t size = run_block_size;
+  while (size > 2 && (trajectories + size - 1) / size < run_min_blocks) size /= 2;
+  return size;
+}
+
 EnsembleDriver::EnsembleDriver(const Plugin& plugin, const PluginModel& model, EnsembleSetup setup)
     : impl_(std::make_unique<Impl>(plugin, model, std::move(setup))) {}
 EnsembleDriver::~EnsembleDriver() = default;
@@ -261,7 +269,7 @@ void EnsembleDriver::restore(DriverState state) {
   Impl& d = *impl_;
   const std::size_t n = d.setup.dimension;
   std::vector<std::vector<std::size_t>> members(d.blocks.size());
-  for (std::size_t k = 0; k < state.active.size(); ++k) members[state.active[k] / run_block_size].push_back(k);
+  for (std::size_t k = 0; k < state.active.size(); ++k) members[state.active[k] / d.block_size].push_back(k);
   for (std::size_t b = 0; b < d.blocks.size(); ++b) {
     std::vector<std::size_t> trajectories;
     std::vector<double> q, p, energies;

@@ -107,7 +107,8 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   EnsembleDriver driver(loaded.plugin, loaded.model,
                         {run.integrator, run.time, job.initial.dimension, job.initial.q, job.initial.p, options.threads,
                          options.stop_requested, run.analysis.tangent_vectors(),
-                         run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1});
+                         run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1,
+                         run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count)});
   const std::size_t count = job.initial.count;
   EnergyErrorObserver energy(count, driver.energy_available() ? run.energy_every : 0,
                              run.analysis.max_relative_energy_error);

@@ -13,9 +13,10 @@
 // (n+1)-th call on (0: never). Parameter sleep_ms: every call of grad V sleeps that long first (a very slow model,
 // to test that the host stays interruptible). Parameters crash_after and crash_how: from its (n+1)-th call on
 // (0: never), grad V crashes the process as a faulty plugin would: crash_how 0 abort() (SIGABRT), 1 SIGSEGV,
-// 2 exit(3) (the plugin's own exit status). Built three times: "blowup" (all functions), "blowup_gradients_only"
-// (no values, no Hessians: no energy) and "blowup_wrong_hessian" (Hess V = diag(2 q_i^2), wrong on purpose, for the
-// derivative check).
+// 2 exit(3) (the plugin's own exit status). Built four times: "blowup" (all functions), "blowup_gradients_only"
+// (no values, no Hessians: no energy), "blowup_wrong_hessian" (Hess V = diag(2 q_i^2), wrong on purpose, for the
+// derivative check) and "blowup_wrong_gradient" (grad V = 2 q^3, wrong on purpose while V and Hess V are right: the
+// run's gradient check refuses it, and the derivative check names grad V as the culprit of Hess V's mismatches).
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -34,8 +35,8 @@
 #ifndef BLOWUP_NAME
 #error "BLOWUP_NAME must be defined"
 #endif
-#if !defined(BLOWUP_WITH_HESSIANS) || !defined(BLOWUP_WRONG_HESSIAN)
-#error "BLOWUP_WITH_HESSIANS and BLOWUP_WRONG_HESSIAN must be defined (0 or 1)"
+#if !defined(BLOWUP_WITH_HESSIANS) || !defined(BLOWUP_WRONG_HESSIAN) || !defined(BLOWUP_WRONG_GRADIENT)
+#error "BLOWUP_WITH_HESSIANS, BLOWUP_WRONG_HESSIAN and BLOWUP_WRONG_GRADIENT must be defined (0 or 1)"
 #endif
 
 struct nonsep_instance {
@@ -165,7 +166,7 @@ nonsep_status grad_V(nonsep_instance* instance, const double* q, double* out, st
       instance->last_error = "q = " + std::to_string(q[i]) + " is beyond fail_single_above (one state)";
       return NONSEP_EVALUATION_FAILED;
     }
-    out[i] = q[i] * q[i] * q[i];
+    out[i] = (BLOWUP_WRONG_GRADIENT ? 2.0 : 1.0) * q[i] * q[i] * q[i];
   }
   return NONSEP_OK;
 }

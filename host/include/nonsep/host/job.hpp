@@ -217,6 +217,13 @@ struct LoadedJob {
 // Adds an issue at /initial/energy when the plugin has no Hessians, or no state of the grid reaches the shell.
 void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues);
 
+// Checks the plugin's grad T and grad V against finite differences of its value_T and value_V at up to 16 of the
+// job's initial states (evenly spread), on an instance of its own, when the plugin has values and a dimension of at
+// most 512. The first disagreement beyond 1e-4 relative to max(1, |finite difference|) is an issue at
+// /model/plugin naming the function, the state and both numbers, and `nonsep inspect PLUGIN --check`. States where
+// the plugin fails or a number is not finite are left to the run.
+void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobIssue>& issues);
+
 // Passes 1 and 2 on the file at `job_file`. Nothing when the file cannot be read (missing, a directory, larger than
 // max_job_file_bytes: an issue at "") or is not strict JSON; otherwise the Job, meaningful only if no issue was added.
 std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<JobIssue>& issues);

@@ -38,6 +38,18 @@ struct PowerLawFit {
 // such pairs or when all their dt are equal. `dt` and `error` have the same length.
 std::optional<PowerLawFit> fit_power_law(std::span<const double> dt, std::span<const double> error);
 
+// Round-off in a study's relative energy errors (double precision; H is a sum of products and its error
+// accumulates over the steps): below round_off_energy_error an error is round-off alone; below round_off_at_most
+// it is round-off where it falls more slowly than half the nominal order predicts.
+inline constexpr double round_off_energy_error = 5e-14;
+inline constexpr double round_off_at_most = 1e-8;
+
+// Where the round-off floor starts in errors ordered by decreasing |dt| (a study's runs in increasing step order):
+// the first usable error (finite, non-zero) below round_off_energy_error, or below round_off_at_most with a local
+// slope d log|error| / d log|dt| under order / 2 from the previous usable one or to the next (it fell too little,
+// or the next one does). That point and every later one are at the floor. Returns dt.size() when there is none.
+std::size_t round_off_floor_start(std::span<const double> dt, std::span<const double> error, double order);
+
 // One run of a study: one integrator at one step count.
 struct StudyRun {
   std::uint64_t steps = 0;
@@ -51,20 +63,25 @@ struct StudyRun {
   int repeats = 0;            // how many runs the median is over
 };
 
-// The fits of one integrator over its completed runs (summary.json "fits"). Values that cannot be fitted (fewer
-// than two usable points) are empty; the phase fit exists only with /study/reference.
+// The fits of one integrator over its completed runs above the round-off floor (round_off_floor_start: those at
+// it are left out and counted) (summary.json "fits"). Values that cannot be fitted (fewer than two usable points)
+// are empty; the phase fit, over the same runs, exists only with /study/reference.
 struct StudyFit {
   std::string integrator;             // the label
   IntegratorDescription description;  // scheme, order (the nominal exponent), t2, symplectic
   std::string steps_from;
-  std::size_t points = 0;  // runs with a finite, non-zero energy error
+  std::size_t points = 0;  // runs fitted: with a finite, non-zero energy error above the round-off floor
+  // The completed runs left out at the round-off floor: how many, the largest |dt| among them and their smallest
+  // |energy error|.
+  std::size_t points_at_round_off = 0;
+  std::optional<double> round_off_dt_max, round_off_error_smallest;
   std::optional<double> exponent, constant, constant_at_nominal_exponent;
   bool energy_error_changes_sign = false;
   // Where round-off shows: the smallest |energy error| fitted, and how many times the |error| at the smallest dt
   // exceeds the nominal power law through the largest dt (about 1 in the asymptotic range; round-off, which
   // flattens the errors, makes it large).
   std::optional<double> energy_error_smallest, energy_error_excess_at_smallest_dt;
-  std::optional<double> dt_min, dt_max;  // by |dt|, over the completed runs
+  std::optional<double> dt_min, dt_max;  // by |dt|, over the runs fitted
   std::optional<std::uint64_t> steps_min, steps_max;
   bool with_reference = false;
   std::optional<double> phase_exponent, phase_constant;

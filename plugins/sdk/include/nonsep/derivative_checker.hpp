@@ -26,6 +26,12 @@
 // options.tolerance * max(1, |finite difference|). A NaN derivative where the finite difference is NaN too (a
 // point outside the model's domain, such as log(q) at q < 0) agrees: it is counted in report.not_a_number, not
 // as a mismatch. Evaluation failures of the model propagate (ModelError).
+//
+// Culprits. A Hessian is differenced from the gradient, so a wrong gradient also makes a right Hessian disagree.
+// Where a point's gradient disagrees with the values and its Hessian with the gradient, the Hessian's diagonal is
+// also compared with second differences of the values, [-f(x-2h) + 16 f(x-h) - 30 f(x) + 16 f(x+h) - f(x+2h)] /
+// (12 h^2), within max(tolerance, 1e-5) (second differences lose more digits): when it agrees, the gradient is
+// named as the likely culprit (report.culprits), once per function.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -67,7 +73,8 @@ struct DerivativeCheckReport {
   double largest_error = 0.0;    // max |computed - finite difference| / max(1, |finite difference|)
   std::size_t not_a_number = 0;  // comparisons (included in `comparisons`) where both were NaN: agreement
   std::vector<DerivativeMismatch> mismatches;
-  std::vector<std::string> skipped;  // checks not made, with the reason
+  std::vector<std::string> skipped;   // checks not made, with the reason
+  std::vector<std::string> culprits;  // e.g. "grad_V": a wrong gradient that a Hessian's mismatches come from
 
   bool passed() const { return mismatches.empty(); }
   // Several lines: counts, the largest error, then up to `shown` mismatches and the skipped checks. Numbers in
@@ -91,6 +98,12 @@ struct DerivativeCheckReport {
               "\n";
     }
     if (mismatches.size() > shown) text += "  ... and " + std::to_string(mismatches.size() - shown) + " more\n";
+    for (const auto& gradient : culprits) {
+      const std::string kind = gradient.substr(gradient.size() - 1);
+      text += "  likely culprit: " + gradient + ", which disagrees with the differences of value_" + kind +
+              "; hessian_" + kind + " agrees with the second differences of value_" + kind +
+              " and disagrees only with those of the wrong " + gradient + ": fix " + gradient + " first\n";
+    }
     for (const auto& s : skipped) text += "  skipped: " + s + "\n";
     return text;
   }
@@ -161,6 +174,15 @@ inline double five_point(const double* f, std::size_t stride, double h) {
   return (f[0] - 8.0 * f[stride] + 8.0 * f[2 * stride] - f[3 * stride]) / (12.0 * h);
 }
 
+// The second derivative from f at x - 2h, x - h, x + h, x + 2h (f[0..3]) and at x (center).
+inline double five_point_second(const double* f, double center, double h) {
+  return (-f[0] + 16.0 * f[1] - 30.0 * center + 16.0 * f[2] - f[3]) / (12.0 * h * h);
+}
+
+inline bool agrees(double computed, double difference, double tolerance) {
+  return std::abs(computed - difference) <= tolerance * std::max(1.0, std::abs(difference));
+}
+
 inline void compare(DerivativeCheckReport& report, const DerivativeCheckOptions& options, const char* function,
                     const std::vector<double>& point, std::size_t component, double computed, double difference) {
   ++report.comparisons;
@@ -207,6 +229,10 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
   std::vector<double> direction(n), third(n), stencil_hessians, quadratic_forms;
 
   std::vector<double> steps, gradient(n), hessian(n * n), stencil_values, stencil_gradients;
+  const auto name_culprit = [&report](const char* gradient_name) {
+    if (std::find(report.culprits.begin(), report.culprits.end(), gradient_name) == report.culprits.end())
+      report.culprits.push_back(gradient_name);
+  };
   for (const auto& x : points) {
     if (x.size() != n) {
       report.skipped.push_back("a sample point with " + std::to_string(x.size()) + " numbers for dimension " +
@@ -217,8 +243,10 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
     const std::size_t count = 4 * n;
     for (const bool kinetic : {true, false}) {
       if (kinetic ? !options.check_kinetic : !options.check_potential) continue;
+      std::size_t gradient_mismatches = 0;
       if constexpr (has_values) {
         if (options.check_gradients) {
+          const std::size_t before = report.mismatches.size();
           stencil_values.resize(count);
           if (kinetic) {
             model.grad_T(x, gradient, 1);
@@ -230,6 +258,7 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
           for (std::size_t i = 0; i < n; ++i)
             detail::compare(report, options, kinetic ? "grad_T" : "grad_V", x, i, gradient[i],
                             detail::five_point(stencil_values.data() + 4 * i, 1, steps[i]));
+          gradient_mismatches = report.mismatches.size() - before;
         }
       }
       if constexpr (has_hessians) {
@@ -243,10 +272,28 @@ DerivativeCheckReport check_derivatives(const M& model, const DerivativeCheckOpt
             model.grad_V(shifted, stencil_gradients, count);
           }
           // Column j of the Hessian is the derivative of the gradient along e_j (stencil block j).
+          const std::size_t before = report.mismatches.size();
           for (std::size_t j = 0; j < n; ++j)
             for (std::size_t i = 0; i < n; ++i)
               detail::compare(report, options, kinetic ? "hessian_T" : "hessian_V", x, i * n + j, hessian[i * n + j],
                               detail::five_point(stencil_gradients.data() + 4 * j * n + i, n, steps[j]));
+          if constexpr (has_values) {
+            if (gradient_mismatches > 0 && report.mismatches.size() > before) {
+              double center = 0.0;
+              if (kinetic)
+                model.value_T(x, std::span<double>(&center, 1), 1);
+              else
+                model.value_V(x, std::span<double>(&center, 1), 1);
+              bool diagonal_agrees = true;
+              for (std::size_t i = 0; i < n; ++i)
+                diagonal_agrees =
+                    diagonal_agrees &&
+                    detail::agrees(hessian[i * n + i],
+                                   detail::five_point_second(stencil_values.data() + 4 * i, center, steps[i]),
+                                   std::max(options.tolerance, 1e-5));
+              if (diagonal_agrees) name_culprit(kinetic ? "grad_T" : "grad_V");
+            }
+          }
         }
       }
       if constexpr (has_third && has_hessians) {

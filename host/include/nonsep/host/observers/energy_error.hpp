@@ -1,6 +1,8 @@
 #pragma once
 // The relative energy error |H - H0| / |H0| of every trajectory, over the steps where H is evaluated: step 0, every
-// written sample (output.every), every output.energy_every-th step, and the last step. Optionally bounded
+// written sample (output.every), every output.energy_every-th step, the last step, and the final state of every
+// trajectory (where it stopped early: its last state before a divergence, at its last Poincare crossing, ...; the
+// driver evaluates H there and on_retire takes it into the maximum). Optionally bounded
 // (analysis.max_relative_energy_error): a trajectory whose error exceeds the bound there retires as "inaccurate".
 // trajectories.csv: max_abs_relative_energy_error (empty when H0 is unknown or 0).
 #include <cstddef>
@@ -26,6 +28,7 @@ class EnergyErrorObserver : public Observer {
   std::uint64_t next_event(std::uint64_t step) const override;
   bool needs_energy(std::uint64_t step) const override { return energy_every_ > 0 && step % energy_every_ == 0; }
   void on_event(const Event& event) override;
+  void on_retire(std::size_t trajectory, const TrajectoryRecord& record) override;
 
   std::string name() const override { return "energy_error"; }
   nlohmann::json save() override;
@@ -43,6 +46,10 @@ class EnergyErrorObserver : public Observer {
   std::uint64_t energy_every_;
   std::optional<double> bound_;
   std::vector<std::optional<double>> max_abs_;
+
+  // Takes (H - H0) / H0 of `trajectory` into its maximum and returns it (nothing when unknown).
+  std::optional<double> include(std::size_t trajectory, std::optional<double> energy,
+                                std::optional<double> energy_initial);
 };
 
 }  // namespace nonsep::host

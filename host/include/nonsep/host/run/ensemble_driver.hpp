@@ -2,11 +2,13 @@
 // The ensemble driver: advances every trajectory of a run from step 0 (or a checkpoint) to the last step, and
 // nothing else. No I/O: everything a run writes or tracks is an observer (observer.hpp).
 //
-// Blocks and threads. The trajectories are split into fixed blocks of `run_block_size` consecutive trajectories,
-// whatever the number of threads; each block is one nonsep::PhaseSpaceBatch with its own Integrator (one plugin
-// call per stage for the whole block). Blocks run on `threads` OpenMP threads, each thread with its own plugin
-// instance (the ABI's contract). The plugin evaluates every state on its own and the blocks do not depend on the
-// thread count, so every number, and every observer's output, is the same for any number of threads.
+// Blocks and threads. The trajectories are split into blocks of consecutive trajectories, sized from the ensemble
+// (run_block_size_for: at most run_block_size, and at least run_min_blocks blocks when the ensemble allows, so that
+// up to that many threads all have work), whatever the number of threads; each block is one nonsep::PhaseSpaceBatch
+// with its own Integrator (one plugin call per stage for the whole block). Blocks run on `threads` worker threads,
+// each thread with its own plugin instance (the ABI's contract). The plugin evaluates every state on its own, and the
+// blocks do not depend on the thread count (the evaluation counts do depend on the blocks when trajectories stop
+// early), so every number, and every observer's output, is the same for any number of threads.
 //
 // Chunks. From one event (an observer's next_event, the end; at most `run_chunk_state_steps` state-steps) to the
 // next, each block advances without per-step checks. When a block's chunk ends with a non-finite number or the
@@ -44,8 +46,16 @@
 
 namespace nonsep::host {
 
-inline constexpr std::size_t run_block_size = 256;               // trajectories per block
+inline constexpr std::size_t run_block_size = 256;               // the most trajectories per block
+inline constexpr std::size_t run_min_blocks = 8;                 // the fewest blocks, when there are enough states
 inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chunk: state-steps of all active states
+
+// Trajectories per block for an ensemble of `trajectories`: the largest power of two from 2 up to run_block_size
+// that still cuts it into at least run_min_blocks blocks (2 for fewer states: states stepped together stay in one
+// plugin call, as plugins that tell batches from single states expect): 71 trajectories are 9 blocks of 8,
+// 600 are 10 of 64, 2048 and more are blocks of 256. A power of two divides run_block_size, so the work units of a
+// distributed run (multiples of run_block_size) cut no block.
+std::size_t run_block_size_for(std::size_t trajectories);
 
 // What the driver integrates.
 struct EnsembleSetup {
@@ -59,6 +69,9 @@ struct EnsembleSetup {
   // must then have Hessians. The states are stepped bit for bit as without them.
   std::size_t tangent_vectors = 0;
   std::uint64_t renormalize_every = 1;
+  // Trajectories per block: run_block_size_for of the whole ensemble, which a distributed run's work unit is part of
+  // (its blocks are then those of the whole run); 0: run_block_size_for of these states.
+  std::size_t block_size = 0;
 };
 
 // The driver's state between two steps, for checkpoints.

@@ -42,6 +42,9 @@ struct RunOptions {
   bool force = false;      // start over in a folder holding another job's results or a checkpoint (run_folder.hpp)
   unsigned threads = 0;    // worker threads; 0: all cores
   bool work_unit = false;  // a distributed run's unit (its folder's kind is "unit": run_folder.hpp)
+  // A distributed run's work unit: the size of the whole ensemble it is part of, whose blocks (run_block_size_for)
+  // the unit keeps, so that it counts evaluations as one process does. 0: the job's states are the whole.
+  std::size_t whole_ensemble = 0;
 };
 
 // How many trajectories ended with each status.

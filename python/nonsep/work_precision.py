@@ -1,7 +1,6 @@
-#!/usr/bin/env python3
-"""Plots the work_precision.csv of a nonsep study (README, "Work-precision studies").
+"""Plots the work_precision.csv of a nonsep study (README, "Work-precision studies"); installed with the package.
 
-Usage: /usr/bin/python3 scripts/plot_work_precision.py STUDY_DIR --out FILE.png [--title TEXT]
+Usage: /usr/bin/python3 -m nonsep.work_precision STUDY_DIR --out FILE.png [--title TEXT]
            [--peers PEERS_CSV --problem NAME] [--error phase|energy] [--dpi N]
 
 Two panels: the error at t_end against the median wall time, and against the evaluations (grad_T + grad_V +
@@ -91,11 +90,11 @@ def main():
     curves = study_curves(os.path.join(args.study_dir, "work_precision.csv"), column)
     if args.peers:
         if not args.problem:
-            sys.exit("plot_work_precision.py: --peers needs --problem (paper1d, tao_product, ...)")
+            sys.exit("nonsep.work_precision: --peers needs --problem (paper1d, tao_product, ...)")
         peer_column = "phase_error" if args.error == "phase" else "energy_error"
         curves.update(peer_curves(args.peers, args.problem, peer_column))
     if not curves:
-        sys.exit("plot_work_precision.py: no completed run with a finite non-zero " + column)
+        sys.exit("nonsep.work_precision: no completed run with a finite non-zero " + column)
     figure, axes = plt.subplots(1, 2, figsize=(12, 5))
     colors = plt.get_cmap("tab20").colors
     for index_curve, (label, (family, points)) in enumerate(sorted(curves.items())):

@@ -1,0 +1,84 @@
+// The check of a plugin's gradients at a job's initial states (load_model, so `nonsep run` and `nonsep validate`):
+// grad T and grad V against 5-point finite differences of value_T and value_V (the SDK's derivative checker,
+// nonsep/derivative_checker.hpp), at up to gradient_check_states states spread evenly over the ensemble, on an
+// instance of the plugin of its own (the run's instance, and any call counts it keeps, are left alone).
+#include <cmath>
+#include <exception>
+
+#include "checker.hpp"
+#include "nonsep/derivative_checker.hpp"
+
+namespace nonsep::host {
+
+namespace {
+
+constexpr std::size_t gradient_check_states = 16;
+// The largest dimension checked: each state's stencil holds 4n points of n numbers.
+constexpr std::size_t gradient_check_largest_dimension = 512;
+// Looser than `inspect --check`'s 1e-6: a smooth model's gradients agree with the differences to about 1e-10, a
+// wrong one differs by far more; what lies between is left to `inspect --check`.
+constexpr double gradient_check_tolerance = 1e-4;
+
+std::string vector_text(const std::vector<double>& x) {
+  std::string text;
+  for (double value : x) text += (text.empty() ? "" : ", ") + DerivativeCheckReport::scientific(value, 6);
+  return "(" + text + ")";
+}
+
+}  // namespace
+
+void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobIssue>& issues) {
+  const InitialStates& initial = loaded.job.initial;
+  const std::size_t n = loaded.model.dimension();
+  if (!loaded.plugin.has_values() || n == 0 || n > gradient_check_largest_dimension || initial.count == 0 ||
+      initial.q.size() != initial.count * n)
+    return;
+  std::optional<PluginModel> own;
+  try {
+    own.emplace(loaded.plugin.create(loaded.job.parameters));
+  } catch (const std::exception&) {
+    return;  // the job's instance was created with these parameters; a second refusal is the plugin's to explain
+  }
+  const std::size_t checked = std::min(initial.count, gradient_check_states);
+  for (std::size_t k = 0; k < checked; ++k) {
+    const std::size_t state = k * initial.count / checked;
+    const auto at = [&](const std::vector<double>& x) {
+      return std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(state * n),
+                                 x.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));
+    };
+    for (const bool kinetic : {true, false}) {
+      DerivativeCheckOptions options;
+      options.random_points = 0;
+      options.points = {at(kinetic ? initial.p : initial.q)};
+      options.tolerance = gradient_check_tolerance;
+      options.check_hessians = options.check_third_derivatives = options.check_hessian_vector_products = false;
+      options.check_kinetic = kinetic;
+      options.check_potential = !kinetic;
+      DerivativeCheckReport report;
+      try {
+        report = check_derivatives(*own, options);
+      } catch (const std::exception&) {
+        continue;  // the model cannot be evaluated there: the run reports it for that trajectory
+      }
+      for (const DerivativeMismatch& mismatch : report.mismatches) {
+        // Values or gradients that overflow or leave the model's domain say nothing about the gradient's formula.
+        if (!std::isfinite(mismatch.computed) || !std::isfinite(mismatch.finite_difference)) continue;
+        const std::string values = kinetic ? "value_T" : "value_V";
+        issues.push_back(
+            {"/model/plugin",
+             "the plugin '" + loaded.plugin.name() + "', whose " + mismatch.function + "[" +
+                 std::to_string(mismatch.component) + "] at initial state " + std::to_string(state) + " (" +
+                 (kinetic ? "p" : "q") + " = " + vector_text(mismatch.point) + ") is " +
+                 DerivativeCheckReport::scientific(mismatch.computed, 6) + " where the finite difference of " + values +
+                 " gives " + DerivativeCheckReport::scientific(mismatch.finite_difference, 6),
+             "a plugin whose gradients are the derivatives of its values (a wrong gradient makes every step "
+             "wrong); `nonsep inspect " +
+                 loaded.plugin.path().string() + " --check --points-from " + loaded.job.file.string() +
+                 "` lists every mismatch"});
+        return;
+      }
+    }
+  }
+}
+
+}  // namespace nonsep::host
