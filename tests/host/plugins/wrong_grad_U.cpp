@@ -22,4 +22,4 @@ class WrongGradU {
 };
 
 NONSEP_EXPORT_MODEL(WrongGradU, "wrong_grad_U", "0.1", "a separable part with a wrong analytic grad U",
-                    "T = p^2/2, V = q^2/4, U = q^2/2 (grad U wrong on purpose)")
+                    "T = p^2/2, V = q^2/4, U = q^2/2 (grad U wrong on purpose)");
