@@ -61,7 +61,7 @@ struct DerivativeCheckOptions {
 };
 
 struct DerivativeMismatch {
-  std::string function;       // "grad_T", "grad_V", "hessian_T", "hessian_V", "d3T", "d3V", "hvp_T", "hvp_V" (or _K, _U)
+  std::string function;  // "grad_T", "grad_V", "hessian_T", "hessian_V", "d3T", "d3V", "hvp_T", "hvp_V" (or _K, _U)
   std::vector<double> point;  // p for *_T and *_K, q for *_V and *_U
   std::size_t component;      // index into the gradient or third derivative (i) or row-major Hessian (i*n + j)
   double computed;
