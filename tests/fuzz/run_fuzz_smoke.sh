@@ -1,17 +1,16 @@
 #!/usr/bin/env bash
-# A short fuzzing pass for CI (a step of scripts/test.sh): configures a clang build with libFuzzer, ASan and UBSan
-# in BUILD_DIR, builds only the harnesses, and fuzzes job-file reading for SECONDS seconds starting from the kept
+# A short fuzzing pass for CI (a step of scripts/test.sh): configures the `sanitize` preset of CMakePresets.json
+# (clang with libFuzzer, ASan and UBSan, in SOURCE_DIR/build-sanitize: after tests/ci/run_sanitized_suite.sh the
+# harnesses are already built), builds only the harnesses, and fuzzes job-file reading for SECONDS seconds starting from the kept
 # corpus (corpus/ and corpus_minimized.tar.xz; neither is modified: the archive is unpacked into, and new inputs go
 # to, a scratch folder), then checkpoint reading for SECONDS seconds from checkpoint_corpus/. Fails on any crash,
 # leak, timeout or sanitizer report.
-# Usage: run_fuzz_smoke.sh SOURCE_DIR BUILD_DIR [SECONDS]
+# Usage: run_fuzz_smoke.sh SOURCE_DIR [SECONDS]
 set -euo pipefail
 source_dir=$1
-build_dir=$2
-seconds=${3:-30}
-CC=clang CXX=clang++ cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-  -DNONSEP_FUZZ=ON -DNONSEP_SANITIZE=ON -DNONSEP_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build "$build_dir" -j2 --target fuzz_job_reader fuzz_checkpoint
+seconds=${2:-30}
+build_dir=$source_dir/build-sanitize
+(cd "$source_dir" && cmake --preset sanitize >/dev/null && cmake --build --preset sanitize --target fuzz_job_reader fuzz_checkpoint)
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 mkdir "$scratch/new" "$scratch/minimized" "$scratch/checkpoints"
