@@ -31,7 +31,7 @@ def read_table(path):
     np.loadtxt as cells of text (quoted cells included), and each column is then converted to its type at once
     (about 6 s of CPU for 10^6 rows of the 14 columns of trajectories.csv).
     A last line without its newline is not a row: the host writes whole rows only, so such a line is what a hard
-    kill (SIGKILL, a crash, a full disk) cut off, and it is dropped (the user guide, "Reading it after a hard kill").
+    kill (SIGKILL, a crash, a full disk) cut off, and it is dropped (docs/outputs.md, "Reading it after a hard kill").
     Raises ValueError when a row has a different number of cells than the header, or a cell cannot be read as
     its column's type.
     """

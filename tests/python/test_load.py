@@ -12,7 +12,7 @@ import nonsep
 from nonsep import tables
 from support import FolderTestCase, blowup_job, number, paper1d_job, read_csv, state
 
-# The header of trajectories.csv (README.md of the host, once the summary's per-trajectory entries move there).
+# The header of trajectories.csv (docs/outputs.md).
 TRAJECTORIES_HEADER = ["trajectory", "status", "step", "t", "q0", "p0", "H0", "H", "relative_energy_error",
                        "max_abs_relative_energy_error", "stop_step", "stop_t", "stop_variable", "message"]
 
