@@ -190,13 +190,14 @@ class Reference:
             self.rows.append((section, path, when, self.type_text(node), default, allowed, text))
         self.children(node, path, when, section)
 
-    def children(self, node, path, when, section):
+    def properties(self, node, path, when, section):
         required = set(node.get("required", []))
         for key, child in node.get("properties", {}).items():
-            if child is True:
-                continue
-            child_path = f"{path}.{key}" if path else key
-            self.walk(child, child_path, when, key in required, section or key)
+            if child is not True:
+                self.walk(child, f"{path}.{key}" if path else key, when, key in required, section or key)
+
+    def children(self, node, path, when, section):
+        self.properties(node, path, when, section)
         extra = node.get("additionalProperties")
         if isinstance(extra, dict):
             self.walk(extra, f"{path}.<name>", when, False, section)
@@ -234,19 +235,10 @@ class Reference:
                     self.rows.append(("(document)", "(document)", branch_when, "object", "", "; ".join(rules), ""))
                 elif self.object_rules(sub) or sub.get("required"):
                     raise SchemaError(f"constraints without a description at {path}: {json.dumps(sub)[:200]}")
-                sub_required = set(sub.get("required", []))
-                for child_key, child in sub.get("properties", {}).items():
-                    if child is True:
-                        continue
-                    child_path = f"{path}.{child_key}" if path else child_key
-                    self.walk(child, child_path, branch_when, child_key in sub_required, section or child_key)
+                self.properties(sub, path, branch_when, section)
 
     def children_of_alternative(self, node, path, when, section):
-        if "properties" in node or "allOf" in node:
-            self.children(node, path, when, section)
-        elif "items" in node:
-            self.children(node, path, when, section)
-        elif "oneOf" in node:
+        if any(key in node for key in ("properties", "allOf", "items", "oneOf")):
             self.children(node, path, when, section)
 
 
