@@ -29,7 +29,7 @@ def read_table(path):
     A file of numbers without empty or quoted cells is parsed by np.loadtxt straight into its typed columns (1.2 to
     2.7 s of CPU for 10^6 rows of 7 columns on a loaded machine, the scan included). Any other file is read by
     np.loadtxt as cells of text (quoted cells included), and each column is then converted to its type at once
-    (about 6 s of CPU for 10^6 rows of the 14 columns of trajectories.csv).
+    (8.3 s of CPU for 10^6 rows of the 14 columns of trajectories.csv on a loaded machine).
     A last line without its newline is not a row: the host writes whole rows only, so such a line is what a hard
     kill (SIGKILL, a crash, a full disk) cut off, and it is dropped (docs/outputs.md, "Reading it after a hard kill").
     Raises ValueError when a row has a different number of cells than the header, or a cell cannot be read as
