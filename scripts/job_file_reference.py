@@ -9,8 +9,9 @@ elements as `[]`, a plugin parameter as `<name>`), the condition under which it 
 study), its type, its default (or **required**), the values allowed (enum, range, length, pattern) and the
 schema's description of it. The schema itself is `nonsep schema`'s output, generated from the job reader's key
 tables and the scheme catalogue; a test (`docs.job_file_reference`) fails when the two files disagree.
-Exit status: 0 written or up to date, 1 out of date (--check), 2 unreadable schema or a schema keyword this script
-does not know (named), so that a new kind of constraint cannot be left out of the reference silently.
+Exit status: 0 written or up to date, 1 out of date (--check), 2 unreadable schema, a schema keyword this script
+does not know, or a description or key of the schema the reference would not show (each named), so that nothing
+of the schema can be left out of the reference silently.
 """
 import argparse
 import json
@@ -58,7 +59,10 @@ class Reference:
             merged["not"] = {"allOf": [merged["not"], node["not"]]}
         elif "not" in node:
             merged["not"] = node["not"]
+        base_description = merged.get("description")
         merged.update({k: v for k, v in node.items() if k not in ("$ref", "not")})
+        if base_description and merged.get("description") != base_description:
+            merged["description"] = f"{sentence(merged['description'])} {base_description}"  # key's, then shape's
         return merged
 
     def type_text(self, node):
@@ -181,9 +185,14 @@ class Reference:
         extra = self.object_rules(node) if is_object(node) else []
         if "oneOf" in node and "type" not in node:
             described = [self.resolve(a) for a in node["oneOf"]]
-            forms = [f"{self.type_text(a)}: {a['description']}" for a in described if a.get("description")]
+            forms = [f"{self.type_text(a)}: {a['description'].rstrip('.')}" for a in described if a.get("description")]
             if forms:
-                text = " ".join([text] + ["Either " + "; or ".join(forms) + "."]).strip()
+                text = f"{sentence(text)} Either " + "; or ".join(forms) + "."
+        if "items" in node and "oneOf" in self.resolve(node["items"]):
+            described = [self.resolve(a) for a in self.resolve(node["items"])["oneOf"]]
+            forms = [f"{self.type_text(a)}: {a['description'].rstrip('.')}" for a in described if a.get("description")]
+            if forms:
+                text = f"{sentence(text)} Each element is either " + "; or ".join(forms) + "."
         if path:
             default = "**required**" if required else (f"`{json.dumps(node['default'])}`" if "default" in node else "")
             allowed = "; ".join([self.allowed_text(node)] + extra).strip("; ")
@@ -242,6 +251,10 @@ class Reference:
             self.children(node, path, when, section)
 
 
+def sentence(text):
+    return text if not text or text.endswith((".", ")")) else text + "."
+
+
 def is_object(node):
     return node.get("type") == "object" or "properties" in node
 
@@ -285,6 +298,29 @@ def cell(text):
     return text.replace("|", "\\|").replace("\n", " ")
 
 
+def missing(schema, text):
+    """What of the schema the reference leaves out: each description that is not in `text`, and each key (a
+    property name) that no row's path ends in."""
+    descriptions, keys = [], set()
+
+    def collect(node):
+        if isinstance(node, dict):
+            if isinstance(node.get("description"), str):
+                descriptions.append(node["description"])
+            for key, value in node.items():
+                if key == "properties" and isinstance(value, dict):
+                    keys.update(value)
+                collect(value)
+        elif isinstance(node, list):
+            for value in node:
+                collect(value)
+
+    collect(schema)
+    lost = [f"description {d[:60]!r}" for d in descriptions if cell(d.rstrip(".")) not in text]
+    lost += [f"key {k}" for k in sorted(keys) if not re.search(rf"`([^`|]*\.)?{re.escape(k)}` \|", text)]
+    return lost
+
+
 def render(schema):
     reference = Reference(schema)
     reference.walk(schema, "", "", False, "")
@@ -326,7 +362,11 @@ def main():
     parser.add_argument("--check", action="store_true", help="compare instead of writing; exit 1 when they differ")
     arguments = parser.parse_args()
     try:
-        text = render(json.loads(arguments.schema.read_text(encoding="utf-8")))
+        schema = json.loads(arguments.schema.read_text(encoding="utf-8"))
+        text = render(schema)
+        lost = missing(schema, text)
+        if lost:
+            raise SchemaError("the reference would leave out " + ", ".join(lost))
     except (OSError, ValueError, SchemaError) as error:
         print(f"job_file_reference: {arguments.schema}: {error}", file=sys.stderr)
         return 2
