@@ -251,7 +251,7 @@ double time_abi_floor(const nonsep::host::LoadedJob& job, const bench::MinimalPl
 // Seconds for the hand-written loop cut as the host cuts an ensemble: blocks of nonsep::host::run_block_size
 // states, each stepped to the end on its own, the blocks shared by `threads` std::threads (contiguous parts).
 // Stage by stage, as the host steps: the fused loop over a block of 256 took 11.5 ns per state and step on one
-// thread here against 3.7 staged, and gave an implausible 2.9x "speed-up" on two cores (25 November 2026).
+// thread here against 3.7 staged, and gave an implausible 2.9x "speed-up" on two cores.
 double time_hand_written_blocks(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
   const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
   Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p), g(q.size());

@@ -1,7 +1,7 @@
-// The goal of issue 17, measured side by side in one run: at each phase-space accuracy 1e-4, 1e-6, 1e-8, 1e-10 on
-// the two paper problems (paper1d to its quarter period, tao_product to t = 5; benchmark_problems.hpp), the time of
-// the fastest *symplectic* scheme nonsep offers (Chin's basic and triplet, tao 2/4/6, implicit midpoint, gauss 4/6;
-// every one through nonsep::Integrator, as the host runs it) against the fastest of GSL's symplectic methods
+// The goal of docs/work-precision.md, measured side by side in one run: at each phase-space accuracy 1e-4, 1e-6, 1e-8,
+// 1e-10 on the two paper problems (paper1d to its quarter period, tao_product to t = 5; benchmark_problems.hpp), the
+// time of the fastest *symplectic* scheme nonsep offers (Chin's basic and triplet, tao 2/4/6, implicit midpoint, gauss
+// 4/6; every one through nonsep::Integrator, as the host runs it) against the fastest of GSL's symplectic methods
 // (rk2imp, rk4imp at driver tolerances 1e-5 .. 1e-14, gsl_gauss_methods.hpp):
 //   single:   one trajectory each; ratio = GSL time / nonsep time (> 1: nonsep is faster);
 //   ensemble: 1024 trajectories, nonsep as one batch per thread (std::thread::hardware_concurrency() threads, each

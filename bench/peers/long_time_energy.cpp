@@ -1,8 +1,8 @@
-// Long-time behaviour at equal cost per period (issue 17): the relative energy error |H - E0| / E0 of paper1d from
-// (q, p) = (2, 0) over 10^5 periods (period 4 x the exact quarter period of nonsep::reference::paper1d_quarter,
-// 1.5455062293...), for Chin's basic and triplet (4/3, 2), Tao 2/4/6, implicit midpoint and Gauss 4/6 (each through
-// nonsep::Integrator, as the host runs it), and as references GSL's rk4imp (2-stage Gauss by Newton) and Odeint's
-// runge_kutta4 (explicit, not symplectic).
+// Long-time behaviour at equal cost per period (docs/work-precision.md): the relative energy error |H - E0| / E0 of
+// paper1d from (q, p) = (2, 0) over 10^5 periods (period 4 x the exact quarter period of
+// nonsep::reference::paper1d_quarter, 1.5455062293...), for Chin's basic and triplet (4/3, 2), Tao 2/4/6, implicit
+// midpoint and Gauss 4/6 (each through nonsep::Integrator, as the host runs it), and as references GSL's rk4imp
+// (2-stage Gauss by Newton) and Odeint's runge_kutta4 (explicit, not symplectic).
 //
 // Equal cost: every scheme spends the same number of model calls per period, a budget B (default 4096 and 16384):
 //   grad T or grad V (Chin's kicks and drifts)              1 call each;

@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 from .results import load
 
-# README.md, "Exit status".
+# docs/user-guide.md, "Exit status".
 EXIT_STATUS_MEANINGS = {
     1: "the run started but did not complete: a trajectory diverged or failed, or an output could not be written",
     2: "invalid input, nothing was run",
@@ -54,7 +54,7 @@ class Problem(NamedTuple):
 class RunError(RuntimeError):
     """`nonsep` exited with a non-zero status.
 
-    status    the exit status (README.md, "Exit status"); negative: the process was killed by that signal
+    status    the exit status (docs/user-guide.md, "Exit status"); negative: the process was killed by that signal
     stderr    everything the process wrote on stderr; stdout likewise
     result    the Result of the outputs, when the run started and wrote summary.json (a diverged, failed or
               interrupted run), else None
@@ -219,7 +219,7 @@ def _absolute_paths(job):
     model = content.get("model")
     if isinstance(model, dict) and isinstance(model.get("plugin"), str):
         plugin = model["plugin"]
-        if "/" in plugin or plugin.endswith(".so"):  # a path, not a name (README.md, model.plugin)
+        if "/" in plugin or plugin.endswith(".so"):  # a path, not a name (docs/user-guide.md, model.plugin)
             model["plugin"] = os.path.abspath(plugin)
     directory = _output_directory_of(content)
     if directory:
@@ -235,7 +235,7 @@ def _output_directory_of(content):
 
 def _output_directory(job_path, content, output):
     """Where the run writes: `output`, else output.directory relative to the job file's folder, else
-    <job file stem>.out beside it (README.md, output.directory). None when the job file is not readable JSON."""
+    <job file stem>.out beside it (docs/user-guide.md, output.directory). None when the job file is not readable JSON."""
     if output is not None:
         return Path(output)
     if content is None:

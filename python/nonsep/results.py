@@ -1,6 +1,6 @@
 """What a nonsep run or study left in its output folder, loaded with numpy: load(output_dir) -> Result.
 
-Files read (README.md, "What a run leaves behind"); each is optional except summary.json:
+Files read (docs/outputs.md); each is optional except summary.json:
   summary.json       Result.summary, as a dict (non-finite numbers are None there, as the host writes null)
   trajectories.csv   Result.trajectories, one row per trajectory (None for a study)
   trajectory.csv     Result.samples() and Result.orbit(i): read on first use and kept

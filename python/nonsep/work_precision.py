@@ -1,4 +1,4 @@
-"""Plots the work_precision.csv of a nonsep study (README, "Work-precision studies"); installed with the package.
+"""Plots the work_precision.csv of a nonsep study (docs/studies.md, "Work-precision studies"); installed with the package.
 
 Usage: /usr/bin/python3 -m nonsep.work_precision STUDY_DIR --out FILE.png [--title TEXT]
            [--peers PEERS_CSV --problem NAME] [--error phase|energy] [--dpi N]

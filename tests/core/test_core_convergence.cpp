@@ -123,7 +123,7 @@ const double default_t2 = ChinCoefficients::default_t2();
 TEST_CASE("exact quarter period of the paper's 1D test by quadrature") {
   const auto exact = nonsep::reference::paper1d_quarter(2.0);
   // The paper prints T_1/4 = 0.385841 and p = -1.569196; the quadrature of the conserved energy gives
-  // 0.38637655733612... and -sqrt(2 (sqrt(5) - 1)) = -1.5723027555148... (see README, "Exact references").
+  // 0.38637655733612... and -sqrt(2 (sqrt(5) - 1)) = -1.5723027555148... (see docs/method.md, "Exact references").
   CHECK(exact.energy == 5.0);
   CHECK(exact.period == doctest::Approx(0.3863765573361232).epsilon(1e-14));
   CHECK(exact.p_final == doctest::Approx(-1.572302755514847).epsilon(1e-15));

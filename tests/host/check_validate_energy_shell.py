@@ -26,7 +26,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--nonsep", required=True)
     args = parser.parse_args()
-    # paper2d at coupling 0.2 has H >= 2 + |p|^2 + 0.4 |q|^2 (README, shipped models), so on the shell H = 3 the
+    # paper2d at coupling 0.2 has H >= 2 + |p|^2 + 0.4 |q|^2 (docs/writing-models.md, shipped models), so on the shell H = 3 the
     # 6 grid points with |q0| = 2 (H >= 3.6 at p1 = 0) are left out and the 3 with q0 = 0 (H about 2) are kept.
     job = {
         "model": {"plugin": "paper2d", "parameters": {"coupling": 0.2}},

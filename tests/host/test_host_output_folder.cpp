@@ -143,8 +143,8 @@ TEST_CASE("a new run of the same job that is killed leaves no summary of the ear
 
 // One write() per buffer ending on a row boundary, but Linux may end a write() to a file between two pages when
 // SIGKILL arrives (generic_perform_write checks for a fatal signal per page), so a hard kill can leave a last line
-// without its newline, cut at a page boundary. What is guaranteed, and what the README's reader rule relies on:
-// every line that ends in a newline is a whole row, and only the last line can lack one.
+// without its newline, cut at a page boundary. What is guaranteed, and what the reader rule of docs/outputs.md relies
+// on: every line that ends in a newline is a whole row, and only the last line can lack one.
 TEST_CASE("after SIGKILL every line of trajectory.csv that ends in a newline is a whole row, every time") {
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", paper1d_job(1.0, 1'000'000'000, 1));

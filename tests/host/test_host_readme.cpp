@@ -1,5 +1,6 @@
-// README.md's examples of the `nonsep` executable are what it does: the worked example (job, command line,
-// summary.json, rows), the example of errors in a job file, and the tables that list the schemes.
+// The manuals' examples of the `nonsep` executable are what it does: README.md's first run (job, command line,
+// summary.json, rows), and docs/user-guide.md's example of errors in a job file, its exit statuses and the tables
+// that list the schemes.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -19,10 +20,11 @@ using namespace nonsep::host_testing;
 
 namespace {
 
-// The fenced code blocks of README.md's section `heading` (up to the next heading of the same or a higher level),
-// each as (language, text).
-std::vector<std::pair<std::string, std::string>> readme_code_blocks(const std::string& heading) {
-  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / "README.md");
+// The fenced code blocks of the section `heading` of the manual `file` (relative to the source tree; up to the next
+// heading of the same or a higher level), each as (language, text).
+std::vector<std::pair<std::string, std::string>> manual_code_blocks(const std::string& file,
+                                                                    const std::string& heading) {
+  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / file);
   const auto start = readme.find("\n" + heading + "\n");
   REQUIRE(start != std::string::npos);
   const auto level = heading.find(' ');
@@ -49,8 +51,8 @@ std::vector<std::pair<std::string, std::string>> readme_code_blocks(const std::s
 
 }  // namespace
 
-TEST_CASE("README: the worked example shows the quickstart's job, command line, summary.json and rows as they are") {
-  const auto blocks = readme_code_blocks("### A worked example");
+TEST_CASE("README: the first run shows the quickstart's job, command line, summary.json and rows as they are") {
+  const auto blocks = manual_code_blocks("README.md", "## A first run");
   REQUIRE(blocks.size() == 5);
   REQUIRE(blocks[0].first == "json");
   REQUIRE(blocks[1].first == "console");
@@ -108,8 +110,8 @@ TEST_CASE("README: the worked example shows the quickstart's job, command line, 
   CHECK(read_text(folder / "quickstart.out/trajectories.csv") == blocks[3].second);
 }
 
-TEST_CASE("README: the example of errors in a job file is what `nonsep validate` prints") {
-  const auto blocks = readme_code_blocks("### Errors in job files");
+TEST_CASE("User guide: the example of errors in a job file is what `nonsep validate` prints") {
+  const auto blocks = manual_code_blocks("docs/user-guide.md", "## Errors in job files");
   REQUIRE(!blocks.empty());
   REQUIRE(blocks[0].first == "console");
   const std::string& shown = blocks[0].second;
@@ -125,8 +127,8 @@ TEST_CASE("README: the example of errors in a job file is what `nonsep validate`
   CHECK(result.err == shown.substr(command_end + 1));
 }
 
-TEST_CASE("README and --help: exit status 1 names every status with which a trajectory stops early") {
-  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / "README.md");
+TEST_CASE("User guide and --help: exit status 1 names every status with which a trajectory stops early") {
+  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / "docs/user-guide.md");
   const auto row = readme.find("\n| 1 | ");
   REQUIRE(row != std::string::npos);
   const std::string readme_row = readme.substr(row + 1, readme.find('\n', row + 1) - row - 1);
@@ -145,8 +147,8 @@ TEST_CASE("README and --help: exit status 1 names every status with which a traj
   }
 }
 
-TEST_CASE("README: the job-key table and the schemes table name every scheme of the catalogue") {
-  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / "README.md");
+TEST_CASE("User guide: the job-key table and the schemes table name every scheme of the catalogue") {
+  const std::string readme = read_text(std::filesystem::path(NONSEP_SOURCE_DIR) / "docs/user-guide.md");
   const auto row = readme.find("\n| `integrator.scheme` | ");
   REQUIRE(row != std::string::npos);
   const std::string key_row = readme.substr(row + 1, readme.find('\n', row + 1) - row - 1);

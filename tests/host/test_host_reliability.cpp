@@ -456,8 +456,9 @@ TEST_CASE("resume checks content: an edited checkpoint or trajectory.csv is refu
 }
 
 TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3), and the rows written before whole") {
-  // The trust model (README): a plugin runs inside nonsep, so its crash is nonsep's: the status is the signal's
-  // 128 + n (SIGABRT 134, SIGSEGV 139) or the plugin's own exit code, and what was flushed before stays readable.
+  // The trust model (docs/trust-model.md): a plugin runs inside nonsep, so its crash is nonsep's: the status is the
+  // signal's 128 + n (SIGABRT 134, SIGSEGV 139) or the plugin's own exit code, and what was flushed before stays
+  // readable.
 #if defined(__SANITIZE_ADDRESS__)
   // The sanitized suite: ASan's handler catches SIGSEGV itself and aborts (abort_on_error=1, tests/ci), and
   // LeakSanitizer would turn exit(3) into its own status by reporting what the interrupted run still held.

@@ -67,7 +67,7 @@ class InterruptTest(FolderTestCase):
         self.assertSameTable(resumed.trajectories, reference.trajectories)
         self.assertSameTable(resumed.samples(), reference.samples())
         # It did resume (a fresh run would give the same numbers): a resumed run evaluates grad V once more than an
-        # uninterrupted one, the gradient the basic step would have reused (README.md, "--resume").
+        # uninterrupted one, the gradient the basic step would have reused (docs/outputs.md, "--resume").
         self.assertEqual(resumed.summary["evaluations"]["grad_T"], reference.summary["evaluations"]["grad_T"])
         self.assertEqual(resumed.summary["evaluations"]["grad_V"], reference.summary["evaluations"]["grad_V"] + 1)
 

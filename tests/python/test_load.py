@@ -12,7 +12,7 @@ import nonsep
 from nonsep import tables
 from support import FolderTestCase, blowup_job, number, paper1d_job, read_csv, state
 
-# The header of trajectories.csv (README.md of the host, once the summary's per-trajectory entries move there).
+# The header of trajectories.csv (docs/outputs.md).
 TRAJECTORIES_HEADER = ["trajectory", "status", "step", "t", "q0", "p0", "H0", "H", "relative_energy_error",
                        "max_abs_relative_energy_error", "stop_step", "stop_t", "stop_variable", "message"]
 
@@ -180,7 +180,8 @@ class TablesTest(FolderTestCase):
             tables.read_table(self.folder / "bad.csv")
 
     def test_the_three_readers_give_the_same_table(self):
-        # Without quotes: np.loadtxt (numbers only, no empty cells) or one split (the rest); with: the csv module.
+        # np.loadtxt into typed columns (numbers only, no empty cells), np.loadtxt as text cells (the rest), and
+        # the csv module (the reference, and the reader that names a row of the wrong length).
         numbers = "trajectory,step,t,q0\n0,0,0,0.1\n0,1,0.30000000000000004,1e-300\n"
         mixed = ("trajectory,status,step,H,stop_variable,note,lyapunov_1\n"
                  "0,completed,5,0.1,,ok,\n1,diverged,2,,p[0],5 steps,2.5e-3\n2,failed,,,,,\n")
@@ -194,7 +195,7 @@ class TablesTest(FolderTestCase):
             header, body = text.split("\n", 1)
             table = tables.read_table(path)
             self.assertSameTable(table, tables._read_cells(header.split(","), body))
-            self.assertSameTable(table, tables._read_unquoted(header.split(","), body))
+            self.assertSameTable(table, tables._read_text(header.split(","), body))
             for name, values in fields.items():
                 self.assertEqual(list(table[name]), values, name)
         self.assertEqual(table.dtype["note"].kind, "U")

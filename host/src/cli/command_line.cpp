@@ -22,8 +22,8 @@ int run_command_line(int argc, char** argv) {
   try {
     CLI::App app{"nonsep " NONSEP_VERSION
                  ": explicit symplectic integrators for non-separable Hamiltonians H = T_i(p) V_ij(q) T_j(p)\n"
-                 "(S. A. Chin). Models are plugins; runs are described by JSON job files. The manual (section\n"
-                 "Running nonsep): " +
+                 "(S. A. Chin). Models are plugins; runs are described by JSON job files. The manual (commands\n"
+                 "and job files in its docs/user-guide.md): " +
                      manual_location(),
                  "nonsep"};
     app.set_version_flag("--version", [] { return build_features_text(); });

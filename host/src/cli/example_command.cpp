@@ -92,7 +92,8 @@ std::string with_installed_schema(std::string text) {
 
 // "directory": "<example>.out" -> "<stem of FILE>.out": the examples name their folder as the default would for
 // their own file name, so without this `nonsep example --output orbit.json && nonsep run orbit.json` wrote to
-// quickstart.out, not orbit.out as the README says of the default, and two copies of one example shared a folder.
+// quickstart.out, not orbit.out as docs/user-guide.md says of the default, and two copies of one example shared a
+// folder.
 std::string with_output_folder_of(std::string text, const std::string& example, const fs::path& file) {
   const std::string stem = file.stem().string();
   if (stem.empty() || stem == example) return text;

@@ -44,23 +44,12 @@ bool looks_like_misspelling(std::string_view written, std::string_view meant) {
 
 namespace nonsep::host::job_reader {
 
-namespace {
-std::string escape_pointer_token(const std::string& token) {
-  std::string escaped;
-  for (char c : token) {
-    if (c == '~')
-      escaped += "~0";
-    else if (c == '/')
-      escaped += "~1";
-    else
-      escaped += c;
-  }
-  return escaped;
+std::string child(const std::string& path, const std::string& key) {
+  return path + (json::json_pointer() / key).to_string();
 }
-}  // namespace
-
-std::string child(const std::string& path, const std::string& key) { return path + "/" + escape_pointer_token(key); }
-std::string child(const std::string& path, std::size_t index) { return path + "/" + std::to_string(index); }
+std::string child(const std::string& path, std::size_t index) {
+  return path + (json::json_pointer() / index).to_string();
+}
 
 std::string describe(const json& value) {
   std::string text = value.dump();

@@ -1,5 +1,5 @@
-// /analysis/poincare, /analysis/lyapunov and /analysis/megno: the dynamics diagnostics of a run (README.md,
-// "Dynamics: Poincare sections, Lyapunov exponents, MEGNO"). Whether the plugin has the Hessians the tangent map
+// /analysis/poincare, /analysis/lyapunov and /analysis/megno: the dynamics diagnostics of a run
+// (docs/dynamics.md). Whether the plugin has the Hessians the tangent map
 // needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
 #include <limits>
 

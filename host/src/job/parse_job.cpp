@@ -15,7 +15,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
   job.directory = job_file.parent_path().empty() ? std::filesystem::path(".") : job_file.parent_path();
   if (!check.object(document, "",
                     "a JSON object with the keys model, integrator, initial, time (" + manual_location() +
-                        ", section Running nonsep)"))
+                        " and its docs/user-guide.md)"))
     return job;
   check.known_keys(document, "", document_keys().names());
   if (const json* value = check.member(document, "", "$schema", false, ""))

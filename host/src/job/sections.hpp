@@ -1,7 +1,7 @@
 #pragma once
 // Internal to the job reader (host/src/job/): one reader per section of a job file, each in its own file, called by
-// parse_job (parse_job.cpp) in the order of README.md's key-by-key table. Each takes the parsed document (or the
-// section's value) and a Checker, returns what it read, and adds one issue per problem; what it returns is
+// parse_job (parse_job.cpp) in the order of the key-by-key table of docs/user-guide.md. Each takes the parsed document
+// (or the section's value) and a Checker, returns what it read, and adds one issue per problem; what it returns is
 // meaningful only if it added none.
 #include <cstdint>
 #include <optional>

@@ -44,7 +44,7 @@ class StrictDocumentBuilder : public nlohmann::json_sax<json> {
     const auto bracket = message.find("] ");
     if (message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos) message = message.substr(bracket + 2);
     issues_.push_back({"", "text that is not JSON (" + message + ")",
-                       "a JSON object as described in " + manual_location() + ", section Running nonsep"});
+                       "a JSON object as described in " + manual_location() + " and its docs/user-guide.md"});
     return false;
   }
 

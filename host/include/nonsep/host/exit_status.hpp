@@ -1,6 +1,6 @@
 #pragma once
 // The exit statuses of the `nonsep` executable. They are part of its interface: scripts and schedulers rely on
-// them, `nonsep --help` and README.md list them.
+// them, `nonsep --help` and docs/user-guide.md list them.
 namespace nonsep::host {
 
 enum class ExitStatus : int {

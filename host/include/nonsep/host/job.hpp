@@ -1,8 +1,8 @@
 #pragma once
 // Job files: reading one, checking every part of it, and reporting all problems at once.
 //
-// The shape of a job file is documented key by key in README.md ("Running nonsep: commands and job files") and
-// formally in schemas/job.schema.json. Reading happens in three passes, each adding to one list of JobIssue:
+// The shape of a job file is documented key by key in docs/user-guide.md and docs/job-file.md, and formally in
+// schemas/job.schema.json. Reading happens in three passes, each adding to one list of JobIssue:
 //   1. parse_job_text  strict JSON: syntax (with line and column), duplicate keys, at most max_nesting_depth levels.
 //   2. parse_job       structure and values that need no plugin: unknown keys, types, required keys, ranges,
 //                      integrator options against nonsep::scheme_catalogue(), the time grid, initial states.

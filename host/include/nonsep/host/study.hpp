@@ -1,5 +1,5 @@
 #pragma once
-// Convergence studies: a job with /study (README.md, "Convergence studies") runs its model from its one
+// Convergence studies: a job with /study (docs/studies.md) runs its model from its one
 // initial state to time.t_end once per integrator and step count, and measures at t_end
 //   - the relative energy error (H - H0) / H0 (needs the plugin's Hessians; empty otherwise), and
 //   - the phase-space error |(q, p) - (q_ref, p_ref)| (Euclidean) against /study/reference, when given.

@@ -2,7 +2,7 @@
 // Observers watch an ensemble that the EnsembleDriver (ensemble_driver.hpp) advances; everything that happens
 // during a run besides stepping is one: the trajectory.csv writer, the energy-error tracker, the closest-return
 // analysis, the checkpoint saver, the progress bar. Adding one does not touch the driver (Odeint's integrate_*
-// with an observer; STYLE.md lesson 11).
+// with an observer).
 //
 // What the driver calls, and when (all on the driver's thread unless said otherwise):
 //   next_event(step)       the first step after `step` at which the observer must see the ensemble; the driver
