@@ -157,7 +157,8 @@ TEST_CASE("time: the problems of dt, t_end and steps") {
 
 TEST_CASE("an end time whose t_end / dt overflows a double is over the step limit, for a run and a study") {
   for (const auto& [dt, t_end] : {std::pair{1e-308, 1e308}, std::pair{5e-324, 1.0}, std::pair{-5e-324, -1.0}}) {
-    CAPTURE(dt);
+    const double step = dt;  // clang 14 cannot capture a structured binding
+    CAPTURE(step);
     const auto issues = parse(with_time({{"dt", dt}, {"t_end", t_end}})).issues;
     REQUIRE(paths(issues) == std::vector<std::string>{"/time/t_end"});
     CHECK(issues[0].found.find("beyond the largest double") != std::string::npos);

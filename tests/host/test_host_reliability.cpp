@@ -107,7 +107,8 @@ TEST_CASE(
       {"not_a_library", "as a shared library"},
   };
   for (const auto& [name, message] : cases) {
-    CAPTURE(std::string(name));
+    const std::string case_name(name);  // clang 14 cannot capture a structured binding
+    CAPTURE(case_name);
     TemporaryFolder folder;
     const auto file = write_job(folder / "job.json", job_with(broken_plugin(name), state(0.5, 0.0)));
     for (const char* command : {"validate", "run"}) {
@@ -469,7 +470,8 @@ TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3),
   const std::pair<int, int> cases[] = {{0, 134}, {1, 139}, {2, 3}};
 #endif
   for (const auto& [how, status] : cases) {
-    CAPTURE(how);
+    const int crash = how;  // clang 14 cannot capture a structured binding
+    CAPTURE(crash);
     TemporaryFolder folder;
     const auto file =
         write_job(folder / "job.json", job_with("blowup", state(0.5, 0.5), {{"crash_after", 50000}, {"crash_how", how}},

@@ -69,7 +69,8 @@ const std::pair<const char*, nlohmann::json> shipped_plugins[] = {
 
 TEST_CASE("every shipped plugin's Hessian-vector products are its dense Hessians times v, in one batched call") {
   for (const auto& [name, parameters] : shipped_plugins) {
-    CAPTURE(std::string(name));
+    const std::string plugin_name(name);  // clang 14 cannot capture a structured binding
+    CAPTURE(plugin_name);
     const PluginModel model = shipped(name, parameters);
     REQUIRE(model.plugin().has_hessian_vector_products());
     CHECK(model.plugin().metadata()["derivatives"]["hvp_V"] == "automatic");
@@ -87,7 +88,8 @@ TEST_CASE("every shipped plugin's Hessian-vector products are its dense Hessians
 
 TEST_CASE("the derivative checker differences Hessian-vector products from the gradients, and finds a wrong one") {
   for (const auto& [name, parameters] : shipped_plugins) {
-    CAPTURE(std::string(name));
+    const std::string plugin_name(name);  // clang 14 cannot capture a structured binding
+    CAPTURE(plugin_name);
     const auto report = nonsep::check_derivatives(shipped(name, parameters));
     INFO(report.summary());
     CHECK(report.passed());

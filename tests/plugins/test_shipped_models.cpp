@@ -116,7 +116,8 @@ TEST_CASE("every shipped plugin passes the derivative checker") {
                                                             {"tao_product", nlohmann::json::object()},
                                                             {"paper2d", {{"coupling", -0.1}}}};
   for (const auto& [name, parameters] : plugins) {
-    CAPTURE(std::string(name));
+    const std::string plugin_name(name);  // clang 14 cannot capture a structured binding
+    CAPTURE(plugin_name);
     const PluginModel model = shipped(name, parameters);
     CHECK(model.plugin().has_values());
     CHECK(model.plugin().has_hessians());
@@ -132,7 +133,8 @@ TEST_CASE("every shipped plugin passes the derivative checker") {
 
 TEST_CASE("each shipped model documents T, V and the Hamiltonian it solves") {
   for (const char* name : {"paper1d", "radial", "quadratic_kinetic", "tao_product", "paper2d", "lattice_chain"}) {
-    CAPTURE(std::string(name));
+    const std::string plugin_name(name);  // clang 14 cannot capture a structured binding
+    CAPTURE(plugin_name);
     const auto plugin = load_plugin(name, "");
     CHECK(plugin.name() == name);
     const std::string hamiltonian = plugin.metadata()["hamiltonian"].get<std::string>();
