@@ -328,7 +328,8 @@ TEST_CASE(
       {{{"scheme", "tao"}, {"order", 2}, {"omega", 20}}, {{"scheme", "tao"}, {"order", 2}, {"omega", 5}}},
       {{{"scheme", "gauss"}, {"max_iterations", 100}}, {{"scheme", "gauss"}, {"max_iterations", 3}}}};
   for (const auto& [before, after] : changes) {
-    CAPTURE(before);
+    const json first = before;  // clang 14 cannot capture a structured binding
+    CAPTURE(first);
     json initial = json::array();
     for (int k = 0; k < 50; ++k) initial.push_back(state(0.5 + 0.005 * k, 0.1));
     json job = paper1d_job(initial, {{"dt", 0.001}, {"steps", 1000000}}, before);

@@ -52,7 +52,7 @@ TEST_CASE("the schema's ranges of numbers and integers are the reader's") {
   const json schema = job_schema();
   const json finite = schema["$defs"]["finite"];
   int checked = 0;
-  for (const auto& [section, key] :
+  for (const auto& [section_name, key_name] :
        std::vector<std::pair<std::string, std::string>>{{"time", "dt"},
                                                         {"time", "steps"},
                                                         {"output", "every"},
@@ -61,6 +61,7 @@ TEST_CASE("the schema's ranges of numbers and integers are the reader's") {
                                                         {"checkpoint", "every_seconds"},
                                                         {"analysis", "closest_return_after"},
                                                         {"analysis", "max_relative_energy_error"}}) {
+    const std::string &section = section_name, &key = key_name;  // clang 14 cannot capture a structured binding
     const std::string path = "/" + section + "/" + key;
     CAPTURE(path);
     const json rule = property_schema(schema, section, key);
@@ -123,7 +124,8 @@ TEST_CASE("the schema's defaults are what the reader fills in, and its required 
     CHECK(names(issues_of(document), "/" + key.get<std::string>()));
   }
   // Every key the schema allows at the top level is known to the reader, and an unknown one is refused by both.
-  for (const auto& [key, value] : properties.items()) {
+  for (const auto& item : properties.items()) {
+    const std::string key = item.key();
     json document = full_run();
     if (!document.contains(key)) document[key] = nullptr;
     const auto problems = issues_of(document);

@@ -141,7 +141,8 @@ TEST_CASE("kernel path: a plugin without kernels, or of another kernel version, 
   for (const auto& [plugin, note] : {std::pair{std::string("blowup"), std::string("no stepping kernels")},
                                      std::pair{std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/kernel_other_version.so",
                                                std::string("kernel version 999")}}) {
-    CAPTURE(plugin);
+    const std::string plugin_name = plugin;  // clang 14 cannot capture a structured binding
+    CAPTURE(plugin_name);
     json job = blowup_job(json::array({state(0.5, 0.25), state(0.7, 0.1)}), json::object(), plugin);
     const auto file = write_job(folder / "job.json", job);
     const auto run = run_with("baseline", folder, "out-" + std::to_string(note.size()), file);
