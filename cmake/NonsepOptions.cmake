@@ -39,12 +39,21 @@ if(NONSEP_SANITIZE)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
-# libFuzzer instrumentation for tests/fuzz (clang only). The harness links -fsanitize=fuzzer; everything else is
-# instrumented without libFuzzer's main.
+# libFuzzer harnesses for tests/fuzz (clang only). The harnesses link -fsanitize=fuzzer; the host's job-file and
+# checkpoint reading, which they fuzz, is compiled with libFuzzer's coverage instrumentation (host/CMakeLists.txt),
+# and nothing else is: the same build runs the sanitized test suite, whose integrations that instrumentation of
+# every comparison would slow several times.
 option(NONSEP_FUZZ "Build the libFuzzer harnesses of tests/fuzz (requires clang)" OFF)
-if(NONSEP_FUZZ)
-  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
-    message(FATAL_ERROR "NONSEP_FUZZ needs clang (CXX=clang++), not ${CMAKE_CXX_COMPILER_ID}")
-  endif()
-  add_compile_options(-fsanitize=fuzzer-no-link)
+if(NONSEP_FUZZ AND NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+  message(FATAL_ERROR "NONSEP_FUZZ needs clang (CXX=clang++), not ${CMAKE_CXX_COMPILER_ID}")
 endif()
+
+# The host library's and the test suites' files spend most of their compile time in the compiler's front end, on
+# the same headers (the JSON library, doctest, the core's templates, the standard library): each such target
+# precompiles the headers its files share, once. Off: every file parses them itself (same program).
+option(NONSEP_PRECOMPILE_HEADERS "Precompile the headers shared by the files of the host library and the test suites" ON)
+function(nonsep_precompile_headers target)
+  if(NONSEP_PRECOMPILE_HEADERS)
+    target_precompile_headers(${target} PRIVATE ${ARGN})
+  endif()
+endfunction()
