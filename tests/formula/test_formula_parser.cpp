@@ -111,10 +111,10 @@ TEST_CASE("formula parser: T refuses q, names the allowed letter, and lists the 
 
 TEST_CASE("formula parser: nesting beyond the limit and over-long text are refused, long flat input is fine") {
   std::string deep;
-  for (int i = 0; i < 10000; ++i) deep += "(";
+  for (int i = 0; i < 2000; ++i) deep += "(";
   deep += "q0";
   CHECK(error_of(deep).found.find("nesting deeper") != std::string::npos);
-  std::string signs(5000, '-');
+  std::string signs(2000, '-');
   CHECK(error_of(signs + "q0").found.find("nesting deeper") != std::string::npos);
   std::string powers = "q0";
   for (int i = 0; i < 200; ++i) powers += "^q0";
@@ -152,7 +152,7 @@ TEST_CASE("formula parser: canonical text parses back to the same tree, with the
       "+q0 - +1",
   };
   for (const auto& text : formulas) {
-    if (text.front() == 'a') {
+    if (text == "a - (b - c)") {
       CHECK(error_of(text).column == 1);
       continue;
     }
