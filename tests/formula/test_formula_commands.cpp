@@ -122,7 +122,8 @@ TEST_CASE("formula commands: validate checks a formula job's parameters and dime
   CHECK(contains(run.err, "apt-get install g++"));
 }
 
-TEST_CASE("formula commands: a compiled formula model gives the hand-written plugin's states; the cache is reused") {
+TEST_CASE(
+    "formula commands: a compiled formula model gives the hand-written plugin's states, and the cache is reused") {
   TemporaryFolder folder;
   Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());
   const json formula_job = job_with({{"formula", paper1d_formula("paper1d_formula")}});
