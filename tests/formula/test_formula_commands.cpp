@@ -128,8 +128,10 @@ TEST_CASE(
   Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());
   const json formula_job = job_with({{"formula", paper1d_formula("paper1d_formula")}});
   const auto formula_file = write_job(folder / "formula.json", formula_job);
+  // The compile takes seconds on an idle machine and minutes on a loaded one: a generous limit, not a timing.
   const auto first =
-      run_nonsep({"run", "--quiet", "-o", (folder / "first").string(), formula_file.string()}, folder.path());
+      finish(start_nonsep({"run", "--quiet", "-o", (folder / "first").string(), formula_file.string()}, folder.path()),
+             std::chrono::seconds(900));
   INFO("stderr: " << first.err);
   REQUIRE(first.status == 0);
   CHECK(contains(first.err, "compiling the formula model 'paper1d_formula'"));
