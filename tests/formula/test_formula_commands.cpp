@@ -149,12 +149,14 @@ TEST_CASE(
   const json by_formula = read_run(folder / "first");
   const json by_plugin = read_run(folder / "plugin");
   REQUIRE(by_formula["trajectories"].size() == 2);
-  for (std::size_t i = 0; i < 2; ++i)
-    for (const char* part : {"q", "p"}) {
-      const double a = by_formula["trajectories"][i]["final"][part][0].get<double>();
-      const double b = by_plugin["trajectories"][i]["final"][part][0].get<double>();
-      CHECK(std::abs(a - b) <= 1e-13 * std::abs(b));
-    }
+  // Relative to the state (q, p): a component passing near 0 has no relative accuracy of its own.
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json& a = by_formula["trajectories"][i]["final"];
+    const json& b = by_plugin["trajectories"][i]["final"];
+    const double scale = std::hypot(b["q"][0].get<double>(), b["p"][0].get<double>());
+    for (const char* part : {"q", "p"})
+      CHECK(std::abs(a[part][0].get<double>() - b[part][0].get<double>()) <= 1e-13 * scale);
+  }
   const json record = by_formula["model"]["formula"];
   CHECK(record["T"] == "p0 + p0^3/6");
   CHECK(record["V"] == "q0^2/2 + q0^4/12");
