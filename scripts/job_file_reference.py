@@ -25,7 +25,7 @@ LARGEST_INT64 = 2**63 - 1
 
 # Keywords this script renders; any other in the schema is an error (exit 2).
 KNOWN = {"$schema", "$id", "title", "description", "type", "additionalProperties", "required", "properties", "allOf",
-         "$defs", "$ref", "minLength", "pattern", "default", "enum", "minimum", "maximum", "exclusiveMinimum", "not",
+         "$defs", "$ref", "minLength", "maxLength", "pattern", "propertyNames", "default", "enum", "minimum", "maximum", "exclusiveMinimum", "not",
          "const", "oneOf", "anyOf", "if", "then", "else", "items", "minItems", "maxItems", "uniqueItems", "examples",
          "dependentRequired", "dependentSchemas"}
 
@@ -116,6 +116,10 @@ class Reference:
             parts.append("non-empty")
         elif "minLength" in node:
             parts.append(f"at least {node['minLength']} characters")
+        if "maxLength" in node:
+            parts.append(f"at most {node['maxLength']} characters")
+        if "propertyNames" in node:
+            parts.append(f"keys match `{node['propertyNames']['pattern']}`")
         if "pattern" in node:
             pattern = node["pattern"]
             parts.append("no NUL character" if pattern == "^[^\\u0000]*$" else f"matches `{pattern}`")

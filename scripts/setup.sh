@@ -13,6 +13,7 @@ packages=(
   ca-certificates cmake g++ make pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev doctest-dev libcli11-dev
   python3 python3-jsonschema python3-matplotlib python3-numpy python3-h5py
+  python3-sympy  # tests/python/test_formula.py: nonsep.formula with SymPy expressions (docs/formula-models.md)
   jupyter-nbconvert python3-nbconvert python3-nbformat python3-ipykernel  # examples/tutorial.ipynb, run headless
   libopenmpi-dev openmpi-bin libhdf5-openmpi-dev hdf5-tools  # MPI ranks, parallel HDF5 output (docs/cluster.md)
   zlib1g-dev  # results.h5: /samples' chunks deflated by nonsep (host/include/nonsep/host/output/shuffle_deflate.hpp)

@@ -10,6 +10,7 @@
 #include "nonsep/core/energy.hpp"
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/output/files.hpp"
@@ -244,6 +245,7 @@ class StudyExecution {
                         {"path", loaded_.plugin.path().string()},
                         {"dimension", job_.initial.dimension},
                         {"parameters", json(loaded_.model.parameters())}};
+    if (job_.formula) summary["model"]["formula"] = formula::formula_record(*job_.formula, job_.formula_cache_key);
     summary["hamiltonian"] = study_.form == HamiltonianForm::TTV ? "TTV" : "VVT";
     json study;
     study["t_end"] = study_.t_end;

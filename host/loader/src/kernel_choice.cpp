@@ -43,6 +43,15 @@ std::string instruction_set_pin() {
   return name == "baseline" ? "x86-64" : name;
 }
 
+std::string instruction_set_to_use(const std::vector<std::string>& names) {
+  const std::string pin = instruction_set_pin();
+  if (pin == "evaluation") return "";
+  if (!pin.empty()) return pin;
+  for (std::size_t i = names.size(); i-- > 0;)
+    if (processor_runs(names[i])) return names[i];
+  return "";
+}
+
 KernelChoice choose_kernel(const json& metadata, const nonsep_plugin_api& api) {
   KernelChoice choice;
   if (api.chin_steps == nullptr) {

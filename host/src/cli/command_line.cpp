@@ -115,6 +115,17 @@ int run_command_line(int argc, char** argv) {
         "tables and the scheme catalogue");
     schema->footer(exit_status_text());
 
+    ModelCompileArguments model_arguments;
+    auto* model = app.add_subcommand("model", "Formula models (docs/formula-models.md)");
+    model->require_subcommand(1);
+    auto* compile = model->add_subcommand(
+        "compile", "Compile a formula model file into a plugin NAME.so (NAME: the model's \"name\")");
+    compile->add_option("FILE", model_arguments.model_file, "the model file (JSON: T, V, parameters)")->required();
+    compile->add_option("--output,-o", model_arguments.output, "the plugin file (default ./NAME.so)");
+    compile->add_flag("--print-source", model_arguments.print_source,
+                      "print the C++ written from the formulas instead of compiling it");
+    compile->footer(exit_status_text());
+
     // CLI11 would call an unknown command a missing subcommand without naming it.
     const auto named = [&](const CLI::App* command) { return command->check_name(argv[1]); };
     if (argc > 1 && argv[1][0] != '-' && app.get_subcommands(named).empty()) {
@@ -138,6 +149,7 @@ int run_command_line(int argc, char** argv) {
     if (models->parsed()) return command_models();
     if (example->parsed()) return command_example(example_arguments);
     if (schema->parsed()) return command_schema();
+    if (compile->parsed()) return command_model_compile(model_arguments);
     return to_int(ExitStatus::invalid_input);
   } catch (const std::exception& error) {
     std::cerr << "nonsep: unexpected error: " << error.what() << "\n";

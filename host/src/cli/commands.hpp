@@ -39,6 +39,16 @@ struct InspectArguments {
 
 int command_inspect(const InspectArguments& arguments);
 int command_models();
+// `nonsep model compile FILE [-o NAME.so] [--print-source]` (model_command.cpp).
+struct ModelCompileArguments {
+  std::string model_file, output;
+  bool print_source = false;
+};
+int command_model_compile(const ModelCompileArguments& arguments);
+// For `nonsep validate`: the job read and, when it has a formula model, checked without compiling (nothing for a
+// job with a plugin); throws InvalidJob.
+std::optional<Job> read_formula_job(const std::string& job_file);
+int report_formula_job(const std::string& job_file, const Job& job);
 int command_schema();
 
 // Texts of --help, generated from the scheme catalogue and the exit statuses.

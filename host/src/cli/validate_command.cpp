@@ -22,6 +22,7 @@ std::string initial_shell_text(const InitialStates& initial) {
 
 int command_validate(const std::string& job_file) {
   try {
+    if (const auto formula_job = read_formula_job(job_file)) return report_formula_job(job_file, *formula_job);
     const LoadedJob loaded = load_job(job_file);
     const Job& job = loaded.job;
     if (job.is_study()) {

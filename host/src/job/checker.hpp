@@ -33,6 +33,7 @@ class Checker {
 
   void issue(std::string path, std::string found, std::string allowed);
   std::size_t issue_count() const { return issues_.size(); }
+  std::vector<JobIssue>& issues() { return issues_; }
 
   // True for an object; otherwise an issue saying `what` is allowed.
   bool object(const json& value, const std::string& path, const std::string& what);

@@ -87,19 +87,26 @@ const KeyTable& document_keys() {
 }
 
 const KeyTable& model_keys() {
-  static const KeyTable table{{
-      {.name = "plugin",
-       .type = ValueType::path,
-       .required = true,
-       .description = "A plugin name (looked up as <name>.so on the search path, see `nonsep models`) or a path to a "
-                      ".so file (contains '/' or ends in .so; relative to the job file's folder)."},
-      {.name = "parameters",
-       .type = ValueType::defined,
-       .default_value = nlohmann::ordered_json::object(),
-       .description = "The plugin's parameters by name (see `nonsep inspect PLUGIN`); missing ones take the "
-                      "plugin's defaults.",
-       .definition = "parameters"},
-  }};
+  static const KeyTable table{
+      {
+          {.name = "plugin",
+           .type = ValueType::path,
+           .description =
+               "A plugin name (looked up as <name>.so on the search path, see `nonsep models`) or a path to a "
+               ".so file (contains '/' or ends in .so; relative to the job file's folder)."},
+          {.name = "formula",
+           .type = ValueType::defined,
+           .description = "Instead of a plugin: T(p) and V(q) as formulas (or the path of a model file holding them), "
+                          "compiled on first use into a cached plugin (docs/formula-models.md).",
+           .definition = "formula"},
+          {.name = "parameters",
+           .type = ValueType::defined,
+           .default_value = nlohmann::ordered_json::object(),
+           .description = "The plugin's parameters by name (see `nonsep inspect PLUGIN`); missing ones take the "
+                          "plugin's defaults.",
+           .definition = "parameters"},
+      },
+      {{"oneOf", {{{"required", {"plugin"}}}, {{"required", {"formula"}}}}}}};
   return table;
 }
 

@@ -9,6 +9,7 @@
 
 #include "job_keys.hpp"
 #include "nonsep/core/scheme_catalogue.hpp"
+#include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/time_grid.hpp"
 
@@ -189,6 +190,7 @@ schema_json definitions() {
                         {"description",
                          "Step sizes of the sign of t_end; each becomes steps = ceil((t_end/dt)(1 - "
                          "1e-9)) as in a run."}};
+  defs["formula"] = formula::formula_schema();
   defs["parameters"] = {
       {"type", "object"},
       {"additionalProperties",

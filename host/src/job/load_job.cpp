@@ -5,6 +5,7 @@
 
 #include "checker.hpp"
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/host/formula/plugin_cache.hpp"
 
 namespace nonsep::host {
 
@@ -80,6 +81,7 @@ std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<J
 }
 
 std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
+  if (job.formula && !formula::attach_formula_plugin(job, issues)) return std::nullopt;
   if (job.plugin.empty()) return std::nullopt;
   LoadedJob loaded{std::move(job), {}, {}};
   const Job& checked = loaded.job;

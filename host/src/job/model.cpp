@@ -3,6 +3,7 @@
 // nonsep::sdk::parameter_fault.
 #include <algorithm>
 
+#include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/sdk/parameters.hpp"
 #include "sections.hpp"
@@ -10,14 +11,22 @@
 namespace nonsep::host::job_reader {
 
 void read_model(Checker& check, const json& document, Job& job) {
-  const std::string what = "an object {\"plugin\": name or path, \"parameters\": {...}}";
+  const std::string what =
+      "an object {\"plugin\": name or path, \"parameters\": {...}} or {\"formula\": {\"T\": ..., \"V\": ...}}";
   const json* model = check.member(document, "", "model", document_keys()["model"].required, what);
   if (!model || !check.object(*model, "/model", what)) return;
   const KeyTable& keys = model_keys();
   check.known_keys(*model, "/model", keys.names());
+  if (model->contains("plugin") == model->contains("formula"))
+    check.issue("/model",
+                model->contains("plugin") ? "both \"plugin\" and \"formula\"" : "neither \"plugin\" nor \"formula\"",
+                "exactly one of \"plugin\" (a compiled model) and \"formula\" (T and V as formulas, "
+                "docs/formula-models.md)");
   const std::string plugin_what = "a plugin name (see `nonsep models`) or a path to a .so file";
-  if (const json* plugin = check.member(*model, "/model", "plugin", keys["plugin"].required, plugin_what))
+  if (const json* plugin = check.member(*model, "/model", "plugin", false, plugin_what))
     if (auto name = check.path_string(*plugin, "/model/plugin", plugin_what)) job.plugin = *name;
+  if (const json* formula = check.member(*model, "/model", "formula", false, ""))
+    job.formula = formula::read_formula_model(*formula, "/model/formula", job.directory, check.issues());
   if (const json* parameters = check.member(*model, "/model", "parameters", false, ""))
     if (check.object(*parameters, "/model/parameters", "an object of the plugin's parameters (see `nonsep inspect`)"))
       job.parameters = *parameters;

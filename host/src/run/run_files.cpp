@@ -1,6 +1,7 @@
 #include "run/run_files.hpp"
 
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/output/files.hpp"
@@ -71,6 +72,7 @@ json run_summary(const RunFacts& facts) {
                       {"path", facts.loaded.plugin.path().string()},
                       {"dimension", job.initial.dimension},
                       {"parameters", json(facts.loaded.model.parameters())}};
+  if (job.formula) summary["model"]["formula"] = formula::formula_record(*job.formula, job.formula_cache_key);
   summary["hamiltonian"] = run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
   summary["integrator"] = {{"scheme", description.scheme},
                            {"family", description.family},

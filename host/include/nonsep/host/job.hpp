@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -28,6 +29,10 @@
 #include "nonsep/host/time_grid.hpp"
 
 namespace nonsep::host {
+
+namespace formula {
+struct FormulaModel;  // nonsep/host/formula/formula_model.hpp
+}
 
 // One problem in a job file. `path` is a JSON Pointer ("/integrator/order"; "" for the whole document),
 // `found` describes what is there ("\"5/3\"", "nothing", "a string"), `allowed` what would be accepted.
@@ -156,9 +161,13 @@ struct SingleRun {
 };
 
 struct Job {
-  std::filesystem::path file;                            // the job file as given
-  std::filesystem::path directory;                       // its folder: relative paths in the job resolve against it
-  std::string plugin;                                    // /model/plugin: a name or a path
+  std::filesystem::path file;       // the job file as given
+  std::filesystem::path directory;  // its folder: relative paths in the job resolve against it
+  std::string plugin;               // /model/plugin: a name or a path
+  // /model/formula (instead of /model/plugin): load_model compiles it (or finds it in the cache) and sets `plugin`
+  // to the plugin's path and `formula_cache_key` to its cache entry (formula/plugin_cache.hpp).
+  std::shared_ptr<const formula::FormulaModel> formula;
+  std::string formula_cache_key;
   nlohmann::json parameters = nlohmann::json::object();  // /model/parameters as written
   InitialStates initial;                                 // a study has exactly one state
   std::filesystem::path output_directory;                // /output/directory resolved against `directory`

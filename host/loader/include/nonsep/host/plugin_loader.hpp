@@ -63,6 +63,11 @@ struct KernelChoice {
   std::string chosen_name() const { return chosen ? instruction_sets[*chosen] : ""; }
 };
 
+// The instruction set a plugin with the kernels `names` would run here, by the same rule: NONSEP_INSTRUCTION_SET's
+// ("x86-64" for "baseline", "" for "evaluation"), else the widest of `names` this processor runs. Formula models
+// compile this one besides the baseline (host/include/nonsep/host/formula/plugin_cache.hpp).
+std::string instruction_set_to_use(const std::vector<std::string>& names);
+
 class Plugin {
  public:
   const std::filesystem::path& path() const;

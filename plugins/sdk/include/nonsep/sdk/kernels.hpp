@@ -13,7 +13,8 @@
 // much). The host chooses the set from the processor's features, or the one NONSEP_INSTRUCTION_SET names.
 // Each wider instantiation is flattened (every call inside inlined), so that the model's code is compiled for the
 // wider set too and not called in its baseline copy. Other processors (and compilers without the attribute) get
-// the baseline alone.
+// the baseline alone. NONSEP_SDK_WIDE_KERNEL_SETS (default 3) chooses the wider sets compiled, as bits: 1 for
+// x86-64-v3, 2 for x86-64-v4, 0 for none (each costs compile time; formula models compile the one the host uses).
 #include <cstddef>
 #include <span>
 #include <string_view>
@@ -23,13 +24,25 @@
 
 namespace nonsep::sdk {
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define NONSEP_SDK_WIDE_KERNELS 1
-inline constexpr std::string_view kernel_instruction_sets[] = {"x86-64", "x86-64-v3", "x86-64-v4"};
-#else
-#define NONSEP_SDK_WIDE_KERNELS 0
-inline constexpr std::string_view kernel_instruction_sets[] = {"x86-64"};
+#ifndef NONSEP_SDK_WIDE_KERNEL_SETS
+#define NONSEP_SDK_WIDE_KERNEL_SETS 3
 #endif
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define NONSEP_SDK_KERNEL_V3 (NONSEP_SDK_WIDE_KERNEL_SETS & 1)
+#define NONSEP_SDK_KERNEL_V4 (NONSEP_SDK_WIDE_KERNEL_SETS & 2)
+#else
+#define NONSEP_SDK_KERNEL_V3 0
+#define NONSEP_SDK_KERNEL_V4 0
+#endif
+inline constexpr std::string_view kernel_instruction_sets[] = {
+    "x86-64",
+#if NONSEP_SDK_KERNEL_V3
+    "x86-64-v3",
+#endif
+#if NONSEP_SDK_KERNEL_V4
+    "x86-64-v4",
+#endif
+};
 
 // The kernels of one adapter type: run(index, adapter, call) advances call by the kernel of instruction set
 // `index` (an index into kernel_instruction_sets; false when out of range). Throws what the model throws.
@@ -41,31 +54,36 @@ struct ChinKernels {
   [[gnu::flatten]] static void baseline(const Adapter& adapter, const ChinStepsCall& call) {
     chin_kernel_steps<fixed_dimension>(adapter, call);
   }
-#if NONSEP_SDK_WIDE_KERNELS
+#if NONSEP_SDK_KERNEL_V3
   [[gnu::target("arch=x86-64-v3"), gnu::flatten]] static void v3(const Adapter& adapter, const ChinStepsCall& call) {
     chin_kernel_steps<fixed_dimension>(adapter, call);
   }
+#endif
+#if NONSEP_SDK_KERNEL_V4
   [[gnu::target("arch=x86-64-v4"), gnu::flatten]] static void v4(const Adapter& adapter, const ChinStepsCall& call) {
     chin_kernel_steps<fixed_dimension>(adapter, call);
   }
 #endif
 
   static bool run(std::size_t index, const Adapter& adapter, const ChinStepsCall& call) {
-    switch (index) {
-      case 0:
-        baseline(adapter, call);
-        return true;
-#if NONSEP_SDK_WIDE_KERNELS
-      case 1:
-        v3(adapter, call);
-        return true;
-      case 2:
-        v4(adapter, call);
-        return true;
-#endif
-      default:
-        return false;
+    std::size_t set = 0;
+    if (index == set++) {
+      baseline(adapter, call);
+      return true;
     }
+#if NONSEP_SDK_KERNEL_V3
+    if (index == set++) {
+      v3(adapter, call);
+      return true;
+    }
+#endif
+#if NONSEP_SDK_KERNEL_V4
+    if (index == set++) {
+      v4(adapter, call);
+      return true;
+    }
+#endif
+    return false;
   }
 };
 

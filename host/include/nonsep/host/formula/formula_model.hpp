@@ -1,0 +1,59 @@
+#pragma once
+// A model written as formulas, in a job (/model/formula) or in a model file the job names. Its JSON shape:
+//   {"name": "pdm_oscillator",                      optional: the plugin's name, [a-z_][a-z0-9_]*, default "formula"
+//    "T": "p0^2 / (2 * (1 + alpha * ...))",         required: T(p), a formula of p0, p1, ... (expression.hpp)
+//    "V": "q0^2 / 4",                               required: V(q), a formula of q0, q1, ...
+//    "K": "...", "U": "alpha^2 * q0^2 / 2",         optional: a separable part K(p) + U(q) of H
+//                                                   (H = T_i V_ij T_j + K + U, nonsep/sdk/model_adapter.hpp)
+//    "parameters": {"alpha": 0.5},                  optional: names (is_parameter_name) and their default values
+//    "dimension": 2}                                optional: n (1..64); default the largest index used plus one
+// /model/formula is that object, or a string: the path of a JSON file holding it (relative to the job's folder).
+// The parameters are numbers; a job's /model/parameters overrides their defaults as for any plugin.
+// Every problem is a JobIssue at a JSON Pointer (in the job, or "<model file>#/V" in a model file); a formula's
+// issue quotes it and points at the column (expression.hpp). Nothing is compiled here.
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nonsep/host/formula/expression.hpp"
+#include "nonsep/host/job.hpp"
+
+namespace nonsep::host::formula {
+
+struct FormulaModel {
+  std::string name = "formula";
+  std::string T, V;  // canonical text (print) of the trees: what the metadata and summary.json show
+  Node t_tree, v_tree;
+  std::string K, U;  // the separable part's canonical text; empty when absent
+  std::optional<Node> k_tree, u_tree;
+  std::vector<std::pair<std::string, double>> parameters;  // in the order of the JSON object (by name)
+  std::size_t dimension = 1;
+  std::filesystem::path file;  // the model file it came from; empty when written in the job
+};
+
+// Reads /model/formula (an object, or the path of a model file relative to `directory`). `pointer` is where the
+// value is ("/model/formula"). Nothing, with issues added, when anything is wrong.
+std::shared_ptr<const FormulaModel> read_formula_model(const nlohmann::json& value, const std::string& pointer,
+                                                       const std::filesystem::path& directory,
+                                                       std::vector<JobIssue>& issues);
+
+// Reads a model file (`nonsep model compile FILE`); issues at "<file>#/...".
+std::shared_ptr<const FormulaModel> read_formula_file(const std::filesystem::path& file, std::vector<JobIssue>& issues);
+
+// The JSON Schema of /model/formula (the job schema's $defs/formula).
+nlohmann::ordered_json formula_schema();
+
+// What summary.json records of a formula model: {"T", "V" (canonical), "parameters" (defaults), "dimension",
+// "file" (the model file, or null), "cache_key"}.
+nlohmann::json formula_record(const FormulaModel& model, const std::string& cache_key);
+
+// The formula's parameters as the plugin metadata will declare them (for checking a job's /model/parameters
+// without compiling).
+std::vector<PluginParameter> declared_parameters(const FormulaModel& model);
+
+}  // namespace nonsep::host::formula

@@ -1,0 +1,74 @@
+// `nonsep model compile FILE [-o NAME.so]` (a formula model file into a plugin) and the formula side of
+// `nonsep validate` (formulas, parameters and dimensions checked without compiling).
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "cli/commands.hpp"
+#include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/formula/cpp_source.hpp"
+#include "nonsep/host/formula/plugin_cache.hpp"
+
+namespace nonsep::host::cli {
+
+namespace fs = std::filesystem;
+
+int command_model_compile(const ModelCompileArguments& arguments) {
+  std::vector<JobIssue> issues;
+  const auto model = formula::read_formula_file(arguments.model_file, issues);
+  if (!model) return report_invalid_job(InvalidJob(arguments.model_file, std::move(issues)));
+  const fs::path output = arguments.output.empty() ? fs::path(model->name + ".so") : fs::path(arguments.output);
+  if (output.filename() != model->name + ".so") {
+    std::cerr << "nonsep: the plugin of the model '" << model->name << "' must be named " << model->name
+              << ".so (the loader checks that a plugin's file is named after it), found " << output.string()
+              << "; give -o " << (output.parent_path() / (model->name + ".so")).string()
+              << " or set \"name\" in the model file\n";
+    return to_int(ExitStatus::invalid_input);
+  }
+  if (arguments.print_source) {
+    std::cout << formula::cpp_source(*model);
+    return to_int(ExitStatus::success);
+  }
+  try {
+    const auto toolchain = formula::find_toolchain();
+    const auto start = std::chrono::steady_clock::now();
+    formula::compile_plugin(formula::cpp_source(*model), toolchain, output);
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%.1f",
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    std::cout << "compiled " << arguments.model_file << " into " << output.string() << " in " << seconds
+              << " s (load it with \"plugin\": \"" << output.string()
+              << "\" or put its folder in NONSEP_PLUGIN_PATH)\n";
+    return to_int(ExitStatus::success);
+  } catch (const formula::FormulaCompileError& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+    return to_int(ExitStatus::invalid_input);
+  }
+}
+
+std::optional<Job> read_formula_job(const std::string& job_file) {
+  std::vector<JobIssue> issues;
+  auto job = read_job(job_file, issues);
+  if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
+  if (!job || !job->formula) return std::nullopt;
+  check_model_parameters(job->parameters, formula::declared_parameters(*job->formula), issues);
+  check_dimension(job->initial, job->formula->dimension, issues);
+  if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
+  return job;
+}
+
+int report_formula_job(const std::string& job_file, const Job& job) {
+  const formula::FormulaModel& model = *job.formula;
+  std::cout << "valid: " << job_file << "\n"
+            << "  model:       formula '" << model.name << "', dimension " << model.dimension
+            << (model.file.empty() ? "" : " (" + model.file.string() + ")") << "\n"
+            << "    T = " << model.T << "\n"
+            << "    V = " << model.V << "\n"
+            << "  parameters:  " << job.parameters.dump() << "\n"
+            << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "
+               "(initial states on an energy shell, the gradient check) is checked then\n";
+  return to_int(ExitStatus::success);
+}
+
+}  // namespace nonsep::host::cli

@@ -1,0 +1,239 @@
+// Reading a formula model (formula_model.hpp) from a job's /model/formula or from a model file.
+#include "nonsep/host/formula/formula_model.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include "job/checker.hpp"
+
+namespace nonsep::host::formula {
+
+namespace {
+
+using job_reader::Checker;
+using nlohmann::json;
+
+constexpr std::size_t max_model_file_bytes = std::size_t{1} << 20;
+const std::vector<std::string> formula_keys = {"name", "T", "V", "K", "U", "parameters", "dimension"};
+
+bool is_plugin_name(const std::string& name) {
+  if (name.empty() || name.size() > 64 || !(name[0] == '_' || (name[0] >= 'a' && name[0] <= 'z'))) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](char c) { return c == '_' || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); });
+}
+
+// One of T and V: parsed against its variable letter and the parameters; an issue quoting it on failure.
+std::optional<Node> read_term(Checker& check, const json& object, const std::string& pointer, const char* key,
+                              const Symbols& symbols, bool required = true) {
+  const std::string what = std::string("a formula of ") + (symbols.variable == 'q' ? "q0, q1, ..." : "p0, p1, ...") +
+                           " (the formula grammar: docs/formula-models.md)";
+  const json* value = check.member(object, pointer, key, required, what);
+  if (!value) return std::nullopt;
+  const std::string path = job_reader::child(pointer, key);
+  if (!value->is_string()) {
+    check.issue(path, job_reader::describe(*value), what);
+    return std::nullopt;
+  }
+  const std::string& text = value->get_ref<const std::string&>();
+  auto result = parse_formula(text, symbols);
+  if (const auto* error = std::get_if<FormulaError>(&result)) {
+    check.issue(path,
+                error->found + " at column " + std::to_string(error->column) + ":\n" +
+                    point_at(text, error->column, "      ") + "\n   ",
+                error->allowed);
+    return std::nullopt;
+  }
+  return std::get<Node>(std::move(result));
+}
+
+std::shared_ptr<const FormulaModel> read_object(const json& object, const std::string& pointer,
+                                                std::vector<JobIssue>& issues) {
+  Checker check(issues);
+  const std::size_t before = check.issue_count();
+  if (!check.object(object, pointer, "an object {\"T\": ..., \"V\": ..., \"parameters\": {...}}")) return nullptr;
+  check.known_keys(object, pointer, formula_keys);
+  FormulaModel model;
+  if (const json* name = check.member(object, pointer, "name", false, "")) {
+    if (name->is_string() && is_plugin_name(name->get<std::string>()))
+      model.name = name->get<std::string>();
+    else
+      check.issue(job_reader::child(pointer, "name"), job_reader::describe(*name),
+                  "a plugin name of lower-case letters, digits and '_' (at most 64, not starting with a digit)");
+  }
+  Symbols symbols;
+  if (const json* parameters = check.member(object, pointer, "parameters", false, "")) {
+    const std::string path = job_reader::child(pointer, "parameters");
+    if (check.object(*parameters, path, "an object of parameter names and their default values")) {
+      for (const auto& [name, value] : parameters->items()) {
+        const std::string member = job_reader::child(path, name);
+        if (!is_parameter_name(name)) {
+          check.issue(member, "the parameter name \"" + name + "\"",
+                      "a name of letters, digits and '_' (at most 64, not starting with a digit) that is not a "
+                      "variable (q0, p1, ...), a function or pi");
+          continue;
+        }
+        if (const auto number = check.finite_number(value, member, "the parameter's default, a finite number")) {
+          model.parameters.emplace_back(name, *number);
+          symbols.parameters.push_back(name);
+        }
+      }
+    }
+  }
+  symbols.variable = 'p';
+  auto t_tree = read_term(check, object, pointer, "T", symbols);
+  model.k_tree = read_term(check, object, pointer, "K", symbols, false);
+  symbols.variable = 'q';
+  auto v_tree = read_term(check, object, pointer, "V", symbols);
+  model.u_tree = read_term(check, object, pointer, "U", symbols, false);
+  if (!t_tree || !v_tree || check.issue_count() != before) return nullptr;
+  model.t_tree = std::move(*t_tree);
+  model.v_tree = std::move(*v_tree);
+  model.T = print(model.t_tree);
+  model.V = print(model.v_tree);
+  std::size_t used = std::max({dimension_used(model.t_tree), dimension_used(model.v_tree), std::size_t{1}});
+  if (model.k_tree) {
+    model.K = print(*model.k_tree);
+    used = std::max(used, dimension_used(*model.k_tree));
+  }
+  if (model.u_tree) {
+    model.U = print(*model.u_tree);
+    used = std::max(used, dimension_used(*model.u_tree));
+  }
+  model.dimension = used;
+  if (const json* dimension = check.member(object, pointer, "dimension", false, ""))
+    if (const auto n = check.integer(*dimension, job_reader::child(pointer, "dimension"),
+                                     static_cast<std::int64_t>(used), static_cast<std::int64_t>(max_formula_dimension),
+                                     "an integer from " + std::to_string(used) +
+                                         " (the largest variable index used, plus one) to " +
+                                         std::to_string(max_formula_dimension)))
+      model.dimension = static_cast<std::size_t>(*n);
+  if (check.issue_count() != before) return nullptr;
+  return std::make_shared<const FormulaModel>(std::move(model));
+}
+
+}  // namespace
+
+std::shared_ptr<const FormulaModel> read_formula_file(const std::filesystem::path& file,
+                                                      std::vector<JobIssue>& issues) {
+  const std::string where = file.string() + "#";
+  std::error_code error;
+  const auto size = std::filesystem::file_size(file, error);
+  if (error || !std::filesystem::is_regular_file(file, error)) {
+    issues.push_back({where, "no readable model file", "the path of a formula model file (JSON)"});
+    return nullptr;
+  }
+  if (size > max_model_file_bytes) {
+    issues.push_back({where, "a file of " + std::to_string(size) + " bytes", "a model file of at most 1 MiB"});
+    return nullptr;
+  }
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) {
+    issues.push_back({where, "no readable model file", "the path of a formula model file (JSON)"});
+    return nullptr;
+  }
+  std::vector<JobIssue> syntax;
+  const auto document = parse_job_text(text.str(), syntax);
+  for (auto& issue : syntax) issues.push_back({where + issue.path, issue.found, issue.allowed});
+  if (!document) return nullptr;
+  auto model = read_object(*document, where, issues);
+  if (!model) return nullptr;
+  auto located = std::make_shared<FormulaModel>(*model);
+  located->file = file;
+  return located;
+}
+
+std::shared_ptr<const FormulaModel> read_formula_model(const nlohmann::json& value, const std::string& pointer,
+                                                       const std::filesystem::path& directory,
+                                                       std::vector<JobIssue>& issues) {
+  if (!value.is_string()) return read_object(value, pointer, issues);
+  const std::string& path = value.get_ref<const std::string&>();
+  if (path.empty() || path.find('\0') != std::string::npos) {
+    issues.push_back({pointer, job_reader::describe(value), "the path of a model file, or a formula object"});
+    return nullptr;
+  }
+  return read_formula_file(directory / path, issues);
+}
+
+std::vector<PluginParameter> declared_parameters(const FormulaModel& model) {
+  std::vector<PluginParameter> declared;
+  for (const auto& [name, value] : model.parameters)
+    declared.push_back({name, "number", value, std::nullopt, std::nullopt, "", "a parameter of the formulas"});
+  return declared;
+}
+
+nlohmann::json formula_record(const FormulaModel& model, const std::string& cache_key) {
+  json parameters = json::object();
+  for (const auto& [name, value] : model.parameters) parameters[name] = value;
+  return {{"name", model.name},
+          {"T", model.T},
+          {"V", model.V},
+          {"K", model.k_tree ? json(model.K) : json(nullptr)},
+          {"U", model.u_tree ? json(model.U) : json(nullptr)},
+          {"parameters", parameters},
+          {"dimension", model.dimension},
+          {"file", model.file.empty() ? json(nullptr) : json(model.file.string())},
+          {"cache_key", cache_key}};
+}
+
+nlohmann::ordered_json formula_schema() {
+  nlohmann::ordered_json parameter_names = {{"pattern", "^[A-Za-z_][A-Za-z0-9_]{0,63}$"}};
+  nlohmann::ordered_json object = {
+      {"type", "object"},
+      {"description",
+       "A model written as formulas, compiled on first use into a cached plugin "
+       "(docs/formula-models.md)."},
+      {"additionalProperties", false},
+      {"required", {"T", "V"}},
+      {"properties",
+       {{"name",
+         {{"type", "string"},
+          {"pattern", "^[a-z_][a-z0-9_]{0,63}$"},
+          {"default", "formula"},
+          {"description", "The plugin's name (summary.json, `nonsep model compile`'s NAME.so)."}}},
+        {"T",
+         {{"type", "string"},
+          {"minLength", 1},
+          {"maxLength", max_formula_length},
+          {"description",
+           "T(p): numbers, p0, p1, ..., the parameters, pi, + - * / ^ (or **), parentheses and the "
+           "functions abs acos acosh asin asinh atan atan2 atanh cbrt cos cosh cube erf exp expm1 "
+           "hypot log log1p max min pow sin sinh sqrt square tan tanh."}}},
+        {"V",
+         {{"type", "string"},
+          {"minLength", 1},
+          {"maxLength", max_formula_length},
+          {"description", "V(q): as T, with q0, q1, ... instead of p0, p1, ...."}}},
+        {"K",
+         {{"type", "string"},
+          {"minLength", 1},
+          {"maxLength", max_formula_length},
+          {"description", "Optional separable part K(p), a formula like T: H = T_i V_ij T_j + K + U."}}},
+        {"U",
+         {{"type", "string"},
+          {"minLength", 1},
+          {"maxLength", max_formula_length},
+          {"description", "Optional separable part U(q), a formula like V."}}},
+        {"parameters",
+         {{"type", "object"},
+          {"propertyNames", parameter_names},
+          {"additionalProperties", {{"type", "number"}}},
+          {"default", nlohmann::ordered_json::object()},
+          {"description", "The formulas' parameters and their default values; /model/parameters overrides them."}}},
+        {"dimension",
+         {{"type", "integer"},
+          {"minimum", 1},
+          {"maximum", max_formula_dimension},
+          {"description", "The dimension n; default the largest variable index used plus one."}}}}}};
+  return {{"oneOf",
+           {object,
+            {{"type", "string"},
+             {"minLength", 1},
+             {"description",
+              "The path of a model file holding such an object, relative to the job file's "
+              "folder."}}}}};
+}
+
+}  // namespace nonsep::host::formula

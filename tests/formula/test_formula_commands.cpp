@@ -1,0 +1,236 @@
+// Formula models through the `nonsep` executable: malformed formulas exit 2 with a column pointer from
+// `nonsep validate` (which compiles nothing); a formula model compiled by the real compiler gives the states of the
+// hand-written paper1d plugin (the one real compile of these tests); the cache's mechanics with a stand-in compiler
+// that copies the shipped paper1d.so (reuse, two runs compiling at once, a damaged entry, an unwritable cache,
+// no compiler, a failing compiler); `nonsep model compile`.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "host_test_support.hpp"
+
+using nlohmann::json;
+using namespace nonsep::host_testing;
+namespace fs = std::filesystem;
+
+struct Malformed {
+  std::string text;
+  std::size_t column;
+};
+extern const std::vector<Malformed> malformed_formulas;  // test_formula_parser.cpp
+
+namespace {
+
+// Sets an environment variable for its lifetime, then restores the previous value.
+class Environment {
+ public:
+  Environment(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~Environment() {
+    if (old_)
+      ::setenv(name_, old_->c_str(), 1);
+    else
+      ::unsetenv(name_);
+  }
+  Environment(const Environment&) = delete;
+  Environment& operator=(const Environment&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+json paper1d_formula(const std::string& name) {
+  return {{"name", name}, {"T", "p0 + p0^3/6"}, {"V", "q0^2/2 + q0^4/12"}};
+}
+
+json job_with(json model) {
+  return {{"model", std::move(model)},
+          {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}}},
+          {"initial", {{{"q", {0.5}}, {"p", {0.25}}}, {{"q", {-1.0}}, {"p", {0.75}}}}},
+          {"time", {{"dt", 0.01}, {"steps", 300}}},
+          {"output", {{"every", 0}}}};
+}
+
+// A stand-in compiler: `--version` prints one line; otherwise it appends a line to FAKE_LOG, waits FAKE_SLEEP
+// seconds and copies the shipped paper1d.so to the -o argument (or fails, with FAKE_FAIL set).
+fs::path write_fake_compiler(const TemporaryFolder& folder) {
+  const fs::path script = folder / "fake-c++";
+  write_text(script,
+             "#!/bin/sh\n"
+             "if [ \"$1\" = --version ]; then echo 'fake compiler 1'; exit 0; fi\n"
+             "echo call >> \"$FAKE_LOG\"\n"
+             "if [ -n \"$FAKE_FAIL\" ]; then echo 'model.cpp:1:1: error: fake failure' >&2; exit 1; fi\n"
+             "sleep \"${FAKE_SLEEP:-0}\"\n"
+             "out=''; previous=''\n"
+             "for a in \"$@\"; do [ \"$previous\" = -o ] && out=\"$a\"; previous=\"$a\"; done\n"
+             "cp '" NONSEP_SHIPPED_PLUGIN_DIR "/paper1d.so' \"$out\"\n");
+  fs::permissions(script, fs::perms::owner_all);
+  return script;
+}
+
+std::size_t count_lines(const fs::path& file) {
+  if (!fs::exists(file)) return 0;
+  const std::string text = read_text(file);
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("formula commands: each malformed formula exits 2 from validate, quoting it with a caret at its column") {
+  TemporaryFolder folder;
+  Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");
+  for (std::size_t i = 0; i < malformed_formulas.size(); ++i) {
+    const auto& [text, column] = malformed_formulas[i];
+    json model = {{"formula", {{"T", "p0^2/2"}, {"V", text}, {"parameters", {{"lambda", 1}, {"k", 2}}}}}};
+    const auto file = write_job(folder / ("bad" + std::to_string(i) + ".json"), job_with(model));
+    const auto result = run_nonsep({"validate", file.string()}, folder.path());
+    INFO("formula: " << text << "\nstderr: " << result.err);
+    CHECK(result.status == 2);
+    CHECK(contains(result.err, "/model/formula/V"));
+    CHECK(contains(result.err, "at column " + std::to_string(column)));
+    CHECK(contains(result.err, "\n" + std::string(6 + column - 1, ' ') + "^"));
+  }
+}
+
+TEST_CASE("formula commands: validate checks a formula job's parameters and dimension without compiling") {
+  TemporaryFolder folder;
+  Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");
+  json good = job_with({{"formula", paper1d_formula("paper1d")}});
+  const auto valid = run_nonsep({"validate", write_job(folder / "good.json", good).string()}, folder.path());
+  INFO(valid.err);
+  CHECK(valid.status == 0);
+  CHECK(contains(valid.out, "T = p0 + p0^3/6"));
+  json wrong = job_with({{"formula", paper1d_formula("paper1d")}, {"parameters", {{"alpha", 1}}}});
+  wrong["initial"] = {{"q", {0.5, 1.0}}, {"p", {0.25, 1.0}}};
+  const auto invalid = run_nonsep({"validate", write_job(folder / "wrong.json", wrong).string()}, folder.path());
+  CHECK(invalid.status == 2);
+  CHECK(contains(invalid.err, "/model/parameters/alpha"));
+  CHECK(contains(invalid.err, "/initial"));
+  json both = job_with({{"plugin", "paper1d"}, {"formula", paper1d_formula("paper1d")}});
+  CHECK(run_nonsep({"validate", write_job(folder / "both.json", both).string()}, folder.path()).status == 2);
+  const auto run = run_nonsep({"run", "--quiet", write_job(folder / "run.json", good).string()}, folder.path());
+  CHECK(run.status == 2);
+  CHECK(contains(run.err, "no C++ compiler"));
+  CHECK(contains(run.err, "apt-get install g++"));
+}
+
+TEST_CASE(
+    "formula commands: a compiled formula model gives the hand-written plugin's states, and the cache is reused") {
+  TemporaryFolder folder;
+  Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());
+  const json formula_job = job_with({{"formula", paper1d_formula("paper1d_formula")}});
+  const auto formula_file = write_job(folder / "formula.json", formula_job);
+  // The compile takes seconds on an idle machine and minutes on a loaded one: a generous limit, not a timing.
+  const auto first =
+      finish(start_nonsep({"run", "--quiet", "-o", (folder / "first").string(), formula_file.string()}, folder.path()),
+             std::chrono::seconds(900));
+  INFO("stderr: " << first.err);
+  REQUIRE(first.status == 0);
+  CHECK(contains(first.err, "compiling the formula model 'paper1d_formula'"));
+  CHECK(contains(first.err, "compiled in "));
+  const auto second =
+      run_nonsep({"run", "--quiet", "-o", (folder / "second").string(), formula_file.string()}, folder.path());
+  CHECK(second.status == 0);
+  CHECK(!contains(second.err, "compiling"));
+  CHECK(read_text(folder / "first" / "trajectories.csv") == read_text(folder / "second" / "trajectories.csv"));
+
+  const auto plugin_file = write_job(folder / "plugin.json", job_with({{"plugin", "paper1d"}}));
+  REQUIRE(
+      run_nonsep({"run", "--quiet", "-o", (folder / "plugin").string(), plugin_file.string()}, folder.path()).status ==
+      0);
+  const json by_formula = read_run(folder / "first");
+  const json by_plugin = read_run(folder / "plugin");
+  REQUIRE(by_formula["trajectories"].size() == 2);
+  // Relative to the state (q, p): a component passing near 0 has no relative accuracy of its own.
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json& a = by_formula["trajectories"][i]["final"];
+    const json& b = by_plugin["trajectories"][i]["final"];
+    const double scale = std::hypot(b["q"][0].get<double>(), b["p"][0].get<double>());
+    for (const char* part : {"q", "p"})
+      CHECK(std::abs(a[part][0].get<double>() - b[part][0].get<double>()) <= 1e-13 * scale);
+  }
+  const json record = by_formula["model"]["formula"];
+  CHECK(record["T"] == "p0 + p0^3/6");
+  CHECK(record["V"] == "q0^2/2 + q0^4/12");
+  CHECK(record["cache_key"].get<std::string>().size() == 16);
+  CHECK(fs::exists(folder / "cache" / "formula" / record["cache_key"].get<std::string>() / "paper1d_formula.so"));
+}
+
+TEST_CASE("formula commands: the cache with a stand-in compiler: one compile for two runs at once, damage, fallback") {
+  TemporaryFolder folder;
+  Environment compiler("NONSEP_CXX", write_fake_compiler(folder).string());
+  Environment log("FAKE_LOG", (folder / "calls.log").string());
+  Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());
+  const auto file = write_job(folder / "job.json", job_with({{"formula", paper1d_formula("paper1d")}}));
+
+  SUBCASE("two runs compiling the same model at once compile it once, and both run") {
+    Environment slow("FAKE_SLEEP", "1");
+    const auto a = start_nonsep({"run", "--quiet", "-o", (folder / "a").string(), file.string()}, folder.path());
+    const auto b = start_nonsep({"run", "--quiet", "-o", (folder / "b").string(), file.string()}, folder.path());
+    const auto done_a = finish(a), done_b = finish(b);
+    INFO(done_a.err << done_b.err);
+    CHECK(done_a.status == 0);
+    CHECK(done_b.status == 0);
+    CHECK(count_lines(folder / "calls.log") == 1);
+    CHECK(read_text(folder / "a" / "trajectories.csv") == read_text(folder / "b" / "trajectories.csv"));
+  }
+  SUBCASE("a damaged or half-written entry is never used: it is compiled again") {
+    CHECK(run_nonsep({"run", "--quiet", "-o", (folder / "a").string(), file.string()}, folder.path()).status == 0);
+    CHECK(count_lines(folder / "calls.log") == 1);
+    CHECK(run_nonsep({"run", "--quiet", "-o", (folder / "b").string(), file.string()}, folder.path()).status == 0);
+    CHECK(count_lines(folder / "calls.log") == 1);
+    const json summary = read_json(folder / "a" / "summary.json");
+    const fs::path entry = folder / "cache" / "formula" / summary["model"]["formula"]["cache_key"].get<std::string>();
+    fs::resize_file(entry / "paper1d.so", fs::file_size(entry / "paper1d.so") / 2);
+    const auto again = run_nonsep({"run", "--quiet", "-o", (folder / "c").string(), file.string()}, folder.path());
+    INFO(again.err);
+    CHECK(again.status == 0);
+    CHECK(count_lines(folder / "calls.log") == 2);
+    fs::remove(entry / "entry.json");
+    CHECK(run_nonsep({"run", "--quiet", "-o", (folder / "d").string(), file.string()}, folder.path()).status == 0);
+    CHECK(count_lines(folder / "calls.log") == 3);
+    CHECK(read_text(folder / "a" / "trajectories.csv") == read_text(folder / "d" / "trajectories.csv"));
+  }
+  SUBCASE("a cache folder that cannot be created falls back to the temporary folder, saying so") {
+    write_text(folder / "not-a-folder", "");
+    Environment unwritable("NONSEP_CACHE_DIR", (folder / "not-a-folder" / "cache").string());
+    Environment temporary("TMPDIR", folder.path().string());
+    const auto result = run_nonsep({"run", "--quiet", "-o", (folder / "a").string(), file.string()}, folder.path());
+    INFO(result.err);
+    CHECK(result.status == 0);
+    CHECK(contains(result.err, "is not writable; using " + folder.path().string()));
+    CHECK(count_lines(folder / "calls.log") == 1);
+  }
+  SUBCASE("a failing compiler is an error with its output, exit 2") {
+    Environment fail("FAKE_FAIL", "1");
+    const auto result = run_nonsep({"run", "--quiet", file.string()}, folder.path());
+    CHECK(result.status == 2);
+    CHECK(contains(result.err, "fake failure"));
+  }
+  SUBCASE("nonsep model compile writes NAME.so and refuses another name") {
+    const auto model_file = write_job(folder / "model.json", paper1d_formula("paper1d"));
+    const auto made =
+        run_nonsep({"model", "compile", model_file.string(), "-o", (folder / "paper1d.so").string()}, folder.path());
+    INFO(made.err);
+    CHECK(made.status == 0);
+    CHECK(fs::file_size(folder / "paper1d.so") == fs::file_size(NONSEP_SHIPPED_PLUGIN_DIR "/paper1d.so"));
+    const auto named =
+        run_nonsep({"model", "compile", model_file.string(), "-o", (folder / "other.so").string()}, folder.path());
+    CHECK(named.status == 2);
+    CHECK(contains(named.err, "must be named paper1d.so"));
+    const auto source = run_nonsep({"model", "compile", model_file.string(), "--print-source"}, folder.path());
+    CHECK(contains(source.out, "NONSEP_EXPORT_MODEL(Formula, \"paper1d\""));
+    write_text(folder / "bad.json", R"({"T": "p0", "V": "q0 + \"; }"})");
+    const auto bad = run_nonsep({"model", "compile", (folder / "bad.json").string()}, folder.path());
+    CHECK(bad.status == 2);
+    CHECK(contains(bad.err, "bad.json#/V"));
+  }
+}

@@ -1,0 +1,210 @@
+// The formula grammar (host/include/nonsep/host/formula/expression.hpp) in-process: well-formed formulas parse and
+// print back to the same tree; malformed ones and injection attempts are refused at the right column; nesting
+// beyond the limit is refused without deep recursion; the C++ written from a tree holds nothing of the text but
+// what the tree says.
+#include <doctest/doctest.h>
+
+#include <string>
+#include <vector>
+
+#include "nonsep/host/formula/cpp_source.hpp"
+#include "nonsep/host/formula/expression.hpp"
+#include "nonsep/host/formula/formula_model.hpp"
+
+using namespace nonsep::host::formula;
+
+namespace {
+
+const Symbols q_symbols{'q', {"lambda", "k"}};
+
+FormulaError error_of(const std::string& text, const Symbols& symbols = q_symbols) {
+  auto result = parse_formula(text, symbols);
+  REQUIRE_MESSAGE(std::holds_alternative<FormulaError>(result), "accepted: " << text);
+  return std::get<FormulaError>(result);
+}
+
+Node tree_of(const std::string& text, const Symbols& symbols = q_symbols) {
+  auto result = parse_formula(text, symbols);
+  if (const auto* error = std::get_if<FormulaError>(&result))
+    FAIL_CHECK("refused: " << text << ": " << error->found << " at column " << error->column);
+  REQUIRE(std::holds_alternative<Node>(result));
+  return std::get<Node>(result);
+}
+
+}  // namespace
+
+// A malformed formula and the column its error must point at (1-based).
+struct Malformed {
+  std::string text;
+  std::size_t column;
+};
+
+// The same list drives tests/formula/test_formula_commands.cpp through `nonsep validate` (exit 2).
+extern const std::vector<Malformed> malformed_formulas;
+const std::vector<Malformed> malformed_formulas = {
+    {"", 1},                    // empty
+    {"   ", 4},                 // blanks only
+    {"q0 +", 5},                // ends after an operator
+    {"q0 + * q1", 6},           // two operators
+    {"* q0", 1},                // starts with an operator
+    {"(q0 + 1", 8},             // unclosed parenthesis
+    {"q0 + 1)", 7},             // unopened parenthesis
+    {"()", 2},                  // empty parentheses
+    {"q0 q1", 4},               // two terms without an operator
+    {"2q0", 2},                 // number glued to a name
+    {"1.5e", 5},                // exponent without digits
+    {"1e999", 1},               // overflow
+    {"x + q0", 1},              // unknown name
+    {"q0 + p0", 6},             // p in V
+    {"q01", 1},                 // leading zero in an index
+    {"q64", 1},                 // index beyond the dimension limit
+    {"sin q0", 5},              // function without parentheses
+    {"sin(q0, q1)", 1},         // too many arguments
+    {"atan2(q0)", 1},           // too few arguments
+    {"foo(q0)", 1},             // unknown function
+    {"sin()", 5},               // no argument
+    {"pow(q0,)", 8},            // empty argument
+    {"q0 ^", 5},                // power without exponent
+    {"q0 ^ * 2", 6},            // power then operator
+    {"q0 = 1", 4},              // assignment
+    {"q0 % 2", 4},              // modulo
+    {"q0; system(\"x\")", 3},   // statement separator
+    {"\"q0\"", 1},              // quotes
+    {"q0 + 'a'", 6},            // single quotes
+    {"#include <cstdlib>", 1},  // preprocessor line
+    {"q0\n#define X", 3},       // newline then preprocessor
+    {"{q0}", 1},                // braces
+    {"q0[0]", 3},               // brackets
+    {"q0 \\ 2", 4},             // backslash
+    {"q0 // comment", 5},       // a C++ comment: '/' then '/'
+    {"q0 /* c */", 5},          // a block comment: '/' then '*'
+    {"q0 & 1", 4},              // bitwise and
+    {"q0 < 1", 4},              // comparison
+    {"q0 ? 1 : 2", 4},          // conditional
+    {"lambda(q0)", 1},          // a parameter called as a function
+    {"sin", 4},                 // a function without call
+    {"q0 + \xc3\xa9", 6},       // non-ASCII
+    {"std::exp(q0)", 4},        // C++ scope
+    {"q0.x", 3},                // member access after an index is a number glued to a name
+    {"0x10", 2},                // hexadecimal
+    {"1,2", 2},                 // comma outside a call
+};
+
+TEST_CASE("formula parser: every malformed formula is refused at its column, saying what is allowed") {
+  CHECK(malformed_formulas.size() >= 30);
+  for (const auto& [text, column] : malformed_formulas) {
+    const FormulaError error = error_of(text);
+    CHECK_MESSAGE(error.column == column, text << ": column " << error.column << ", found " << error.found);
+    CHECK_MESSAGE(!error.found.empty(), text);
+    CHECK_MESSAGE(!error.allowed.empty(), text);
+  }
+}
+
+TEST_CASE("formula parser: T refuses q, names the allowed letter, and lists the functions at a bad term") {
+  const FormulaError error = error_of("p0 + q0", Symbols{'p', {}});
+  CHECK(error.column == 6);
+  CHECK(error.allowed.find("p0, p1") != std::string::npos);
+  const FormulaError term = error_of("q0 + )");
+  CHECK(term.allowed.find("atan2(a, b)") != std::string::npos);
+  CHECK(term.allowed.find("lambda") != std::string::npos);
+}
+
+TEST_CASE("formula parser: nesting beyond the limit and over-long text are refused, long flat input is fine") {
+  std::string deep;
+  for (int i = 0; i < 2000; ++i) deep += "(";
+  deep += "q0";
+  CHECK(error_of(deep).found.find("nesting deeper") != std::string::npos);
+  std::string signs(2000, '-');
+  CHECK(error_of(signs + "q0").found.find("nesting deeper") != std::string::npos);
+  std::string powers = "q0";
+  for (int i = 0; i < 200; ++i) powers += "^q0";
+  CHECK(error_of(powers).found.find("nesting deeper") != std::string::npos);
+  std::string calls;
+  for (int i = 0; i < 200; ++i) calls += "sin(";
+  CHECK(error_of(calls + "q0").found.find("nesting deeper") != std::string::npos);
+  std::string nested = "q0";
+  for (int i = 0; i < 20; ++i) nested = "(" + nested + " + 1)";
+  CHECK(tree_of(nested).kind == Node::Kind::sum);
+  std::string flat = "q0";
+  while (flat.size() + 5 < max_formula_length) flat += " + q0";
+  const Node wide = tree_of(flat);
+  CHECK(wide.operands.size() > 800);
+  CHECK(error_of(flat + " + q0 + q0").found.find("characters") != std::string::npos);
+  CHECK(error_of(std::string(1 << 20, '1')).column == max_formula_length + 1);
+}
+
+TEST_CASE("formula parser: canonical text parses back to the same tree, with the grammar's precedence") {
+  const std::vector<std::string> formulas = {
+      "q0",
+      "q0^2/2 + q0^4/12",
+      "-q0^2",
+      "(-q0)^2",
+      "2^3^2",
+      "(2^3)^2",
+      "q0 ** 2 * lambda",
+      "-(q0 * q1) - -q1",
+      "a - (b - c)",  // refused below: unknown names
+      "q0 - (q1 - q2) + (q0 + q1)",
+      "q0 / (q1 * q2) / q3",
+      "atan2(q0, q1) + hypot(q0, 1.5e-3) * pow(q1, k)",
+      "exp(-lambda * (q0^2 + q1^2)) + 1e+300 + .5 + 7.",
+      "2^-q0 + q0^-2 + q0^(1/3) + pi",
+      "+q0 - +1",
+  };
+  for (const auto& text : formulas) {
+    if (text == "a - (b - c)") {
+      CHECK(error_of(text).column == 1);
+      continue;
+    }
+    const Node tree = tree_of(text);
+    const std::string printed = print(tree);
+    CHECK_MESSAGE(tree_of(printed) == tree, text << " -> " << printed);
+    CHECK_MESSAGE(print(tree_of(printed)) == printed, printed);
+  }
+  CHECK(print(tree_of("2^3^2")) == "2^3^2");
+  CHECK(tree_of("2^3^2").operands[1].kind == Node::Kind::power);
+  CHECK(tree_of("-q0^2").kind == Node::Kind::negate);
+  CHECK(print(tree_of("q0*(q1*q2)")) == "q0*(q1*q2)");
+  CHECK(print(tree_of("q0 ** 2")) == "q0^2");
+  CHECK(dimension_used(tree_of("q0 + q7")) == 8);
+}
+
+TEST_CASE("formula C++: written from the tree alone, with products for integer powers") {
+  std::vector<nonsep::host::JobIssue> issues;
+  const auto model = read_formula_model(nlohmann::json{{"name", "oscillator"},
+                                                       {"T", "p0^2 / 2"},
+                                                       {"V", "q0^2/4   + lambda*q0^4/24"},
+                                                       {"U", "alpha^2 * q0^2 / (2 * (1 + lambda * q0^2))"},
+                                                       {"parameters", {{"lambda", 0.5}, {"alpha", 1}}}},
+                                        "/model/formula", ".", issues);
+  REQUIRE(issues.empty());
+  REQUIRE(model);
+  CHECK(model->V == "q0^2/4 + lambda*q0^4/24");
+  const std::string source = cpp_source(*model);
+  CHECK(source.find("integer_power<4>(q[0])") != std::string::npos);
+  CHECK(source.find("parameter_lambda") != std::string::npos);
+  CHECK(source.find("S U(") != std::string::npos);
+  CHECK(source.find("S K(") == std::string::npos);
+  CHECK(source.find("q0^2/4   +") == std::string::npos);
+}
+
+TEST_CASE("formula models: bad keys, parameter names, names and dimensions are issues at their pointers") {
+  std::vector<nonsep::host::JobIssue> issues;
+  CHECK(!read_formula_model(nlohmann::json{{"T", "p0"},
+                                           {"V", "q0 +"},
+                                           {"W", "1"},
+                                           {"name", "Bad-Name\"; int x;"},
+                                           {"dimension", 0},
+                                           {"parameters", {{"q1", 1}, {"sin", 2}, {"a;b", 3}, {"ok", "x"}}}},
+                            "/model/formula", ".", issues));
+  std::vector<std::string> paths;
+  for (const auto& issue : issues) paths.push_back(issue.path);
+  for (const std::string expected :
+       {"/model/formula/W", "/model/formula/name", "/model/formula/V", "/model/formula/parameters/q1",
+        "/model/formula/parameters/sin", "/model/formula/parameters/a;b", "/model/formula/parameters/ok"})
+    CHECK_MESSAGE(std::find(paths.begin(), paths.end(), expected) != paths.end(), expected);
+  issues.clear();
+  CHECK(!read_formula_model(nlohmann::json{{"T", "p0 + p3"}, {"V", "q0"}, {"dimension", 2}}, "/f", ".", issues));
+  REQUIRE(issues.size() == 1);
+  CHECK(issues[0].path == "/f/dimension");
+}
