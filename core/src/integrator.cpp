@@ -1,5 +1,6 @@
 #include "nonsep/core/integrator.hpp"
 
+#include <charconv>
 #include <stdexcept>
 
 namespace nonsep {
@@ -39,11 +40,48 @@ OptionField option_field(IntegratorSpec& spec, const ParameterDescription& param
   throw std::logic_error("IntegratorSpec has no field for the catalogue option '" + parameter.name + "'");
 }
 
+std::variant<Fraction, double> option_value(const IntegratorSpec& spec, const ParameterDescription& parameter) {
+  IntegratorSpec copy = spec;  // option_field hands out fields to write; here they are only read
+  return std::visit([](auto* field) -> std::variant<Fraction, double> { return *field; },
+                    option_field(copy, parameter));
+}
+
+std::variant<Fraction, double> default_option_value(const ParameterDescription& parameter) {
+  if (parameter.kind == ParameterDescription::Kind::Order) return Fraction::parse(parameter.default_text);
+  const auto& text = parameter.default_text;
+  double number = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), number);
+  if (ec != std::errc() || end != text.data() + text.size())
+    throw std::logic_error("catalogue default '" + text + "' of '" + parameter.name + "' is not a number");
+  return number;
+}
+
+void set_option(IntegratorSpec& spec, const ParameterDescription& parameter,
+                const std::variant<Fraction, double>& value) {
+  std::visit(
+      [&](auto* field) {
+        using Field = std::remove_pointer_t<decltype(field)>;
+        const auto* given = std::get_if<Field>(&value);
+        if (!given) throw std::logic_error("option '" + parameter.name + "' set with a value of the other kind");
+        *field = *given;
+      },
+      option_field(spec, parameter));
+}
+
+IntegratorSpec default_spec(const Scheme& scheme, HamiltonianForm form) {
+  IntegratorSpec spec;
+  spec.scheme = scheme.name;
+  spec.form = form;
+  for (const auto& parameter : scheme.parameters)
+    if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
+  return spec;
+}
+
 Integrator::Integrator(const IntegratorSpec& spec) : spec_(spec), form_(spec.form), stepper_(build(spec)) {}
 
 IntegratorDescription Integrator::describe() const {
   IntegratorDescription d = std::visit([](const auto& stepper) { return description_of(stepper); }, stepper_);
-  d.scheme = spec_.scheme == "implicit_midpoint" ? spec_.scheme : d.scheme;
+  d.scheme = spec_.scheme;  // one stepper type serves two entries (gauss, implicit_midpoint): the entry's name
   return d;
 }
 

@@ -1,7 +1,6 @@
 #include "nonsep/host/checkpoint.hpp"
 
 #include <bit>
-#include <charconv>
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -22,7 +21,7 @@ using json = nlohmann::json;
 
 namespace {
 
-constexpr const char* format_tag = "nonsep checkpoint 4";  // 4: Tao's copies and the grad H count
+constexpr const char* format_tag = "nonsep checkpoint 4";  // 4: the scheme's private state and the grad H count
 
 json encode(double value) { return format_number(value); }
 
@@ -48,48 +47,9 @@ json encode(const MegnoRecord& record) {
 }
 
 // Every read of a malformed file ends here, with what was wrong.
-[[noreturn]] void damaged(const std::filesystem::path& path, const std::string& what) {
-  throw CheckpointError(path.string() + " is damaged (" + what +
-                        "); run the job with --force instead of --resume to start it over");
+SavedState reader(const std::filesystem::path& path) {
+  return SavedState(path.string(), "; run the job with --force instead of --resume to start it over");
 }
-
-struct Reader {
-  const std::filesystem::path& path;
-
-  double number(const json& value, const char* what) const {
-    if (!value.is_string()) damaged(path, std::string(what) + " is not a number");
-    const std::string& text = value.get_ref<const std::string&>();
-    double x = 0.0;
-    const auto result = std::from_chars(text.data(), text.data() + text.size(), x);
-    if (result.ec != std::errc() || result.ptr != text.data() + text.size())
-      damaged(path, std::string(what) + " is not a number: \"" + text + "\"");
-    return x;
-  }
-  std::optional<double> optional_number(const json& value, const char* what) const {
-    if (value.is_null()) return std::nullopt;
-    return number(value, what);
-  }
-  std::vector<double> numbers(const json& value, std::size_t size, const char* what) const {
-    if (!value.is_array() || value.size() != size)
-      damaged(path, std::string(what) + " does not have " + std::to_string(size) + " numbers");
-    std::vector<double> result;
-    result.reserve(size);
-    for (const auto& x : value) result.push_back(number(x, what));
-    return result;
-  }
-  std::uint64_t unsigned_integer(const json& value, const char* what) const {
-    if (!value.is_number_unsigned()) damaged(path, std::string(what) + " is not an integer >= 0");
-    return value.get<std::uint64_t>();
-  }
-  std::string string(const json& value, const char* what) const {
-    if (!value.is_string()) damaged(path, std::string(what) + " is not a string");
-    return value.get<std::string>();
-  }
-  const json& member(const json& object, const char* key) const {
-    if (!object.is_object() || !object.contains(key)) damaged(path, std::string("\"") + key + "\" is missing");
-    return object.at(key);
-  }
-};
 
 void append_bits(std::string& text, double value) {
   text += std::to_string(std::bit_cast<std::uint64_t>(value));
@@ -98,17 +58,17 @@ void append_bits(std::string& text, double value) {
 
 // What the checksum cannot catch (a checkpoint written by a faulty build, or rewritten with a fresh checksum):
 // active trajectories have finite states and the status "running", retired ones another status.
-void check_consistency(const std::filesystem::path& path, const DriverState& state, std::size_t n) {
+void check_consistency(const SavedState& read, const DriverState& state, std::size_t n) {
   for (std::size_t i = 0; i < state.q.size(); ++i)
     if (!std::isfinite(state.q[i]) || !std::isfinite(state.p[i]))
-      damaged(path, "active trajectory " + std::to_string(state.active[i / n]) + " has a state that is not finite");
+      read.damaged("active trajectory " + std::to_string(state.active[i / n]) + " has a state that is not finite");
   std::vector<bool> active(state.records.size(), false);
   for (std::size_t index : state.active) active[index] = true;
   for (std::size_t i = 0; i < state.records.size(); ++i)
     if (active[i] != (state.records[i].status == TrajectoryStatus::running))
-      damaged(path, "trajectory " + std::to_string(i) +
-                        (active[i] ? " is active but its record says \"" : " is not active but its record says \"") +
-                        std::string(to_string(state.records[i].status)) + "\"");
+      read.damaged("trajectory " + std::to_string(i) +
+                   (active[i] ? " is active but its record says \"" : " is not active but its record says \"") +
+                   std::string(to_string(state.records[i].status)) + "\"");
 }
 
 }  // namespace
@@ -119,23 +79,22 @@ namespace {
 std::uint64_t file_hash(const std::filesystem::path& path) { return file_content_hash(path).value_or(0); }
 
 // The integrator's part: the scheme and the form; then one part per option of the scheme's catalogue entry
-// ("integrator.omega"), read through option_field, so that every option of every scheme is in the fingerprint and a
+// ("integrator.omega"), read through option_value, so that every option of every scheme is in the fingerprint and a
 // changed one is named.
 void add_integrator_parts(std::vector<std::pair<std::string, std::string>>& parts, const IntegratorSpec& spec) {
   parts.emplace_back("integrator", spec.scheme + '\n' + (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT"));
   const Scheme* scheme = find_scheme(spec.scheme);
-  if (!scheme) return;         // the job reader refuses an unknown scheme; the name alone identifies it
-  IntegratorSpec copy = spec;  // option_field hands out fields to write; here they are only read
+  if (!scheme) return;  // the job reader refuses an unknown scheme; the name alone identifies it
   for (const ParameterDescription& option : scheme->parameters) {
     std::string text;
     std::visit(
-        [&](auto* field) {
-          if constexpr (std::is_same_v<decltype(field), Fraction*>)
-            text = field->to_string();
+        [&](const auto& value) {
+          if constexpr (std::is_same_v<std::decay_t<decltype(value)>, Fraction>)
+            text = value.to_string();
           else
-            append_bits(text, *field);
+            append_bits(text, value);
         },
-        option_field(copy, option));
+        option_value(spec, option));
     parts.emplace_back("integrator." + option.name, text);
   }
 }
@@ -235,24 +194,26 @@ void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkp
     evaluations["grad_K"] = state.evaluations.grad_K;
     evaluations["grad_U"] = state.evaluations.grad_U;
   }
-  const json document = {{"format", format_tag},
-                         {"job_fingerprint", fingerprint},
-                         {"step", state.step},
-                         {"evaluations", evaluations},
-                         {"max_copy_distance", encode(state.max_copy_distance)},
-                         {"active",
-                          {{"trajectories", state.active},
-                           {"q", encode(state.q)},
-                           {"p", encode(state.p)},
-                           {"energies", encode(state.energies)},
-                           {"tangent_q", encode(state.tangent_q)},
-                           {"tangent_p", encode(state.tangent_p)},
-                           {"copies_q", encode(state.copies_q)},
-                           {"copies_p", encode(state.copies_p)},
-                           {"lyapunov", std::move(lyapunov)},
-                           {"megno", std::move(megno)}}},
-                         {"records", std::move(records)},
-                         {"observers", checkpoint.observers}};
+  json document = {{"format", format_tag},
+                   {"job_fingerprint", fingerprint},
+                   {"step", state.step},
+                   {"evaluations", evaluations},
+                   {"active",
+                    {{"trajectories", state.active},
+                     {"q", encode(state.q)},
+                     {"p", encode(state.p)},
+                     {"energies", encode(state.energies)},
+                     {"tangent_q", encode(state.tangent_q)},
+                     {"tangent_p", encode(state.tangent_p)},
+                     {"lyapunov", std::move(lyapunov)},
+                     {"megno", std::move(megno)}}},
+                   {"records", std::move(records)},
+                   {"observers", checkpoint.observers}};
+  // The scheme's private state, under the names it gives: its columns with the active trajectories', its numbers
+  // about the run at the top.
+  for (const SchemeState::Column& column : state.scheme.columns)
+    document["active"][column.name] = encode(column.values);
+  for (const SchemeState::Largest& number : state.scheme.largest) document[number.name] = encode(number.value);
   // The checksum covers everything else, as dumped (keys sorted, numbers as strings): an edited or damaged
   // checkpoint is refused instead of changing the results.
   json signed_document = document;
@@ -275,15 +236,15 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   try {
     document = json::parse(*text);
   } catch (const json::exception& error) {
-    damaged(path, std::string("not JSON: ") + error.what());
+    reader(path).damaged(std::string("not JSON: ") + error.what());
   }
-  const Reader read{path};
+  const SavedState read = reader(path);
   if (read.string(read.member(document, "format"), "format") != format_tag)
-    damaged(path, std::string("its format is not \"") + format_tag + "\"");
+    read.damaged(std::string("its format is not \"") + format_tag + "\"");
   const std::string checksum = read.string(read.member(document, "checksum"), "checksum");
   document.erase("checksum");
   if (checksum != content_hash_hex(content_hash(document.dump())))
-    damaged(path, "its content does not match its checksum: it was edited or damaged");
+    read.damaged("its content does not match its checksum: it was edited or damaged");
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
   if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)
     throw CheckpointError(
@@ -294,25 +255,24 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   Checkpoint checkpoint;
   DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;
-  state.step = read.unsigned_integer(read.member(document, "step"), "step");
-  if (state.step > job.run().time.steps) damaged(path, "its step is beyond the job's last step");
+  state.step = read.count(read.member(document, "step"), "step");
+  if (state.step > job.run().time.steps) read.damaged("its step is beyond the job's last step");
   const json& evaluations = read.member(document, "evaluations");
-  state.evaluations.grad_T = read.unsigned_integer(read.member(evaluations, "grad_T"), "evaluations");
-  state.evaluations.grad_V = read.unsigned_integer(read.member(evaluations, "grad_V"), "evaluations");
-  state.evaluations.grad_H = read.unsigned_integer(read.member(evaluations, "grad_H"), "evaluations");
+  state.evaluations.grad_T = read.count(read.member(evaluations, "grad_T"), "evaluations");
+  state.evaluations.grad_V = read.count(read.member(evaluations, "grad_V"), "evaluations");
+  state.evaluations.grad_H = read.count(read.member(evaluations, "grad_H"), "evaluations");
   if (evaluations.contains("grad_K") || evaluations.contains("grad_U")) {
-    state.evaluations.grad_K = read.unsigned_integer(read.member(evaluations, "grad_K"), "evaluations");
-    state.evaluations.grad_U = read.unsigned_integer(read.member(evaluations, "grad_U"), "evaluations");
+    state.evaluations.grad_K = read.count(read.member(evaluations, "grad_K"), "evaluations");
+    state.evaluations.grad_U = read.count(read.member(evaluations, "grad_U"), "evaluations");
   }
-  state.max_copy_distance = read.number(read.member(document, "max_copy_distance"), "max_copy_distance");
   const json& active = read.member(document, "active");
   const json& trajectories = read.member(active, "trajectories");
-  if (!trajectories.is_array()) damaged(path, "active.trajectories is not an array");
+  if (!trajectories.is_array()) read.damaged("active.trajectories is not an array");
   std::optional<std::size_t> previous;
   for (const auto& entry : trajectories) {
-    const auto index = read.unsigned_integer(entry, "active.trajectories");
+    const auto index = read.count(entry, "active.trajectories");
     if (index >= job.initial.count || (previous && index <= *previous))
-      damaged(path, "active.trajectories is not increasing trajectory indices of the job");
+      read.damaged("active.trajectories is not increasing trajectory indices of the job");
     previous = static_cast<std::size_t>(index);
     state.active.push_back(static_cast<std::size_t>(index));
   }
@@ -322,14 +282,19 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   const std::size_t k = job.run().analysis.tangent_vectors(), tangent_size = state.active.size() * k * n;
   state.tangent_q = read.numbers(read.member(active, "tangent_q"), tangent_size, "active.tangent_q");
   state.tangent_p = read.numbers(read.member(active, "tangent_p"), tangent_size, "active.tangent_p");
-  const std::size_t copies_size = job.run().integrator.scheme == "tao" ? state.active.size() * n : 0;
-  state.copies_q = read.numbers(read.member(active, "copies_q"), copies_size, "active.copies_q");
-  state.copies_p = read.numbers(read.member(active, "copies_p"), copies_size, "active.copies_p");
+  // The scheme's private state, as the scheme names and sizes it (nothing for most schemes).
+  state.scheme = Integrator(job.run().integrator).save_state(PhaseSpaceBatch(n, 0));
+  for (SchemeState::Column& column : state.scheme.columns) {
+    const std::string what = "active." + column.name;
+    column.values = read.numbers(read.member(active, column.name), state.active.size() * column.per_state, what);
+  }
+  for (SchemeState::Largest& number : state.scheme.largest)
+    number.value = read.number(read.member(document, number.name), number.name);
   const json& lyapunov = read.member(active, "lyapunov");
   const json& megno = read.member(active, "megno");
   if (!lyapunov.is_array() || !megno.is_array() || lyapunov.size() != (k > 0 ? state.active.size() : 0) ||
       megno.size() != lyapunov.size())
-    damaged(path, "active.lyapunov and active.megno do not have one entry per active trajectory");
+    read.damaged("active.lyapunov and active.megno do not have one entry per active trajectory");
   for (std::size_t i = 0; i < lyapunov.size(); ++i) {
     const auto l = read.numbers(lyapunov[i], 5 + k, "active.lyapunov");
     const auto m = read.numbers(megno[i], 3, "active.megno");
@@ -345,13 +310,13 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   }
   const json& records = read.member(document, "records");
   if (!records.is_array() || records.size() != job.initial.count)
-    damaged(path, "it does not have one record per trajectory");
+    read.damaged("it does not have one record per trajectory");
   for (const auto& entry : records) {
     TrajectoryRecord record;
     const auto status = trajectory_status_from_string(read.string(read.member(entry, "status"), "status"));
-    if (!status) damaged(path, "a record's status is not a trajectory status");
+    if (!status) read.damaged("a record's status is not a trajectory status");
     record.status = *status;
-    record.final_step = read.unsigned_integer(read.member(entry, "final_step"), "final_step");
+    record.final_step = read.count(read.member(entry, "final_step"), "final_step");
     record.final_t = read.number(read.member(entry, "final_t"), "final_t");
     const json& final_q = read.member(entry, "final_q");
     const std::size_t final_size = final_q.is_array() && final_q.empty() ? 0 : n;
@@ -359,7 +324,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     record.final_p = read.numbers(read.member(entry, "final_p"), final_size, "final_p");
     record.energy_initial = read.optional_number(read.member(entry, "energy_initial"), "energy_initial");
     record.energy_final = read.optional_number(read.member(entry, "energy_final"), "energy_final");
-    record.stop_step = read.unsigned_integer(read.member(entry, "stop_step"), "stop_step");
+    record.stop_step = read.count(read.member(entry, "stop_step"), "stop_step");
     record.stop_t = read.number(read.member(entry, "stop_t"), "stop_t");
     record.stop_variable = read.string(read.member(entry, "stop_variable"), "stop_variable");
     record.message = read.string(read.member(entry, "message"), "message");
@@ -369,9 +334,9 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     record.mean_megno = read.optional_number(read.member(entry, "mean_megno"), "mean_megno");
     state.records.push_back(std::move(record));
   }
-  check_consistency(path, state, n);
+  check_consistency(read, state, n);
   checkpoint.observers = read.member(document, "observers");
-  if (!checkpoint.observers.is_object()) damaged(path, "observers is not an object");
+  if (!checkpoint.observers.is_object()) read.damaged("observers is not an object");
   return checkpoint;
 }
 

@@ -1,6 +1,7 @@
 // The kernel part of `nonsep inspect --check` (plugin_report.hpp, check_kernels): each kernel this processor runs
 // against the evaluation path, on a few steps of the basic step (one dt for all states) and of MPE 4/3 (a step
-// size per state), both forms.
+// size per state), both forms: the catalogue's Chin schemes with one order and those that are not symplectic (the
+// sums of substeps), each at its default options.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -23,6 +24,26 @@ PhaseSpaceBatch run(const PluginModel& model, const IntegratorSpec& spec, std::s
   Integrator integrator(spec);
   integrator.step_n(model, x, dt, steps);
   return x;
+}
+
+// The schemes the check steps, in catalogue order: the basic step and the multi-product expansion.
+std::vector<IntegratorSpec> checked_schemes() {
+  std::vector<IntegratorSpec> specs;
+  for (const Scheme& scheme : scheme_catalogue())
+    if (scheme.family == "chin" && (scheme.highest_order_index == 1 || !scheme.symplectic))
+      specs.push_back(default_spec(scheme));
+  return specs;
+}
+
+// "basic and mpe 4/3": each scheme with its order unless it has only one.
+std::string checked_schemes_text(const std::vector<IntegratorSpec>& specs) {
+  std::string text;
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    text += i == 0 ? "" : i + 1 == specs.size() ? " and " : ", ";
+    text += specs[i].scheme;
+    if (find_scheme(specs[i].scheme)->highest_order_index > 1) text += " " + specs[i].order.to_string();
+  }
+  return text;
 }
 
 }  // namespace
@@ -51,9 +72,8 @@ KernelCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::s
     double largest = 0.0;  // relative to max(1, |number|)
     bool identical = true, comparable = true;
     std::string failure;
-    for (const char* scheme : {"basic", "mpe"})
+    for (IntegratorSpec spec : checked_schemes())
       for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT}) {
-        IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
         spec.form = form;
         try {
           const PhaseSpaceBatch expected = run(model, spec, q, p, count, dt, steps);
@@ -94,7 +114,7 @@ KernelCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::s
     result.largest_difference = std::max(result.largest_difference, largest);
     result.text += line + (index == kernels.chosen ? " [used by runs]" : "") + "\n";
   }
-  result.text = "kernels (" + std::to_string(steps) + " steps of basic and mpe 4/3, dt " +
+  result.text = "kernels (" + std::to_string(steps) + " steps of " + checked_schemes_text(checked_schemes()) + ", dt " +
                 std::to_string(dt).substr(0, 5) + ", TTV and VVT, " + std::to_string(count) + " states):\n" +
                 result.text;
   return result;

@@ -208,15 +208,11 @@ class StudyExecution {
     const Scheme* scheme = find_scheme(spec.scheme);
     for (const auto& parameter : scheme ? scheme->parameters : std::vector<ParameterDescription>{}) {
       std::string value;
-      if (parameter.name == "order") {
-        value = spec.order.to_string();
-      } else {
-        const double number = parameter.name == "t2"       ? spec.t2
-                              : parameter.name == "omega"  ? spec.omega
-                              : parameter.name == "stages" ? spec.stages
-                                                           : spec.max_iterations;
-        append_number(value, number);
-      }
+      const auto option = option_value(spec, parameter);
+      if (const auto* order = std::get_if<Fraction>(&option))
+        value = order->to_string();
+      else
+        append_number(value, std::get<double>(option));
       text += (text.empty() ? "" : " ") + parameter.name + "=" + value;
     }
     return text;

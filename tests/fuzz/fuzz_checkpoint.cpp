@@ -94,8 +94,8 @@ void try_checkpoint(const std::string& text) {
     nonsep::host::EnergyErrorObserver energy(job.initial.count, 0, job.run().analysis.max_relative_energy_error);
     nonsep::host::ClosestReturnObserver closest(*job.run().analysis.closest_return_after, job.initial.dimension,
                                                 job.initial.q, job.initial.p);
-    for (nonsep::host::Observer* observer :
-         {static_cast<nonsep::host::Observer*>(&energy), static_cast<nonsep::host::Observer*>(&closest)})
+    for (nonsep::host::CheckpointedObserver* observer : {static_cast<nonsep::host::CheckpointedObserver*>(&energy),
+                                                         static_cast<nonsep::host::CheckpointedObserver*>(&closest)})
       if (checkpoint.observers.contains(observer->name())) observer->restore(checkpoint.observers[observer->name()]);
   } catch (const nonsep::host::CheckpointError&) {
   }

@@ -110,8 +110,8 @@ TEST_CASE(
 
 namespace {
 
-// Counts the blocks a driver steps (Observer::prepare_blocks) and the trajectories it retires.
-struct BlockCounter : nonsep::host::Observer {
+// Counts the blocks a driver steps (ChunkObserver::prepare_blocks) and the trajectories it retires.
+struct BlockCounter : nonsep::host::Observer, nonsep::host::ChunkObserver {
   std::size_t blocks = 0, retired = 0;
   void prepare_blocks(std::size_t count) override { blocks = count; }
   void on_retire(std::size_t, const nonsep::host::TrajectoryRecord&) override { ++retired; }

@@ -3,9 +3,7 @@
 #include "nonsep/core/integrator.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <stdexcept>
-#include <type_traits>
 #include <variant>
 
 #include "nonsep/core/error.hpp"
@@ -21,54 +19,20 @@ std::string scheme_names() {
   return list;
 }
 
-// The value of one catalogue parameter, as the job wrote it or as its default text.
-struct OptionValue {
-  double number = 0.0;
-  Fraction order;
-};
-
-void set_option(IntegratorSpec& spec, const ParameterDescription& parameter, const OptionValue& value) {
-  std::visit(
-      [&](auto* field) {
-        if constexpr (std::is_same_v<decltype(field), Fraction*>)
-          *field = value.order;
-        else
-          *field = value.number;
-      },
-      option_field(spec, parameter));
-}
-
-OptionValue default_option(const ParameterDescription& parameter) {
-  OptionValue value;
-  if (parameter.kind == ParameterDescription::Kind::Order) {
-    value.order = Fraction::parse(parameter.default_text);
-  } else {
-    const auto& text = parameter.default_text;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value.number);
-    if (ec != std::errc() || end != text.data() + text.size())
-      throw std::logic_error("catalogue default '" + text + "' of '" + parameter.name + "' is not a number");
-  }
-  return value;
-}
+// The value of one catalogue parameter, as the job wrote it or as its default: a Fraction for the order, a double
+// otherwise (nonsep::set_option).
+using OptionValue = std::variant<Fraction, double>;
 
 std::optional<OptionValue> read_option(Checker& check, const ParameterDescription& parameter, const json& value,
                                        const std::string& path) {
-  OptionValue result;
   if (parameter.kind == ParameterDescription::Kind::Number) {
     const auto x = check.finite_number(value, path, "a finite number: " + parameter.description);
     if (!x) return std::nullopt;
-    result.number = *x;
-    return result;
+    return OptionValue(*x);
   }
   try {
-    if (value.is_string()) {
-      result.order = Fraction::parse(value.get<std::string>());
-      return result;
-    }
-    if (const auto integral = integral_value(value)) {
-      result.order = Fraction(*integral);
-      return result;
-    }
+    if (value.is_string()) return OptionValue(Fraction::parse(value.get<std::string>()));
+    if (const auto integral = integral_value(value)) return OptionValue(Fraction(*integral));
   } catch (const InvalidArgument&) {
   }
   check.issue(path, describe(value),
@@ -123,13 +87,13 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
   // comparator refuses IntegratorSpec's own default order 2/3).
   if (scheme)
     for (const auto& parameter : parameters)
-      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option(parameter));
+      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
   for (const auto& parameter : parameters) {
     const std::string option_path = child(path, parameter.name);
     const json* given =
         check.member(integrator, path, parameter.name, parameter.default_text.empty(), parameter.description);
     if (!given) {
-      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option(parameter));
+      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
       continue;
     }
     const auto value = read_option(check, parameter, *given, option_path);
@@ -137,7 +101,7 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
     // The core decides what is valid: build the scheme with this one option set and the others at their defaults.
     IntegratorSpec probe{scheme->name, {}, {}, spec.form};
     for (const auto& other : parameters)
-      if (!other.default_text.empty()) set_option(probe, other, default_option(other));
+      if (!other.default_text.empty()) set_option(probe, other, default_option_value(other));
     set_option(probe, parameter, *value);
     try {
       const Integrator probe_integrator(probe);

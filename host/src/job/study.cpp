@@ -82,11 +82,13 @@ std::optional<std::vector<std::uint64_t>> read_steps_or_dt(Checker& check, const
   return read_step_list(check, object[key], child(path, key), key, t_end);
 }
 
-// The label of an integrator without "label": the scheme alone for basic (it has one order), else the scheme and
-// the order of what the catalogue's factory builds from the spec, as summary.json reports it ("gauss 6" for 3
-// stages, "implicit_midpoint 2"); the spec's order when the factory refuses the spec (the reader reports why).
+// The label of an integrator without "label": the scheme alone for a Chin scheme with one order (basic), else the
+// scheme and the order of what the catalogue's factory builds from the spec, as summary.json reports it ("gauss 6"
+// for 3 stages, "implicit_midpoint 2"); the spec's order when the factory refuses the spec (the reader reports why).
 std::string default_label(const IntegratorSpec& spec) {
-  if (spec.scheme == "basic") return spec.scheme;
+  if (const Scheme* scheme = find_scheme(spec.scheme);
+      scheme && scheme->family == "chin" && scheme->highest_order_index == 1)
+    return spec.scheme;
   Fraction order = spec.order;
   try {
     order = Integrator(spec).describe().order;

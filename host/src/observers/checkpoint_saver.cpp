@@ -35,8 +35,9 @@ void CheckpointSaver::before_finish(std::uint64_t, bool interrupted) {
 
 void CheckpointSaver::save_now() {
   Checkpoint checkpoint;
-  for (Observer* observer : observers_)
-    if (const std::string name = observer->name(); !name.empty()) checkpoint.observers[name] = observer->save();
+  for (Observer* each : observers_)
+    if (auto* observer = dynamic_cast<CheckpointedObserver*>(each); observer && !observer->name().empty())
+      checkpoint.observers[observer->name()] = observer->save();
   checkpoint.driver = driver_.state();
   save_checkpoint(path_, checkpoint, fingerprint_);
   next_save_ =

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/csv.hpp"
+#include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {
 
@@ -49,22 +49,18 @@ nlohmann::json ClosestReturnObserver::save() {
 }
 
 void ClosestReturnObserver::restore(const nlohmann::json& state) {
-  const nlohmann::json* list = state.is_object() && state.contains("closest") ? &state["closest"] : nullptr;
-  if (!list || !list->is_array() || list->size() != closest_.size())
-    throw CheckpointError("its closest_return state is damaged (not one entry per trajectory)");
+  const SavedState read = SavedState::of_observer(name(), state);
+  const nlohmann::json& list = read.list(read.member(state, "closest"), closest_.size(), "closest");
   for (std::size_t i = 0; i < closest_.size(); ++i) {
-    const nlohmann::json& entry = (*list)[i];
-    if (entry.is_null()) {
+    if (list[i].is_null()) {
       closest_[i] = {};
       continue;
     }
-    const bool shaped = entry.is_array() && entry.size() == 3 && entry[0].is_string() &&
-                        entry[1].is_number_unsigned() && entry[2].is_string();
-    const auto distance = shaped ? parse_number(entry[0].get<std::string>()) : std::nullopt;
-    const auto t = shaped ? parse_number(entry[2].get<std::string>()) : std::nullopt;
-    if (!distance || !t || !(*distance >= 0.0))
-      throw CheckpointError("its closest_return state is damaged (entry " + std::to_string(i) + ")");
-    closest_[i] = {*distance, entry[1].get<std::uint64_t>(), *t};
+    const std::string what = "closest entry " + std::to_string(i);
+    const nlohmann::json& entry = read.list(list[i], 3, what);
+    const double distance = read.number(entry[0], what);
+    if (!(distance >= 0.0)) read.damaged(what + " has a distance that is not >= 0");
+    closest_[i] = {distance, read.count(entry[1], what), read.number(entry[2], what)};
   }
 }
 

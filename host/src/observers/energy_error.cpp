@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/csv.hpp"
+#include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {
 
@@ -57,18 +57,11 @@ nlohmann::json EnergyErrorObserver::save() {
 }
 
 void EnergyErrorObserver::restore(const nlohmann::json& state) {
-  const nlohmann::json* values = state.is_object() && state.contains("max_abs") ? &state["max_abs"] : nullptr;
-  if (!values || !values->is_array() || values->size() != max_abs_.size())
-    throw CheckpointError("its energy_error state is damaged (not one value per trajectory)");
+  const SavedState read = SavedState::of_observer(name(), state);
+  const nlohmann::json& values = read.list(read.member(state, "max_abs"), max_abs_.size(), "max_abs");
   for (std::size_t i = 0; i < max_abs_.size(); ++i) {
-    const nlohmann::json& value = (*values)[i];
-    if (value.is_null()) {
-      max_abs_[i].reset();
-      continue;
-    }
-    const auto x = value.is_string() ? parse_number(value.get<std::string>()) : std::nullopt;
-    if (!x || !(*x >= 0.0)) throw CheckpointError("its energy_error state is damaged (not a number >= 0)");
-    max_abs_[i] = *x;
+    max_abs_[i] = read.optional_number(values[i], "max_abs");
+    if (max_abs_[i] && !(*max_abs_[i] >= 0.0)) read.damaged("max_abs is not a number >= 0");
   }
 }
 

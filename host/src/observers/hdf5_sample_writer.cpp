@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <limits>
 
-#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/output/files.hpp"
+#include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {
 
@@ -112,10 +112,8 @@ void Hdf5SampleWriter::restore(const nlohmann::json& state) {
   const auto refuse = [&](const std::string& why) {
     throw CheckpointError("cannot resume into " + path_.string() + ": " + why + "; run with --force to start over");
   };
-  if (!state.is_object() || !state.contains("rows") || !state["rows"].is_number_unsigned() ||
-      state["rows"].get<std::uint64_t>() > layout_.samples)
-    throw CheckpointError("its results_h5 state is damaged (no number of rows from 0 to " +
-                          std::to_string(layout_.samples) + ")");
+  const SavedState read = SavedState::of_observer(name(), state);
+  const std::uint64_t saved_rows = read.count(read.member(state, "rows"), "rows", layout_.samples);
   try {
     file_.emplace(Hdf5File::open(path_));
     datasets_.emplace(SampleDatasets::open(*file_));
@@ -129,7 +127,7 @@ void Hdf5SampleWriter::restore(const nlohmann::json& state) {
            std::to_string(datasets_->layout().trajectories) + " trajectories of dimension " +
            std::to_string(datasets_->layout().dimension) + ", the run " + std::to_string(layout_.samples) + " of " +
            std::to_string(layout_.trajectories) + " of dimension " + std::to_string(layout_.dimension));
-  rows_written_ = state["rows"].get<std::uint64_t>();
+  rows_written_ = saved_rows;
   if (rows_written_ == layout_.samples) return;
   // The rows of the incomplete chunk written before the checkpoint, which its next write must carry again.
   start_group_of(rows_written_);

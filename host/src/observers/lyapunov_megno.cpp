@@ -1,6 +1,6 @@
 #include "nonsep/host/observers/lyapunov_megno.hpp"
 
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {
 
@@ -47,11 +47,8 @@ void LyapunovMegnoObserver::on_event(const Event& event) {
 nlohmann::json LyapunovMegnoObserver::save() { return csv_checkpoint_state(*file_); }
 
 void LyapunovMegnoObserver::restore(const nlohmann::json& state) {
-  const auto damaged = [](const std::string& what) {
-    throw CheckpointError("its lyapunov_csv state is damaged (" + what + ")");
-  };
-  if (!state.is_object()) damaged("not an object");
-  resume_csv(file_, path_, state, damaged);
+  const SavedState read = SavedState::of_observer(name(), state);
+  resume_csv(file_, path_, state, [&](const std::string& what) { read.damaged(what); });
 }
 
 void LyapunovMegnoObserver::columns(std::vector<std::string>& names) const {

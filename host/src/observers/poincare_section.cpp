@@ -5,8 +5,8 @@
 #include <tuple>
 
 #include "nonsep/core/error.hpp"
-#include "nonsep/host/checkpoint.hpp"
 #include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {
 
@@ -148,17 +148,10 @@ nlohmann::json PoincareSectionObserver::save() {
 }
 
 void PoincareSectionObserver::restore(const nlohmann::json& state) {
-  const auto damaged = [](const std::string& what) {
-    throw CheckpointError("its poincare_csv state is damaged (" + what + ")");
-  };
-  if (!state.is_object()) damaged("not an object");
-  const nlohmann::json& counts = state.contains("crossings") ? state["crossings"] : nlohmann::json();
-  if (!counts.is_array() || counts.size() != counts_.size()) damaged("not one crossing count per trajectory");
-  for (std::size_t i = 0; i < counts.size(); ++i) {
-    if (!counts[i].is_number_unsigned()) damaged("a crossing count is not a count");
-    counts_[i] = counts[i].get<std::uint64_t>();
-  }
-  resume_csv(file_, path_, state, damaged);
+  const SavedState read = SavedState::of_observer(name(), state);
+  const nlohmann::json& counts = read.list(read.member(state, "crossings"), counts_.size(), "crossings");
+  for (std::size_t i = 0; i < counts.size(); ++i) counts_[i] = read.count(counts[i], "a crossing count");
+  resume_csv(file_, path_, state, [&](const std::string& what) { read.damaged(what); });
 }
 
 void PoincareSectionObserver::cells(std::size_t trajectory, std::string& row) const {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <tuple>
 
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {
 
@@ -99,22 +99,12 @@ nlohmann::json SampleWriter::save() {
 }
 
 void SampleWriter::restore(const nlohmann::json& state) {
-  const auto damaged = [](const std::string& what) {
-    throw CheckpointError("its trajectory_csv state is damaged (" + what + ")");
-  };
-  if (!state.is_object()) damaged("not an object");
-  const nlohmann::json& last = state.contains("last_written_step") ? state["last_written_step"] : nlohmann::json();
-  if (!last.is_array() || last.size() != last_written_.size()) damaged("not one last row per trajectory");
-  for (std::size_t i = 0; i < last.size(); ++i) {
-    if (last[i].is_null()) {
-      last_written_[i] = none;
-    } else if (last[i].is_number_unsigned() && last[i].get<std::uint64_t>() <= steps_) {
-      last_written_[i] = last[i].get<std::uint64_t>();
-    } else {
-      damaged("a last row's step is not a step of the run");
-    }
-  }
-  resume_csv(file_, path_, state, damaged);
+  const SavedState read = SavedState::of_observer(name(), state);
+  const nlohmann::json& last =
+      read.list(read.member(state, "last_written_step"), last_written_.size(), "last_written_step");
+  for (std::size_t i = 0; i < last.size(); ++i)
+    last_written_[i] = last[i].is_null() ? none : read.count(last[i], "a last row's step", steps_);
+  resume_csv(file_, path_, state, [&](const std::string& what) { read.damaged(what); });
 }
 
 }  // namespace nonsep::host

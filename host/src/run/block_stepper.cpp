@@ -21,7 +21,7 @@ void BlockStepper::watch_step(Block& block, Worker& worker, std::uint64_t step) 
   std::vector<RetirementRequest> requests;
   auto v = view(block, worker);
   v.retire = &requests;
-  for (Observer* watcher : step_watchers) watcher->on_step(step, setup.time.time_at(step), v);
+  for (StepObserver* watcher : step_watchers) watcher->on_step(step, setup.time.time_at(step), v);
   if (requests.empty()) return;
   sort_requests(requests);
   block.retire_requested(requests, step, [&](std::size_t slot) { return energy_of(worker, block.batch, slot); });
@@ -29,7 +29,7 @@ void BlockStepper::watch_step(Block& block, Worker& worker, std::uint64_t step) 
 
 void BlockStepper::advance_block(Block& block, Worker& worker, std::uint64_t from, std::uint64_t to) {
   block.begin_chunk();
-  for (Observer* watcher : step_watchers) watcher->save_block(view(block, worker));
+  for (StepObserver* watcher : step_watchers) watcher->save_block(view(block, worker));
   const double dt = setup.time.dt;
   bool clean = true;
   try {
@@ -45,7 +45,7 @@ void BlockStepper::advance_block(Block& block, Worker& worker, std::uint64_t fro
   }
   if (clean && block.all_finite()) return;
   block.rollback_chunk();
-  for (Observer* watcher : step_watchers) watcher->restore_block(view(block, worker));
+  for (StepObserver* watcher : step_watchers) watcher->restore_block(view(block, worker));
   for (std::uint64_t step = from + 1; step <= to && !block.empty(); ++step) {
     checked_step(block, worker, step);
     if (!block.empty()) watch_step(block, worker, step);
@@ -57,7 +57,7 @@ void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step
   const PhaseSpaceBatch before = block.batch;
   const std::optional<PhaseSpaceBatch> tangents_before =
       block.tangents ? std::optional<PhaseSpaceBatch>(block.tangents->vectors) : std::nullopt;
-  const Integrator integrator_before = block.integrator;  // Tao's copies, for a redo state by state
+  const Integrator integrator_before = block.integrator;  // the scheme's private state, for a redo state by state
   const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
     if (block.tangents)
       block.tangents->step_part(worker.model, x, *tangents_before, first, setup.time.dt);

@@ -36,7 +36,7 @@ class BlockStepper {
  public:
   // The references are the driver's and outlive the stepper; `blocks` is not resized after construction.
   BlockStepper(const EnsembleSetup& setup, const std::vector<Block>& blocks,
-               const std::vector<Observer*>& step_watchers, std::vector<TrajectoryRecord>& records,
+               const std::vector<StepObserver*>& step_watchers, std::vector<TrajectoryRecord>& records,
                bool energy_available)
       : setup(setup),
         blocks(blocks),
@@ -60,7 +60,7 @@ class BlockStepper {
 
   const EnsembleSetup& setup;
   const std::vector<Block>& blocks;
-  const std::vector<Observer*>& step_watchers;
+  const std::vector<StepObserver*>& step_watchers;
   std::vector<TrajectoryRecord>& records;
   bool energy_available;
 };

@@ -27,7 +27,8 @@ struct EnsembleDriver::Impl {
   std::size_t block_size = run_block_size;  // trajectories per block (the last may have fewer)
   std::vector<Worker> workers;
   std::vector<Observer*> observers;
-  std::vector<Observer*> step_watchers;
+  std::vector<ChunkObserver*> chunk_observers;
+  std::vector<StepObserver*> step_watchers;
   std::unique_ptr<WorkerPool> pool;  // after `workers`: destroyed (its threads joined) before them
   BlockStepper stepper{setup, blocks, step_watchers, records, energy_available};
   std::uint64_t completed = 0;
@@ -229,12 +230,13 @@ EnsembleDriver::~EnsembleDriver() = default;
 
 void EnsembleDriver::add_observer(Observer& observer) {
   impl_->observers.push_back(&observer);
-  if (observer.watches_every_step()) impl_->step_watchers.push_back(&observer);
+  if (auto* chunks = dynamic_cast<ChunkObserver*>(&observer)) impl_->chunk_observers.push_back(chunks);
+  if (auto* steps = dynamic_cast<StepObserver*>(&observer)) impl_->step_watchers.push_back(steps);
 }
 
 DriverEnd EnsembleDriver::run() {
   Impl& d = *impl_;
-  for (Observer* observer : d.observers) observer->prepare_blocks(d.blocks.size());
+  for (ChunkObserver* observer : d.chunk_observers) observer->prepare_blocks(d.blocks.size());
   bool interrupted = false;
   try {
     if (!d.resumed) d.start();
@@ -244,9 +246,9 @@ DriverEnd EnsembleDriver::run() {
         break;
       }
       d.advance(d.completed, d.next_event(d.completed));
-      for (Observer* observer : d.observers) observer->after_chunk(d.completed);
+      for (ChunkObserver* observer : d.chunk_observers) observer->after_chunk(d.completed);
     }
-    for (Observer* observer : d.observers) observer->before_finish(d.completed, interrupted);
+    for (ChunkObserver* observer : d.chunk_observers) observer->before_finish(d.completed, interrupted);
   } catch (const std::exception& thrown) {
     d.error = thrown.what();
   }
@@ -288,17 +290,7 @@ void EnsembleDriver::restore(DriverState state) {
           .restore(members[b], state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
     d.blocks[b].energies = std::move(energies);
     d.blocks[b].energy_step = state.step;
-    if (!state.copies_q.empty() && !members[b].empty()) {
-      PhaseSpaceBatch copies(n, members[b].size());
-      for (std::size_t slot = 0; slot < members[b].size(); ++slot) {
-        const auto from = static_cast<std::ptrdiff_t>(members[b][slot] * n);
-        std::copy(state.copies_q.begin() + from, state.copies_q.begin() + from + static_cast<std::ptrdiff_t>(n),
-                  copies.q(slot).begin());
-        std::copy(state.copies_p.begin() + from, state.copies_p.begin() + from + static_cast<std::ptrdiff_t>(n),
-                  copies.p(slot).begin());
-      }
-      d.blocks[b].integrator.restore_copies(std::move(copies), state.max_copy_distance);
-    }
+    if (!members[b].empty()) d.blocks[b].integrator.restore_state(state.scheme.select(members[b]));
   }
   d.records = std::move(state.records);
   d.completed = state.step;
@@ -310,6 +302,7 @@ DriverState EnsembleDriver::state() const {
   const Impl& d = *impl_;
   DriverState state;
   state.step = d.completed;
+  state.scheme = Integrator(d.setup.integrator).save_state(PhaseSpaceBatch(d.setup.dimension, 0));
   for (const Block& block : d.blocks) {
     state.active.insert(state.active.end(), block.trajectories.begin(), block.trajectories.end());
     state.q.insert(state.q.end(), block.batch.q().begin(), block.batch.q().end());
@@ -317,15 +310,8 @@ DriverState EnsembleDriver::state() const {
     for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
       state.energies.push_back(block.energy_step == d.completed ? block.energies[slot] : std::nan(""));
     if (block.tangents) block.tangents->save(state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
-    if (d.setup.integrator.scheme == "tao") {
-      // Before its first step a Tao block has no copies yet: they are its states then, as the step would set.
-      const PhaseSpaceBatch* copies = block.integrator.copies();
-      const PhaseSpaceBatch& held = copies && copies->count() == block.trajectories.size() ? *copies : block.batch;
-      state.copies_q.insert(state.copies_q.end(), held.q().begin(), held.q().end());
-      state.copies_p.insert(state.copies_p.end(), held.p().begin(), held.p().end());
-    }
+    state.scheme.append(block.integrator.save_state(block.batch));
   }
-  state.max_copy_distance = max_copy_distance();
   state.records = d.records;
   state.evaluations = evaluations();
   return state;
@@ -337,10 +323,14 @@ EvaluationCounts EnsembleDriver::evaluations() const {
   for (const Block& block : impl_->blocks) counts += block.evaluations();
   return counts;
 }
-double EnsembleDriver::max_copy_distance() const {
-  double distance = 0.0;
-  for (const Block& block : impl_->blocks) distance = std::max(distance, block.integrator.max_copy_distance());
-  return distance;
+std::vector<SchemeFigure> EnsembleDriver::scheme_report() const {
+  std::vector<SchemeFigure> report = Integrator(impl_->setup.integrator).report();
+  for (const Block& block : impl_->blocks) {
+    const std::vector<SchemeFigure> part = block.integrator.report();
+    for (std::size_t i = 0; i < report.size() && i < part.size(); ++i)
+      report[i].value = std::max(report[i].value, part[i].value);
+  }
+  return report;
 }
 std::uint64_t EnsembleDriver::kernel_calls() const {
   std::uint64_t calls = 0;

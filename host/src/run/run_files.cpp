@@ -109,18 +109,20 @@ json run_summary(const RunFacts& facts) {
     summary["evaluations"]["grad_U"] = evaluations.grad_U;
   }
   summary["stepping"] = stepping_facts(facts);
-  if (run.integrator.scheme == "tao")
-    summary["comparator"] = {{"omega", run.integrator.omega},
-                             {"max_copy_distance", facts.driver.max_copy_distance()},
-                             {"max_copy_distance_note",
-                              "largest |(q, p) - (x, y)| over the trajectories and steps "
-                              "of this process (a resumed run counts from the resume)"}};
+  // What the scheme reports, under its family's name ("comparator": Tao's omega and largest copy distance).
+  if (const std::vector<SchemeFigure> report = facts.driver.scheme_report(); !report.empty()) {
+    json& figures = summary[find_scheme(run.integrator.scheme)->family];
+    for (const SchemeFigure& figure : report) {
+      figures[figure.name] = figure.value;
+      if (!figure.note.empty()) figures[figure.name + "_note"] = figure.note;
+    }
+  }
   summary["wall_seconds"] = facts.wall_seconds;
   return summary;
 }
 
 void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& facts,
-                            std::span<const Observer* const> observers) {
+                            std::span<const TrajectoryColumns* const> observers) {
   const std::size_t n = facts.loaded.job.initial.dimension;
   std::string text = "trajectory,status,step,t";
   for (const char* name : {"q", "p"})
@@ -131,7 +133,7 @@ void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& f
     }
   text += ",H0,H,relative_energy_error,stop_step,stop_t,stop_variable,message";
   std::vector<std::string> columns;
-  for (const Observer* observer : observers) observer->columns(columns);
+  for (const TrajectoryColumns* observer : observers) observer->columns(columns);
   for (const std::string& column : columns) text += "," + column;
   text += '\n';
   AtomicFile file(path);
@@ -168,7 +170,7 @@ void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& f
     append_csv_text(text, record.stop_variable);
     text += ',';
     append_csv_text(text, record.message);
-    for (const Observer* observer : observers) observer->cells(index, text);
+    for (const TrajectoryColumns* observer : observers) observer->cells(index, text);
     text += '\n';
     if (text.size() >= (1 << 16)) {
       file.write(text);

@@ -30,6 +30,6 @@ nlohmann::ordered_json run_summary(const RunFacts& facts);
 
 // Throws OutputError.
 void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& facts,
-                            std::span<const Observer* const> observers);
+                            std::span<const TrajectoryColumns* const> observers);
 
 }  // namespace nonsep::host

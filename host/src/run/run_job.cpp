@@ -161,8 +161,9 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   driver.add_observer(progress);
   if (checkpoint) {
     driver.restore(std::move(checkpoint->driver));
-    for (Observer* observer : observers)
-      if (const std::string name = observer->name(); !name.empty()) {
+    for (Observer* each : observers)
+      if (auto* observer = dynamic_cast<CheckpointedObserver*>(each); observer && !observer->name().empty()) {
+        const std::string name = observer->name();
         if (!checkpoint->observers.contains(name))
           throw CheckpointError((directory / checkpoint_file_name).string() + " is damaged (no state for " + name +
                                 ")");
@@ -207,7 +208,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
     outcome.summary["status"] = to_string(outcome.status);
   };
   try {
-    std::vector<const Observer*> columns{&energy};
+    std::vector<const TrajectoryColumns*> columns{&energy};
     if (closest) columns.push_back(&*closest);
     if (poincare) columns.push_back(&*poincare);
     if (chaos) columns.push_back(&*chaos);

@@ -5,10 +5,11 @@
 // TaoExtendedPhaseSpace or GaussLegendre directly.
 //
 // Comparators (family "comparator") need ModelWithThirdDerivatives: stepping one with a model type without them
-// throws InvalidArgument (the host refuses such jobs before running). Tao's stepper holds the extended copy (x, y)
-// of each state: the Integrator keeps it aligned with the batch the caller steps (compact() when states leave,
-// step_part() when a step is redone state by state) and tracks the largest copy distance seen.
-#include <algorithm>
+// throws InvalidArgument (the host refuses such jobs before running). A stepper may keep private state per state
+// (Tao's extended copy (x, y)): the Integrator hands the caller's batch changes on to it (compact() when states
+// leave, step_part() when a step is redone state by state) and its state out and back as an opaque SchemeState
+// (save_state(), restore_state(); scheme_state.hpp), so that the caller needs to know nothing of it.
+#include <concepts>
 #include <cstdint>
 #include <string>
 #include <type_traits>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "nonsep/core/scheme_catalogue.hpp"
+#include "nonsep/core/scheme_state.hpp"
 
 namespace nonsep {
 
@@ -37,6 +39,18 @@ struct IntegratorSpec {
 // the host's tests read every option of every catalogue entry).
 using OptionField = std::variant<Fraction*, double*>;
 OptionField option_field(IntegratorSpec& spec, const ParameterDescription& parameter);
+// The value of that field, for readers (summaries, fingerprints): the same mapping as option_field.
+std::variant<Fraction, double> option_value(const IntegratorSpec& spec, const ParameterDescription& parameter);
+// A catalogue option's default (ParameterDescription::default_text) as its value. Throws std::logic_error when the
+// text is not one (a programming error in the catalogue; the host's tests read every default).
+std::variant<Fraction, double> default_option_value(const ParameterDescription& parameter);
+// Sets option `parameter` of `spec` to `value` (a Fraction for the order, a double otherwise; std::logic_error for
+// the other kind).
+void set_option(IntegratorSpec& spec, const ParameterDescription& parameter,
+                const std::variant<Fraction, double>& value);
+// The spec of `scheme` with every option at its catalogue default (required options, without one, as IntegratorSpec
+// has them), in form `form`.
+IntegratorSpec default_spec(const Scheme& scheme, HamiltonianForm form = HamiltonianForm::TTV);
 
 class Integrator {
  public:
@@ -50,12 +64,10 @@ class Integrator {
         [&](auto& stepper) {
           using S = std::decay_t<decltype(stepper)>;
           if constexpr (is_comparator_stepper<S>) {
-            if constexpr (ModelWithThirdDerivatives<M>) {
+            if constexpr (ModelWithThirdDerivatives<M>)
               stepper.step(model, x, dt);
-              if constexpr (std::is_same_v<S, TaoExtendedPhaseSpace>) track_copy_distance(stepper, x);
-            } else {
+            else
               throw InvalidArgument(needs_third_derivatives());
-            }
           } else {
             stepper.step(model, x, dt);
           }
@@ -75,37 +87,67 @@ class Integrator {
   }
 
   // Redoes one step for part of a batch: `part` holds states first .. first + part.count() - 1 of a batch of
-  // `total` states whose step `before` (this integrator as it was before the step) was to take. For Tao the
-  // copies of those states come from `before` and are written back into this integrator's copies; the other
-  // schemes hold nothing per state and step part as step() does.
+  // `total` states whose step `before` (this integrator as it was before the step) was to take. A stepper with
+  // private state per state takes that of those states from `before` and writes it back into its own; the others
+  // step part as step() does.
   template <Model M>
   void step_part(const M& model, PhaseSpaceBatch& part, const Integrator& before, std::size_t first, std::size_t total,
                  double dt) {
-    auto* tao = std::get_if<TaoExtendedPhaseSpace>(&stepper_);
-    if (!tao) {
-      step(model, part, dt);
-      return;
-    }
-    if constexpr (ModelWithThirdDerivatives<M>) {
-      const auto& held = std::get<TaoExtendedPhaseSpace>(before.stepper_).copies();
-      PhaseSpaceBatch copies = held.count() == total ? slice(held, first, part.count()) : part;
-      tao->step(model, part, copies, dt);
-      PhaseSpaceBatch all = tao->copies().count() == total ? tao->copies() : PhaseSpaceBatch(part.dimension(), total);
-      for (std::size_t b = 0; b < part.count(); ++b) {
-        std::copy(copies.q(b).begin(), copies.q(b).end(), all.q(first + b).begin());
-        std::copy(copies.p(b).begin(), copies.p(b).end(), all.p(first + b).begin());
-      }
-      tao->restore_copies(std::move(all));
-      track_copy_distance(*tao, part, &copies);
-    } else {
-      throw InvalidArgument(needs_third_derivatives());
-    }
+    std::visit(
+        [&](auto& stepper) {
+          using S = std::decay_t<decltype(stepper)>;
+          if constexpr (has_private_state<S>) {
+            if constexpr (ModelWithThirdDerivatives<M>)
+              stepper.step_part(model, part, std::get<S>(before.stepper_), first, total, dt);
+            else
+              throw InvalidArgument(needs_third_derivatives());
+          } else {
+            step(model, part, dt);
+          }
+        },
+        stepper_);
   }
 
-  // The states with retire[b] true leave the batch: Tao drops their copies (nothing for the other schemes).
+  // The states with retire[b] true leave the batch: a stepper with private state per state drops theirs.
   void compact(const std::vector<bool>& retire) {
-    if (auto* tao = std::get_if<TaoExtendedPhaseSpace>(&stepper_); tao && tao->copies().count() == retire.size())
-      tao->compact_copies(retire);
+    std::visit(
+        [&](auto& stepper) {
+          if constexpr (has_private_state<std::decay_t<decltype(stepper)>>) stepper.compact(retire);
+        },
+        stepper_);
+  }
+
+  // The stepper's private state of the batch `states` it steps (empty for a stepper without one), and back: a
+  // caller that checkpoints stores it (for any subset of the states, SchemeState::select) and restores it into an
+  // integrator of the same spec stepping those states, which then goes on as if never stopped.
+  SchemeState save_state(const PhaseSpaceBatch& states) const {
+    return std::visit(
+        [&](const auto& stepper) {
+          if constexpr (has_private_state<std::decay_t<decltype(stepper)>>)
+            return stepper.save_state(states);
+          else
+            return SchemeState{};
+        },
+        stepper_);
+  }
+  void restore_state(const SchemeState& state) {
+    std::visit(
+        [&](auto& stepper) {
+          if constexpr (has_private_state<std::decay_t<decltype(stepper)>>) stepper.restore_state(state);
+        },
+        stepper_);
+  }
+  // What the scheme reports about the steps this integrator took (Tao: omega and the largest copy distance); empty
+  // for most schemes.
+  std::vector<SchemeFigure> report() const {
+    return std::visit(
+        [](const auto& stepper) {
+          if constexpr (has_private_state<std::decay_t<decltype(stepper)>>)
+            return stepper.report();
+          else
+            return std::vector<SchemeFigure>{};
+        },
+        stepper_);
   }
 
   const EvaluationCounts& evaluations() const {
@@ -116,21 +158,6 @@ class Integrator {
   bool is_comparator() const {
     return std::visit([](const auto& s) { return is_comparator_stepper<std::decay_t<decltype(s)>>; }, stepper_);
   }
-  // Tao only: the largest |(q, p) - (x, y)| over the states and steps this integrator took (0 before a step).
-  double max_copy_distance() const { return max_copy_distance_; }
-  // Tao only: the extended copies of the batch's states, or nullptr (other schemes; Tao before its first step).
-  const PhaseSpaceBatch* copies() const {
-    const auto* tao = std::get_if<TaoExtendedPhaseSpace>(&stepper_);
-    return tao && tao->copies().count() > 0 ? &tao->copies() : nullptr;
-  }
-  // Tao only (nothing for the other schemes): continues from a checkpoint, with these copies of the batch's states
-  // and the largest copy distance of the steps before it, so that the run goes on as if never stopped.
-  void restore_copies(PhaseSpaceBatch copies, double max_copy_distance) {
-    if (auto* tao = std::get_if<TaoExtendedPhaseSpace>(&stepper_)) {
-      tao->restore_copies(std::move(copies));
-      max_copy_distance_ = max_copy_distance;
-    }
-  }
   HamiltonianForm form() const { return form_; }
   const IntegratorSpec& spec() const { return spec_; }
   // The stepper the catalogue entry built (TangentIntegrator maps it to its tangent map).
@@ -138,26 +165,14 @@ class Integrator {
 
  private:
   std::string needs_third_derivatives() const;
-  static PhaseSpaceBatch slice(const PhaseSpaceBatch& x, std::size_t first, std::size_t count) {
-    PhaseSpaceBatch out(x.dimension(), count);
-    for (std::size_t b = 0; b < count; ++b) {
-      std::copy(x.q(first + b).begin(), x.q(first + b).end(), out.q(b).begin());
-      std::copy(x.p(first + b).begin(), x.p(first + b).end(), out.p(b).begin());
-    }
-    return out;
-  }
-  void track_copy_distance(const TaoExtendedPhaseSpace& tao, const PhaseSpaceBatch& x,
-                           const PhaseSpaceBatch* copies = nullptr) {
-    distances_.resize(x.count());
-    TaoExtendedPhaseSpace::copy_distance(x, copies ? *copies : tao.copies(), distances_);
-    for (double d : distances_) max_copy_distance_ = std::max(max_copy_distance_, d);
-  }
+  template <class S>
+  static constexpr bool has_private_state = requires(const S& stepper, const PhaseSpaceBatch& states) {
+    { stepper.save_state(states) } -> std::same_as<SchemeState>;
+  };
 
   IntegratorSpec spec_;
   HamiltonianForm form_;
   SchemeStepper stepper_;
-  double max_copy_distance_ = 0.0;
-  std::vector<double> distances_;
 };
 
 }  // namespace nonsep

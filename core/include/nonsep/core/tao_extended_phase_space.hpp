@@ -33,6 +33,9 @@
 // to (q, p) by the next step, and the host must keep it aligned with the states: compact_copies() when it retires
 // states, copy_of() / restore_copies() to save, redo a single state or restore from a checkpoint.
 // copy_distance() reports |(q, p) - (x, y)| per state: small (compared with the state) while the binding holds.
+// For a runner that holds the copies in the stepper (nonsep::Integrator): step_part(), compact(), save_state() and
+// restore_state() (scheme_state.hpp) keep them aligned with the states without the runner knowing of them, and the
+// stepper tracks the largest copy distance of its steps (report()).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -44,6 +47,7 @@
 #include "nonsep/core/chin_basic_step.hpp"
 #include "nonsep/core/comparator_description.hpp"
 #include "nonsep/core/hamiltonian_gradient.hpp"
+#include "nonsep/core/scheme_state.hpp"
 
 namespace nonsep {
 
@@ -98,11 +102,62 @@ class TaoExtendedPhaseSpace {
     compose(order_ / 2 - 1, model, x, copies, dt);
   }
 
-  // The same with the copies held by the stepper (initialised to x when empty).
+  // The same with the copies held by the stepper (initialised to x when empty); tracks the largest copy distance.
   template <ModelWithThirdDerivatives M>
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
     if (copies_.count() == 0) copies_ = x;
     step(model, x, copies_, dt);
+    track_copy_distance(x, copies_);
+  }
+
+  // Redoes one step for part of the batch the stepper holds copies of: `part` holds states first ..
+  // first + part.count() - 1 of a batch of `total` states whose step `before` (this stepper as it was before the
+  // step) was to take. Their copies come from `before` (from the states when it held none yet) and are written
+  // back into this stepper's copies.
+  template <ModelWithThirdDerivatives M>
+  void step_part(const M& model, PhaseSpaceBatch& part, const TaoExtendedPhaseSpace& before, std::size_t first,
+                 std::size_t total, double dt) {
+    PhaseSpaceBatch copies = before.copies_.count() == total ? slice(before.copies_, first, part.count()) : part;
+    step(model, part, copies, dt);
+    PhaseSpaceBatch all = copies_.count() == total ? copies_ : PhaseSpaceBatch(part.dimension(), total);
+    for (std::size_t b = 0; b < part.count(); ++b) {
+      std::copy(copies.q(b).begin(), copies.q(b).end(), all.q(first + b).begin());
+      std::copy(copies.p(b).begin(), copies.p(b).end(), all.p(first + b).begin());
+    }
+    copies_ = std::move(all);
+    track_copy_distance(part, copies);
+  }
+
+  // compact_copies(), or nothing before the first step (no copies held yet).
+  void compact(const std::vector<bool>& retire) {
+    if (copies_.count() == retire.size()) compact_copies(retire);
+  }
+
+  // The copies of `states` (the batch the stepper steps; before its first step the copies are the states, as the
+  // step would set them): columns "copies_q" (x) and "copies_p" (y), n numbers per state; and the largest copy
+  // distance so far, "max_copy_distance".
+  SchemeState save_state(const PhaseSpaceBatch& states) const {
+    const PhaseSpaceBatch& held = copies_.count() == states.count() && copies_.count() > 0 ? copies_ : states;
+    const std::size_t n = states.dimension();
+    return {{{"copies_q", n, {held.q().begin(), held.q().end()}}, {"copies_p", n, {held.p().begin(), held.p().end()}}},
+            {{"max_copy_distance", max_copy_distance_}}};
+  }
+  // Continues from save_state's copies (nothing when it has none), so that the run goes on as if never stopped.
+  void restore_state(const SchemeState& state) {
+    if (state.columns.size() != 2 || state.columns[0].values.empty() || state.columns[0].per_state == 0) return;
+    const std::size_t n = state.columns[0].per_state;
+    PhaseSpaceBatch copies(n, state.columns[0].values.size() / n);
+    std::copy_n(state.columns[0].values.begin(), copies.size(), copies.q().begin());
+    std::copy_n(state.columns[1].values.begin(), copies.size(), copies.p().begin());
+    copies_ = std::move(copies);
+    if (!state.largest.empty()) max_copy_distance_ = state.largest[0].value;
+  }
+  // For a run's summary: omega and the largest |(q, p) - (x, y)| of the steps this stepper took with its own copies.
+  std::vector<SchemeFigure> report() const {
+    return {{"omega", omega_, ""},
+            {"max_copy_distance", max_copy_distance_,
+             "largest |(q, p) - (x, y)| over the trajectories and steps of this process (a resumed run counts from "
+             "the resume)"}};
   }
 
   // The copies held by the stepper (empty before the first step and after reset_copies()).
@@ -153,6 +208,20 @@ class TaoExtendedPhaseSpace {
   }
 
  private:
+  static PhaseSpaceBatch slice(const PhaseSpaceBatch& x, std::size_t first, std::size_t count) {
+    PhaseSpaceBatch out(x.dimension(), count);
+    for (std::size_t b = 0; b < count; ++b) {
+      std::copy(x.q(first + b).begin(), x.q(first + b).end(), out.q(b).begin());
+      std::copy(x.p(first + b).begin(), x.p(first + b).end(), out.p(b).begin());
+    }
+    return out;
+  }
+  void track_copy_distance(const PhaseSpaceBatch& x, const PhaseSpaceBatch& copies) {
+    distances_.resize(x.count());
+    copy_distance(x, copies, distances_);
+    for (double d : distances_) max_copy_distance_ = std::max(max_copy_distance_, d);
+  }
+
   template <ModelWithThirdDerivatives M>
   void compose(int level, const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt) {
     if (level == 0) {
@@ -228,6 +297,8 @@ class TaoExtendedPhaseSpace {
   std::vector<double> at_a_dq_, at_a_dp_;  // grad H at (q, y), the point the cache names
   std::vector<double> cached_q_, cached_y_;
   std::vector<double> at_b_dq_, at_b_dp_;  // grad H at (x, p)
+  double max_copy_distance_ = 0.0;         // over the steps with the stepper's copies
+  std::vector<double> distances_;
 };
 
 }  // namespace nonsep

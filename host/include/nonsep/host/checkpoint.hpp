@@ -26,15 +26,9 @@
 #include "nonsep/core/model.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
+#include "nonsep/host/run/saved_state.hpp"  // CheckpointError
 
 namespace nonsep::host {
-
-// A checkpoint cannot be read, belongs to another job, or does not fit it. The message names the file and says
-// what to do.
-class CheckpointError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 // What a checkpoint holds: the driver's state and each observer's, by its name().
 struct Checkpoint {

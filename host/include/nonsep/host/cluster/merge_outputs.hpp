@@ -30,8 +30,8 @@ void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& out
 // the first unit's, with what depends on the ensemble recomputed: status (the first of interrupted, failed,
 // diverged, inaccurate, completed that a unit has), error, counts and evaluations (sums), steps completed (the
 // largest), the largest energy error (the first unit's largest that no later unit exceeds, as one process finds it),
-// Tao's largest copy distance, Poincare crossings (sum), the number of trajectories and states, the output folder,
-// and wall_seconds (the run's, passed in).
+// the scheme's figures (the largest: Tao's copy distance), Poincare crossings (sum), the number of trajectories and
+// states, the output folder, and wall_seconds (the run's, passed in).
 nlohmann::ordered_json merge_summaries(std::span<const nlohmann::ordered_json> units,
                                        std::span<const std::size_t> first_trajectories, std::size_t trajectories,
                                        const std::filesystem::path& directory, double wall_seconds);

@@ -13,7 +13,7 @@
 
 namespace nonsep::host {
 
-class CheckpointSaver : public Observer {
+class CheckpointSaver : public Observer, public ChunkObserver {
  public:
   // `observers`: those whose state goes into the checkpoint (not owned).
   CheckpointSaver(std::filesystem::path path, std::string fingerprint, const CheckpointPolicy& policy,

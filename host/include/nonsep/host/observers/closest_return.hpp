@@ -12,7 +12,11 @@
 
 namespace nonsep::host {
 
-class ClosestReturnObserver : public Observer {
+class ClosestReturnObserver : public Observer,
+                              public ChunkObserver,
+                              public StepObserver,
+                              public CheckpointedObserver,
+                              public TrajectoryColumns {
  public:
   struct Closest {
     std::optional<double> distance;
@@ -23,7 +27,6 @@ class ClosestReturnObserver : public Observer {
   // `after`: the time from which returns count (|t| >= |after|); q0, p0: the initial states, state-major.
   ClosestReturnObserver(double after, std::size_t dimension, std::span<const double> q0, std::span<const double> p0);
 
-  bool watches_every_step() const override { return true; }
   void prepare_blocks(std::size_t blocks) override { saved_.resize(blocks); }
   void on_step(std::uint64_t step, double t, const BlockView& block) override;
   void save_block(const BlockView& block) override;

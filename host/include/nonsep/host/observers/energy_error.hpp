@@ -20,7 +20,7 @@ struct LargestEnergyError {
   std::size_t trajectory = 0;
 };
 
-class EnergyErrorObserver : public Observer {
+class EnergyErrorObserver : public Observer, public CheckpointedObserver, public TrajectoryColumns {
  public:
   // energy_every: output.energy_every (0: none of its own); bound: analysis.max_relative_energy_error.
   EnergyErrorObserver(std::size_t trajectories, std::uint64_t energy_every, std::optional<double> bound);

@@ -25,7 +25,7 @@
 
 namespace nonsep::host {
 
-class Hdf5SampleWriter : public Observer {
+class Hdf5SampleWriter : public Observer, public CheckpointedObserver {
  public:
   static constexpr const char* file_name = "results.h5";
 

@@ -20,7 +20,7 @@
 
 namespace nonsep::host {
 
-class LyapunovMegnoObserver : public Observer {
+class LyapunovMegnoObserver : public Observer, public CheckpointedObserver, public TrajectoryColumns {
  public:
   static constexpr const char* file_name = "lyapunov.csv";
 

@@ -36,7 +36,11 @@
 
 namespace nonsep::host {
 
-class PoincareSectionObserver : public Observer {
+class PoincareSectionObserver : public Observer,
+                                public ChunkObserver,
+                                public StepObserver,
+                                public CheckpointedObserver,
+                                public TrajectoryColumns {
  public:
   static constexpr const char* file_name = "poincare.csv";
 
@@ -46,7 +50,6 @@ class PoincareSectionObserver : public Observer {
                           const IntegratorSpec& integrator, const TimeGrid& time, std::size_t dimension,
                           std::size_t trajectories, bool energy, bool resuming);
 
-  bool watches_every_step() const override { return true; }
   void prepare_blocks(std::size_t blocks) override;
   void on_step(std::uint64_t step, double t, const BlockView& block) override;
   void save_block(const BlockView& block) override;

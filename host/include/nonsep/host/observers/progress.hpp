@@ -8,7 +8,7 @@
 
 namespace nonsep::host {
 
-class ProgressObserver : public Observer {
+class ProgressObserver : public Observer, public ChunkObserver {
  public:
   // `energy` may be null.
   ProgressObserver(bool enabled, const EnsembleDriver& driver, const EnergyErrorObserver* energy)

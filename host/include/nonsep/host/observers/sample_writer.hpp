@@ -22,7 +22,7 @@
 
 namespace nonsep::host {
 
-class SampleWriter : public Observer {
+class SampleWriter : public Observer, public ChunkObserver, public CheckpointedObserver {
  public:
   static constexpr const char* file_name = "trajectory.csv";
 

@@ -87,10 +87,9 @@ struct DriverState {
   std::vector<double> tangent_q, tangent_p;
   std::vector<LyapunovRecord> lyapunov;
   std::vector<MegnoRecord> megno;
-  // With Tao's scheme: the active trajectories' extended copies (x, y), state-major like q and p, and the largest
-  // copy distance so far; empty and 0 for the other schemes.
-  std::vector<double> copies_q, copies_p;
-  double max_copy_distance = 0.0;
+  // The scheme's private state of the active trajectories (its columns in the order of `active`) and its numbers
+  // about the run (nonsep::SchemeState): stored and handed back, never read; empty for most schemes.
+  SchemeState scheme;
 };
 
 // How the stepping ended.
@@ -122,9 +121,9 @@ class EnsembleDriver {
 
   const std::vector<TrajectoryRecord>& records() const;
   EvaluationCounts evaluations() const;
-  // Tao's scheme: the largest distance between a state and its extended copy over every block and step of this
-  // process (a resumed run restarts the copies from the states and counts from there); 0 for the other schemes.
-  double max_copy_distance() const;
+  // What the scheme reports about this process's steps (Integrator::report), the largest of every block's numbers;
+  // empty for most schemes.
+  std::vector<SchemeFigure> scheme_report() const;
   // Calls of the plugin's stepping kernel in this process (0: every step went through the evaluation path). The
   // kernel takes the chunks no every-step observer watches, without tangent vectors; replays after a failure and
   // every other step go through the evaluations.

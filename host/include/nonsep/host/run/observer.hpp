@@ -18,7 +18,11 @@
 //   after_chunk(step)      after every chunk (at most run_chunk_state_steps state-steps, a fraction of a second).
 //   before_finish(step, interrupted)  the stepping is over, before the active states are retired.
 //   on_end()               after the last retirement: flush, close.
-// Observers that watch every step (watches_every_step() true) are called inside chunks, on the worker thread of
+// The interface is small, as Odeint's observer is one callable: Observer has the events every observer may want;
+// what few observers need are facets, separate small interfaces an observer also derives from and the driver finds
+// by dynamic_cast: ChunkObserver (prepare_blocks, after_chunk, before_finish), StepObserver (every step),
+// CheckpointedObserver (save, restore) and TrajectoryColumns (trajectories.csv).
+// Observers that watch every step (StepObserver) are called inside chunks, on the worker thread of
 // each block, with that block's states only (on_step); they must touch nothing but their state for those
 // trajectories. Before a chunk the driver calls save_block; when a chunk is redone step by step (a state stopped
 // being finite, or the plugin failed, somewhere in it) restore_block puts the block's trajectories back. The view
@@ -27,9 +31,9 @@
 // observer may ask for trajectories to stop at this step (BlockView::retire: the driver removes them from the block
 // after every watcher saw the step; their final state is the state at this step).
 //
-// Checkpoints: save() returns the observer's state as JSON (numbers as shortest round-trip strings: see
-// checkpoint.hpp), restore() takes it back after a resume; a resumed run must end bit for bit as an uninterrupted
-// one. trajectories.csv: columns() names the observer's per-trajectory columns, cells() writes them.
+// Checkpoints: save() returns the observer's state as JSON (numbers as shortest round-trip strings), restore()
+// takes it back after a resume and reads it with the one reader, SavedState (saved_state.hpp); a resumed run must
+// end bit for bit as an uninterrupted one. The observer knows nothing of the checkpoint file.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -86,6 +90,7 @@ struct BlockView {
   std::vector<RetirementRequest>* retire = nullptr;  // on_step only: stop these trajectories at this step
 };
 
+// The observer every observer is: the events of the run, seen on the driver's thread.
 class Observer {
  public:
   virtual ~Observer() = default;
@@ -94,25 +99,44 @@ class Observer {
   virtual bool needs_energy(std::uint64_t /*step*/) const { return false; }
   virtual void on_event(const Event& /*event*/) {}
   virtual void on_retire(std::size_t /*trajectory*/, const TrajectoryRecord& /*record*/) {}
+  virtual void on_end() {}
+};
+
+// Facet: the course of the run between chunks (prepare_blocks once before stepping, with the number of blocks;
+// after_chunk; before_finish).
+class ChunkObserver {
+ public:
+  virtual ~ChunkObserver() = default;
+  virtual void prepare_blocks(std::size_t /*blocks*/) {}
   virtual void after_chunk(std::uint64_t /*step*/) {}
   virtual void before_finish(std::uint64_t /*step*/, bool /*interrupted*/) {}
-  virtual void on_end() {}
+};
 
-  virtual bool watches_every_step() const { return false; }
-  // Called once before stepping with the number of blocks.
-  virtual void prepare_blocks(std::size_t /*blocks*/) {}
-  virtual void on_step(std::uint64_t /*step*/, double /*t*/, const BlockView& /*block*/) {}
-  virtual void save_block(const BlockView& /*block*/) {}
-  virtual void restore_block(const BlockView& /*block*/) {}
+// Facet: every step, inside chunks, on the worker threads (see above); an observer with it watches every step.
+class StepObserver {
+ public:
+  virtual ~StepObserver() = default;
+  virtual void on_step(std::uint64_t step, double t, const BlockView& block) = 0;
+  virtual void save_block(const BlockView& block) = 0;
+  virtual void restore_block(const BlockView& block) = 0;
+};
 
-  // Checkpoints. `name()` keys the observer's state in checkpoint.json; empty: nothing to save.
-  virtual std::string name() const { return ""; }
-  virtual nlohmann::json save() { return nullptr; }
-  virtual void restore(const nlohmann::json& /*state*/) {}
+// Facet: state for checkpoints. `name()` keys it in checkpoint.json (empty: nothing to save); save() returns it as
+// JSON, restore() takes it back and reads it with a SavedState (saved_state.hpp), which refuses a damaged one.
+class CheckpointedObserver {
+ public:
+  virtual ~CheckpointedObserver() = default;
+  virtual std::string name() const = 0;
+  virtual nlohmann::json save() = 0;
+  virtual void restore(const nlohmann::json& state) = 0;
+};
 
-  // trajectories.csv
-  virtual void columns(std::vector<std::string>& /*names*/) const {}
-  virtual void cells(std::size_t /*trajectory*/, std::string& /*row*/) const {}
+// Facet: per-trajectory columns of trajectories.csv: columns() names them, cells() writes a trajectory's.
+class TrajectoryColumns {
+ public:
+  virtual ~TrajectoryColumns() = default;
+  virtual void columns(std::vector<std::string>& names) const = 0;
+  virtual void cells(std::size_t trajectory, std::string& row) const = 0;
 };
 
 }  // namespace nonsep::host
