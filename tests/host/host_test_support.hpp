@@ -148,8 +148,10 @@ inline Result finish(const Process& process, std::chrono::seconds timeout = std:
 
 // Polls `condition` (a callable returning bool) every few milliseconds until it holds: true as soon as it does,
 // false once `timeout` has passed without it. Tests wait on what they need (a file, a row count), never a fixed time.
+// The default timeout is generous because it only bounds a failure: under the sanitizers a run reaches its
+// checkpoints and units ten to fifty times later than in the release build.
 template <class Condition>
-bool wait_until(Condition condition, std::chrono::seconds timeout = std::chrono::seconds(30)) {
+bool wait_until(Condition condition, std::chrono::seconds timeout = std::chrono::seconds(300)) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (!condition()) {
     if (std::chrono::steady_clock::now() > deadline) return false;
@@ -165,7 +167,7 @@ inline Result run_nonsep(const std::vector<std::string>& args, const std::filesy
 
 // Starts `nonsep run --quiet --output OUTPUT JOB_FILE`, waits until its checkpoint.json is at step `at_least` or
 // later, kills the process with SIGKILL and returns the step of the checkpoint it left (a test then resumes it).
-// Throws (failing the test) when no such checkpoint appears within 30 s.
+// Throws (failing the test) when no such checkpoint appears within wait_until's timeout.
 inline std::uint64_t kill_after_checkpoint(const std::filesystem::path& job_file, const std::filesystem::path& output,
                                            std::uint64_t at_least, const std::filesystem::path& folder) {
   const auto process = start_nonsep({"run", "--quiet", "--output", output.string(), job_file.string()}, folder);
@@ -180,7 +182,7 @@ inline std::uint64_t kill_after_checkpoint(const std::filesystem::path& job_file
   ::kill(process.pid, SIGKILL);
   finish(process, std::chrono::seconds(30));
   if (!reached)
-    throw std::runtime_error("no checkpoint at step " + std::to_string(at_least) + " or later in 30 s in " +
+    throw std::runtime_error("no checkpoint at step " + std::to_string(at_least) + " or later in 300 s in " +
                              output.string());
   return checkpoint_step();
 }
