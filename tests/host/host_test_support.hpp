@@ -123,8 +123,8 @@ struct Result {
 };
 
 // Waits for `process` to end; after `timeout` it is killed (SIGKILL) and std::runtime_error thrown, so that a test
-// of a process that fails to stop fails instead of hanging.
-inline Result finish(const Process& process, std::chrono::seconds timeout = std::chrono::seconds(120)) {
+// of a process that fails to stop fails instead of hanging. The default bounds a whole run under the sanitizers.
+inline Result finish(const Process& process, std::chrono::seconds timeout = std::chrono::seconds(900)) {
   int wait_status = 0;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
