@@ -9,19 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "address_sanitizer.hpp"
 #include "host_test_support.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
-// AddressSanitizer reserves terabytes of shadow memory: it cannot run under an address-space limit.
-#if defined(__SANITIZE_ADDRESS__)
-#define NONSEP_TEST_ADDRESS_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define NONSEP_TEST_ADDRESS_SANITIZER 1
-#endif
-#endif
+// AddressSanitizer reserves terabytes of shadow memory: it cannot run under an address-space limit
+// (NONSEP_TEST_ADDRESS_SANITIZER, address_sanitizer.hpp).
 
 namespace {
 

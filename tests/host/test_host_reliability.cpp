@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "address_sanitizer.hpp"
 #include "host_test_support.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 
@@ -460,7 +461,7 @@ TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3),
   // The trust model (docs/trust-model.md): a plugin runs inside nonsep, so its crash is nonsep's: the status is the
   // signal's 128 + n (SIGABRT 134, SIGSEGV 139) or the plugin's own exit code, and what was flushed before stays
   // readable.
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(NONSEP_TEST_ADDRESS_SANITIZER)
   // The sanitized suite: ASan's handler catches SIGSEGV itself and aborts (abort_on_error=1, tests/ci), and
   // LeakSanitizer would turn exit(3) into its own status by reporting what the interrupted run still held.
   const std::pair<int, int> cases[] = {{0, 134}, {1, 134}, {2, 3}};
@@ -483,7 +484,7 @@ TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3),
     CHECK(rows.size() > 1000);  // buffers of 64 KiB were flushed before the crash, each ending on a row
     CHECK(!std::filesystem::exists(folder / "out/summary.json"));
   }
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(NONSEP_TEST_ADDRESS_SANITIZER)
   ::setenv("ASAN_OPTIONS", sanitizer_options.c_str(), 1);
 #endif
 }
