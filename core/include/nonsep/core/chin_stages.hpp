@@ -41,7 +41,10 @@ namespace nonsep {
 struct ChinCoefficients {
   double t1, t2, v0, v1, v2;
 
-  static double default_t2() { return -std::cbrt(6.0); }
+  // -6^(1/3), correctly rounded, written out: std::cbrt is not correctly rounded in glibc (GCC folds the call at
+  // compile time to this value, clang calls glibc at run time and gets 2 ulp less), and the default must be one
+  // number on every compiler.
+  static constexpr double default_t2() { return -1.8171205928321397; }
   // Throws InvalidArgument when t2 is zero or not finite.
   static ChinCoefficients from_t2(double t2) {
     if (!std::isfinite(t2) || t2 == 0.0)
