@@ -8,8 +8,8 @@
 # Left out here, and run by the release suite (ctest in build/):
 #   - tests labelled slow (an install and a rebuild, mpirun);
 #   - the tests below, which integrate whole example studies or large ensembles: under the sanitizers each takes
-#     minutes (examples.dynamics.run over 300 s, a distributed run on one rank over 300 s), and the code they run
-#     is the code the other tests run on small jobs.
+#     minutes (examples.dynamics.run over 300 s, a distributed run on one rank over 300 s, the kernel and dynamics
+#     kill-and-resume references over 120 s), and the code they run is the code the other tests run on small jobs.
 # A step of scripts/test.sh (CI).
 # Usage: run_sanitized_suite.sh SOURCE_DIR
 set -euo pipefail
@@ -20,6 +20,8 @@ long_runs=(
   '^examples\.tutorial$'
   '^a distributed run on one rank writes the files of an ordinary run'
   '^a distributed resume verifies every finished unit'
+  '^killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv bit for bit'
+  '^kernel path: a run killed and resumed gives'
 )
 exclude=$(IFS='|'; echo "${long_runs[*]}")
 start=$SECONDS
