@@ -77,8 +77,8 @@ TEST_CASE("usage: --version, --help with the schemes, options and exit statuses,
     CHECK(run_nonsep(args, folder.path()).status == 2);
   }
   const auto unknown = run_nonsep({"frobnicate", "job.json"}, folder.path());
-  CHECK(unknown.err.find("unknown command 'frobnicate'; the commands are run, validate, inspect, models, example and "
-                         "schema") != std::string::npos);
+  CHECK(unknown.err.find("unknown command 'frobnicate'; the commands are run, validate, inspect, models, example, "
+                         "schema and model") != std::string::npos);
   for (const char* command : {"models", "example"}) CHECK(unknown.err.find(command) != std::string::npos);
 }
 

@@ -50,8 +50,9 @@ int command_model_compile(const ModelCompileArguments& arguments) {
 std::optional<Job> read_formula_job(const std::string& job_file) {
   std::vector<JobIssue> issues;
   auto job = read_job(job_file, issues);
-  if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
+  // Not a formula job: load_job reads it again and reports its issues together with the plugin's.
   if (!job || !job->formula) return std::nullopt;
+  if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
   check_model_parameters(job->parameters, formula::declared_parameters(*job->formula), issues);
   check_dimension(job->initial, job->formula->dimension, issues);
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));

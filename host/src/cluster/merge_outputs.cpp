@@ -178,7 +178,8 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
     auto& completed = merged["time"]["steps_completed"];
     completed = std::max(completed.get<std::uint64_t>(), unit["time"]["steps_completed"].get<std::uint64_t>());
     // The scheme's figures (under its family's name, run_files.cpp) combine by the largest, as a process's blocks do.
-    if (const std::string family = merged["integrator"].value("family", ""); merged.contains(family))
+    if (const std::string family = merged.contains("integrator") ? merged["integrator"].value("family", "") : "";
+        !family.empty() && merged.contains(family))
       for (auto figure = merged[family].begin(); figure != merged[family].end(); ++figure)
         if (figure->is_number()) *figure = std::max(figure->get<double>(), unit[family][figure.key()].get<double>());
     if (merged.contains("analysis") && merged["analysis"].contains("poincare"))
