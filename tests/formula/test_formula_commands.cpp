@@ -88,7 +88,8 @@ TEST_CASE("formula commands: each malformed formula exits 2 from validate, quoti
   TemporaryFolder folder;
   Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");
   for (std::size_t i = 0; i < malformed_formulas.size(); ++i) {
-    const auto& [text, column] = malformed_formulas[i];
+    const auto& text = malformed_formulas[i].text;  // named, not bound: clang 14 cannot capture a binding
+    const auto column = malformed_formulas[i].column;
     json model = {{"formula", {{"T", "p0^2/2"}, {"V", text}, {"parameters", {{"lambda", 1}, {"k", 2}}}}}};
     const auto file = write_job(folder / ("bad" + std::to_string(i) + ".json"), job_with(model));
     const auto result = run_nonsep({"validate", file.string()}, folder.path());

@@ -92,7 +92,9 @@ const std::vector<Malformed> malformed_formulas = {
 
 TEST_CASE("formula parser: every malformed formula is refused at its column, saying what is allowed") {
   CHECK(malformed_formulas.size() >= 30);
-  for (const auto& [text, column] : malformed_formulas) {
+  for (const auto& malformed : malformed_formulas) {
+    const auto& text = malformed.text;  // named, not bound: clang 14 cannot capture a binding
+    const auto column = malformed.column;
     const FormulaError error = error_of(text);
     CHECK_MESSAGE(error.column == column, text << ": column " << error.column << ", found " << error.found);
     CHECK_MESSAGE(!error.found.empty(), text);
