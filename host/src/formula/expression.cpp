@@ -164,33 +164,24 @@ class Parser {
     return false;
   }
 
-  Node sum() {
-    Node first = product();
-    if (error_ || !(at_symbol("+") || at_symbol("-"))) return first;
-    Node node{.kind = Node::Kind::sum};
-    node.operands.push_back(std::move(first));
-    node.signs.push_back('+');
-    while (!error_ && (at_symbol("+") || at_symbol("-"))) {
+  // One left-associative level of n-ary operators (sums: + -, products: * /): an operand of the next level, then
+  // any number of (operator, operand); a lone operand is returned as it is.
+  Node chain(Node::Kind kind, const char* first, const char* second, Node (Parser::*operand)()) {
+    Node head = (this->*operand)();
+    if (error_ || !(at_symbol(first) || at_symbol(second))) return head;
+    Node node{.kind = kind};
+    node.operands.push_back(std::move(head));
+    node.signs.push_back(first[0]);
+    while (!error_ && (at_symbol(first) || at_symbol(second))) {
       node.signs.push_back(peek().text[0]);
       ++position_;
-      node.operands.push_back(product());
+      node.operands.push_back((this->*operand)());
     }
     return node;
   }
 
-  Node product() {
-    Node first = unary();
-    if (error_ || !(at_symbol("*") || at_symbol("/"))) return first;
-    Node node{.kind = Node::Kind::product};
-    node.operands.push_back(std::move(first));
-    node.signs.push_back('*');
-    while (!error_ && (at_symbol("*") || at_symbol("/"))) {
-      node.signs.push_back(peek().text[0]);
-      ++position_;
-      node.operands.push_back(unary());
-    }
-    return node;
-  }
+  Node sum() { return chain(Node::Kind::sum, "+", "-", &Parser::product); }
+  Node product() { return chain(Node::Kind::product, "*", "/", &Parser::unary); }
 
   Node unary() {
     if (!enter()) return {};
