@@ -165,6 +165,39 @@ TEST_CASE(
   CHECK(fs::exists(folder / "cache" / "formula" / record["cache_key"].get<std::string>() / "paper1d_formula.so"));
 }
 
+TEST_CASE("formula commands: every function compiles, and the gradients written from the trees pass the check") {
+  TemporaryFolder folder;
+  Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());
+  const json model = {
+      {"name", "every_function"},
+      {"parameters", {{"lambda", 0.5}}},
+      {"T",
+       "p0^2/2 + p1^2/2 + lambda*cosh(p0)*sqrt(1 + p1^2) + abs(p0 - 7) + max(p1, -5) + min(p0, 9) + "
+       "hypot(p0, 1) + pow(2, p1/10) + atan(p0)"},
+      {"V",
+       "q0^2/2 + q1^4/4 + exp(-q0^2) * sin(q1) + log(2 + q0^2) + log1p(q1^2) + cbrt(3 + q0) + erf(q1) + "
+       "tanh(q0) + asinh(q1) + acosh(2 + q0^2) + atanh(q1/10) + atan2(q1, 3) + tan(q0/10) + expm1(q1/4) + "
+       "square(q0) + cube(q1/3) + sinh(q0/3) + cos(q1) + asin(q0/10) + acos(q1/10) + pow(2 + q1^2, q0/5) + "
+       "q0^-2 * 0.01 / (1 + q0^-2)"},
+      {"K", "p0^4/40 + sin(p1)"},
+      {"U", "q1^2/10 * cosh(q0/5)"}};
+  const fs::path model_file = folder / "every_function.json";
+  write_text(model_file, model.dump());
+  // The compile takes seconds on an idle machine and minutes on a loaded one: a generous limit, not a timing.
+  const auto compiled =
+      finish(start_nonsep({"model", "compile", model_file.string(), "-o", (folder / "every_function.so").string()},
+                          folder.path()),
+             std::chrono::seconds(900));
+  INFO("stderr: " << compiled.err);
+  REQUIRE(compiled.status == 0);
+  const auto check = run_nonsep({"inspect", (folder / "every_function.so").string(), "--check"}, folder.path());
+  INFO("stdout: " << check.out << "\nstderr: " << check.err);
+  CHECK(check.status == 0);
+  CHECK(contains(check.out, "grad_K analytic, grad_T analytic, grad_U analytic, grad_V analytic"));
+  CHECK(contains(check.out, " 0 mismatches"));
+  CHECK(contains(check.out, "derivative check passed"));
+}
+
 TEST_CASE("formula commands: the cache with a stand-in compiler: one compile for two runs at once, damage, fallback") {
   TemporaryFolder folder;
   Environment compiler("NONSEP_CXX", write_fake_compiler(folder).string());

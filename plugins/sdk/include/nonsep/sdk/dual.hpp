@@ -196,6 +196,41 @@ using std::sqrt;
 using std::tan;
 using std::tanh;
 
+// The derivatives whose special cases are rules of their own, written once for the dual numbers below and for the
+// gradients nonsep writes for formula models (formulas.md in the documentation), for double and duals alike:
+//   log_derivative(x)     1/x, NaN below 0 (where log is NaN: 1/x would pretend a derivative exists there)
+//   log1p_derivative(x)   1/(1 + x), NaN below -1 (as for log)
+//   abs_derivative(x)     sign(x), NaN at 0 (|x| has no derivative there: a trajectory reaching it diverges)
+//   pow_exponent_derivative(x, r)   d/dy x^y = r log x with r = x^y, taken as 0 for x <= 0 (see pow below)
+//   min_derivative(a, b, da, db), max_derivative(a, b, da, db)   the derivative of the smaller (larger) argument;
+//                         at a tie the first's
+template <class S>
+S log_derivative(const S& x) {
+  return value_of(x) < 0.0 ? S(std::nan("")) : S(S(1.0) / x);
+}
+template <class S>
+S log1p_derivative(const S& x) {
+  return value_of(x) < -1.0 ? S(std::nan("")) : S(S(1.0) / (1.0 + x));
+}
+template <class S>
+S abs_derivative(const S& x) {
+  const double v = value_of(x);
+  return v == 0.0 ? S(std::nan("")) : S(v > 0.0 ? 1.0 : -1.0);
+}
+template <class S>
+S pow_exponent_derivative(const S& x, const S& r) {
+  using std::log;
+  return value_of(x) <= 0.0 ? S(0.0) : S(r * log(x));
+}
+template <class S>
+S min_derivative(const S& a, const S& b, const S& da, const S& db) {
+  return value_of(b) < value_of(a) ? db : da;
+}
+template <class S>
+S max_derivative(const S& a, const S& b, const S& da, const S& db) {
+  return value_of(a) < value_of(b) ? db : da;
+}
+
 namespace detail {
 // f(x) for a dual x, given f(x.value) and f'(x.value) (both of type S, so nesting works).
 template <class S, std::size_t K>
@@ -243,9 +278,7 @@ Dual<S, K> exp(const Dual<S, K>& x) {
 }
 template <class S, std::size_t K>
 Dual<S, K> log(const Dual<S, K>& x) {
-  // Below 0 the value is NaN; so is the derivative (1/x would pretend a derivative exists there).
-  const S f_prime = value_of(x) < 0.0 ? S(std::nan("")) : S(S(1.0) / x.value);
-  return detail::chain(x, S(log(x.value)), f_prime);
+  return detail::chain(x, S(log(x.value)), log_derivative(x.value));
 }
 // x^e for a constant exponent e.
 template <class S, std::size_t K>
@@ -308,9 +341,7 @@ Dual<S, K> expm1(const Dual<S, K>& x) {
 }
 template <class S, std::size_t K>
 Dual<S, K> log1p(const Dual<S, K>& x) {
-  // Below -1 the value is NaN, and so is the derivative (as for log).
-  const S f_prime = value_of(x) < -1.0 ? S(std::nan("")) : S(S(1.0) / (1.0 + x.value));
-  return detail::chain(x, S(log1p(x.value)), f_prime);
+  return detail::chain(x, S(log1p(x.value)), log1p_derivative(x.value));
 }
 template <class S, std::size_t K>
 Dual<S, K> erf(const Dual<S, K>& x) {
@@ -334,8 +365,7 @@ NONSEP_SDK_DUAL_MIXED(hypot)
 template <class S, std::size_t K>
 Dual<S, K> pow(const Dual<S, K>& x, const Dual<S, K>& y) {
   const S r = pow(x.value, y.value);
-  const S d_dy = value_of(x) <= 0.0 ? S(0.0) : S(r * log(x.value));
-  return detail::chain(x, y, r, S(y.value * pow(x.value, y.value - 1.0)), d_dy);
+  return detail::chain(x, y, r, S(y.value * pow(x.value, y.value - 1.0)), pow_exponent_derivative(x.value, r));
 }
 // a^y for a constant base a.
 template <class S, std::size_t K>
