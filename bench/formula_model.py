@@ -7,10 +7,11 @@ one run of this script, with a cache folder of its own:
                   the same source compiled with all three kernel sets (what a shipped plugin carries), for the
                   trade-off of compiling one wide set only
   cached run      wall time of a 10-step run, formula (from the cache) minus plugin: medians of 11, alternating
-  per step        wall time of 64 states x 20000 steps on one thread, formula over plugin: medians of 5, alternating
+  per step        wall time of 64 states x 200000 steps on one thread, formula over plugin: the median of the
+                  ratios of 5 alternating pairs (pairs, so that a change of the machine's load between pairs cancels)
 The machine's load average is printed with the numbers: other work on the machine widens the spread.
 
-Usage: python3 bench/formula_model.py --nonsep build/bin/nonsep [--repeats 5]
+Usage: python3 bench/formula_model.py --nonsep build/bin/nonsep [--repeats 5] [--steps 200000]
 """
 import argparse
 import json
@@ -57,6 +58,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--nonsep", required=True)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--steps", type=int, default=200000)
     arguments = parser.parse_args()
     nonsep = os.path.abspath(arguments.nonsep)
     with tempfile.TemporaryDirectory(prefix="nonsep-formula-bench-") as folder:
@@ -92,15 +94,15 @@ def main():
         print(f"cached run, 10 steps: formula {spread(small['formula'])} s; plugin {spread(small['plugin'])} s; "
               f"overhead {overhead * 1000:.1f} ms")
 
-        big_formula = write(folder, "big_formula.json", job(formula_model, 64, 20000, "bf"))
-        big_plugin = write(folder, "big_plugin.json", job(plugin_model, 64, 20000, "bp"))
+        big_formula = write(folder, "big_formula.json", job(formula_model, 64, arguments.steps, "bf"))
+        big_plugin = write(folder, "big_plugin.json", job(plugin_model, 64, arguments.steps, "bp"))
         big = {"formula": [], "plugin": []}
         for _ in range(arguments.repeats):
             big["formula"].append(timed_run(nonsep, big_formula, environment)[0])
             big["plugin"].append(timed_run(nonsep, big_plugin, environment)[0])
-        ratio = statistics.median(big["formula"]) / statistics.median(big["plugin"])
-        print(f"64 states x 20000 steps, 1 thread: formula {spread(big['formula'])} s; plugin "
-              f"{spread(big['plugin'])} s; time per step formula/plugin {ratio:.3f}")
+        ratios = [f / p for f, p in zip(big["formula"], big["plugin"])]
+        print(f"64 states x {arguments.steps} steps, 1 thread: formula {spread(big['formula'])} s; plugin "
+              f"{spread(big['plugin'])} s; time per step formula/plugin: {spread(ratios)} (of pairs)")
         print(f"load average after: {os.getloadavg()}")
 
 

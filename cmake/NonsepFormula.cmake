@@ -5,7 +5,9 @@
 # SDK and core headers of the sources). The flags are those of a Release plugin (nonsep_add_model), never the
 # build's own CMAKE_CXX_FLAGS: a sanitized build still compiles formula models without sanitizers, and a library
 # without instrumentation loads into an instrumented process. A different compiler: NONSEP_CXX at run time.
-set(NONSEP_FORMULA_FLAGS -std=c++20 -O3 -DNDEBUG -fPIC -shared -fvisibility=hidden -fvisibility-inlines-hidden)
+# -O2, not the plugins' -O3: a user waits for the first compile, and -O3 added a sixth to it with no faster steps
+# (docs/formula-models.md, "Measured").
+set(NONSEP_FORMULA_FLAGS -std=c++20 -O2 -DNDEBUG -fPIC -shared -fvisibility=hidden -fvisibility-inlines-hidden)
 if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   list(APPEND NONSEP_FORMULA_FLAGS -fno-gnu-unique)
 endif()
