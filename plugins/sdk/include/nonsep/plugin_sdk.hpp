@@ -149,8 +149,8 @@ class PluginTable {
                                  {"hessian_V", kind(Adapter::analytic_hessian_V)},
                                  {"d3T", kind(Adapter::analytic_d3T)},
                                  {"d3V", kind(Adapter::analytic_d3V)},
-                                 {"hvp_T", "automatic"},
-                                 {"hvp_V", "automatic"}}},
+                                 {"hvp_T", kind(Adapter::analytic_hvp_T)},
+                                 {"hvp_V", kind(Adapter::analytic_hvp_V)}}},
                                {"kernels", {{"version", chin_kernel_version}, {"instruction_sets", kernel_sets}}}};
     for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
     for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;

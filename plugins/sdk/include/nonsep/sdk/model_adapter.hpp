@@ -20,6 +20,10 @@
 //   void d3T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> u, std::span<double> out) const;
 //   void d3V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> u, std::span<double> out) const;
 //                                     directional third derivatives, out[k] = sum_ij T_ijk u_i u_j (n entries).
+//   void hvp_T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> v, std::span<double> out) const;
+//   void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const;
+//                                     Hessian-vector products, out[i] = sum_j T_ij v_j (n entries): what the energy
+//                                     and the tangent map of a large sparse model cost (plugins/lattice_chain).
 //   template <class S> S K(nonsep::sdk::Vector<S> p) const;      a separable part: H = T_i V_ij T_j + K(p) + U(q)
 //   template <class S> S U(nonsep::sdk::Vector<S> q) const;      (either or both; the other is zero)
 //   void grad_K(...), grad_U(...), hessian_K(...), hessian_U(...)  analytic derivatives of K and U, as for T and V
@@ -196,6 +200,14 @@ template <class M>
 concept HasAnalyticD3V = requires(const M& m, Vector<double> x, Vector<double> u, std::span<double> out) {
   m.d3V(x, u, out);
 };
+template <class M>
+concept HasAnalyticHvpT = requires(const M& m, Vector<double> x, Vector<double> v, std::span<double> out) {
+  m.hvp_T(x, v, out);
+};
+template <class M>
+concept HasAnalyticHvpV = requires(const M& m, Vector<double> x, Vector<double> v, std::span<double> out) {
+  m.hvp_V(x, v, out);
+};
 
 // The parameter table of M (empty when M declares none).
 template <class M>
@@ -268,6 +280,8 @@ class ModelAdapter {
   static constexpr bool analytic_hessian_V = policy == Derivatives::preferred && HasAnalyticHessianV<M>;
   static constexpr bool analytic_d3T = policy == Derivatives::preferred && HasAnalyticD3T<M>;
   static constexpr bool analytic_d3V = policy == Derivatives::preferred && HasAnalyticD3V<M>;
+  static constexpr bool analytic_hvp_T = policy == Derivatives::preferred && HasAnalyticHvpT<M>;
+  static constexpr bool analytic_hvp_V = policy == Derivatives::preferred && HasAnalyticHvpV<M>;
   // Higher derivatives by automatic differentiation of the gradient templates (else of T and V).
   static constexpr bool differentiates_gradients = policy == Derivatives::preferred && HasGradientTemplates<M>;
   static_assert(differentiates_gradients || HasDualTV<M>,
@@ -423,14 +437,17 @@ class ModelAdapter {
   }
 
   // Hessian-vector products, out[b*n + i] = sum_j T_ij(p_b) v[b*n + j] (hvp_T), the same for V in q (hvp_V); v has
-  // the layout of p. One directional pass over the gradient template, or one Hessian-column pass over T or V.
+  // the layout of p. The model's own product, or one directional pass over the gradient template, or one
+  // Hessian-column pass over T or V.
   void hvp_T(std::span<const double> p, std::span<const double> v, std::span<double> out, std::size_t count) const {
-    hessian_vector([](const auto& m, auto y, auto g) { m.grad_T(y, g); }, [](const auto& m, auto w) { return m.T(w); },
-                   p, v, out, count);
+    hessian_vector<analytic_hvp_T>([](const auto& m, auto x, auto w, auto d) { m.hvp_T(x, w, d); },
+                                   [](const auto& m, auto y, auto g) { m.grad_T(y, g); },
+                                   [](const auto& m, auto w) { return m.T(w); }, p, v, out, count);
   }
   void hvp_V(std::span<const double> q, std::span<const double> v, std::span<double> out, std::size_t count) const {
-    hessian_vector([](const auto& m, auto y, auto g) { m.grad_V(y, g); }, [](const auto& m, auto w) { return m.V(w); },
-                   q, v, out, count);
+    hessian_vector<analytic_hvp_V>([](const auto& m, auto x, auto w, auto d) { m.hvp_V(x, w, d); },
+                                   [](const auto& m, auto y, auto g) { m.grad_V(y, g); },
+                                   [](const auto& m, auto w) { return m.V(w); }, q, v, out, count);
   }
 
  private:
@@ -481,11 +498,12 @@ class ModelAdapter {
     for (std::size_t b = 0; b < count; ++b)
       detail::hessian_by_gradient(gradient, x.data() + b * n, n, out.data() + b * n * n);
   }
-  // Hessian-vector products of T or V: one directional pass over the gradient template `gradient(model, y, g)`, or
-  // one Hessian-column pass over `function(model, w)`.
-  template <class Gradient, class Function>
-  void hessian_vector(const Gradient& gradient, const Function& function, std::span<const double> x,
-                      std::span<const double> v, std::span<double> out, std::size_t count) const {
+  // Hessian-vector products of T or V: the model's `product(model, x, v, out)` when `analytic`, else one directional
+  // pass over the gradient template `gradient(model, y, g)`, or one Hessian-column pass over `function(model, w)`.
+  template <bool analytic, class Product, class Gradient, class Function>
+  void hessian_vector(const Product& product, const Gradient& gradient, const Function& function,
+                      std::span<const double> x, std::span<const double> v, std::span<double> out,
+                      std::size_t count) const {
     check_sizes(x, out, count, dimension_);
     check_sizes(v, out, count, dimension_);
     const std::size_t n = batch_dimension();
@@ -493,7 +511,9 @@ class ModelAdapter {
       const double* xb = x.data() + b * n;
       const double* vb = v.data() + b * n;
       double* d = out.data() + b * n;
-      if constexpr (differentiates_gradients)
+      if constexpr (analytic)
+        product(model_, Vector<double>(xb, n), Vector<double>(vb, n), std::span<double>(d, n));
+      else if constexpr (differentiates_gradients)
         detail::hessian_vector_by_gradient([&](auto y, auto g) { gradient(model_, y, g); }, xb, vb, n, d);
       else
         detail::poison_if_not_finite(
