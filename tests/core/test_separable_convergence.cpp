@@ -266,7 +266,8 @@ TEST_CASE("separable part in the VVT form with K and U: the reference solves the
   }
 }
 
-TEST_CASE("separable part in the VVT form with K and U: basic, triplet and MPE converge with their orders up to 10/3 and 4") {
+TEST_CASE(
+    "separable part in the VVT form with K and U: basic, triplet and MPE converge with their orders up to 10/3 and 4") {
   for (const Study& study : vvt_cases()) {
     CAPTURE(study.spec.scheme);
     CAPTURE(Integrator(study.spec).describe().order.to_string());
