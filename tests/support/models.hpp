@@ -370,4 +370,43 @@ struct VariableMass2D {
   }
 };
 
+// VariableMass2D with the roles of T and V swapped, for the VVT form: V = |q|^2/2 and T = |p|^2/4 + lambda |p|^4/24,
+// so that H_VVT = V_i T_ij V_j = q . Hess T(p) q, and the same K and U:
+//   H = (1/2)(1 + lambda |p|^2/3) |q|^2 + (lambda/3) (q.p)^2 + kappa |p|^2/2 + (q1^2 + omega^2 q2^2)/2 + mu q1^2 q2^2.
+struct SwappedVariableMass2D : VariableMass2D {
+  void value_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    VariableMass2D::value_V(p, out, count);
+  }
+  void value_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    VariableMass2D::value_T(q, out, count);
+  }
+  void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    VariableMass2D::grad_V(p, out, count);
+  }
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    VariableMass2D::grad_T(q, out, count);
+  }
+  void hessian_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
+    VariableMass2D::hessian_V(p, out, count);
+  }
+  void hessian_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    VariableMass2D::hessian_T(q, out, count);
+  }
+  void d3T(std::span<const double> p, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    VariableMass2D::d3V(p, u, out, count);
+  }
+  void d3V(std::span<const double> q, std::span<const double> u, std::span<double> out, std::size_t count) const {
+    VariableMass2D::d3T(q, u, out, count);
+  }
+  // The full H for any scalar type, x = (q1, q2, p1, p2).
+  template <class S>
+  S hamiltonian(const S* x) const {
+    const S r2 = x[0] * x[0] + x[1] * x[1], pp = x[2] * x[2] + x[3] * x[3], qp = x[0] * x[2] + x[1] * x[3];
+    S h = (0.5 + lambda * pp / 6.0) * r2 + lambda / 3.0 * qp * qp;
+    if (with_K) h = h + 0.5 * kappa * pp;
+    if (with_U) h = h + 0.5 * (x[0] * x[0] + omega * omega * x[1] * x[1]) + mu * x[0] * x[0] * x[1] * x[1];
+    return h;
+  }
+};
+
 }  // namespace nonsep::testing
