@@ -8,7 +8,10 @@
 // derivative the SDK's dual numbers use (plugins/sdk/include/nonsep/sdk/dual.hpp), with the same special cases: the
 // functions whose special cases are rules of their own (log and log1p outside their domain, abs at 0, min and max at
 // a tie, the exponent of pow at a base <= 0) are calls of the SDK's functions of the same rule (derivative_rule
-// names them), so a formula model's gradient is the automatic one up to rounding, everywhere.
+// names them), so a formula model's gradient is the automatic one up to rounding, and non-finite at the same
+// states. (Where automatic differentiation multiplies an infinite or NaN derivative, as of abs at 0, by another
+// variable's zero derivative, it writes NaN in that variable's component too; the tree writes that component's own
+// value. The gradient is non-finite either way, so a run diverges at the same step.)
 //
 // The trees are simplified as they are built (numbers folded in sums and products, zero terms and unit factors
 // dropped, nested sums and products flattened), and depend only on the tree: the same formula gives the same code.
