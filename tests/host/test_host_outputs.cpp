@@ -17,9 +17,9 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/csv.hpp"
-#include "nonsep/host/output/files.hpp"
 
 using namespace nonsep::host;
 using nonsep::host_testing::read_csv;

@@ -7,10 +7,10 @@
 #include <queue>
 #include <tuple>
 
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/launch/run_job.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/held_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "nonsep/host/run/run_job.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 namespace nonsep::host {
@@ -177,7 +177,8 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
     add_counts(merged["evaluations"], unit["evaluations"]);
     auto& completed = merged["time"]["steps_completed"];
     completed = std::max(completed.get<std::uint64_t>(), unit["time"]["steps_completed"].get<std::uint64_t>());
-    // The scheme's figures (under its family's name, run_files.cpp) combine by the largest, as a process's blocks do.
+    // The scheme's figures (under its family's name, output/run_summary.cpp) combine by the largest, as a process's
+    // blocks do.
     if (const std::string family = merged.contains("integrator") ? merged["integrator"].value("family", "") : "";
         !family.empty() && merged.contains(family))
       for (auto figure = merged[family].begin(); figure != merged[family].end(); ++figure)

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/held_folder.hpp"
 #include "nonsep/host/output/shuffle_deflate.hpp"
 

@@ -1,22 +1,22 @@
-#include "nonsep/host/run/run_job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <optional>
 
-#include "nonsep/host/checkpoint.hpp"
-#include "nonsep/host/observers/checkpoint_saver.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
+#include "nonsep/host/checkpoint/checkpoint_saver.hpp"
 #include "nonsep/host/observers/closest_return.hpp"
 #include "nonsep/host/observers/lyapunov_megno.hpp"
 #include "nonsep/host/observers/poincare_section.hpp"
 #include "nonsep/host/observers/progress.hpp"
 #include "nonsep/host/observers/sample_writer.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "run/run_files.hpp"
+#include "output/run_summary.hpp"
 #ifdef NONSEP_HAVE_HDF5
 #include "nonsep/host/observers/hdf5_sample_writer.hpp"
-#include "run/results_file.hpp"
+#include "output/results_h5.hpp"
 #endif
 
 namespace nonsep::host {

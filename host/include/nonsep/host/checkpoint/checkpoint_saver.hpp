@@ -1,5 +1,5 @@
 #pragma once
-// checkpoint.json (checkpoint.hpp): saved after every `every_steps` steps and/or once `every_seconds` of wall time
+// checkpoint.json (checkpoint_file.hpp): saved after every `every_steps` steps and/or once `every_seconds` of wall time
 // have passed since the last one (job /checkpoint), and when the run is interrupted, from the driver's state and
 // every observer's save(). A run that ends otherwise removes it. Add it after the observers whose state it saves.
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 
 #include <bit>
 #include <cmath>
@@ -12,8 +12,8 @@
 
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
-#include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
 

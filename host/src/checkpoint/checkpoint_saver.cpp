@@ -1,7 +1,7 @@
-#include "nonsep/host/observers/checkpoint_saver.hpp"
+#include "nonsep/host/checkpoint/checkpoint_saver.hpp"
 
-#include "nonsep/host/checkpoint.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 
 namespace nonsep::host {
 
