@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "nonsep/host/job.hpp"
-#include "nonsep/host/run/run_job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 
 namespace {
 

@@ -72,9 +72,9 @@
 #include "nonsep/core/chin_basic_step.hpp"
 #include "nonsep/core/multi_product_expansion.hpp"
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "nonsep/host/run/run_job.hpp"
 #include "paper1d/paper1d.hpp"
 
 namespace {

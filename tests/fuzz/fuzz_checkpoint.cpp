@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/observers/closest_return.hpp"
 #include "nonsep/host/observers/energy_error.hpp"
@@ -63,7 +63,7 @@ Fixture& fixture() {
   return fixture;
 }
 
-// What an accepted checkpoint promises (checkpoint.hpp): a step of the job, the active trajectories in increasing
+// What an accepted checkpoint promises (checkpoint_file.hpp): a step of the job, the active trajectories in increasing
 // order with finite states of the job's dimension, a record for every trajectory, "running" exactly for the active.
 void check_accepted(const nonsep::host::Checkpoint& checkpoint, const nonsep::host::Job& job) {
   const auto& state = checkpoint.driver;

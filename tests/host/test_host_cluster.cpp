@@ -13,9 +13,9 @@
 #include "nonsep/host/cluster/distributed_run.hpp"
 #include "nonsep/host/cluster/merge_outputs.hpp"
 #include "nonsep/host/cluster/ranks.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/launch/run_job.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "nonsep/host/run/run_job.hpp"
 
 using nonsep::host_testing::read_text;
 using nonsep::host_testing::TemporaryFolder;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "host_run_support.hpp"
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/job.hpp"
 
 using json = nlohmann::json;

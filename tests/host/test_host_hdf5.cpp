@@ -8,14 +8,14 @@
 #include <vector>
 
 #include "host_test_support.hpp"
-#include "nonsep/host/build_features.hpp"
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/observers/hdf5_sample_writer.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/hdf5_file.hpp"
 #include "nonsep/host/output/hdf5_samples.hpp"
 #include "nonsep/host/output/hdf5_tables.hpp"
+#include "nonsep/host/platform/build_features.hpp"
 
 using namespace nonsep::host;
 using nonsep::host_testing::TemporaryFolder;

@@ -10,8 +10,8 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/core/scheme_catalogue.hpp"
-#include "nonsep/host/build_features.hpp"
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/platform/build_features.hpp"
 
 using nlohmann::json;
 using namespace nonsep;

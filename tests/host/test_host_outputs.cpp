@@ -1,5 +1,5 @@
 // The output writers in-process: the number format, the CSV writer (layout, quoting, buffering on whole rows,
-// resuming) and atomic replacement.
+// resuming), the CSV reader and atomic replacement.
 #include <doctest/doctest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -17,9 +17,10 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/csv.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/csv_reader.hpp"
 
 using namespace nonsep::host;
 using nonsep::host_testing::read_csv;
@@ -159,4 +160,47 @@ TEST_CASE("a folder that is not writable is named as such, not as a temporary fi
   ::chmod(locked.c_str(), 0755);
   REQUIRE(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
+}
+
+TEST_CASE("CsvReader reads what CsvAppender writes: cells unquoted, each row's text as in the file, cut rows dropped") {
+  const TemporaryFolder folder;
+  {
+    CsvAppender file(folder / "table.csv", "trajectory,message,t");
+    file.row() += "3,";
+    append_csv_text(file.row(), "x, \"y\"\nz");
+    file.row() += ",0.5";
+    file.end_row();
+    file.row() += "4,,";
+    file.end_row();
+    file.flush();
+  }
+  const std::string written = read_text(folder / "table.csv");
+  write_file_atomically(folder / "cut.csv", written + "5,partial");
+  for (const char* name : {"table.csv", "cut.csv"}) {
+    CAPTURE(name);
+    CsvReader reader(folder / name, "to test it");
+    std::vector<std::string> cells;
+    REQUIRE(reader.next(cells));
+    CHECK(cells == std::vector<std::string>{"trajectory", "message", "t"});
+    REQUIRE(reader.next(cells));
+    CHECK(cells == std::vector<std::string>{"3", "x, \"y\"\nz", "0.5"});
+    CHECK(reader.text() == "3,\"x, \"\"y\"\"\nz\",0.5");
+    CHECK(reader.offset(0) == 0);
+    CHECK(reader.offset(1) == 2);
+    CHECK(reader.text().substr(reader.offset(2)) == "0.5");
+    CHECK(reader.line() == 3);
+    REQUIRE(reader.next(cells));
+    CHECK(cells == std::vector<std::string>{"4", "", ""});
+    CHECK(reader.text() == "4,,");
+    CHECK_FALSE(reader.next(cells));
+  }
+  write_file_atomically(folder / "open_quote.csv", "a,b\n1,\"never closed\n");
+  CsvReader open_quote(folder / "open_quote.csv", "to test it");
+  std::vector<std::string> cells;
+  CHECK(open_quote.next(cells));
+  CHECK_THROWS_WITH_AS(open_quote.next(cells), doctest::Contains("open_quote.csv:2: a quoted cell is not closed"),
+                       OutputError);
+  const std::string missing = "cannot read " + (folder / "missing.csv").string() + " to test it";
+  CHECK_THROWS_WITH_AS(CsvReader(folder / "missing.csv", "to test it"), doctest::Contains(missing.c_str()),
+                       OutputError);
 }

@@ -12,7 +12,7 @@
 #include "host_test_support.hpp"
 #include "nonsep/core.hpp"
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/host/study.hpp"
+#include "nonsep/host/study/convergence_study.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 #include "paper1d/paper1d.hpp"
 

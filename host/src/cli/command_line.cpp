@@ -6,9 +6,9 @@
 #include <string>
 
 #include "cli/commands.hpp"
-#include "nonsep/host/build_features.hpp"
 #include "nonsep/host/exit_status.hpp"
-#include "nonsep/host/installation.hpp"
+#include "nonsep/host/platform/build_features.hpp"
+#include "nonsep/host/platform/installation.hpp"
 
 #ifndef NONSEP_VERSION
 #error "NONSEP_VERSION must be defined by the build"

@@ -1,6 +1,6 @@
 // `nonsep example [NAME] [--output FILE] [--list]`: a starting job file. The examples are the job files of
-// share/nonsep/examples/{jobs,paper,dynamics} beside the executable (installation.hpp); the quickstart job is also
-// compiled in (examples/jobs/quickstart.json, embedded_examples.cpp), so it is there even when the executable was
+// share/nonsep/examples/{jobs,paper,dynamics} beside the executable (platform/installation.hpp); the quickstart job is
+// also compiled in (examples/jobs/quickstart.json, embedded_examples.cpp), so it is there even when the executable was
 // copied alone. The written file is the example's text unchanged but for "$schema", which is made to point at the
 // schema of this installation (the examples' own value is relative to their folder).
 #include <fcntl.h>
@@ -21,7 +21,7 @@
 
 #include "cli/commands.hpp"
 #include "nonsep/host/exit_status.hpp"
-#include "nonsep/host/installation.hpp"
+#include "nonsep/host/platform/installation.hpp"
 
 namespace nonsep::host::cli {
 

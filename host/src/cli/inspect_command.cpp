@@ -12,9 +12,9 @@
 #include "cli/commands.hpp"
 #include "nonsep/core/error.hpp"
 #include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/inspect/plugin_report.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/plugin_loader.hpp"
-#include "nonsep/host/plugin_report.hpp"
 
 namespace nonsep::host::cli {
 

@@ -3,8 +3,8 @@
 
 #include "cli/commands.hpp"
 #include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/inspect/plugin_report.hpp"
 #include "nonsep/host/plugin_loader.hpp"
-#include "nonsep/host/plugin_report.hpp"
 
 namespace nonsep::host::cli {
 

@@ -13,15 +13,15 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/cluster/distributed_run.hpp"
 #include "nonsep/host/cluster/ranks.hpp"
 #include "nonsep/host/exit_status.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/host/output/files.hpp"
-#include "nonsep/host/progress_bar.hpp"
-#include "nonsep/host/run/run_job.hpp"
-#include "nonsep/host/study.hpp"
+#include "nonsep/host/observers/progress_bar.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
+#include "nonsep/host/study/convergence_study.hpp"
 
 namespace nonsep::host::cli {
 
@@ -118,7 +118,7 @@ class OnlyRankZeroSpeaks {
 
 // Round-off also shows as errors at the smallest dt this many times above the nominal power law through the
 // largest dt (StudyFit::energy_error_excess_at_smallest_dt), when they are small enough to be round-off at all
-// (round_off_at_most, study.hpp).
+// (round_off_at_most, study/convergence_study.hpp).
 constexpr double flattened_excess = 10.0;
 
 std::string four_digits(double x) {

@@ -5,15 +5,15 @@
 #include <optional>
 
 #include "cluster/unit_seal.hpp"
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/cluster/merge_outputs.hpp"
 #include "nonsep/host/cluster/merge_results_h5.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "run/run_files.hpp"
+#include "output/run_summary.hpp"
 #ifdef NONSEP_HAVE_HDF5
-#include "run/results_file.hpp"
+#include "output/results_h5.hpp"
 #endif
 
 namespace nonsep::host {

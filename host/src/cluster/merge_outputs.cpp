@@ -2,49 +2,25 @@
 
 #include <algorithm>
 #include <charconv>
-#include <fstream>
 #include <memory>
+#include <optional>
 #include <queue>
 #include <tuple>
 
-#include "nonsep/host/output/files.hpp"
-#include "nonsep/host/output/held_folder.hpp"
+#include "nonsep/host/launch/run_job.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
+#include "nonsep/host/output/csv_reader.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "nonsep/host/run/run_job.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 namespace nonsep::host {
 
 namespace {
 
-// Reads one CSV record (quoted cells may hold commas and line breaks), without its final '\n'.
-bool read_record(std::istream& in, std::string& record) {
-  record.clear();
-  bool quoted = false;
-  for (int c = in.get(); c != std::char_traits<char>::eof(); c = in.get()) {
-    if (c == '"') quoted = !quoted;
-    if (c == '\n' && !quoted) return true;
-    record += static_cast<char>(c);
-  }
-  return !record.empty();
-}
-
-std::vector<std::string_view> leading_cells(std::string_view record, std::size_t count) {
-  std::vector<std::string_view> cells;
-  std::size_t start = 0;
-  while (cells.size() < count) {
-    const std::size_t comma = record.find(',', start);
-    cells.push_back(record.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return cells;
-}
-
 struct Part {
   const UnitFile* file;
-  std::ifstream in;
-  std::string record;
+  std::optional<CsvReader> rows;
+  std::vector<std::string> cells;  // of the row last read (rows->text() as it is in the file)
   std::vector<std::uint64_t> key;
   std::uint64_t line = 1;
 };
@@ -65,12 +41,16 @@ void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& out
   for (const UnitFile& file : parts) {
     auto part = std::make_unique<Part>();
     part->file = &file;
-    part->in.open(held_path(file.path), std::ios::binary);
-    std::string first;
-    if (!part->in || !read_record(part->in, first)) unfit(*part, "missing or empty");
+    try {
+      part->rows.emplace(file.path, "to merge it");
+    } catch (const OutputError&) {
+      unfit(*part, "missing or empty");
+    }
+    if (!part->rows->next(part->cells)) unfit(*part, "missing or empty");
+    const std::string& first = part->rows->text();
     if (open.empty()) {
       header = first;
-      const auto names = leading_cells(header, static_cast<std::size_t>(-1));
+      const std::vector<std::string>& names = part->cells;
       const auto column = [&](const std::string& name) {
         const auto at = std::find(names.begin(), names.end(), name);
         if (at == names.end()) unfit(*part, "no column " + name);
@@ -85,14 +65,13 @@ void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& out
     open.push_back(std::move(part));
   }
   const auto advance = [&](Part& part) {
-    if (!read_record(part.in, part.record)) return false;
+    if (!part.rows->next(part.cells)) return false;
     ++part.line;
-    const auto cells = leading_cells(part.record, leading);
-    if (cells.size() < leading) unfit(part, "too few cells");
+    if (part.cells.size() < leading) unfit(part, "too few cells");
     part.key.clear();
     for (std::size_t column : key_columns) {
       std::uint64_t value = 0;
-      const auto cell = cells[column];
+      const std::string& cell = part.cells[column];
       auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
       if (error != std::errc() || end != cell.data() + cell.size()) unfit(part, "not an integer key");
       if (column == trajectory_column) value += part.file->first_trajectory;
@@ -111,14 +90,14 @@ void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& out
     Part* part = queue.top();
     queue.pop();
     // The row with its trajectory number shifted: the cells before it, the new number, the rest.
-    const auto cells = leading_cells(part->record, trajectory_column + 1);
-    const std::size_t begin = static_cast<std::size_t>(cells[trajectory_column].data() - part->record.data());
-    text.append(part->record, 0, begin);
+    const std::string& record = part->rows->text();
+    const std::string& cell = part->cells[trajectory_column];
+    const std::size_t begin = part->rows->offset(trajectory_column);
+    text.append(record, 0, begin);
     std::uint64_t local = 0;
-    std::from_chars(cells[trajectory_column].data(), cells[trajectory_column].data() + cells[trajectory_column].size(),
-                    local);
+    std::from_chars(cell.data(), cell.data() + cell.size(), local);
     text += std::to_string(local + part->file->first_trajectory);
-    text.append(part->record, begin + cells[trajectory_column].size());
+    text.append(record, begin + cell.size());
     text += '\n';
     if (text.size() >= (1 << 20)) {
       file.write(text);
@@ -126,8 +105,6 @@ void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& out
     }
     if (advance(*part)) queue.push(part);
   }
-  for (auto& part : open)
-    if (part->in.bad()) unfit(*part, "read error");
   file.write(text);
   file.commit();
 }
@@ -177,7 +154,8 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
     add_counts(merged["evaluations"], unit["evaluations"]);
     auto& completed = merged["time"]["steps_completed"];
     completed = std::max(completed.get<std::uint64_t>(), unit["time"]["steps_completed"].get<std::uint64_t>());
-    // The scheme's figures (under its family's name, run_files.cpp) combine by the largest, as a process's blocks do.
+    // The scheme's figures (under its family's name, output/run_summary.cpp) combine by the largest, as a process's
+    // blocks do.
     if (const std::string family = merged.contains("integrator") ? merged["integrator"].value("family", "") : "";
         !family.empty() && merged.contains(family))
       for (auto figure = merged[family].begin(); figure != merged[family].end(); ++figure)

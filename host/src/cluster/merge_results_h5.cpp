@@ -8,7 +8,7 @@
 #endif
 
 #include "nonsep/host/observers/hdf5_sample_writer.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/hdf5_file.hpp"
 #include "nonsep/host/output/hdf5_samples.hpp"
 

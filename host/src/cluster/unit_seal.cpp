@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <string_view>
 
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
-#include "nonsep/host/output/files.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 
 namespace nonsep::host {

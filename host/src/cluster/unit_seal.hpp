@@ -6,10 +6,10 @@
 // is refused (exit 2, naming the unit), never merged.
 //
 // The seal holds the unit's number, first trajectory and size, the fingerprint of the job restricted to the unit's
-// trajectories (checkpoint.hpp's job_fingerprint: plugin, parameters, integrator and its options, initial states,
-// time grid, outputs, analysis), and for each of the unit's files its size, content hash and number of rows (line
-// ends). verify_unit also checks what the seal does not say: that trajectories.csv has one row per trajectory of
-// the unit and summary.json names as many, and that no file has appeared or gone since.
+// trajectories (checkpoint/checkpoint_file.hpp's job_fingerprint: plugin, parameters, integrator and its options,
+// initial states, time grid, outputs, analysis), and for each of the unit's files its size, content hash and number of
+// rows (line ends). verify_unit also checks what the seal does not say: that trajectories.csv has one row per
+// trajectory of the unit and summary.json names as many, and that no file has appeared or gone since.
 #include <cstddef>
 #include <filesystem>
 #include <string>

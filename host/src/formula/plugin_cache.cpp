@@ -20,8 +20,8 @@
 
 #include "nonsep/core/chin_kernel.hpp"
 #include "nonsep/host/formula/cpp_source.hpp"
-#include "nonsep/host/installation.hpp"
 #include "nonsep/host/output/content_hash.hpp"
+#include "nonsep/host/platform/installation.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/plugin_abi.h"
 

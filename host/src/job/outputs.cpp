@@ -1,6 +1,6 @@
 // /output (where results go and how often), /analysis (per-trajectory analyses of a run) and /checkpoint (when a
 // run saves checkpoint.json).
-#include "nonsep/host/build_features.hpp"
+#include "nonsep/host/platform/build_features.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {

@@ -1,7 +1,7 @@
 // Pass 2 of the job reader: the whole document, section by section (sections.hpp), and the rules that join
 // sections: a study has no /integrator, /analysis or /checkpoint, one initial state, and a reference of its
 // dimension.
-#include "nonsep/host/installation.hpp"
+#include "nonsep/host/platform/installation.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host {

@@ -39,8 +39,8 @@ void read_energy_shell(Checker& check, const json& initial, InitialStates& state
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
                 const std::string& first_path);
 
-// /study (study.cpp), with the study's end time (0 when /time/t_end is invalid: the step sizes are then only
-// checked, not turned into counts).
+// /study (study/convergence_study.cpp), with the study's end time (0 when /time/t_end is invalid: the step sizes are
+// then only checked, not turned into counts).
 Study read_study(Checker& check, const json& study, HamiltonianForm form, double t_end);
 
 // /output, /analysis and /checkpoint (outputs.cpp). read_output sets job.output_directory and, in a single run,

@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "checker.hpp"
-#include "nonsep/host/installation.hpp"
+#include "nonsep/host/platform/installation.hpp"
 
 namespace nonsep::host {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {

@@ -8,8 +8,8 @@
 #include <charconv>
 #include <cstring>
 
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
-#include "nonsep/host/output/files.hpp"
 #include "nonsep/host/output/held_folder.hpp"
 
 namespace nonsep::host {

@@ -2,7 +2,7 @@
 
 #include <bit>
 
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/held_folder.hpp"
 #include "nonsep/host/output/shuffle_deflate.hpp"
 

@@ -2,15 +2,14 @@
 
 #include <algorithm>
 #include <charconv>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <span>
 #include <vector>
 
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/host/output/files.hpp"
-#include "nonsep/host/output/held_folder.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
+#include "nonsep/host/output/csv_reader.hpp"
 #include "nonsep/host/output/shuffle_deflate.hpp"
 
 namespace nonsep::host {
@@ -18,78 +17,6 @@ namespace nonsep::host {
 namespace {
 
 constexpr std::size_t rows_per_block = 65536;
-
-// Rows of a CSV file as csv.hpp writes them (RFC 4180 quoting, '\n' line ends), read through a buffer of 1 MiB.
-class CsvRows {
- public:
-  explicit CsvRows(const std::filesystem::path& path)
-      : path_(path), in_(held_path(path), std::ios::binary), buffer_(1 << 20) {
-    if (!in_) throw OutputError("cannot read " + path.string() + " to copy it into results.h5");
-  }
-  // The next whole row into `cells` (whose strings are reused), or false at the end (a last line without '\n' is
-  // not a row).
-  bool next(std::vector<std::string>& cells) {
-    std::size_t count = 0;
-    const auto start_cell = [&] {
-      if (count == cells.size()) cells.emplace_back();
-      cells[count++].clear();
-    };
-    start_cell();
-    bool quoted = false;
-    const std::uint64_t first_line = line_;
-    for (int c; (c = get()) != EOF;) {
-      if (quoted) {
-        if (c != '"') {
-          line_ += c == '\n';
-          cells[count - 1] += static_cast<char>(c);
-        } else if (peek() == '"') {
-          cells[count - 1] += static_cast<char>(get());
-        } else {
-          quoted = false;
-        }
-      } else if (c == '"') {
-        quoted = true;
-      } else if (c == ',') {
-        start_cell();
-      } else if (c == '\n') {
-        ++line_;
-        cells.resize(count);
-        return true;
-      } else {
-        // The rest of an unquoted cell in the buffer at once: most cells are numbers with no quote.
-        const std::size_t begin = next_ - 1;
-        while (next_ < end_ && buffer_[next_] != ',' && buffer_[next_] != '\n' && buffer_[next_] != '"') ++next_;
-        cells[count - 1].append(buffer_.data() + begin, next_ - begin);
-      }
-    }
-    if (quoted) throw OutputError(path_.string() + ":" + std::to_string(first_line) + ": a quoted cell is not closed");
-    return false;
-  }
-  std::uint64_t line() const { return line_ - 1; }  // of the row last read
-
- private:
-  int peek() {
-    if (next_ == end_) refill();
-    return next_ == end_ ? EOF : static_cast<unsigned char>(buffer_[next_]);
-  }
-  int get() {
-    const int c = peek();
-    if (c != EOF) ++next_;
-    return c;
-  }
-  void refill() {
-    in_.read(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
-    next_ = 0;
-    end_ = static_cast<std::size_t>(in_.gcount());
-    if (in_.bad()) throw OutputError("cannot read " + path_.string() + " to copy it into results.h5");
-  }
-
-  std::filesystem::path path_;
-  std::ifstream in_;
-  std::vector<char> buffer_;
-  std::size_t next_ = 0, end_ = 0;
-  std::uint64_t line_ = 1;
-};
 
 bool is_integer(const std::string& cell) {
   std::int64_t value = 0;
@@ -107,7 +34,7 @@ struct Column {
 
 // The header and each column's kind, and the number of rows.
 std::vector<Column> survey(const std::filesystem::path& csv, std::uint64_t& rows) {
-  CsvRows reader(csv);
+  CsvReader reader(csv, "to copy it into results.h5");
   std::vector<std::string> cells;
   if (!reader.next(cells)) throw OutputError(csv.string() + " has no header line to copy into results.h5");
   std::vector<Column> columns(cells.size());
@@ -243,7 +170,7 @@ void write_csv_table(const Hdf5File& file, const std::string& group, const std::
   const auto changed = [&] {
     throw OutputError(csv.string() + " changed while it was copied into " + file.path().string());
   };
-  CsvRows reader(csv);
+  CsvReader reader(csv, "to copy it into results.h5");
   const hsize_t chunk = std::min<std::uint64_t>(rows, rows_per_block);
   ShuffleDeflate filter(1);
   std::vector<std::vector<std::string>> block(chunk);

@@ -10,7 +10,7 @@
 #include <mutex>
 #include <optional>
 
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 
 namespace nonsep::host {
 

@@ -87,6 +87,12 @@ std::vector<std::string> isolate_failures(PhaseSpaceBatch& x, const PhaseSpaceBa
   return errors;
 }
 
+// Retirement requests in trajectory order, the order a step-by-step run applies them (Block::retire_requested).
+inline void sort_requests(std::vector<RetirementRequest>& requests) {
+  std::sort(requests.begin(), requests.end(),
+            [](const RetirementRequest& a, const RetirementRequest& b) { return a.trajectory < b.trajectory; });
+}
+
 // Consecutive trajectories stepped together; the unit of work of a thread.
 struct alignas(64) Block {  // a cache line of its own: threads count evaluations in neighbouring blocks
   PhaseSpaceBatch batch;

@@ -6,31 +6,27 @@
 
 namespace nonsep::host {
 
-BlockView BlockStepper::view(const Block& block, const Worker& worker) const {
-  return {static_cast<std::size_t>(&block - blocks.data()),
-          setup.dimension,
-          block.trajectories,
-          block.batch.q(),
-          block.batch.p(),
-          &worker.model};
+BlockView BlockStepper::view(const Block& block, std::size_t index, const Worker& worker) const {
+  return {index, dimension, block.trajectories, block.batch.q(), block.batch.p(), &worker.model};
 }
 
 // The every-step observers see the block at `step`; the trajectories they ask to stop leave it there.
-void BlockStepper::watch_step(Block& block, Worker& worker, std::uint64_t step) {
+void BlockStepper::watch_step(Block& block, std::size_t index, Worker& worker, std::uint64_t step) {
   if (step_watchers.empty()) return;
   std::vector<RetirementRequest> requests;
-  auto v = view(block, worker);
+  auto v = view(block, index, worker);
   v.retire = &requests;
-  for (StepObserver* watcher : step_watchers) watcher->on_step(step, setup.time.time_at(step), v);
+  for (StepObserver* watcher : step_watchers) watcher->on_step(step, time.time_at(step), v);
   if (requests.empty()) return;
   sort_requests(requests);
   block.retire_requested(requests, step, [&](std::size_t slot) { return energy_of(worker, block.batch, slot); });
 }
 
-void BlockStepper::advance_block(Block& block, Worker& worker, std::uint64_t from, std::uint64_t to) {
+void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker, std::uint64_t from,
+                                 std::uint64_t to) {
   block.begin_chunk();
-  for (StepObserver* watcher : step_watchers) watcher->save_block(view(block, worker));
-  const double dt = setup.time.dt;
+  for (StepObserver* watcher : step_watchers) watcher->save_block(view(block, index, worker));
+  const double dt = time.dt;
   bool clean = true;
   try {
     if (step_watchers.empty())  // the common case: the whole chunk in one call, through the kernel when there is one
@@ -38,17 +34,17 @@ void BlockStepper::advance_block(Block& block, Worker& worker, std::uint64_t fro
     else
       for (std::uint64_t step = from; step < to && !block.empty(); ++step) {
         block.step(worker.model, dt);
-        watch_step(block, worker, step + 1);
+        watch_step(block, index, worker, step + 1);
       }
   } catch (const ModelError&) {
     clean = false;
   }
   if (clean && block.all_finite()) return;
   block.rollback_chunk();
-  for (StepObserver* watcher : step_watchers) watcher->restore_block(view(block, worker));
+  for (StepObserver* watcher : step_watchers) watcher->restore_block(view(block, index, worker));
   for (std::uint64_t step = from + 1; step <= to && !block.empty(); ++step) {
     checked_step(block, worker, step);
-    if (!block.empty()) watch_step(block, worker, step);
+    if (!block.empty()) watch_step(block, index, worker, step);
   }
 }
 
@@ -60,13 +56,13 @@ void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step
   const Integrator integrator_before = block.integrator;  // the scheme's private state, for a redo state by state
   const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
     if (block.tangents)
-      block.tangents->step_part(worker.model, x, *tangents_before, first, setup.time.dt);
+      block.tangents->step_part(worker.model, x, *tangents_before, first, time.dt);
     else if (x.count() == before.count())
-      block.integrator.step(worker.model, x, setup.time.dt);
+      block.integrator.step(worker.model, x, time.dt);
     else
-      block.integrator.step_part(worker.model, x, integrator_before, first, before.count(), setup.time.dt);
+      block.integrator.step_part(worker.model, x, integrator_before, first, before.count(), time.dt);
   });
-  if (block.tangents) block.tangents->after_step(setup.time.dt);
+  if (block.tangents) block.tangents->after_step(time.dt);
   std::vector<bool> retire(block.trajectories.size(), false);
   for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
     Departure departure;
@@ -102,16 +98,12 @@ std::optional<double> BlockStepper::energy_of(Worker& worker, const PhaseSpaceBa
   return std::nullopt;
 }
 
-// H of the block's states at `step`; the states the model fails on retire as "failed". Sets H0 at step 0 (each
-// trajectory belongs to one block: no two threads touch the same record).
+// H of the block's states at `step`; the states the model fails on leave the block as "failed" departures.
 void BlockStepper::evaluate_energies(Block& block, Worker& worker, std::uint64_t step) {
   const auto errors = compute_energies(block, worker, step);
   std::vector<bool> retire(block.trajectories.size(), false);
   for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
-    if (errors[slot].empty()) {
-      if (step == 0) records[block.trajectories[slot]].energy_initial = block.energy(slot);
-      continue;
-    }
+    if (errors[slot].empty()) continue;
     retire[slot] = true;
     Departure departure;
     departure.trajectory = block.trajectories[slot];

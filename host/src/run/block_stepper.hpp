@@ -4,7 +4,6 @@
 // plugin failed in it, puts the block back and redoes the chunk step by step, retiring the states that fail or
 // diverge (Departure, block.hpp); it shows every step to the observers that watch every step, and evaluates H.
 // The driver decides which blocks run where and when; this class knows one block at a time.
-#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -12,8 +11,8 @@
 
 #include "nonsep/core/energy.hpp"
 #include "nonsep/host/plugin_loader.hpp"
-#include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/observer.hpp"
+#include "nonsep/host/time_grid.hpp"
 #include "run/block.hpp"
 
 namespace nonsep::host {
@@ -26,42 +25,31 @@ struct alignas(64) Worker {
   PluginModel stepping = model.with_kernel();
 };
 
-// Retirement requests in trajectory order, the order a step-by-step run applies them.
-inline void sort_requests(std::vector<RetirementRequest>& requests) {
-  std::sort(requests.begin(), requests.end(),
-            [](const RetirementRequest& a, const RetirementRequest& b) { return a.trajectory < b.trajectory; });
-}
-
 class BlockStepper {
  public:
-  // The references are the driver's and outlive the stepper; `blocks` is not resized after construction.
-  BlockStepper(const EnsembleSetup& setup, const std::vector<Block>& blocks,
-               const std::vector<StepObserver*>& step_watchers, std::vector<TrajectoryRecord>& records,
+  // `time` and `step_watchers` are the driver's and outlive the stepper.
+  BlockStepper(std::size_t dimension, const TimeGrid& time, const std::vector<StepObserver*>& step_watchers,
                bool energy_available)
-      : setup(setup),
-        blocks(blocks),
-        step_watchers(step_watchers),
-        records(records),
-        energy_available(energy_available) {}
+      : dimension(dimension), time(time), step_watchers(step_watchers), energy_available(energy_available) {}
 
-  // Steps `block` from step `from` to `to` (see above).
-  void advance_block(Block& block, Worker& worker, std::uint64_t from, std::uint64_t to);
-  // H of the block's states at `step`; the states the model fails on retire as "failed". Sets H0 at step 0 (each
-  // trajectory belongs to one block: no two threads touch the same record).
+  // Steps `block`, the driver's block number `index`, from step `from` to `to` (see above); the states that stop
+  // are in block.departures.
+  void advance_block(Block& block, std::size_t index, Worker& worker, std::uint64_t from, std::uint64_t to);
+  // H of the block's states at `step` (block.energies); the states the model fails on leave the block as "failed"
+  // departures.
   void evaluate_energies(Block& block, Worker& worker, std::uint64_t step);
   // Fills block.energies at `step` (NaN where the model fails); returns the model's message per slot.
   static std::vector<std::string> compute_energies(Block& block, Worker& worker, std::uint64_t step);
 
  private:
-  BlockView view(const Block& block, const Worker& worker) const;
-  void watch_step(Block& block, Worker& worker, std::uint64_t step);
+  BlockView view(const Block& block, std::size_t index, const Worker& worker) const;
+  void watch_step(Block& block, std::size_t index, Worker& worker, std::uint64_t step);
   void checked_step(Block& block, Worker& worker, std::uint64_t step);
   std::optional<double> energy_of(Worker& worker, const PhaseSpaceBatch& x, std::size_t slot) const;
 
-  const EnsembleSetup& setup;
-  const std::vector<Block>& blocks;
+  std::size_t dimension;
+  const TimeGrid& time;
   const std::vector<StepObserver*>& step_watchers;
-  std::vector<TrajectoryRecord>& records;
   bool energy_available;
 };
 

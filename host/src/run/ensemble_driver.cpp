@@ -30,7 +30,7 @@ struct EnsembleDriver::Impl {
   std::vector<ChunkObserver*> chunk_observers;
   std::vector<StepObserver*> step_watchers;
   std::unique_ptr<WorkerPool> pool;  // after `workers`: destroyed (its threads joined) before them
-  BlockStepper stepper{setup, blocks, step_watchers, records, energy_available};
+  BlockStepper stepper{setup.dimension, setup.time, step_watchers, energy_available};
   std::uint64_t completed = 0;
   bool resumed = false;
   EvaluationCounts evaluations_before;
@@ -166,7 +166,9 @@ struct EnsembleDriver::Impl {
   // Every block from step `from` to `to`, then H at `to` when asked for, then the event.
   void advance(std::uint64_t from, std::uint64_t to) {
     try {
-      for_each_block([&](Block& block, Worker& worker) { stepper.advance_block(block, worker, from, to); });
+      for_each_block([&](Block& block, Worker& worker) {
+        stepper.advance_block(block, static_cast<std::size_t>(&block - blocks.data()), worker, from, to);
+      });
     } catch (...) {
       for (Block& block : blocks) block.abandon_chunk();  // the run ends at `from`
       throw;
@@ -181,9 +183,15 @@ struct EnsembleDriver::Impl {
     notify_event(to, energy);
   }
 
+  // H0 of the states whose H is known at step 0 (each trajectory belongs to one block: no two threads touch the
+  // same record).
   void start() {
     if (energy_available)
-      for_each_block([&](Block& block, Worker& worker) { stepper.evaluate_energies(block, worker, 0); });
+      for_each_block([&](Block& block, Worker& worker) {
+        stepper.evaluate_energies(block, worker, 0);
+        for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
+          records[block.trajectories[slot]].energy_initial = block.energy(slot);
+      });
     apply_departures();
     notify_event(0, energy_available);
   }

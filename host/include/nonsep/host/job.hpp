@@ -83,8 +83,9 @@ struct InitialStates {
 };
 
 // A convergence study (/study): the job's model and initial state are run to /time/t_end by each integrator at
-// each of its step counts, and the errors at t_end are compared (study.hpp). Step counts are per integrator: the
-// study's list (/study/steps, or /study/dt turned into counts as TimeGrid does) unless the integrator gives its own.
+// each of its step counts, and the errors at t_end are compared (study/convergence_study.hpp). Step counts are per
+// integrator: the study's list (/study/steps, or /study/dt turned into counts as TimeGrid does) unless the integrator
+// gives its own.
 struct StudyIntegrator {
   std::string label;    // /study/integrators/<i>/label, default "<scheme> <order>" ("triplet 4/3"; "basic")
   IntegratorSpec spec;  // as /integrator of a single run, sharing /hamiltonian
@@ -136,9 +137,9 @@ struct Analysis {
   std::optional<double> max_relative_energy_error;
 };
 
-// When a run saves checkpoint.json (host/include/nonsep/host/checkpoint.hpp) so that `nonsep run --resume` can
-// continue it: after every `every_steps` steps and/or once `every_seconds` of wall time have passed since the
-// last one (0 turns either off), and always when the run is interrupted.
+// When a run saves checkpoint.json (host/include/nonsep/host/checkpoint/checkpoint_file.hpp) so that `nonsep run
+// --resume` can continue it: after every `every_steps` steps and/or once `every_seconds` of wall time have passed since
+// the last one (0 turns either off), and always when the run is interrupted.
 struct CheckpointPolicy {
   std::uint64_t every_steps = 0;
   double every_seconds = 60.0;

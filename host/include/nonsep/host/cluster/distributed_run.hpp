@@ -33,7 +33,7 @@
 
 #include "nonsep/host/cluster/ranks.hpp"
 #include "nonsep/host/job.hpp"
-#include "nonsep/host/run/run_job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 
 namespace nonsep::host {
 

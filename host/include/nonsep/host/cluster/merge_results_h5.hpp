@@ -3,7 +3,7 @@
 // results.h5; the ranks copy the units' /samples into the run's results.h5 together, through MPI-IO (HDF5's
 // collective writes, which its compressed datasets require), each rank the units r, r + size, r + 2 size, ... (a
 // static split: the copy is I/O, the same amount per unit). Rank 0 then adds the tables and attributes from the
-// merged CSV files and summary (run/results_file.hpp), as one process does. The numbers equal one process's; the
+// merged CSV files and summary (output/results_h5.hpp), as one process does. The numbers equal one process's; the
 // file's bytes may not (HDF5 places chunks in the order they are written).
 #include <cstddef>
 #include <filesystem>

@@ -3,7 +3,7 @@
 // (observers/sample_writer.hpp), as one row of every trajectory per sample step (step 0, every `every`-th step, the
 // last step) written when the run reaches it. A trajectory that stopped before a sample has NaN there; one that
 // stopped exactly at a sample step has its final state there, as trajectory.csv has its row. Final states of
-// trajectories that stopped elsewhere are in /trajectories (added at the end of the run, run/results_file.hpp).
+// trajectories that stopped elsewhere are in /trajectories (added at the end of the run, output/results_h5.hpp).
 //
 // Rows are kept until they fill a chunk of /samples (one row when the ensemble fills a chunk, several for small
 // ensembles: SampleDatasets::samples_per_chunk), so that every chunk is filtered and written once, whole.

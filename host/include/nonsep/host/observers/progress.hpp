@@ -2,7 +2,7 @@
 // The progress bar (progress_bar.hpp) as an observer: redrawn after chunks, with the step, the active trajectories
 // and the largest relative energy error so far.
 #include "nonsep/host/observers/energy_error.hpp"
-#include "nonsep/host/progress_bar.hpp"
+#include "nonsep/host/observers/progress_bar.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/observer.hpp"
 

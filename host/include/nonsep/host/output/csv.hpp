@@ -7,7 +7,7 @@
 //
 // CsvAppender streams rows to a file as a run goes: rows are buffered (64 KiB) and handed to the file only as whole
 // rows, one write() per buffer; a reader that finds a last line without its '\n' (after a hard kill or a full disk)
-// must drop it. A whole file that is produced at once goes through write_file_atomically (files.hpp) instead.
+// must drop it. A whole file that is produced at once goes through write_file_atomically (atomic_files.hpp) instead.
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>

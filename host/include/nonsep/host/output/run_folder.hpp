@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/held_folder.hpp"
 
 namespace nonsep::host {

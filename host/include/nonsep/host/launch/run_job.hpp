@@ -3,10 +3,10 @@
 // run's files. In the output folder:
 //   trajectory.csv    the samples (observers/sample_writer.hpp), streamed; none when output.every is 0
 //   results.h5        output.format "hdf5" only, instead of trajectory.csv: the samples (observers/
-//                     hdf5_sample_writer.hpp), then the tables and the run's facts (run/results_file.hpp)
+//                     hdf5_sample_writer.hpp), then the tables and the run's facts (output/results_h5.hpp)
 //   trajectories.csv  one row per trajectory, written at the end (header below)
 //   summary.json      the run's facts (status, job, model, integrator, time grid, energy, counts, evaluations)
-//   checkpoint.json   while the run is interrupted (observers/checkpoint_saver.hpp)
+//   checkpoint.json   while the run is interrupted (checkpoint/checkpoint_saver.hpp)
 // trajectories.csv header:
 //   trajectory,status,step,t,q0,...,q<n-1>,p0,...,p<n-1>,H0,H,relative_energy_error,stop_step,stop_t,
 //   stop_variable,message, then the observers' columns: max_abs_relative_energy_error, and with
@@ -38,7 +38,7 @@ struct RunOptions {
   // Checked between chunks (a fraction of a second apart); when true the run stops with status "interrupted"
   // (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;
-  bool resume = false;     // continue from output_directory/checkpoint.json (checkpoint.hpp)
+  bool resume = false;     // continue from output_directory/checkpoint.json (checkpoint_file.hpp)
   bool force = false;      // start over in a folder holding another job's results or a checkpoint (run_folder.hpp)
   unsigned threads = 0;    // worker threads; 0: all cores
   bool work_unit = false;  // a distributed run's unit (its folder's kind is "unit": run_folder.hpp)

@@ -1,6 +1,7 @@
 #pragma once
 // checkpoint.json: everything a run needs to continue, bit for bit, after an interruption or a crash
-// (`nonsep run JOB --resume`).
+// (`nonsep run JOB --resume`). This file reads it (load_checkpoint, once, before a resumed run's driver starts:
+// launch/run_plan.hpp) and identifies the job it belongs to; CheckpointSaver (checkpoint_saver.hpp) writes it.
 //
 // A checkpoint is taken between two steps and holds: the number of steps completed, the active states in
 // trajectory order with their energies, every trajectory's record (retired ones included: status, final state,
@@ -25,6 +26,7 @@
 
 #include "nonsep/core/model.hpp"
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/saved_state.hpp"  // CheckpointError
 
@@ -47,8 +49,13 @@ std::string fingerprint_difference(const std::string& a, const std::string& b);
 // The file name inside a run's output folder.
 inline constexpr const char* checkpoint_file_name = "checkpoint.json";
 
-// Writes `checkpoint` to `path` atomically. Throws OutputError.
-void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint, const std::string& fingerprint);
+// The value of the file's "format" key; a checkpoint with another is refused.
+inline constexpr const char* checkpoint_format = "nonsep checkpoint 4";  // 4: the scheme's private state, grad H
+// The value of the file's "checksum" key: the content hash of everything else, as dumped (keys sorted, numbers as
+// strings), so that an edited or damaged checkpoint is refused instead of changing the results.
+inline std::string checkpoint_checksum(const nlohmann::json& document) {
+  return content_hash_hex(content_hash(document.dump()));
+}
 
 // Reads the checkpoint at `path` and checks it against the job (fingerprint, number of trajectories, dimension,
 // steps). The observers' states are checked by the observers' restore(). Throws CheckpointError.

@@ -1,22 +1,15 @@
-#include "nonsep/host/run/run_job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <optional>
 
-#include "nonsep/host/checkpoint.hpp"
-#include "nonsep/host/observers/checkpoint_saver.hpp"
-#include "nonsep/host/observers/closest_return.hpp"
-#include "nonsep/host/observers/lyapunov_megno.hpp"
-#include "nonsep/host/observers/poincare_section.hpp"
-#include "nonsep/host/observers/progress.hpp"
-#include "nonsep/host/observers/sample_writer.hpp"
-#include "nonsep/host/output/files.hpp"
+#include "launch/run_plan.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "run/run_files.hpp"
+#include "output/run_summary.hpp"
 #ifdef NONSEP_HAVE_HDF5
-#include "nonsep/host/observers/hdf5_sample_writer.hpp"
-#include "run/results_file.hpp"
+#include "output/results_h5.hpp"
 #endif
 
 namespace nonsep::host {
@@ -37,9 +30,6 @@ std::size_t& StatusCounts::operator[](TrajectoryStatus status) {
 }
 
 namespace {
-
-// An earlier run's file that this run does not write would mislead.
-void remove_stale(const std::filesystem::path& path) { remove_file(path); }
 
 nlohmann::ordered_json poincare_facts(const PoincareSection& section, const PoincareSectionObserver& observer) {
   const char* direction = section.direction == CrossingDirection::up     ? "+"
@@ -99,79 +89,12 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const Job& job = loaded.job;
   const SingleRun& run = job.run();
-  const std::filesystem::path& directory = options.output_directory;
-  const RunFolder folder(directory, options.work_unit ? "unit" : "run", job.file, folder_use(options));
-  std::optional<Checkpoint> checkpoint;
-  if (options.resume) checkpoint = load_checkpoint(directory / checkpoint_file_name, loaded);
-
-  EnsembleDriver driver(loaded.plugin, loaded.model,
-                        {run.integrator, run.time, job.initial.dimension, job.initial.q, job.initial.p, options.threads,
-                         options.stop_requested, run.analysis.tangent_vectors(),
-                         run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1,
-                         run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count)});
-  const std::size_t count = job.initial.count;
-  EnergyErrorObserver energy(count, driver.energy_available() ? run.energy_every : 0,
-                             run.analysis.max_relative_energy_error);
-  std::optional<ClosestReturnObserver> closest;
-  if (run.analysis.closest_return_after)
-    closest.emplace(*run.analysis.closest_return_after, job.initial.dimension, job.initial.q, job.initial.p);
+  RunPlan plan(loaded, options);
+  const std::filesystem::path& directory = plan.directory;
+  const EnsembleDriver& driver = plan.driver;
   const bool hdf5 = run.format == OutputFormat::hdf5;
-  std::optional<SampleWriter> samples;
-  if (run.every > 0 && !hdf5) {
-    samples.emplace(directory / SampleWriter::file_name, job.initial.dimension, count, run.every, driver.time(),
-                    options.resume);
-  } else {
-    remove_stale(directory / SampleWriter::file_name);
-  }
-#ifdef NONSEP_HAVE_HDF5
-  std::optional<Hdf5SampleWriter> hdf5_samples;
-  if (run.every > 0 && hdf5)
-    hdf5_samples.emplace(directory / results_file_name, job.initial.dimension, count, run.every, driver.time(),
-                         options.resume);
-#else
-  if (hdf5) throw OutputError("output.format \"hdf5\": this build of nonsep has no HDF5");  // the reader refuses it
-#endif
-  if (!hdf5 || (run.every == 0 && !options.resume)) remove_stale(directory / results_file_name);
-  std::optional<PoincareSectionObserver> poincare;
-  if (run.analysis.poincare)
-    poincare.emplace(directory / PoincareSectionObserver::file_name, *run.analysis.poincare, run.integrator,
-                     driver.time(), job.initial.dimension, count, driver.energy_available(), options.resume);
-  else
-    remove_stale(directory / PoincareSectionObserver::file_name);
-  std::optional<LyapunovMegnoObserver> chaos;
-  if (run.analysis.tangent_vectors() > 0)
-    chaos.emplace(directory / LyapunovMegnoObserver::file_name,
-                  run.analysis.lyapunov ? run.analysis.lyapunov->vectors : 0, run.analysis.megno,
-                  run.analysis.lyapunov ? run.analysis.lyapunov->every : 0, driver.time(), driver.records(),
-                  options.resume);
-  if (!chaos || !run.analysis.lyapunov || run.analysis.lyapunov->every == 0)
-    remove_stale(directory / LyapunovMegnoObserver::file_name);
-  std::vector<Observer*> observers{&energy};
-  if (chaos) observers.push_back(&*chaos);
-  if (closest) observers.push_back(&*closest);
-  if (samples) observers.push_back(&*samples);
-#ifdef NONSEP_HAVE_HDF5
-  if (hdf5_samples) observers.push_back(&*hdf5_samples);
-#endif
-  if (poincare) observers.push_back(&*poincare);
-  CheckpointSaver saver(directory / checkpoint_file_name, job_fingerprint(loaded), run.checkpoint, driver, observers);
-  ProgressObserver progress(options.show_progress, driver, &energy);
-  for (Observer* observer : observers) driver.add_observer(*observer);
-  driver.add_observer(saver);
-  driver.add_observer(progress);
-  if (checkpoint) {
-    driver.restore(std::move(checkpoint->driver));
-    for (Observer* each : observers)
-      if (auto* observer = dynamic_cast<CheckpointedObserver*>(each); observer && !observer->name().empty()) {
-        const std::string name = observer->name();
-        if (!checkpoint->observers.contains(name))
-          throw CheckpointError((directory / checkpoint_file_name).string() + " is damaged (no state for " + name +
-                                ")");
-        observer->restore(checkpoint->observers[name]);
-      }
-  }
 
-  const DriverEnd end = driver.run();
+  const DriverEnd end = plan.driver.run();
   RunOutcome outcome;
   outcome.error = driver.error();
   outcome.trajectories = driver.records();
@@ -182,7 +105,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   for (const TrajectoryRecord& record : outcome.trajectories) ++outcome.counts[record.status];
   outcome.status = run_status(end, outcome.counts);
   outcome.exit_status = exit_status_of(outcome.status);
-  outcome.largest_energy_error = energy.largest();
+  outcome.largest_energy_error = plan.energy.largest();
   if (!loaded.plugin.thread_safe() && options.threads != 1)
     outcome.notes.push_back("ran on one thread: the plugin '" + loaded.plugin.name() +
                             "' declares \"thread_safe\": false (plugin_abi.h)");
@@ -193,8 +116,8 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
                        run.every > 0 && !hdf5,
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
   outcome.summary = run_summary(facts);
-  if (poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *poincare);
-  if (chaos) outcome.summary["analysis"]["tangent_map"] = tangent_facts(run.analysis);
+  if (plan.poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *plan.poincare);
+  if (plan.chaos) outcome.summary["analysis"]["tangent_map"] = tangent_facts(run.analysis);
   if (const auto& shell = job.initial.shell)
     outcome.summary["energy_shell"] = {{"energy", shell->energy},
                                        {"solve_for", shell->solve_for},
@@ -208,10 +131,10 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
     outcome.summary["status"] = to_string(outcome.status);
   };
   try {
-    std::vector<const TrajectoryColumns*> columns{&energy};
-    if (closest) columns.push_back(&*closest);
-    if (poincare) columns.push_back(&*poincare);
-    if (chaos) columns.push_back(&*chaos);
+    std::vector<const TrajectoryColumns*> columns{&plan.energy};
+    if (plan.closest) columns.push_back(&*plan.closest);
+    if (plan.poincare) columns.push_back(&*plan.poincare);
+    if (plan.chaos) columns.push_back(&*plan.chaos);
     write_trajectories_csv(directory / trajectories_file_name, facts, columns);
   } catch (const OutputError& error) {
     fail(error);

@@ -1,10 +1,10 @@
-#include "run/run_files.hpp"
+#include "output/run_summary.hpp"
 
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/csv.hpp"
-#include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
 

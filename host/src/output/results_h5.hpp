@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "run/run_files.hpp"
+#include "output/run_summary.hpp"
 
 namespace nonsep::host {
 

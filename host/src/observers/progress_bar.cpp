@@ -1,4 +1,4 @@
-#include "nonsep/host/progress_bar.hpp"
+#include "nonsep/host/observers/progress_bar.hpp"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "nonsep/host/checkpoint.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 
 #include <bit>
 #include <cmath>
@@ -11,40 +11,14 @@
 #include <vector>
 
 #include "nonsep/core/integrator.hpp"
-#include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
-#include "nonsep/host/output/files.hpp"
 
 namespace nonsep::host {
 
 using json = nlohmann::json;
 
 namespace {
-
-constexpr const char* format_tag = "nonsep checkpoint 4";  // 4: the scheme's private state and the grad H count
-
-json encode(double value) { return format_number(value); }
-
-json encode(const std::vector<double>& values) {
-  json list = json::array();
-  for (double value : values) list.push_back(encode(value));
-  return list;
-}
-
-json encode(const std::optional<double>& value) { return value ? encode(*value) : json(nullptr); }
-
-// A LyapunovRecord as numbers: steps, steps since renormalisation, time, time since, ln |v_1|, then the k sums.
-json encode(const LyapunovRecord& record, std::size_t k) {
-  std::vector<double> numbers{static_cast<double>(record.steps),
-                              static_cast<double>(record.steps_since_renormalization), record.time,
-                              record.time_since_renormalization, record.log_norm_first};
-  numbers.insert(numbers.end(), record.log_stretch.begin(),
-                 record.log_stretch.begin() + static_cast<std::ptrdiff_t>(k));
-  return encode(numbers);
-}
-json encode(const MegnoRecord& record) {
-  return encode(std::vector<double>{record.time, record.weighted_growth, record.integrated_y});
-}
 
 // Every read of a malformed file ends here, with what was wrong.
 SavedState reader(const std::filesystem::path& path) {
@@ -165,62 +139,6 @@ std::string fingerprint_difference(const std::string& a, const std::string& b) {
   return differ.empty() ? "the job's identity" : differ;
 }
 
-void save_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint, const std::string& fingerprint) {
-  const DriverState& state = checkpoint.driver;
-  json records = json::array();
-  for (const TrajectoryRecord& record : state.records)
-    records.push_back({{"status", to_string(record.status)},
-                       {"final_step", record.final_step},
-                       {"final_t", encode(record.final_t)},
-                       {"final_q", encode(record.final_q)},
-                       {"final_p", encode(record.final_p)},
-                       {"energy_initial", encode(record.energy_initial)},
-                       {"energy_final", encode(record.energy_final)},
-                       {"stop_step", record.stop_step},
-                       {"stop_t", encode(record.stop_t)},
-                       {"stop_variable", record.stop_variable},
-                       {"message", record.message},
-                       {"lyapunov", encode(record.lyapunov)},
-                       {"megno", encode(record.megno)},
-                       {"mean_megno", encode(record.mean_megno)}});
-  json lyapunov = json::array(), megno = json::array();
-  const std::size_t k = state.active.empty() ? 0 : state.tangent_q.size() / std::max<std::size_t>(1, state.q.size());
-  for (const LyapunovRecord& record : state.lyapunov) lyapunov.push_back(encode(record, k));
-  for (const MegnoRecord& record : state.megno) megno.push_back(encode(record));
-  json evaluations = {
-      {"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}, {"grad_H", state.evaluations.grad_H}};
-  // The separable part's counts, only for a model that has one (the checkpoints of other models are unchanged).
-  if (state.evaluations.grad_K + state.evaluations.grad_U > 0) {
-    evaluations["grad_K"] = state.evaluations.grad_K;
-    evaluations["grad_U"] = state.evaluations.grad_U;
-  }
-  json document = {{"format", format_tag},
-                   {"job_fingerprint", fingerprint},
-                   {"step", state.step},
-                   {"evaluations", evaluations},
-                   {"active",
-                    {{"trajectories", state.active},
-                     {"q", encode(state.q)},
-                     {"p", encode(state.p)},
-                     {"energies", encode(state.energies)},
-                     {"tangent_q", encode(state.tangent_q)},
-                     {"tangent_p", encode(state.tangent_p)},
-                     {"lyapunov", std::move(lyapunov)},
-                     {"megno", std::move(megno)}}},
-                   {"records", std::move(records)},
-                   {"observers", checkpoint.observers}};
-  // The scheme's private state, under the names it gives: its columns with the active trajectories', its numbers
-  // about the run at the top.
-  for (const SchemeState::Column& column : state.scheme.columns)
-    document["active"][column.name] = encode(column.values);
-  for (const SchemeState::Largest& number : state.scheme.largest) document[number.name] = encode(number.value);
-  // The checksum covers everything else, as dumped (keys sorted, numbers as strings): an edited or damaged
-  // checkpoint is refused instead of changing the results.
-  json signed_document = document;
-  signed_document["checksum"] = content_hash_hex(content_hash(document.dump()));
-  write_file_atomically(path, signed_document.dump() + "\n");
-}
-
 Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded) {
   const Job& job = loaded.job;
   std::optional<std::string> text;
@@ -239,11 +157,11 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     reader(path).damaged(std::string("not JSON: ") + error.what());
   }
   const SavedState read = reader(path);
-  if (read.string(read.member(document, "format"), "format") != format_tag)
-    read.damaged(std::string("its format is not \"") + format_tag + "\"");
+  if (read.string(read.member(document, "format"), "format") != checkpoint_format)
+    read.damaged(std::string("its format is not \"") + checkpoint_format + "\"");
   const std::string checksum = read.string(read.member(document, "checksum"), "checksum");
   document.erase("checksum");
-  if (checksum != content_hash_hex(content_hash(document.dump())))
+  if (checksum != checkpoint_checksum(document))
     read.damaged("its content does not match its checksum: it was edited or damaged");
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
   if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)

@@ -23,7 +23,7 @@
 #include "nonsep/core/integrator_description.hpp"
 #include "nonsep/core/model.hpp"
 #include "nonsep/host/job.hpp"
-#include "nonsep/host/run/run_job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 
 namespace nonsep::host {
 

@@ -1,4 +1,4 @@
-#include "nonsep/host/installation.hpp"
+#include "nonsep/host/platform/installation.hpp"
 
 #include <algorithm>
 

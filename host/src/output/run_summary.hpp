@@ -1,21 +1,21 @@
 #pragma once
 // What a run writes at its end: summary.json (the run's facts, written with nlohmann-json) and trajectories.csv
-// (one row per trajectory; columns in run_job.hpp). Both are replaced atomically.
+// (one row per trajectory; columns in launch/run_job.hpp). Both are replaced atomically.
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <vector>
 
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/observer.hpp"
-#include "nonsep/host/run/run_job.hpp"
 
 namespace nonsep::host {
 
 inline constexpr const char* summary_file_name = "summary.json";
 inline constexpr const char* trajectories_file_name = "trajectories.csv";
-inline constexpr const char* results_file_name = "results.h5";  // output.format "hdf5" (run/results_file.hpp)
+inline constexpr const char* results_file_name = "results.h5";  // output.format "hdf5" (output/results_h5.hpp)
 
 struct RunFacts {
   const LoadedJob& loaded;

@@ -1,4 +1,4 @@
-#include "nonsep/host/plugin_report.hpp"
+#include "nonsep/host/inspect/plugin_report.hpp"
 
 #include <algorithm>
 #include <cmath>

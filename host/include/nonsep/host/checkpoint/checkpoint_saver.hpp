@@ -1,7 +1,8 @@
 #pragma once
-// checkpoint.json (checkpoint.hpp): saved after every `every_steps` steps and/or once `every_seconds` of wall time
+// checkpoint.json (checkpoint_file.hpp): saved after every `every_steps` steps and/or once `every_seconds` of wall time
 // have passed since the last one (job /checkpoint), and when the run is interrupted, from the driver's state and
 // every observer's save(). A run that ends otherwise removes it. Add it after the observers whose state it saves.
+// The one writer of the file: its layout is written here and read back by load_checkpoint (checkpoint_file.hpp).
 #include <chrono>
 #include <filesystem>
 #include <string>

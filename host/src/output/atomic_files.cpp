@@ -1,4 +1,4 @@
-#include "nonsep/host/output/files.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -1,4 +1,4 @@
-#include "nonsep/host/build_features.hpp"
+#include "nonsep/host/platform/build_features.hpp"
 
 #ifdef NONSEP_HAVE_MPI
 #include <mpi.h>

@@ -1,9 +1,9 @@
-// The fits of a convergence study (study.hpp): a power law through each integrator's errors at t_end, and the
-// fit as summary.json's "fits" entry.
+// The fits of a convergence study (convergence_study.hpp): a power law through each integrator's errors at t_end, and
+// the fit as summary.json's "fits" entry.
 #include <algorithm>
 #include <cmath>
 
-#include "nonsep/host/study.hpp"
+#include "nonsep/host/study/convergence_study.hpp"
 
 namespace nonsep::host {
 

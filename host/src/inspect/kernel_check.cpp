@@ -9,7 +9,7 @@
 
 #include "nonsep/core/chin_kernel.hpp"
 #include "nonsep/core/integrator.hpp"
-#include "nonsep/host/plugin_report.hpp"
+#include "nonsep/host/inspect/plugin_report.hpp"
 
 namespace nonsep::host {
 

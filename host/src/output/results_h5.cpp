@@ -1,4 +1,4 @@
-#include "run/results_file.hpp"
+#include "output/results_h5.hpp"
 
 #include <array>
 

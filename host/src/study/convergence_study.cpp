@@ -1,4 +1,4 @@
-#include "nonsep/host/study.hpp"
+#include "nonsep/host/study/convergence_study.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -12,8 +12,8 @@
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/csv.hpp"
-#include "nonsep/host/output/files.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 

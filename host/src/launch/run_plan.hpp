@@ -1,0 +1,63 @@
+#pragma once
+// A loaded job made ready to run, built once and in the order its data flows: the output folder (taken,
+// run_folder.hpp), the state a resumed run continues from (checkpoint.json, read here and nowhere else:
+// checkpoint_file.hpp), the driver, the observers the job asks for (their files opened; earlier runs' files this run
+// does not write removed), the resumed state handed to the driver and to each observer, then the checkpoint saver (the
+// one writer of checkpoint.json: checkpoint_saver.hpp) and the progress bar. run_job (run_job.hpp) runs the driver and
+// writes the run's files from what the plan's observers hold. Internal to src/launch/.
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
+#include "nonsep/host/checkpoint/checkpoint_saver.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
+#include "nonsep/host/observers/closest_return.hpp"
+#include "nonsep/host/observers/energy_error.hpp"
+#include "nonsep/host/observers/lyapunov_megno.hpp"
+#include "nonsep/host/observers/poincare_section.hpp"
+#include "nonsep/host/observers/progress.hpp"
+#include "nonsep/host/observers/sample_writer.hpp"
+#include "nonsep/host/output/run_folder.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+#include "nonsep/host/run/observer.hpp"
+#ifdef NONSEP_HAVE_HDF5
+#include "nonsep/host/observers/hdf5_sample_writer.hpp"
+#endif
+
+namespace nonsep::host {
+
+class RunPlan {
+ public:
+  // Throws, before anything is computed: FolderInUse, OutputError and CheckpointError (run_job.hpp says when).
+  RunPlan(const LoadedJob& loaded, const RunOptions& options);
+  RunPlan(const RunPlan&) = delete;
+  RunPlan& operator=(const RunPlan&) = delete;
+
+  const std::filesystem::path directory;
+
+ private:
+  RunFolder folder_;
+  std::optional<Checkpoint> resumed_;  // until the constructor hands it to the driver and the observers
+
+ public:
+  EnsembleDriver driver;
+  EnergyErrorObserver energy;
+  std::optional<ClosestReturnObserver> closest;
+  std::optional<SampleWriter> samples;
+#ifdef NONSEP_HAVE_HDF5
+  std::optional<Hdf5SampleWriter> hdf5_samples;
+#endif
+  std::optional<PoincareSectionObserver> poincare;
+  std::optional<LyapunovMegnoObserver> chaos;
+  // The observers above that the driver tells, in the order it tells them; the saver and the progress bar follow.
+  std::vector<Observer*> observers;
+  std::optional<CheckpointSaver> saver;
+  std::optional<ProgressObserver> progress;
+
+ private:
+  void resume(Checkpoint checkpoint);
+};
+
+}  // namespace nonsep::host
