@@ -113,7 +113,9 @@ TEST_CASE("the derivative checker differences Hessian-vector products from the g
   CHECK(report.mismatches.front().component == 2);
 }
 
-TEST_CASE("lattice chain: its written-out products and differentiated gradient templates give what differentiating T and V gives") {
+TEST_CASE(
+    "lattice chain: its written-out products and differentiated gradient templates give what differentiating T and V "
+    "gives") {
   const std::string parameters = R"({"sites": 9, "kinetic_quartic": 0.7, "coupling": 0.4, "bond_quartic": 1.3})";
   using Model = LatticeChainModel<16>;
   const auto of_gradients = ModelAdapter<Model>::from_json(parameters);
