@@ -116,8 +116,6 @@ void check_cases_of(const std::string& scheme) {
   CHECK(cases > 0);
 }
 
-const double default_t2 = ChinCoefficients::default_t2();
-
 }  // namespace
 
 TEST_CASE("exact quarter period of the paper's 1D test by quadrature") {

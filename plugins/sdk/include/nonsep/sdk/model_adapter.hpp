@@ -310,14 +310,14 @@ class ModelAdapter {
   void grad_T(std::span<const double> p, std::span<double> out, std::size_t count) const {
     gradients<analytic_grad_T>(
         p, out, count, [this](auto v) { return model_.T(v); },
-        [this](Vector<double> x, std::span<double> g) {
+        [&](Vector<double> x, std::span<double> g) {
           if constexpr (HasAnalyticGradT<M>) model_.grad_T(x, g);
         });
   }
   void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
     gradients<analytic_grad_V>(
         q, out, count, [this](auto v) { return model_.V(v); },
-        [this](Vector<double> x, std::span<double> g) {
+        [&](Vector<double> x, std::span<double> g) {
           if constexpr (HasAnalyticGradV<M>) model_.grad_V(x, g);
         });
   }
@@ -327,7 +327,7 @@ class ModelAdapter {
     else
       hessians<analytic_hessian_T>(
           p, out, count, [this](auto w) { return model_.T(w); },
-          [this](Vector<double> x, std::span<double> h) {
+          [&](Vector<double> x, std::span<double> h) {
             if constexpr (HasAnalyticHessianT<M>) model_.hessian_T(x, h);
           });
   }
@@ -337,7 +337,7 @@ class ModelAdapter {
     else
       hessians<analytic_hessian_V>(
           q, out, count, [this](auto w) { return model_.V(w); },
-          [this](Vector<double> x, std::span<double> h) {
+          [&](Vector<double> x, std::span<double> h) {
             if constexpr (HasAnalyticHessianV<M>) model_.hessian_V(x, h);
           });
   }
@@ -361,7 +361,7 @@ class ModelAdapter {
     if constexpr (HasK<M>)
       gradients<analytic_grad_K>(
           p, out, count, [this](auto v) { return model_.K(v); },
-          [this](Vector<double> x, std::span<double> g) {
+          [&](Vector<double> x, std::span<double> g) {
             if constexpr (HasAnalyticGradK<M>) model_.grad_K(x, g);
           });
     else
@@ -371,7 +371,7 @@ class ModelAdapter {
     if constexpr (HasU<M>)
       gradients<analytic_grad_U>(
           q, out, count, [this](auto v) { return model_.U(v); },
-          [this](Vector<double> x, std::span<double> g) {
+          [&](Vector<double> x, std::span<double> g) {
             if constexpr (HasAnalyticGradU<M>) model_.grad_U(x, g);
           });
     else
@@ -382,7 +382,7 @@ class ModelAdapter {
     if constexpr (HasK<M>)
       hessians<analytic_hessian_K>(
           p, out, count, [this](auto v) { return model_.K(v); },
-          [this](Vector<double> x, std::span<double> h) {
+          [&](Vector<double> x, std::span<double> h) {
             if constexpr (HasAnalyticHessianK<M>) model_.hessian_K(x, h);
           });
     else
@@ -393,7 +393,7 @@ class ModelAdapter {
     if constexpr (HasU<M>)
       hessians<analytic_hessian_U>(
           q, out, count, [this](auto v) { return model_.U(v); },
-          [this](Vector<double> x, std::span<double> h) {
+          [&](Vector<double> x, std::span<double> h) {
             if constexpr (HasAnalyticHessianU<M>) model_.hessian_U(x, h);
           });
     else
