@@ -1,6 +1,7 @@
 // The stepping kernel (chin_kernel.hpp) against the evaluation path: a model offering chin_steps gets bit for bit
 // the numbers and evaluation counts of the same model without it, through every Chin scheme (basic, triplet, mpe),
-// both forms, 1, 5 and 300 states, fixed and run-time dimensions; and a kernel that fails leaves nothing stale.
+// both forms, 1, 5 and 300 states, fixed and run-time dimensions; a triplet's run of steps is one call (a schedule
+// of sub-steps); and a kernel that fails leaves nothing stale.
 #include <doctest/doctest.h>
 
 #include <array>
@@ -80,6 +81,56 @@ TEST_CASE("kernel path: every Chin scheme and form gives the evaluation path's n
         check_scheme<Coupled2D, 2>(scheme, form, count);  // blocks of 8
         check_scheme<Coupled2D, 0>(scheme, form, count);  // the dimension known at run time: the caller's arrays
       }
+}
+
+TEST_CASE("kernel path: a run of triplet steps is one kernel call, the schedule of its basic steps") {
+  for (int levels : {1, 2}) {
+    CAPTURE(levels);
+    WithKernel<Paper1D, 1> kernel{};
+    TripletComposition<SeparableBasicStep> with(SeparableBasicStep{}, levels), without(SeparableBasicStep{}, levels);
+    auto x = spread_states(1, 5);
+    auto y = x;
+    with.step_n(kernel, x, 0.01, 7);
+    for (int k = 0; k < 7; ++k) without.step(Paper1D{}, y, 0.01);
+    CHECK(x == y);
+    CHECK(with.evaluations() == without.evaluations());
+    CHECK(kernel.calls == 1);
+  }
+}
+
+TEST_CASE("kernel path: a schedule of basic steps gives the steps one by one, with or without a kernel") {
+  const std::array<double, 3> schedule{0.02, -0.013, 0.005};
+  for (const auto form : forms)
+    for (std::size_t count : {std::size_t{1}, std::size_t{3}, std::size_t{40}}) {
+      CAPTURE(static_cast<int>(form));
+      CAPTURE(count);
+      WithKernel<Coupled2D, 2> kernel{};
+      ChinBasicStep scheduled(form), scheduled_without_kernel(form), one_by_one(form);
+      auto x = spread_states(2, count);
+      auto y = x;
+      auto z = x;
+      scheduled.step_schedule_n(kernel, x, schedule, 4);
+      scheduled_without_kernel.step_schedule_n(Coupled2D{}, z, schedule, 4);
+      for (int k = 0; k < 4; ++k)
+        for (double dt : schedule) one_by_one.step(Coupled2D{}, y, dt);
+      CHECK(x == y);
+      CHECK(z == y);
+      CHECK(scheduled.evaluations() == one_by_one.evaluations());
+      CHECK(scheduled_without_kernel.evaluations() == one_by_one.evaluations());
+      CHECK(kernel.calls == 1);
+    }
+}
+
+TEST_CASE("kernel path: a call's step sizes fit its sub-steps and states") {
+  CHECK(chin_eps_fit(1, 1, 5));
+  CHECK(chin_eps_fit(5, 1, 5));
+  CHECK(chin_eps_fit(3, 3, 5));
+  CHECK(chin_eps_fit(3, 3, 3));
+  CHECK_FALSE(chin_eps_fit(5, 3, 5));
+  CHECK_FALSE(chin_eps_fit(1, 3, 5));
+  CHECK_FALSE(chin_eps_fit(4, 1, 5));
+  CHECK_FALSE(chin_eps_fit(0, 0, 5));
+  CHECK_FALSE(chin_eps_fit(0, 1, 0));
 }
 
 TEST_CASE("kernel path: a model whose kernel is not at hand is stepped through its evaluations") {

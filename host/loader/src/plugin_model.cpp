@@ -135,7 +135,7 @@ bool PluginModel::chin_steps(const ChinStepsCall& call) const {
   if (!kernel_) return false;
   const std::size_t size = call.count * instance_->dimension;
   if (call.q.size() != size || call.p.size() != size || call.outer_gradient.size() != size ||
-      call.inner_gradient.size() != size || (call.eps.size() != 1 && call.eps.size() != call.count)) [[unlikely]]
+      call.inner_gradient.size() != size || !chin_eps_fit(call.eps.size(), call.substeps, call.count)) [[unlikely]]
     throw_bad_spans("chin_steps", call.count, instance_->dimension, instance_->dimension, call.q.size(), call.p.size());
   const nonsep_plugin_api& api = *instance_->api;
   const nonsep_chin_steps_args args{call.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT,
@@ -147,6 +147,7 @@ bool PluginModel::chin_steps(const ChinStepsCall& call) const {
                                     call.coefficients.v2,
                                     call.eps.data(),
                                     call.eps.size(),
+                                    call.substeps,
                                     call.steps,
                                     call.count,
                                     call.q.data(),

@@ -114,9 +114,10 @@ class ChinBasicStep {
       throw InvalidArgument("a batch of " + std::to_string(x.count()) + " states needs as many step sizes (found " +
                             std::to_string(dt.size()) + ")");
     eps_.resize(dt.size());
-    for (std::size_t b = 0; b < dt.size(); ++b) {
+    substeps_ = 1;
+    for (std::size_t b = 0; b < dt.size(); ++b) {  // runs of equal sizes (MPE's terms) share one cube root
       check_step_size(dt[b]);
-      eps_[b] = runtime_cube_root(dt[b]);
+      eps_[b] = b > 0 && dt[b] == dt[b - 1] ? eps_[b - 1] : cube_root(dt[b]);
     }
     advance(model, x, observe);
   }
@@ -131,6 +132,24 @@ class ChinBasicStep {
     if (n == 0) return;
     check_batch_fits(model, x);
     use_step_size(dt);
+    begin_steps(model, x);
+    NoStageObserver none;
+    stages(model, x, none, n);
+    end_steps(x);
+  }
+
+  // Advances every state of `x` by `n` times the schedule `dts` of basic steps (each finite and non-zero): bit for
+  // bit n times the calls step(model, x, dts[0]), step(model, x, dts[1]), ..., evaluations counted alike, with the
+  // per-step bookkeeping done once, as step_n does; a model with a kernel takes the whole run in one call. This is
+  // how a composition's steps (TripletComposition::step_n) reach the kernel whole. Throws as step_n does.
+  template <Model M>
+  void step_schedule_n(const M& model, PhaseSpaceBatch& x, std::span<const double> dts, std::uint64_t n) {
+    if (n == 0 || dts.empty()) return;
+    check_batch_fits(model, x);
+    for (double dt : dts) check_step_size(dt);
+    eps_.resize(dts.size());
+    for (std::size_t s = 0; s < dts.size(); ++s) eps_[s] = cube_root(dts[s]);
+    substeps_ = dts.size();
     begin_steps(model, x);
     NoStageObserver none;
     stages(model, x, none, n);
@@ -155,9 +174,13 @@ class ChinBasicStep {
   struct Cache {
     std::vector<double> at, gradient;
   };
-  Cache save_cache() const {
-    return {cache_valid_ ? std::vector<double>(cached_at_.begin(), cached_at_.end()) : std::vector<double>{},
-            std::vector<double>(outer_gradient_.begin(), outer_gradient_.end())};
+  // Into `cache`, reusing its storage (a wrapper saving every step allocates nothing once warmed up).
+  void save_cache(Cache& cache) const {
+    if (cache_valid_)
+      cache.at.assign(cached_at_.begin(), cached_at_.end());
+    else
+      cache.at.clear();
+    cache.gradient.assign(outer_gradient_.begin(), outer_gradient_.end());
   }
   void restore_cache(const Cache& cache) {
     cached_at_.assign(cache.at.begin(), cache.at.end());
@@ -192,21 +215,27 @@ class ChinBasicStep {
     cache_valid_ = true;
   }
 
-  // `steps` times the nine flows of eq. (expalg) (chin_stages.hpp), from outer_gradient_ at x's current point;
+  // `steps` times the substeps_ basic steps of eps_ (chin_stages.hpp: each the nine flows of eq. (expalg)), from
+  // outer_gradient_ at x's current point;
   // leaves in outer_gradient_ the outer gradient at the new point. Steps that no observer watches go to the model's
   // kernel when it offers one (ModelWithChinSteps), the same numbers and evaluation counts.
   template <Model M, class StageObserver>
   void stages(const M& model, PhaseSpaceBatch& x, StageObserver& observe, std::uint64_t steps) {
     const std::size_t count = x.count();
+    const ChinStepsCall call{form_, c_, eps_, substeps_, steps, count, x.q(), x.p(), outer_gradient_, inner_gradient_};
+    const std::uint64_t basic_steps = steps * substeps_;
     if constexpr (ModelWithChinSteps<M> && std::is_same_v<std::decay_t<StageObserver>, NoStageObserver>) {
-      const ChinStepsCall call{form_, c_, eps_, steps, count, x.q(), x.p(), outer_gradient_, inner_gradient_};
       if (model.chin_steps(call)) {
-        evaluations_.grad_T += 4 * steps * count;
-        evaluations_.grad_V += 4 * steps * count;
+        evaluations_.grad_T += 4 * basic_steps * count;
+        evaluations_.grad_V += 4 * basic_steps * count;
         return;
       }
     }
     const CountedModel<M> counted{model, evaluations_};
+    if (substeps_ != 1) {
+      chin_scheduled_stages(counted, call);
+      return;
+    }
     chin_stages(counted, form_, c_, eps_, steps, count, x.q(), x.p(), outer_gradient_, inner_gradient_,
                 [&](const FlowStage& stage) { observe(stage, std::span<const double>(eps_), std::as_const(x)); });
   }
@@ -241,6 +270,7 @@ class ChinBasicStep {
     const double eps = cube_root(dt);
     if (eps_.size() != 1) eps_.resize(1);
     eps_[0] = eps;
+    substeps_ = 1;
   }
 
   // cbrt(dt), remembered for the last few step sizes: a run steps with one dt (basic, MPE's terms) or cycles
@@ -264,8 +294,9 @@ class ChinBasicStep {
   EvaluationCounts evaluations_;
   AlignedDoubles outer_gradient_, inner_gradient_, cached_at_;  // streamed through by every stage
   bool cache_valid_ = false;                                    // outer_gradient_ is the outer gradient at cached_at_
-  std::vector<double> eps_;                                     // cbrt(dt): one entry, or one per state
-  std::array<std::pair<double, double>, 4> roots_{};            // (dt, cbrt(dt)); dt = 0 never asked (check_step_size)
+  std::vector<double> eps_;   // cbrt(dt): one entry, one per state, or one per sub-step of a schedule
+  std::size_t substeps_ = 1;  // basic steps per step: eps_.size() for a schedule (step_schedule_n), else 1
+  std::array<std::pair<double, double>, 4> roots_{};  // (dt, cbrt(dt)); dt = 0 never asked (check_step_size)
   std::size_t next_root_ = 0;
 };
 

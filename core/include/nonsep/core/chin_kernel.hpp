@@ -27,7 +27,8 @@ namespace nonsep {
 
 // The version of what a kernel computes (the ChinStepsCall it takes, chin_stages' flows): a plugin records the
 // version it was compiled from, and a host whose core has another one steps that plugin through its evaluations.
-inline constexpr std::uint64_t chin_kernel_version = 1;
+// Version 2: a call carries a schedule of sub-steps (ChinStepsCall::substeps).
+inline constexpr std::uint64_t chin_kernel_version = 2;
 
 // States per block: 16 numbers of each array for a small fixed dimension, one state from 16 on.
 constexpr std::size_t block_states(std::size_t dimension) { return dimension >= 16 ? 1 : 16 / dimension; }
@@ -35,6 +36,9 @@ constexpr std::size_t block_states(std::size_t dimension) { return dimension >= 
 inline std::size_t block_states_at_run_time(std::size_t dimension) { return std::max<std::size_t>(1, 512 / dimension); }
 
 namespace detail {
+
+// Whether the call's eps holds one entry per state (else one per sub-step, for every state).
+inline bool eps_per_state(const ChinStepsCall& call) { return call.substeps == 1 && call.eps.size() != 1; }
 
 // The call's steps for states [first, first + B) of dimension N, in local arrays.
 template <std::size_t N, std::size_t B, Model M>
@@ -47,11 +51,12 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
   std::copy_n(call.p.begin() + static_cast<std::ptrdiff_t>(offset), size, p.begin());
   std::copy_n(call.outer_gradient.begin() + static_cast<std::ptrdiff_t>(offset), size, outer_gradient.begin());
   std::span<const double> block_eps = call.eps;
-  if (call.eps.size() != 1) {
+  if (eps_per_state(call)) {
     std::copy_n(call.eps.begin() + static_cast<std::ptrdiff_t>(first), B, eps.begin());
     block_eps = eps;
   }
-  chin_stages(model, call.form, call.coefficients, block_eps, call.steps, B, q, p, outer_gradient, inner_gradient);
+  chin_scheduled_stages(model, ChinStepsCall{call.form, call.coefficients, block_eps, call.substeps, call.steps, B, q,
+                                             p, outer_gradient, inner_gradient});
   std::copy_n(q.begin(), size, call.q.begin() + static_cast<std::ptrdiff_t>(offset));
   std::copy_n(p.begin(), size, call.p.begin() + static_cast<std::ptrdiff_t>(offset));
   std::copy_n(outer_gradient.begin(), size, call.outer_gradient.begin() + static_cast<std::ptrdiff_t>(offset));
@@ -60,7 +65,7 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
 }  // namespace detail
 
 // The steps of `call` for `model` (its dimension is FixedDimension when that is not 0). Requires the sizes of
-// chin_stages: q, p and both gradients count*n numbers, eps 1 or count.
+// chin_stages: q, p and both gradients count*n numbers, and chin_eps_fit(call.eps.size(), call.substeps, count).
 template <std::size_t FixedDimension, Model M>
 void chin_kernel_steps(const M& model, const ChinStepsCall& call) {
   const std::size_t count = call.count;
@@ -75,10 +80,11 @@ void chin_kernel_steps(const M& model, const ChinStepsCall& call) {
     const std::size_t block = block_states_at_run_time(n);
     for (std::size_t first = 0; first < count; first += block) {
       const std::size_t states = std::min(block, count - first), offset = first * n, size = states * n;
-      const std::span<const double> eps = call.eps.size() == 1 ? call.eps : call.eps.subspan(first, states);
-      chin_stages(model, call.form, call.coefficients, eps, call.steps, states, call.q.subspan(offset, size),
-                  call.p.subspan(offset, size), call.outer_gradient.subspan(offset, size),
-                  call.inner_gradient.subspan(offset, size));
+      const std::span<const double> eps = detail::eps_per_state(call) ? call.eps.subspan(first, states) : call.eps;
+      chin_scheduled_stages(
+          model, ChinStepsCall{call.form, call.coefficients, eps, call.substeps, call.steps, states,
+                               call.q.subspan(offset, size), call.p.subspan(offset, size),
+                               call.outer_gradient.subspan(offset, size), call.inner_gradient.subspan(offset, size)});
     }
   }
 }

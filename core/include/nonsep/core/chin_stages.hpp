@@ -24,6 +24,10 @@
 //   after_flow      called after each flow as after_flow(FlowStage{kick, coefficient}); does nothing by default
 // Each step evaluates 4 grad T and 4 grad V on the batch (model.grad_T(x, out, count), model.grad_V(...)). The
 // arrays must not overlap. A model exception propagates, leaving the arrays at whatever the flows reached.
+//
+// chin_scheduled_stages(model, call) runs a ChinStepsCall (below): `steps` times a schedule of `substeps` basic
+// steps, sub-step s with its own eps[s] (a triplet composition's composed step, triplet_composition.hpp), each
+// sub-step chin_stages' own one step: the numbers of the basic steps taken one by one.
 #include <cmath>
 #include <concepts>
 #include <cstddef>
@@ -76,23 +80,32 @@ inline void chin_gradient(const M& model, bool potential, std::span<const double
     model.grad_T(at, out, count);
 }
 
-// What a stepping kernel is asked to do: chin_stages' arguments (above) in one value.
+// What a stepping kernel is asked to do: `steps` times a schedule of `substeps` basic steps of `count` states.
+//   eps       cbrt(dt) of each sub-step, for every state (substeps entries); or, with one sub-step, one entry for
+//             every state or one per state (count entries)
+//   the rest  chin_stages' arguments
 struct ChinStepsCall {
   HamiltonianForm form;
   ChinCoefficients coefficients;
   std::span<const double> eps;
+  std::size_t substeps;
   std::uint64_t steps;
   std::size_t count;
   std::span<double> q, p, outer_gradient, inner_gradient;
 };
 
+// Whether eps of `eps_size` entries fits a call of `substeps` sub-steps of `count` states (ChinStepsCall above).
+constexpr bool chin_eps_fit(std::size_t eps_size, std::size_t substeps, std::size_t count) {
+  return substeps >= 1 && (eps_size == substeps || (substeps == 1 && eps_size == count && count > 0));
+}
+
 // A model that may take whole runs of basic steps itself, with its gradients inlined (a plugin's kernel):
 //   m.chin_steps(call) -> bool   true when it advanced call's arrays as chin_stages would (the same numbers for
 //                                code built alike), false when no kernel is at hand for this call (none, another
-//                                kernel version, or turned off): the caller then runs chin_stages itself.
+//                                kernel version, or turned off): the caller then runs chin_scheduled_stages.
 //                                Throws ModelError when the model fails inside; the arrays are then unspecified.
 // ChinBasicStep uses it for the steps no flow observer watches. The evaluations it performs are counted as
-// chin_stages' (4 grad T and 4 grad V per state and step).
+// chin_stages' (4 grad T and 4 grad V per state and basic step).
 template <class M>
 concept ModelWithChinSteps = Model<M> && requires(const M& m, const ChinStepsCall& call) {
   { m.chin_steps(call) } -> std::same_as<bool>;
@@ -148,6 +161,20 @@ inline void chin_stages(const M& model, HamiltonianForm form, const ChinCoeffici
     inner_flow(c.t2);
     outer_flow(c.v2);
   }
+}
+
+// The steps of `call` (requires chin_eps_fit(call.eps.size(), call.substeps, call.count) and chin_stages' sizes).
+template <Model M>
+inline void chin_scheduled_stages(const M& model, const ChinStepsCall& call) {
+  if (call.substeps == 1) {
+    chin_stages(model, call.form, call.coefficients, call.eps, call.steps, call.count, call.q, call.p,
+                call.outer_gradient, call.inner_gradient);
+    return;
+  }
+  for (std::uint64_t step = 0; step < call.steps; ++step)
+    for (std::size_t s = 0; s < call.substeps; ++s)
+      chin_stages(model, call.form, call.coefficients, call.eps.subspan(s, 1), 1, call.count, call.q, call.p,
+                  call.outer_gradient, call.inner_gradient);
 }
 
 }  // namespace nonsep

@@ -75,12 +75,17 @@ class Integrator {
         stepper_);
   }
 
-  // n steps of dt: bit for bit n calls of step(model, x, dt). The basic step does its per-step bookkeeping once
-  // (ChinBasicStep::step_n, through SeparableComposition::step_n); the other schemes take their steps one by one.
+  // n steps of dt: bit for bit n calls of step(model, x, dt). The basic step and the triplet composition do their
+  // per-step bookkeeping once (ChinBasicStep::step_n and step_schedule_n, through SeparableComposition), so that a
+  // model with a kernel takes the n steps in one call; the other schemes take their steps one by one.
   template <Model M>
   void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
     if (auto* basic = std::get_if<SeparableBasicStep>(&stepper_)) {
       basic->step_n(model, x, dt, n);
+      return;
+    }
+    if (auto* triplet = std::get_if<TripletComposition<SeparableBasicStep>>(&stepper_)) {
+      triplet->step_n(model, x, dt, n);
       return;
     }
     for (std::uint64_t k = 0; k < n; ++k) step(model, x, dt);

@@ -44,17 +44,18 @@ struct ModelArchetype {
 //   b.step(model, x, dt)           advances every state of x by one double dt
 //   b.step(model, x, sizes)        advances state i of x by sizes[i] (std::span<const double>, x.count() entries)
 //   b.prime(model, x)              makes the first-same-as-last gradient at x's point available
-//   typename B::Cache, cb.save_cache(), b.restore_cache(cache)    that gradient saved and restored
+//   typename B::Cache, cb.save_cache(cache), b.restore_cache(cache)    that gradient saved (into cache, reusing its
+//                                  storage) and restored
 //   cb.evaluations()               EvaluationCounts, per state
 //   cb.describe()                  IntegratorDescription
 template <class B>
 concept StepperWithPerStateStepSizes = requires(B& b, const B& cb, const detail::ModelArchetype& model,
                                                 PhaseSpaceBatch& x, double dt, std::span<const double> sizes,
-                                                const typename B::Cache& cache) {
+                                                typename B::Cache& cache) {
   b.step(model, x, dt);
   b.step(model, x, sizes);
   b.prime(model, x);
-  { cb.save_cache() } -> std::convertible_to<typename B::Cache>;
+  cb.save_cache(cache);
   b.restore_cache(cache);
   { cb.evaluations() } -> std::convertible_to<const EvaluationCounts&>;
   { cb.describe() } -> std::convertible_to<IntegratorDescription>;
@@ -114,48 +115,51 @@ class MultiProductExpansion {
     }
     const std::size_t count = x.count(), n = x.dimension(), size = count * n;
     base_.prime(model, x);
-    const auto start_cache = base_.save_cache();
+    base_.save_cache(start_cache_);
     // Group g = m - k holds term k: states [g count, (g + 1) count), step size dt / k. The groups still running
-    // are a prefix, because the term with the fewest steps (the smallest k) is the last group.
-    terms_ = PhaseSpaceBatch(n, static_cast<std::size_t>(m) * count);
+    // are a prefix, because the term with the fewest steps (the smallest k) is the last group. The work batches
+    // and caches keep their storage from step to step.
+    reshape(terms_, n, static_cast<std::size_t>(m) * count);
     step_sizes_.resize(static_cast<std::size_t>(m) * count);
-    typename Base::Cache cache;
+    cache_.at.clear();
+    cache_.gradient.clear();
     for (int g = 0; g < m; ++g) {
       const auto offset = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(g) * size);
       std::copy(x.q().begin(), x.q().end(), terms_.q().begin() + offset);
       std::copy(x.p().begin(), x.p().end(), terms_.p().begin() + offset);
       std::fill_n(step_sizes_.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(g) * count), count,
                   dt / (m - g));
-      cache.at.insert(cache.at.end(), start_cache.at.begin(), start_cache.at.end());
-      cache.gradient.insert(cache.gradient.end(), start_cache.gradient.begin(), start_cache.gradient.end());
+      cache_.at.insert(cache_.at.end(), start_cache_.at.begin(), start_cache_.at.end());
+      cache_.gradient.insert(cache_.gradient.end(), start_cache_.gradient.begin(), start_cache_.gradient.end());
     }
-    base_.restore_cache(cache);
-    typename Base::Cache last_term_cache;  // left by term 1, which step_term_by_term runs last
+    base_.restore_cache(cache_);
+    running_.resize(static_cast<std::size_t>(m));
     for (int round = 0; round < m; ++round) {
       const auto running = static_cast<std::size_t>(m - round);  // the terms with k > round
       if (running * count < terms_.count()) {
-        running_ = PhaseSpaceBatch(n, running * count);
-        std::copy_n(terms_.q().begin(), running * size, running_.q().begin());
-        std::copy_n(terms_.p().begin(), running * size, running_.p().begin());
-        cache = base_.save_cache();
-        cache.at.resize(running * size);
-        cache.gradient.resize(running * size);
-        base_.restore_cache(cache);
-        base_.step(model, running_, std::span<const double>(step_sizes_).first(running * count));
-        std::copy_n(running_.q().begin(), running * size, terms_.q().begin());
-        std::copy_n(running_.p().begin(), running * size, terms_.p().begin());
+        PhaseSpaceBatch& prefix = running_[running];
+        reshape(prefix, n, running * count);
+        std::copy_n(terms_.q().begin(), running * size, prefix.q().begin());
+        std::copy_n(terms_.p().begin(), running * size, prefix.p().begin());
+        base_.save_cache(cache_);
+        cache_.at.resize(running * size);
+        cache_.gradient.resize(running * size);
+        base_.restore_cache(cache_);
+        base_.step(model, prefix, std::span<const double>(step_sizes_).first(running * count));
+        std::copy_n(prefix.q().begin(), running * size, terms_.q().begin());
+        std::copy_n(prefix.p().begin(), running * size, terms_.p().begin());
       } else {
         base_.step(model, terms_, std::span<const double>(step_sizes_));
       }
-      if (round == 0) {
-        last_term_cache = base_.save_cache();
-        last_term_cache.at.erase(last_term_cache.at.begin(),
-                                 last_term_cache.at.end() - static_cast<std::ptrdiff_t>(size));
-        last_term_cache.gradient.erase(last_term_cache.gradient.begin(),
-                                       last_term_cache.gradient.end() - static_cast<std::ptrdiff_t>(size));
+      if (round == 0) {  // the cache left by term 1, which step_term_by_term runs last
+        base_.save_cache(last_term_cache_);
+        last_term_cache_.at.erase(last_term_cache_.at.begin(),
+                                  last_term_cache_.at.end() - static_cast<std::ptrdiff_t>(size));
+        last_term_cache_.gradient.erase(last_term_cache_.gradient.begin(),
+                                        last_term_cache_.gradient.end() - static_cast<std::ptrdiff_t>(size));
       }
     }
-    base_.restore_cache(last_term_cache);
+    base_.restore_cache(last_term_cache_);
     // y_m, then + c_k (y_k - y_m) for k = m-1 down to 1, as step_term_by_term accumulates.
     std::copy_n(terms_.q().begin(), size, x.q().begin());
     std::copy_n(terms_.p().begin(), size, x.p().begin());
@@ -180,12 +184,12 @@ class MultiProductExpansion {
     }
     start_ = x;
     base_.prime(model, start_);
-    const auto start_cache = base_.save_cache();
+    base_.save_cache(start_cache_);
     // Terms run from k = m down to 1; the result is accumulated as y_m + sum_k c_k (y_k - y_m), which equals
     // sum_k c_k y_k because the c_k sum to 1 and loses less to rounding when the y_k are close.
     for (int k = m; k >= 1; --k) {
       term_ = start_;
-      if (k != m) base_.restore_cache(start_cache);
+      if (k != m) base_.restore_cache(start_cache_);
       for (int r = 0; r < k; ++r) base_.step(model, term_, dt / k);
       if (k == m) {
         last_ = term_;
@@ -203,15 +207,21 @@ class MultiProductExpansion {
   }
 
  private:
+  // batch holds count states of dimension n afterwards (their numbers unspecified), its storage kept when it fits.
+  static void reshape(PhaseSpaceBatch& batch, std::size_t n, std::size_t count) {
+    if (batch.dimension() != n || batch.count() != count) batch = PhaseSpaceBatch(n, count);
+  }
   static void accumulate(std::span<double> sum, double c, std::span<const double> y, std::span<const double> ym) {
     for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += c * (y[i] - ym[i]);
   }
 
   Base base_;
   std::vector<double> weights_;
-  PhaseSpaceBatch start_, term_, last_;  // step_term_by_term: the starting point, the term being run, and y_m
-  PhaseSpaceBatch terms_, running_;      // step: all terms side by side, and the prefix still running
-  std::vector<double> step_sizes_;       // step: dt / k per state of terms_
+  PhaseSpaceBatch start_, term_, last_;   // step_term_by_term: the starting point, the term being run, and y_m
+  PhaseSpaceBatch terms_;                 // step: all terms side by side
+  std::vector<PhaseSpaceBatch> running_;  // step: [r] the prefix of r terms still running
+  std::vector<double> step_sizes_;        // step: dt / k per state of terms_
+  typename Base::Cache start_cache_, cache_, last_term_cache_;  // the first-same-as-last gradients saved
 };
 
 }  // namespace nonsep

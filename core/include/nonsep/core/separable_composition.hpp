@@ -38,8 +38,8 @@
 // variable unchanged (TTV: no K, so q is not moved; VVT: no U); otherwise the basic step evaluates it again.
 //
 // SeparableComposition wraps a base stepper with the ChinBasicStep interface (step with one dt or one per state,
-// step_n, prime, save_cache, restore_cache, evaluations, describe, form, coefficients); it is the base of the
-// catalogue's triplet and MPE (scheme_catalogue.hpp). Errors: those of the base step; the model's exceptions
+// step_n, step_schedule_n, prime, save_cache, restore_cache, evaluations, describe, form, coefficients); it is the base
+// of the catalogue's triplet and MPE (scheme_catalogue.hpp). Errors: those of the base step; the model's exceptions
 // propagate and leave x unspecified but valid.
 #include <cstdint>
 #include <span>
@@ -134,13 +134,25 @@ class SeparableComposition {
     for (std::uint64_t s = 0; s < n; ++s) step(model, x, dt);
   }
 
+  // n times the schedule dts of steps, bit for bit the steps one by one; without a separable part the base's
+  // step_schedule_n (one kernel call for the whole run when the model has a kernel).
+  template <Model M>
+  void step_schedule_n(const M& model, PhaseSpaceBatch& x, std::span<const double> dts, std::uint64_t n) {
+    if (!has_separable_part(model)) {
+      base_.step_schedule_n(model, x, dts, n);
+      return;
+    }
+    for (std::uint64_t s = 0; s < n; ++s)
+      for (double dt : dts) step(model, x, dt);
+  }
+
   // Primes the base's first-same-as-last gradient when the first half-flow leaves its point unchanged.
   template <Model M>
   void prime(const M& model, const PhaseSpaceBatch& x) {
     const bool moved = base_.form() == HamiltonianForm::TTV ? has_K(model) : has_U(model);
     if (!moved) base_.prime(model, x);
   }
-  Cache save_cache() const { return base_.save_cache(); }
+  void save_cache(Cache& cache) const { base_.save_cache(cache); }
   void restore_cache(const Cache& cache) { base_.restore_cache(cache); }
 
   // The flow's update of `changed` (p for a kick, q for a drift) from the gradient at the unchanged variable:

@@ -12,6 +12,8 @@
 // TripletComposition wraps a base stepper (any type with the ChinBasicStep interface) instead of copying it.
 #include <cmath>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "nonsep/core/chin_basic_step.hpp"
 
@@ -54,6 +56,23 @@ class TripletComposition {
     for_each_basic_step(levels_, dt, [&](double basic_dt) { base_.step(model, x, basic_dt); });
   }
 
+  // n composed steps of dt: bit for bit n calls of step(model, x, dt). A base with step_schedule_n (ChinBasicStep,
+  // SeparableComposition) takes the 3^levels basic steps of each composed step as one schedule, so that a model with
+  // a kernel runs the n composed steps in one call.
+  template <Model M>
+  void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
+    if (n == 0) return;
+    check_step_size(dt);
+    schedule_.clear();
+    for_each_basic_step(levels_, dt, [&](double basic_dt) { schedule_.push_back(basic_dt); });
+    if constexpr (requires { base_.step_schedule_n(model, x, std::span<const double>(schedule_), n); }) {
+      base_.step_schedule_n(model, x, std::span<const double>(schedule_), n);
+    } else {
+      for (std::uint64_t k = 0; k < n; ++k)
+        for (double basic_dt : schedule_) base_.step(model, x, basic_dt);
+    }
+  }
+
   // Calls basic_step(dt_j) for the 3^levels basic steps of one composed step of dt, in order: the schedule of
   // the composition, shared with the tangent map (tangent_triplet_composition.hpp).
   template <class BasicStep>
@@ -76,6 +95,7 @@ class TripletComposition {
  private:
   Base base_;
   int levels_;
+  std::vector<double> schedule_;  // step_n's basic step sizes, kept for their storage
 };
 
 }  // namespace nonsep

@@ -87,13 +87,16 @@ typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin *
 #define NONSEP_FORM_TTV 0u /* H = T_i V_ij T_j (+ K + U) */
 #define NONSEP_FORM_VVT 1u /* H = V_i T_ij V_j (+ K + U) */
 
-/* The arguments of chin_steps (below): `steps` basic steps of eq. (expalg) of every state, in place. */
+/* The arguments of chin_steps (below): `steps` times a schedule of `substeps` basic steps of eq. (expalg) of every
+ * state, in place (kernel version 2; a triplet composition's step is its schedule of 3^levels basic steps). */
 typedef struct nonsep_chin_steps_args {
   uint32_t form;             /* NONSEP_FORM_TTV or NONSEP_FORM_VVT */
   uint32_t instruction_set;  /* index into the metadata's "kernels": {"instruction_sets": [...]} */
   double t1, t2, v0, v1, v2; /* the coefficients of eq. (expalg) */
-  const double* eps;         /* cbrt(dt): one number for every state (eps_count 1) or one per state */
-  size_t eps_count;          /* 1 or count */
+  const double* eps;         /* cbrt(dt) of each sub-step, for every state; or, with one sub-step, one number for
+                                every state or one per state */
+  size_t eps_count;          /* substeps, or (substeps 1) 1 or count */
+  size_t substeps;           /* >= 1: basic steps per step, sub-step s with eps[s] */
   uint64_t steps;            /* >= 1 */
   size_t count;              /* states, in the batch layout */
   double* q;                 /* count*n, advanced in place */
@@ -158,7 +161,8 @@ typedef struct nonsep_plugin_api {
   nonsep_status (*hvp_K)(nonsep_instance* instance, const double* p, const double* v, double* out, size_t count);
   nonsep_status (*hvp_U)(nonsep_instance* instance, const double* q, const double* v, double* out, size_t count);
 
-  /* The stepping kernel: args->steps basic steps of eq. (expalg) of args->count states, the stages those of the
+  /* The stepping kernel: args->steps times args->substeps basic steps of eq. (expalg) of args->count states (a
+   * triplet composition's steps whole, its sub-steps' eps in turn), the stages those of the
    * core's own template with this model's gradients inlined, so that with the baseline instruction set the
    * numbers are bit for bit those of the host stepping through grad_T and grad_V. Announced with the metadata
    * object "kernels": {"version": K, "instruction_sets": [...]}, K the core's kernel version it was compiled

@@ -278,12 +278,14 @@ class PluginTable {
       if (args->form != NONSEP_FORM_TTV && args->form != NONSEP_FORM_VVT)
         throw std::invalid_argument("chin_steps: form " + std::to_string(args->form) +
                                     " is neither TTV (0) nor VVT (1)");
-      if (args->eps_count != 1 && args->eps_count != args->count)
+      if (!chin_eps_fit(args->eps_count, args->substeps, args->count))
         throw std::invalid_argument("chin_steps: " + std::to_string(args->eps_count) + " step sizes for " +
-                                    std::to_string(args->count) + " states (expected 1 or one per state)");
+                                    std::to_string(args->substeps) + " sub-steps of " + std::to_string(args->count) +
+                                    " states (expected one per sub-step, or with one sub-step 1 or one per state)");
       const ChinStepsCall call{args->form == NONSEP_FORM_VVT ? HamiltonianForm::VVT : HamiltonianForm::TTV,
                                ChinCoefficients{args->t1, args->t2, args->v0, args->v1, args->v2},
                                std::span<const double>(args->eps, args->eps_count),
+                               args->substeps,
                                args->steps,
                                args->count,
                                std::span<double>(args->q, size),
