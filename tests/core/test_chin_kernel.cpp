@@ -1,7 +1,7 @@
 // The stepping kernel (chin_kernel.hpp) against the evaluation path: a model offering chin_steps gets bit for bit
 // the numbers and evaluation counts of the same model without it, through every Chin scheme (basic, triplet, mpe),
-// both forms, 1, 5 and 300 states, fixed and run-time dimensions; a triplet's run of steps is one call (a schedule
-// of sub-steps); and a kernel that fails leaves nothing stale.
+// both forms, 1, 5, 33 and 300 states, fixed and run-time dimensions, one step size or one per state; a triplet's
+// run of steps is one call (a schedule of sub-steps); and a kernel that fails leaves nothing stale.
 #include <doctest/doctest.h>
 
 #include <array>
@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "nonsep/core.hpp"
 #include "nonsep/core/chin_kernel.hpp"
@@ -76,9 +77,10 @@ void check_scheme(const std::string& scheme, HamiltonianForm form, std::size_t c
 TEST_CASE("kernel path: every Chin scheme and form gives the evaluation path's numbers and counts bit for bit") {
   for (const char* scheme : {"basic", "triplet", "mpe"})
     for (const auto form : forms)
-      for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{300}}) {
-        check_scheme<Paper1D, 1>(scheme, form, count);    // blocks of 16 states in local arrays, then one by one
-        check_scheme<Coupled2D, 2>(scheme, form, count);  // blocks of 8
+      for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{33}, std::size_t{300}}) {
+        // Blocks of 32 states in local arrays; the rest in place (5; 12 of 300) or in registers (1; 1 of 33).
+        check_scheme<Paper1D, 1>(scheme, form, count);
+        check_scheme<Coupled2D, 2>(scheme, form, count);
         check_scheme<Coupled2D, 0>(scheme, form, count);  // the dimension known at run time: the caller's arrays
       }
 }
@@ -131,6 +133,27 @@ TEST_CASE("kernel path: a call's step sizes fit its sub-steps and states") {
   CHECK_FALSE(chin_eps_fit(4, 1, 5));
   CHECK_FALSE(chin_eps_fit(0, 0, 5));
   CHECK_FALSE(chin_eps_fit(0, 1, 0));
+}
+
+TEST_CASE("kernel path: states with step sizes of their own get the evaluation path's numbers bit for bit") {
+  for (const auto form : forms)
+    for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{33}, std::size_t{300}}) {
+      CAPTURE(static_cast<int>(form));
+      CAPTURE(count);
+      std::vector<double> dt(count);
+      for (std::size_t b = 0; b < count; ++b) dt[b] = 0.01 * (1.0 + static_cast<double>(b % 7) / 10.0);
+      WithKernel<Paper1D, 1> kernel{};
+      ChinBasicStep with(form), without(form);
+      auto x = spread_states(1, count);
+      auto y = x;
+      for (int step = 0; step < 3; ++step) {
+        with.step(kernel, x, dt);
+        without.step(Paper1D{}, y, dt);
+      }
+      CHECK(x == y);
+      CHECK(with.evaluations() == without.evaluations());
+      CHECK(kernel.calls == 3);
+    }
 }
 
 TEST_CASE("kernel path: a model whose kernel is not at hand is stepped through its evaluations") {

@@ -5,11 +5,18 @@
 // the order in which states and steps are visited:
 //   - the states go in blocks that take all of the call's steps before the next block starts, so a block stays in
 //     the first-level cache (or in registers) instead of the whole batch streaming through memory 17 times a step;
-//   - for a dimension N known at compile time (FixedDimension = N > 0), a block of B = block_states(N) states is
-//     copied into local arrays whose sizes the compiler knows: one state of dimension <= 4 keeps q, p and both
-//     gradients in registers through the nine flows, and a block of B states vectorizes across states. The states
-//     left over after the whole blocks go one by one.
+//   - for a dimension N known at compile time (FixedDimension = N > 0), blocks of B = block_states(N) states are
+//     copied into local arrays whose sizes the compiler knows, so that the nine flows and the gradients vectorize
+//     across the block without alias checks or loops of unknown length;
+//   - the states left over after the whole blocks go in place, as one block of the caller's arrays; one state left
+//     over (a single trajectory) goes in local arrays of one state, which keep q, p and both gradients in registers
+//     through the nine flows (dimension <= 4);
 //   - with a dimension known only at run time (FixedDimension = 0), blocks of the caller's arrays.
+// Why blocks of 32 states (docs/performance.md, "Stepping kernels"): one state's step is a chain of dependent
+// operations (a division in each grad V; about 55 ns a step in registers, twice that through memory), so a block must
+// hold enough independent states to keep the divider and the multipliers busy. Blocks of 16 ran at the chain's
+// latency whatever the vector width (GCC unrolls their loops completely and vectorizes them piecemeal); blocks of 32
+// and 64 run at the machine's throughput, as the hand-written loop over all states does.
 // Each number sees the same operations in the same order as in the evaluation path, so a kernel compiled with the
 // evaluation path's flags gives its numbers bit for bit (tests/core/test_chin_kernel.cpp).
 //
@@ -30,8 +37,9 @@ namespace nonsep {
 // Version 2: a call carries a schedule of sub-steps (ChinStepsCall::substeps).
 inline constexpr std::uint64_t chin_kernel_version = 2;
 
-// States per block: 16 numbers of each array for a small fixed dimension, one state from 16 on.
-constexpr std::size_t block_states(std::size_t dimension) { return dimension >= 16 ? 1 : 16 / dimension; }
+// States per block of local arrays for a fixed dimension: 32 states, at most 128 numbers of each array (the four
+// arrays then take 4 KB of the first-level cache), one state from dimension 128 on.
+constexpr std::size_t block_states(std::size_t dimension) { return std::clamp<std::size_t>(128 / dimension, 1, 32); }
 // States per block of the caller's arrays when the dimension is known at run time only: about 512 numbers each.
 inline std::size_t block_states_at_run_time(std::size_t dimension) { return std::max<std::size_t>(1, 512 / dimension); }
 
@@ -62,6 +70,18 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
   std::copy_n(outer_gradient.begin(), size, call.outer_gradient.begin() + static_cast<std::ptrdiff_t>(offset));
 }
 
+// The call's steps for states [first, first + states) of dimension n, in the caller's arrays.
+template <Model M>
+inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::size_t n, std::size_t first,
+                                std::size_t states) {
+  const std::size_t offset = first * n, size = states * n;
+  const std::span<const double> eps = eps_per_state(call) ? call.eps.subspan(first, states) : call.eps;
+  chin_scheduled_stages(model, ChinStepsCall{call.form, call.coefficients, eps, call.substeps, call.steps, states,
+                                             call.q.subspan(offset, size), call.p.subspan(offset, size),
+                                             call.outer_gradient.subspan(offset, size),
+                                             call.inner_gradient.subspan(offset, size)});
+}
+
 }  // namespace detail
 
 // The steps of `call` for `model` (its dimension is FixedDimension when that is not 0). Requires the sizes of
@@ -74,18 +94,15 @@ void chin_kernel_steps(const M& model, const ChinStepsCall& call) {
     std::size_t first = 0;
     if constexpr (B > 1)
       for (; first + B <= count; first += B) detail::chin_steps_in_local_arrays<FixedDimension, B>(model, call, first);
-    for (; first < count; ++first) detail::chin_steps_in_local_arrays<FixedDimension, 1>(model, call, first);
+    if (count - first == 1)
+      detail::chin_steps_in_local_arrays<FixedDimension, 1>(model, call, first);
+    else if (first < count)
+      detail::chin_steps_in_place(model, call, FixedDimension, first, count - first);
   } else {
     const std::size_t n = count == 0 ? 0 : call.q.size() / count;
     const std::size_t block = block_states_at_run_time(n);
-    for (std::size_t first = 0; first < count; first += block) {
-      const std::size_t states = std::min(block, count - first), offset = first * n, size = states * n;
-      const std::span<const double> eps = detail::eps_per_state(call) ? call.eps.subspan(first, states) : call.eps;
-      chin_scheduled_stages(
-          model, ChinStepsCall{call.form, call.coefficients, eps, call.substeps, call.steps, states,
-                               call.q.subspan(offset, size), call.p.subspan(offset, size),
-                               call.outer_gradient.subspan(offset, size), call.inner_gradient.subspan(offset, size)});
-    }
+    for (std::size_t first = 0; first < count; first += block)
+      detail::chin_steps_in_place(model, call, n, first, std::min(block, count - first));
   }
 }
 

@@ -13,8 +13,11 @@
 // much). The host chooses the set from the processor's features, or the one NONSEP_INSTRUCTION_SET names.
 // Each wider instantiation is flattened (every call inside inlined), so that the model's code is compiled for the
 // wider set too and not called in its baseline copy. Other processors (and compilers without the attribute) get
-// the baseline alone. NONSEP_SDK_WIDE_KERNEL_SETS (default 3) chooses the wider sets compiled, as bits: 1 for
-// x86-64-v3, 2 for x86-64-v4, 0 for none (each costs compile time; formula models compile the one the host uses).
+// the baseline alone, and so does a plugin compiled for a processor already (-march=native, NONSEP_NATIVE: __AVX__
+// defined): its baseline uses that processor's vectors, and GCC inlines nothing compiled for one processor into a
+// function of another arch, so a wider kernel there would call the model's gradients out of line.
+// NONSEP_SDK_WIDE_KERNEL_SETS (default 3) chooses the wider sets compiled, as bits: 1 for x86-64-v3, 2 for x86-64-v4, 0
+// for none (each costs compile time; formula models compile the one the host uses).
 #include <cstddef>
 #include <span>
 #include <string_view>
@@ -27,7 +30,7 @@ namespace nonsep::sdk {
 #ifndef NONSEP_SDK_WIDE_KERNEL_SETS
 #define NONSEP_SDK_WIDE_KERNEL_SETS 3
 #endif
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX__)
 #define NONSEP_SDK_KERNEL_V3 (NONSEP_SDK_WIDE_KERNEL_SETS & 1)
 #define NONSEP_SDK_KERNEL_V4 (NONSEP_SDK_WIDE_KERNEL_SETS & 2)
 #else
