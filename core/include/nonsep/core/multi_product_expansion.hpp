@@ -45,6 +45,7 @@ struct ModelArchetype {
 //   b.step(model, x, sizes)        advances state i of x by sizes[i] (std::span<const double>, x.count() entries)
 //   b.prime(model, x)              makes the first-same-as-last gradient at x's point available
 //   typename B::Cache, cb.save_cache(), b.restore_cache(cache)    that gradient saved and restored
+//   b.keep_cache_prefix(size)      that gradient kept for the batch's first `size` numbers of q and p only
 //   cb.evaluations()               EvaluationCounts, per state
 //   cb.describe()                  IntegratorDescription
 template <class B>
@@ -56,6 +57,7 @@ concept StepperWithPerStateStepSizes = requires(B& b, const B& cb, const detail:
   b.prime(model, x);
   { cb.save_cache() } -> std::convertible_to<typename B::Cache>;
   b.restore_cache(cache);
+  b.keep_cache_prefix(std::size_t{});
   { cb.evaluations() } -> std::convertible_to<const EvaluationCounts&>;
   { cb.describe() } -> std::convertible_to<IntegratorDescription>;
 };
@@ -116,37 +118,29 @@ class MultiProductExpansion {
     base_.prime(model, x);
     const auto start_cache = base_.save_cache();
     // Group g = m - k holds term k: states [g count, (g + 1) count), step size dt / k. The groups still running
-    // are a prefix, because the term with the fewest steps (the smallest k) is the last group.
-    terms_ = PhaseSpaceBatch(n, static_cast<std::size_t>(m) * count);
+    // are a prefix, because the term with the fewest steps (the smallest k) is the last group: after each round the
+    // last running group is done, is copied to done_ and dropped from terms_ and from the base's cache.
+    if (terms_.dimension() != n) terms_ = PhaseSpaceBatch(n, 0);
+    if (done_.dimension() != n) done_ = PhaseSpaceBatch(n, 0);
+    terms_.resize(static_cast<std::size_t>(m) * count);
+    done_.resize(static_cast<std::size_t>(m) * count);
     step_sizes_.resize(static_cast<std::size_t>(m) * count);
-    typename Base::Cache cache;
+    cache_.at.clear();
+    cache_.gradient.clear();
     for (int g = 0; g < m; ++g) {
       const auto offset = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(g) * size);
       std::copy(x.q().begin(), x.q().end(), terms_.q().begin() + offset);
       std::copy(x.p().begin(), x.p().end(), terms_.p().begin() + offset);
       std::fill_n(step_sizes_.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(g) * count), count,
                   dt / (m - g));
-      cache.at.insert(cache.at.end(), start_cache.at.begin(), start_cache.at.end());
-      cache.gradient.insert(cache.gradient.end(), start_cache.gradient.begin(), start_cache.gradient.end());
+      cache_.at.insert(cache_.at.end(), start_cache.at.begin(), start_cache.at.end());
+      cache_.gradient.insert(cache_.gradient.end(), start_cache.gradient.begin(), start_cache.gradient.end());
     }
-    base_.restore_cache(cache);
+    base_.restore_cache(cache_);
     typename Base::Cache last_term_cache;  // left by term 1, which step_term_by_term runs last
     for (int round = 0; round < m; ++round) {
       const auto running = static_cast<std::size_t>(m - round);  // the terms with k > round
-      if (running * count < terms_.count()) {
-        running_ = PhaseSpaceBatch(n, running * count);
-        std::copy_n(terms_.q().begin(), running * size, running_.q().begin());
-        std::copy_n(terms_.p().begin(), running * size, running_.p().begin());
-        cache = base_.save_cache();
-        cache.at.resize(running * size);
-        cache.gradient.resize(running * size);
-        base_.restore_cache(cache);
-        base_.step(model, running_, std::span<const double>(step_sizes_).first(running * count));
-        std::copy_n(running_.q().begin(), running * size, terms_.q().begin());
-        std::copy_n(running_.p().begin(), running * size, terms_.p().begin());
-      } else {
-        base_.step(model, terms_, std::span<const double>(step_sizes_));
-      }
+      base_.step(model, terms_, std::span<const double>(step_sizes_).first(running * count));
       if (round == 0) {
         last_term_cache = base_.save_cache();
         last_term_cache.at.erase(last_term_cache.at.begin(),
@@ -154,12 +148,19 @@ class MultiProductExpansion {
         last_term_cache.gradient.erase(last_term_cache.gradient.begin(),
                                        last_term_cache.gradient.end() - static_cast<std::ptrdiff_t>(size));
       }
+      const std::size_t finished = (running - 1) * size;  // where term k = round + 1 starts
+      std::copy_n(terms_.q().begin() + static_cast<std::ptrdiff_t>(finished), size,
+                  done_.q().begin() + static_cast<std::ptrdiff_t>(finished));
+      std::copy_n(terms_.p().begin() + static_cast<std::ptrdiff_t>(finished), size,
+                  done_.p().begin() + static_cast<std::ptrdiff_t>(finished));
+      terms_.resize((running - 1) * count);
+      base_.keep_cache_prefix(finished);
     }
     base_.restore_cache(last_term_cache);
     // y_m, then + c_k (y_k - y_m) for k = m-1 down to 1, as step_term_by_term accumulates.
-    std::copy_n(terms_.q().begin(), size, x.q().begin());
-    std::copy_n(terms_.p().begin(), size, x.p().begin());
-    const std::span<const double> q = terms_.q(), p = terms_.p();
+    std::copy_n(done_.q().begin(), size, x.q().begin());
+    std::copy_n(done_.p().begin(), size, x.p().begin());
+    const std::span<const double> q = done_.q(), p = done_.p();
     for (int k = m - 1; k >= 1; --k) {
       const double c = weights_[static_cast<std::size_t>(k - 1)];
       const std::size_t offset = static_cast<std::size_t>(m - k) * size;
@@ -210,8 +211,9 @@ class MultiProductExpansion {
   Base base_;
   std::vector<double> weights_;
   PhaseSpaceBatch start_, term_, last_;  // step_term_by_term: the starting point, the term being run, and y_m
-  PhaseSpaceBatch terms_, running_;      // step: all terms side by side, and the prefix still running
+  PhaseSpaceBatch terms_, done_;         // step: the terms still running side by side, and every term's end point
   std::vector<double> step_sizes_;       // step: dt / k per state of terms_
+  typename Base::Cache cache_;           // step: the starting point's cache, once per term
 };
 
 }  // namespace nonsep
