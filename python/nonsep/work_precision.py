@@ -1,17 +1,20 @@
 """Plots the work_precision.csv of a nonsep study (docs/studies.md, "Work-precision studies"); installed with the package.
 
 Usage: /usr/bin/python3 -m nonsep.work_precision STUDY_DIR --out FILE.png [--title TEXT]
-           [--peers PEERS_CSV --problem NAME] [--error phase|energy] [--dpi N]
+           [--peers PEERS_CSV --problem NAME] [--error phase|energy|relative-phase] [--dpi N]
 
 Two panels: the error at t_end against the median wall time, and against the evaluations (grad_T + grad_V +
 grad_H per trajectory), log-log. Each curve is one integrator's Pareto front over its step counts: the smallest
-error reached at that cost or less. Failed or diverged runs are left out. With --peers, the rows of
+error reached at that cost or less. Failed or diverged runs are left out. --error relative-phase divides the phase-space error by the length
+|(q, p)_ref| of the study's reference state (summary.json study.reference), so that an accuracy means the same per
+degree of freedom whatever the dimension. With --peers, the rows of
 bench/peers' work_precision.csv for --problem (GSL rk2imp/rk4imp, Odeint dopri5/rk4; columns method, problem,
 wall_seconds_median, evaluations, energy_error, phase_error, status) join both panels as dashed fronts.
 Needs matplotlib (Debian's python3-matplotlib: /usr/bin/python3).
 """
 import argparse
 import csv
+import json
 import math
 import os
 import sys
@@ -40,8 +43,17 @@ def number(text):
     return abs(value) if math.isfinite(value) and value != 0.0 else None
 
 
-def study_curves(path, error_column):
-    """{label: (family, [(wall, evaluations, error)])} from a study's work_precision.csv."""
+def reference_length(study_dir):
+    """|(q, p)_ref| of a study's reference state (summary.json study.reference)."""
+    with open(os.path.join(study_dir, "summary.json")) as f:
+        reference = json.load(f)["study"].get("reference")
+    if not reference:
+        sys.exit(f"nonsep.work_precision: {study_dir}/summary.json has no study.reference (a study with a reference)")
+    return math.sqrt(sum(x * x for x in reference["q"] + reference["p"]))
+
+
+def study_curves(path, error_column, scale=1.0):
+    """{label: (family, [(wall, evaluations, error / scale)])} from a study's work_precision.csv."""
     curves = {}
     with open(path, newline="") as f:
         for row in csv.DictReader(f):
@@ -52,7 +64,7 @@ def study_curves(path, error_column):
                 continue
             family = row["family"]
             curves.setdefault(row["integrator"], (family, []))[1].append(
-                (float(row["wall_seconds"]), float(row["evaluations"]), error))
+                (float(row["wall_seconds"]), float(row["evaluations"]), error / scale))
     return curves
 
 
@@ -83,14 +95,17 @@ def main():
     parser.add_argument("--title", default="")
     parser.add_argument("--peers")
     parser.add_argument("--problem")
-    parser.add_argument("--error", choices=["phase", "energy"], default="phase")
+    parser.add_argument("--error", choices=["phase", "energy", "relative-phase"], default="phase")
     parser.add_argument("--dpi", type=int, default=150)
     args = parser.parse_args()
-    column = "phase_error" if args.error == "phase" else "relative_energy_error"
-    curves = study_curves(os.path.join(args.study_dir, "work_precision.csv"), column)
+    column = "relative_energy_error" if args.error == "energy" else "phase_error"
+    scale = reference_length(args.study_dir) if args.error == "relative-phase" else 1.0
+    curves = study_curves(os.path.join(args.study_dir, "work_precision.csv"), column, scale)
     if args.peers:
         if not args.problem:
             sys.exit("nonsep.work_precision: --peers needs --problem (paper1d, tao_product, ...)")
+        if args.error == "relative-phase":
+            sys.exit("nonsep.work_precision: --peers gives absolute phase errors; use --error phase with --peers")
         peer_column = "phase_error" if args.error == "phase" else "energy_error"
         curves.update(peer_curves(args.peers, args.problem, peer_column))
     if not curves:
@@ -104,7 +119,8 @@ def main():
                         marker=MARKER.get(family, "x"), markersize=3, label=label,
                         color=colors[index_curve % len(colors)])
             axis.set_xlabel(name)
-    ylabel = "phase-space error at t_end" if args.error == "phase" else "relative energy error at t_end"
+    ylabel = {"phase": "phase-space error at t_end", "energy": "relative energy error at t_end",
+              "relative-phase": "relative phase-space error at t_end"}[args.error]
     for axis in axes:
         axis.set_ylabel(ylabel)
         axis.grid(True, which="major", alpha=0.3)

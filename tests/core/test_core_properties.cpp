@@ -164,6 +164,36 @@ TEST_CASE("first-same-as-last: 4 grad T + 4 grad V per basic step, plus one at t
   CHECK(mpe.evaluations().grad_V == (4 * 6 + 1) * 5);
 }
 
+TEST_CASE("first-same-as-last: a batch cut to its first states keeps its cached gradient (keep_cache_prefix)") {
+  for (const auto form : forms) {
+    CAPTURE(static_cast<int>(form));
+    PhaseSpaceBatch batch(2, 3);
+    const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};
+    std::copy(std::begin(qs), std::end(qs), batch.q().begin());
+    std::copy(std::begin(ps), std::end(ps), batch.p().begin());
+    ChinBasicStep cut(form);
+    cut.step(Coupled2D{}, batch, 0.01);
+    const double* storage = batch.q().data();
+    batch.resize(2);
+    CHECK(batch.count() == 2);
+    CHECK(batch.q().data() == storage);  // the first states stay where they were
+    auto alone = PhaseSpaceBatch::single(batch.q(1), batch.p(1));
+    ChinBasicStep fresh(form);
+    fresh.step(Coupled2D{}, alone, 0.02);
+    const auto before = cut.evaluations();
+    cut.keep_cache_prefix(batch.size());
+    cut.step(Coupled2D{}, batch, 0.02);
+    // 4 + 4 per state of the 2 left and no new starting gradient; state 1 as stepped alone, bit for bit.
+    CHECK(cut.evaluations().grad_T + cut.evaluations().grad_V == before.grad_T + before.grad_V + 2 * 8);
+    CHECK(std::ranges::equal(batch.q(1), alone.q()));
+    CHECK(std::ranges::equal(batch.p(1), alone.p()));
+    batch.resize(3);
+    CHECK(batch.q().data() == storage);  // growing back within the storage does not move it
+    CHECK(batch.q(2)[0] == 0.0);
+    CHECK(batch.p(2)[1] == 0.0);
+  }
+}
+
 // Paper1D whose gradient evaluation number `fail_at` (counting both gradients from 1) throws ModelError after
 // writing garbage into its output, as a failing plugin may leave it.
 struct FailingOnce {

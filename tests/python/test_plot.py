@@ -1,6 +1,8 @@
 """nonsep.plot: each function returns labelled axes whose lines hold exactly the loaded data, with a legend when
 there are several series; headless (Agg). `python3 -m nonsep.work_precision` on a study; the package's message when
 numpy is missing."""
+import json
+import math
 import os
 import subprocess
 import sys
@@ -14,6 +16,7 @@ import numpy as np  # noqa: E402
 
 import nonsep  # noqa: E402
 import nonsep.plot  # noqa: E402
+import nonsep.work_precision  # noqa: E402
 from support import FolderTestCase, paper1d_job, state  # noqa: E402
 
 
@@ -95,6 +98,33 @@ class WorkPrecisionTest(FolderTestCase):
                                str(self.folder / "wp.png")], capture_output=True, text=True, env=os.environ)
         self.assertEqual(done.returncode, 0, done.stderr)
         self.assertGreater((self.folder / "wp.png").stat().st_size, 1000)
+
+    def test_the_relative_phase_error_is_the_phase_error_over_the_reference_length(self):
+        job = {"model": {"plugin": "paper2d"}, "initial": {"q": [0.5, 0.2], "p": [0.3, -0.4]}, "time": {"t_end": 0.5},
+               "study": {"reference_run": {"scheme": "gauss", "stages": 3, "steps": [64]},
+                         "integrators": [{"scheme": "mpe", "order": 4, "steps": [8, 16]}]}}
+        nonsep.run(job, output="study")
+        with open(self.folder / "study" / "summary.json") as f:
+            reference = json.load(f)["study"]["reference"]
+        length = math.sqrt(sum(x * x for x in reference["q"] + reference["p"]))
+        self.assertEqual(nonsep.work_precision.reference_length(str(self.folder / "study")), length)
+        table = str(self.folder / "study" / "work_precision.csv")
+        absolute = nonsep.work_precision.study_curves(table, "phase_error")["mpe 4"][1]
+        relative = nonsep.work_precision.study_curves(table, "phase_error", length)["mpe 4"][1]
+        self.assertEqual(len(relative), 2)
+        self.assertEqual([e / length for _, _, e in absolute], [e for _, _, e in relative])
+        done = subprocess.run([sys.executable, "-m", "nonsep.work_precision", str(self.folder / "study"), "--out",
+                               str(self.folder / "wp.png"), "--error", "relative-phase"],
+                              capture_output=True, text=True, env=os.environ)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertGreater((self.folder / "wp.png").stat().st_size, 1000)
+        del job["study"]["reference_run"]
+        nonsep.run(job, output="no-reference")
+        done = subprocess.run([sys.executable, "-m", "nonsep.work_precision", str(self.folder / "no-reference"),
+                               "--out", str(self.folder / "none.png"), "--error", "relative-phase"],
+                              capture_output=True, text=True, env=os.environ)
+        self.assertNotEqual(done.returncode, 0)
+        self.assertIn("no study.reference", done.stderr)
 
     def test_without_numpy_the_package_names_the_interpreter_to_use(self):
         done = subprocess.run([sys.executable, "-c", "import sys; sys.modules['numpy'] = None; import nonsep"],

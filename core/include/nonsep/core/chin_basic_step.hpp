@@ -187,6 +187,12 @@ class ChinBasicStep {
     outer_gradient_.assign(cache.gradient.begin(), cache.gradient.end());
     cache_valid_ = true;  // an empty `at` (saved while invalid) matches no batch
   }
+  // Keeps the cache of the batch's first `size` numbers of q and of p (its first size / n states, layout b*n + i):
+  // for a wrapper that drops the batch's last states (PhaseSpaceBatch::resize), without copying the rest.
+  void keep_cache_prefix(std::size_t size) {
+    if (cached_at_.size() > size) cached_at_.resize(size);
+    if (outer_gradient_.size() > size) outer_gradient_.resize(size);
+  }
 
  private:
   // One basic step of every state; eps_ holds eps = cbrt(dt), one for all states or one per state.

@@ -76,10 +76,10 @@ inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::
                                 std::size_t states) {
   const std::size_t offset = first * n, size = states * n;
   const std::span<const double> eps = eps_per_state(call) ? call.eps.subspan(first, states) : call.eps;
-  chin_scheduled_stages(model, ChinStepsCall{call.form, call.coefficients, eps, call.substeps, call.steps, states,
-                                             call.q.subspan(offset, size), call.p.subspan(offset, size),
-                                             call.outer_gradient.subspan(offset, size),
-                                             call.inner_gradient.subspan(offset, size)});
+  chin_scheduled_stages(
+      model, ChinStepsCall{call.form, call.coefficients, eps, call.substeps, call.steps, states,
+                           call.q.subspan(offset, size), call.p.subspan(offset, size),
+                           call.outer_gradient.subspan(offset, size), call.inner_gradient.subspan(offset, size)});
 }
 
 }  // namespace detail

@@ -46,6 +46,7 @@ struct ModelArchetype {
 //   b.prime(model, x)              makes the first-same-as-last gradient at x's point available
 //   typename B::Cache, cb.save_cache(cache), b.restore_cache(cache)    that gradient saved (into cache, reusing its
 //                                  storage) and restored
+//   b.keep_cache_prefix(size)      that gradient kept for the batch's first `size` numbers of q and p only
 //   cb.evaluations()               EvaluationCounts, per state
 //   cb.describe()                  IntegratorDescription
 template <class B>
@@ -57,6 +58,7 @@ concept StepperWithPerStateStepSizes = requires(B& b, const B& cb, const detail:
   b.prime(model, x);
   cb.save_cache(cache);
   b.restore_cache(cache);
+  b.keep_cache_prefix(std::size_t{});
   { cb.evaluations() } -> std::convertible_to<const EvaluationCounts&>;
   { cb.describe() } -> std::convertible_to<IntegratorDescription>;
 };
@@ -117,9 +119,12 @@ class MultiProductExpansion {
     base_.prime(model, x);
     base_.save_cache(start_cache_);
     // Group g = m - k holds term k: states [g count, (g + 1) count), step size dt / k. The groups still running
-    // are a prefix, because the term with the fewest steps (the smallest k) is the last group. The work batches
-    // and caches keep their storage from step to step.
-    reshape(terms_, n, static_cast<std::size_t>(m) * count);
+    // are a prefix, because the term with the fewest steps (the smallest k) is the last group: after each round the
+    // last running group is done, is copied to done_ and dropped from terms_ and from the base's cache.
+    if (terms_.dimension() != n) terms_ = PhaseSpaceBatch(n, 0);
+    if (done_.dimension() != n) done_ = PhaseSpaceBatch(n, 0);
+    terms_.resize(static_cast<std::size_t>(m) * count);
+    done_.resize(static_cast<std::size_t>(m) * count);
     step_sizes_.resize(static_cast<std::size_t>(m) * count);
     cache_.at.clear();
     cache_.gradient.clear();
@@ -133,37 +138,29 @@ class MultiProductExpansion {
       cache_.gradient.insert(cache_.gradient.end(), start_cache_.gradient.begin(), start_cache_.gradient.end());
     }
     base_.restore_cache(cache_);
-    running_.resize(static_cast<std::size_t>(m));
     for (int round = 0; round < m; ++round) {
       const auto running = static_cast<std::size_t>(m - round);  // the terms with k > round
-      if (running * count < terms_.count()) {
-        PhaseSpaceBatch& prefix = running_[running];
-        reshape(prefix, n, running * count);
-        std::copy_n(terms_.q().begin(), running * size, prefix.q().begin());
-        std::copy_n(terms_.p().begin(), running * size, prefix.p().begin());
-        base_.save_cache(cache_);
-        cache_.at.resize(running * size);
-        cache_.gradient.resize(running * size);
-        base_.restore_cache(cache_);
-        base_.step(model, prefix, std::span<const double>(step_sizes_).first(running * count));
-        std::copy_n(prefix.q().begin(), running * size, terms_.q().begin());
-        std::copy_n(prefix.p().begin(), running * size, terms_.p().begin());
-      } else {
-        base_.step(model, terms_, std::span<const double>(step_sizes_));
-      }
-      if (round == 0) {  // the cache left by term 1, which step_term_by_term runs last
-        base_.save_cache(last_term_cache_);
+      base_.step(model, terms_, std::span<const double>(step_sizes_).first(running * count));
+      if (round == 0) {
+        base_.save_cache(last_term_cache_);  // left by term 1, which step_term_by_term runs last
         last_term_cache_.at.erase(last_term_cache_.at.begin(),
                                   last_term_cache_.at.end() - static_cast<std::ptrdiff_t>(size));
         last_term_cache_.gradient.erase(last_term_cache_.gradient.begin(),
                                         last_term_cache_.gradient.end() - static_cast<std::ptrdiff_t>(size));
       }
+      const std::size_t finished = (running - 1) * size;  // where term k = round + 1 starts
+      std::copy_n(terms_.q().begin() + static_cast<std::ptrdiff_t>(finished), size,
+                  done_.q().begin() + static_cast<std::ptrdiff_t>(finished));
+      std::copy_n(terms_.p().begin() + static_cast<std::ptrdiff_t>(finished), size,
+                  done_.p().begin() + static_cast<std::ptrdiff_t>(finished));
+      terms_.resize((running - 1) * count);
+      base_.keep_cache_prefix(finished);
     }
     base_.restore_cache(last_term_cache_);
     // y_m, then + c_k (y_k - y_m) for k = m-1 down to 1, as step_term_by_term accumulates.
-    std::copy_n(terms_.q().begin(), size, x.q().begin());
-    std::copy_n(terms_.p().begin(), size, x.p().begin());
-    const std::span<const double> q = terms_.q(), p = terms_.p();
+    std::copy_n(done_.q().begin(), size, x.q().begin());
+    std::copy_n(done_.p().begin(), size, x.p().begin());
+    const std::span<const double> q = done_.q(), p = done_.p();
     for (int k = m - 1; k >= 1; --k) {
       const double c = weights_[static_cast<std::size_t>(k - 1)];
       const std::size_t offset = static_cast<std::size_t>(m - k) * size;
@@ -207,21 +204,17 @@ class MultiProductExpansion {
   }
 
  private:
-  // batch holds count states of dimension n afterwards (their numbers unspecified), its storage kept when it fits.
-  static void reshape(PhaseSpaceBatch& batch, std::size_t n, std::size_t count) {
-    if (batch.dimension() != n || batch.count() != count) batch = PhaseSpaceBatch(n, count);
-  }
   static void accumulate(std::span<double> sum, double c, std::span<const double> y, std::span<const double> ym) {
     for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += c * (y[i] - ym[i]);
   }
 
   Base base_;
   std::vector<double> weights_;
-  PhaseSpaceBatch start_, term_, last_;   // step_term_by_term: the starting point, the term being run, and y_m
-  PhaseSpaceBatch terms_;                 // step: all terms side by side
-  std::vector<PhaseSpaceBatch> running_;  // step: [r] the prefix of r terms still running
-  std::vector<double> step_sizes_;        // step: dt / k per state of terms_
-  typename Base::Cache start_cache_, cache_, last_term_cache_;  // the first-same-as-last gradients saved
+  PhaseSpaceBatch start_, term_, last_;  // step_term_by_term: the starting point, the term being run, and y_m
+  PhaseSpaceBatch terms_, done_;         // step: the terms still running side by side, and every term's end point
+  std::vector<double> step_sizes_;       // step: dt / k per state of terms_
+  typename Base::Cache start_cache_, cache_, last_term_cache_;  // the first-same-as-last gradients saved: at the
+                                                                // start, once per term (step), and term 1's
 };
 
 }  // namespace nonsep

@@ -29,6 +29,14 @@ class PhaseSpaceBatch {
     return batch;
   }
 
+  // Keeps the first min(count, count()) states as they are; states added are zero. Shrinking keeps the storage, so
+  // growing back to at most the largest count so far does not allocate.
+  void resize(std::size_t count) {
+    count_ = count;
+    q_.resize(dimension_ * count);
+    p_.resize(dimension_ * count);
+  }
+
   std::size_t dimension() const { return dimension_; }
   std::size_t count() const { return count_; }
   // Numbers in each of q and p: dimension * count.

@@ -38,9 +38,9 @@
 // variable unchanged (TTV: no K, so q is not moved; VVT: no U); otherwise the basic step evaluates it again.
 //
 // SeparableComposition wraps a base stepper with the ChinBasicStep interface (step with one dt or one per state,
-// step_n, step_schedule_n, prime, save_cache, restore_cache, evaluations, describe, form, coefficients); it is the base
-// of the catalogue's triplet and MPE (scheme_catalogue.hpp). Errors: those of the base step; the model's exceptions
-// propagate and leave x unspecified but valid.
+// step_n, step_schedule_n, prime, save_cache, restore_cache, keep_cache_prefix, evaluations, describe, form,
+// coefficients); it is the base of the catalogue's triplet and MPE (scheme_catalogue.hpp). Errors: those of the base
+// step; the model's exceptions propagate and leave x unspecified but valid.
 #include <cstdint>
 #include <span>
 #include <string>
@@ -154,6 +154,7 @@ class SeparableComposition {
   }
   void save_cache(Cache& cache) const { base_.save_cache(cache); }
   void restore_cache(const Cache& cache) { base_.restore_cache(cache); }
+  void keep_cache_prefix(std::size_t size) { base_.keep_cache_prefix(size); }
 
   // The flow's update of `changed` (p for a kick, q for a drift) from the gradient at the unchanged variable:
   // changed_b += (-1 for a kick, +1 for a drift) f.fraction dt_b gradient_b, dt one for all states or one per state.
