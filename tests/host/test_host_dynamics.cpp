@@ -322,6 +322,30 @@ TEST_CASE("an energy shell: \"p1\" takes the root p1 >= 0, \"-p1\" the root p1 <
   }
 }
 
+TEST_CASE("an energy shell of a lattice of 20000 sites: O(n) through Hessian-vector products, on H = E to round-off") {
+  // A dense Hessian of this size would take 3 GiB and be refused; the shell's H is one product per evaluation.
+  TemporaryFolder folder;
+  const std::size_t n = 20000;
+  json q = json::array_t(n, json(0.0)), p = json::array_t(n, json(0.0));
+  q[0] = {{"from", -0.2}, {"to", 0.2}, {"count", 3}};
+  q[1] = 0.1;
+  const json job = {{"model", {{"plugin", "lattice_chain"}, {"parameters", {{"sites", n}}}}},
+                    {"integrator", {{"scheme", "basic"}}},
+                    {"initial", {{"grid", {{"q", q}, {"p", p}}}, {"energy", 0.5}, {"solve_for", "-p0"}}},
+                    {"time", {{"dt", 1e-3}, {"steps", 2}}},
+                    {"output", {{"every", 0}}}};
+  const auto result = run_named(folder, "lattice", job);
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  CHECK(read_json(folder / "lattice" / "summary.json")["energy_shell"]["left_out"] == 0);
+  const auto rows = table(folder / "lattice" / "trajectories.csv");
+  REQUIRE(rows.size() == 3);
+  for (const auto& row : rows) {
+    CHECK(cell(row, "H0") == doctest::Approx(0.5).epsilon(1e-15));
+    CHECK(cell(row, "p0") < 0.0);
+  }
+}
+
 TEST_CASE("a chunk redone step by step after a divergence keeps the crossings and max_crossings stops of the others") {
   TemporaryFolder folder;
   const json analysis = {{"poincare", {{"component", "q0"}, {"max_crossings", 3}}}, {"megno", true}};
