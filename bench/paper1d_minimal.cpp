@@ -69,6 +69,8 @@ const nonsep_plugin_api table = {
     nullptr,  // hvp_K
     nullptr,  // hvp_U
     nullptr,  // chin_steps
+    nullptr,  // energy_TTV
+    nullptr,  // energy_VVT
 };
 
 }  // namespace

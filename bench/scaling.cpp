@@ -2,7 +2,8 @@
 // n = 10 .. 10^6, each configuration's time per step as a ratio to one gradient evaluation (grad V, the
 // hand-written analytic gradient behind the plugin boundary) in the same run.
 //
-// Configurations: one gradient (the unit), one Hessian-vector product, the energy H of one state; Chin's basic
+// Configurations: one gradient (the unit), one Hessian-vector product, the energy H of one state (the plugin's own
+// energy_TTV, and through grad T and hvp_V as for a plugin without it); Chin's basic
 // step, plain, written out by hand (HandWrittenLatticeStep: the machine's limit for the step's memory traffic; its
 // numbers are checked against the plugin's before it is timed), with the energy every step, and with one
 // tangent vector (a Lyapunov vector); MPE 4 (6 terms),
@@ -120,6 +121,11 @@ std::vector<Configuration> configurations(const PluginModel& model) {
                   }});
   list.push_back({"energy", [=, &model](std::uint64_t s) {
                     for (std::uint64_t k = 0; k < s; ++k) (*out)[0] = energy->evaluate_one(model, *x);
+                  }});
+  // H as a plugin without energy_TTV gets it: grad T, hvp_V and their dot product.
+  auto through_products = std::make_shared<PluginModel>(model.without_product_energy());
+  list.push_back({"energy_by_products", [=](std::uint64_t s) {
+                    for (std::uint64_t k = 0; k < s; ++k) (*out)[0] = energy->evaluate_one(*through_products, *x);
                   }});
   // Each stepping configuration owns its state, stepper and (for the tangent) vector.
   auto stepping = [&](const std::string& name, auto stepper) {

@@ -11,7 +11,8 @@
 // too (f' replaces p). Every evaluation is O(n): a gradient, a Hessian-vector product and H itself.
 //
 // The gradients are templates over the number type, so the SDK differentiates them (not T and V) for the
-// directional third derivatives and the (dense, n x n) Hessians; the Hessian-vector products are written out; the
+// directional third derivatives and the (dense, n x n) Hessians; the Hessian-vector products and the product term
+// of H (energy_TTV, energy_VVT) are written out; the
 // dimension is the parameter "sites", 3 .. Capacity. LatticeChainModel<Capacity> with a small Capacity also compiles T
 // and V for the SDK's capacity-sized dual numbers (the tests compare the two ways of differentiating).
 #include <cstddef>
@@ -98,10 +99,40 @@ struct LatticeChainModel {
     out[n - 1] = v[n - 1] + bond(n - 2, n - 1) - bond(n - 1, 0);
   }
 
+  // The product term of H written out, one pass over the sites (plugin_abi.h energy_TTV, energy_VVT): with
+  // t = f'(p) and the tridiagonal V'' met as its bonds,
+  //   H_TTV = sum_i [t_i^2 + W''(q_{i+1} - q_i) (t_{i+1} - t_i)^2],   H_VVT = sum_i f''(p_i) (grad V)_i^2.
+  // Through the products H costs a gradient, a product and a pass for their dot product; this, about a gradient.
+  double energy_TTV(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> p) const {
+    return periodic_sum(q.size(), [&](std::size_t, std::size_t i, std::size_t next) {
+      const double ti = kinetic_slope(p[i]), step = kinetic_slope(p[next]) - ti;
+      return ti * ti + bond_stiffness(q[next] - q[i]) * step * step;
+    });
+  }
+  double energy_VVT(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> p) const {
+    return periodic_sum(q.size(), [&](std::size_t previous, std::size_t i, std::size_t next) {
+      const double g = q[i] + bond_force(q[i] - q[previous]) - bond_force(q[next] - q[i]);
+      return (1.0 + a * p[i] * p[i]) * g * g;
+    });
+  }
+
   double a, k, b;
 
  private:
+  double kinetic_slope(double p) const { return p + a / 3.0 * p * p * p; }
   double bond_stiffness(double r) const { return k + 3.0 * b * r * r; }
+  // sum_i term(i - 1, i, i + 1) over the n >= 3 sites, the ends wrapping around; four partial sums, so that the
+  // additions do not wait on one another.
+  template <class Term>
+  static double periodic_sum(std::size_t n, const Term& term) {
+    double partial[4] = {0.0, 0.0, 0.0, 0.0};
+    double sum = term(n - 1, 0, 1) + term(n - 2, n - 1, 0);
+    std::size_t i = 1;
+    for (; i + 4 < n; i += 4)
+      for (std::size_t j = 0; j < 4; ++j) partial[j] += term(i + j - 1, i + j, i + j + 1);
+    for (; i + 1 < n; ++i) sum += term(i - 1, i, i + 1);
+    return sum + ((partial[0] + partial[1]) + (partial[2] + partial[3]));
+  }
   template <class S>
   S bond_force(const S& r) const {
     return (k + b * r * r) * r;

@@ -140,6 +140,19 @@ TEST_CASE("inspect shows the metadata, --json the raw metadata, --check the deri
   result = run_nonsep({"inspect", "mathews_lakshmanan", "--check"}, folder.path());
   CHECK(result.status == 0);
   CHECK(result.out.find("derivative check passed") != std::string::npos);
+  // A written-out product term of H is compared with H from the products: a wrong one fails, a right one passes.
+  result = run_nonsep({"inspect", "wrong_energy", "--check"}, folder.path());
+  CHECK(result.status == 1);
+  const auto line = [&](const std::string& start) {
+    const auto at = result.out.find(start);
+    return at == std::string::npos ? std::string() : result.out.substr(at, result.out.find('\n', at) - at);
+  };
+  CHECK(line("energy_TTV (written out)").ends_with("(relative to max(1, |H|)): FAILED, above the tolerance"));
+  CHECK(line("energy_VVT (written out)").ends_with("(relative to max(1, |H|))"));
+  result = run_nonsep({"inspect", "lattice_chain", "--check"}, folder.path());
+  CHECK(result.status == 0);
+  CHECK(result.out.find("energy_TTV (written out) against the products or Hessians") != std::string::npos);
+  CHECK(result.out.find("derivative check passed") != std::string::npos);
 
   result = run_nonsep({"inspect", "no_such_plugin"}, folder.path());
   CHECK(result.status == 2);

@@ -2,7 +2,7 @@
 // templates the SDK differentiates: every shipped plugin's products equal its dense Hessian times v; the derivative
 // checker differences them from the gradients; differentiating the lattice's gradient templates gives what
 // differentiating its T and V gives; its products at n = 10^5 are the tridiagonal closed form; its energy is
-// sum_ij T_i V_ij T_j.
+// sum_ij T_i V_ij T_j, and its written-out energy (energy_TTV, energy_VVT) is H from the dense Hessians.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -254,6 +254,59 @@ TEST_CASE("the energy and the gradient of H through products equal the dense one
       CHECK(gradient.evaluations().grad_H == count);
     }
   }
+}
+
+TEST_CASE("lattice chain: its written-out energy_TTV and energy_VVT are H from dense Hessians of T and V by AD") {
+  // The reference: the adapter that differentiates T and V (no written-out derivative, no product energy) behind a
+  // model without products, so that the core forms the n x n Hessians.
+  using Model = LatticeChainModel<16>;
+  static_assert(nonsep::ModelWithProductEnergy<ModelAdapter<Model>>);
+  static_assert(!nonsep::ModelWithProductEnergy<ModelAdapter<Model, Derivatives::automatic>>);
+  // n = 3, 5, 6 and 9: the sites between the two ends in the partial sums' four lanes, in the remainder, or both.
+  for (const std::size_t n : {3, 5, 6, 9}) {
+    CAPTURE(n);
+    const std::string parameters =
+        R"({"kinetic_quartic": 0.7, "coupling": 0.4, "bond_quartic": 1.3, "sites": )" + std::to_string(n) + "}";
+    const auto sized = ModelAdapter<Model>::from_json(parameters);
+    const auto sized_automatic = ModelAdapter<Model, Derivatives::automatic>::from_json(parameters);
+    const Forwarding<decltype(sized_automatic), false> sized_dense{sized_automatic};
+    const std::size_t count = 37;
+    nonsep::PhaseSpaceBatch x(n, count);
+    const auto q = random_points(count * n, 1.5, 31), p = random_points(count * n, 1.5, 37);
+    std::copy(q.begin(), q.end(), x.q().begin());
+    std::copy(p.begin(), p.end(), x.p().begin());
+    for (const auto form : {nonsep::HamiltonianForm::TTV, nonsep::HamiltonianForm::VVT}) {
+      CAPTURE(form == nonsep::HamiltonianForm::TTV);
+      CHECK(sized.has_product_energy(form));
+      std::vector<double> own(count), reference(count), direct(count);
+      nonsep::EnergyEvaluator(form).evaluate(sized, x, own);
+      nonsep::EnergyEvaluator(form).evaluate(sized_dense, x, reference);
+      sized.product_energy(form, x.q(), x.p(), direct, count);
+      check_agree(own, reference, 1e-13, "H");
+      CHECK(own == direct);
+    }
+  }
+}
+
+TEST_CASE("lattice chain at n = 10^5 through the plugin: its own H equals H through the products, in both forms") {
+  const std::size_t n = 100000;
+  const PluginModel model = shipped("lattice_chain", {{"sites", n}, {"kinetic_quartic", 0.7}});
+  nonsep::PhaseSpaceBatch x(n, 2);
+  const auto q = random_points(2 * n, 1.5, 41), p = random_points(2 * n, 1.5, 43);
+  std::copy(q.begin(), q.end(), x.q().begin());
+  std::copy(p.begin(), p.end(), x.p().begin());
+  for (const auto form : {nonsep::HamiltonianForm::TTV, nonsep::HamiltonianForm::VVT}) {
+    CAPTURE(form == nonsep::HamiltonianForm::TTV);
+    CHECK(model.has_product_energy(form));
+    CHECK_FALSE(model.without_product_energy().has_product_energy(form));
+    std::vector<double> own(2), by_products(2);
+    nonsep::EnergyEvaluator(form).evaluate(model, x, own);
+    nonsep::EnergyEvaluator(form).evaluate(model.without_product_energy(), x, by_products);
+    check_agree(own, by_products, 1e-12, "H");
+    CHECK(own[0] != by_products[0]);  // not the same path: the sums run in another order
+  }
+  // A model that does not write it out says so.
+  CHECK_FALSE(shipped("paper2d").has_product_energy(nonsep::HamiltonianForm::TTV));
 }
 
 TEST_CASE("lattice chain: MPE 4 converges to Runge-Kutta-Fehlberg 7(8) on the closed-form Hamilton's equations") {

@@ -149,6 +149,20 @@ TEST_CASE("a plugin of ABI version 3 loads: its shorter table, none of version 4
   // (a capability it does not claim, and grad_K without value_K).
 }
 
+TEST_CASE("a version-4 table that ends after chin_steps loads without the energy entries past its end") {
+  const Plugin plugin = load_plugin("version_4_kernel_table.so", test_plugins);
+  CHECK(plugin.abi_version() == 4);
+  // The table it was built with holds energy_TTV past that size: a loader reading it would refuse the plugin (a
+  // capability it does not claim).
+  CHECK_FALSE(plugin.has_product_energy(nonsep::HamiltonianForm::TTV));
+  CHECK_FALSE(plugin.has_product_energy(nonsep::HamiltonianForm::VVT));
+  const PluginModel model = plugin.create(nlohmann::json::object());
+  CHECK_FALSE(model.has_product_energy(nonsep::HamiltonianForm::TTV));
+  const double q[] = {0.5}, p[] = {0.25};
+  double out[1] = {0.0};
+  CHECK_THROWS_AS(model.product_energy(nonsep::HamiltonianForm::TTV, q, p, out, 1), nonsep::ModelError);
+}
+
 TEST_CASE("a separable part without its value: the energy of H needs it") {
   const std::string message = load_error("grad_U_without_value_U.so");
   CHECK(contains(message, "gives grad_U but not value_U: the energy of H = T_i V_ij T_j + K + U needs U itself"));
@@ -171,6 +185,9 @@ TEST_CASE("wrong table size: expected and found") {
   const std::string message = load_error("wrong_table_size.so");
   CHECK(contains(message, "(expected " + std::to_string(expected) + ", found " + std::to_string(found) + ")"));
   CHECK(contains(message, "has a function table of " + std::to_string(found) + " bytes"));
+  // Version 4's two sizes are named: the whole table, and the one that ends after chin_steps.
+  CHECK(contains(message,
+                 "defines " + std::to_string(expected) + " or " + std::to_string(NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE)));
 }
 
 TEST_CASE("metadata that is not valid JSON") {

@@ -79,6 +79,9 @@ bool Plugin::has_third_derivatives() const { return loaded_->api->d3T != nullptr
 bool Plugin::has_hessian_vector_products() const {
   return loaded_->api->hvp_T != nullptr && loaded_->api->hvp_V != nullptr;
 }
+bool Plugin::has_product_energy(HamiltonianForm form) const {
+  return (form == HamiltonianForm::TTV ? loaded_->api->energy_TTV : loaded_->api->energy_VVT) != nullptr;
+}
 unsigned Plugin::abi_version() const { return loaded_->abi_version; }
 const KernelChoice& Plugin::kernels() const { return loaded_->kernels; }
 bool Plugin::thread_safe() const { return loaded_->metadata["thread_safe"].get<bool>(); }
@@ -244,13 +247,16 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                       " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
                       std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " or 3, found " + std::to_string(version) + "); " +
                       rebuild_hint);
+  // Version 4's table may end after chin_steps (before the energy entries); version 3's before grad_K.
   const std::size_t size = version == 3 ? NONSEP_PLUGIN_V3_STRUCT_SIZE : sizeof(nonsep_plugin_api);
-  if (api->struct_size != size)
+  const bool shorter_v4 = version == 4 && api->struct_size == NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE;
+  if (api->struct_size != size && !shorter_v4)
     throw PluginError("plugin " + quoted(path) + " has a function table of " + std::to_string(api->struct_size) +
                       " bytes but ABI version " + std::to_string(version) + " defines " + std::to_string(size) +
+                      (version == 4 ? " or " + std::to_string(NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE) : std::string()) +
                       " (expected " + std::to_string(size) + ", found " + std::to_string(api->struct_size) +
                       "); the plugin was built against a different plugin_abi.h");
-  std::memcpy(&loaded->entries, api, size);  // a version-3 table leaves the version-4 entries null
+  std::memcpy(&loaded->entries, api, api->struct_size);  // the entries a shorter table lacks stay null
   loaded->abi_version = version;
   api = &loaded->entries;
   const std::pair<const char*, bool> required[] = {{"metadata_json", api->metadata_json != nullptr},

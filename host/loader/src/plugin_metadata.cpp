@@ -88,7 +88,9 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
                                                   {"hvp_V", api.hvp_V != nullptr},
                                                   {"hvp_K", api.hvp_K != nullptr},
                                                   {"hvp_U", api.hvp_U != nullptr},
-                                                  {"chin_steps", api.chin_steps != nullptr}};
+                                                  {"chin_steps", api.chin_steps != nullptr},
+                                                  {"energy_TTV", api.energy_TTV != nullptr},
+                                                  {"energy_VVT", api.energy_VVT != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");

@@ -115,6 +115,30 @@ NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_T)
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_V)
 #undef NONSEP_PLUGIN_MODEL_DIRECTIONAL
 
+bool PluginModel::has_product_energy(HamiltonianForm form) const {
+  return product_energy_ && instance_->plugin.has_product_energy(form);
+}
+
+void PluginModel::product_energy(HamiltonianForm form, std::span<const double> q, std::span<const double> p,
+                                 std::span<double> out, std::size_t count) const {
+  const std::size_t n = instance_->dimension;
+  const bool ttv = form == HamiltonianForm::TTV;
+  const char* name = ttv ? "energy_TTV" : "energy_VVT";
+  if (p.size() < count * n) throw_bad_spans(name, count, n, 1, p.size(), out.size());
+  const nonsep_plugin_api& api = *instance_->api;
+  const auto entry = ttv ? api.energy_TTV : api.energy_VVT;
+  evaluate(*this, instance_->handle, api, entry != nullptr, name, n, q, out, count, 1,
+           [&](nonsep_instance* handle, const double* in, double* result, std::size_t size) {
+             return entry(handle, in, p.data(), result, size);
+           });
+}
+
+PluginModel PluginModel::without_product_energy() const {
+  PluginModel model = *this;
+  model.product_energy_ = false;
+  return model;
+}
+
 PluginModel PluginModel::with_kernel() const {
   const auto chosen = plugin().kernels().chosen;
   return chosen ? with_kernel(*chosen) : *this;

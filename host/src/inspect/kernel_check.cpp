@@ -48,9 +48,9 @@ std::string checked_schemes_text(const std::vector<IntegratorSpec>& specs) {
 
 }  // namespace
 
-KernelCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
-                          std::span<const double> p, std::size_t count, double tolerance) {
-  KernelCheck result;
+PathCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                        std::span<const double> p, std::size_t count, double tolerance) {
+  PathCheck result;
   const KernelChoice& kernels = plugin.kernels();
   if (!kernels.present) {
     result.text = "kernels: none (the evaluation path steps this plugin)\n";

@@ -140,7 +140,8 @@ bool same_number(double a, double b) {
   return std::memcmp(&a, &b, sizeof(double)) == 0 || (std::isnan(a) && std::isnan(b));
 }
 
-// The batched functions the plugin has, as (model, x, u, out, count) calls; u is read by d3T and d3V only.
+// The batched functions the plugin has, as (model, x, u, out, count) calls; u is read by d3T, d3V, the products and
+// the energies (as p).
 struct EvaluationFunction {
   const char* name;
   const char* variable;
@@ -168,6 +169,13 @@ std::vector<EvaluationFunction> evaluation_functions(const Plugin& plugin, std::
     functions.push_back({"hvp_T", "p", n, [](M m, X x, X v, Out out, C c) { m.hvp_T(x, v, out, c); }});
     functions.push_back({"hvp_V", "q", n, [](M m, X x, X v, Out out, C c) { m.hvp_V(x, v, out, c); }});
   }
+  // The product term of H: at q, with the directions as the momenta.
+  if (plugin.has_product_energy(HamiltonianForm::TTV))
+    functions.push_back({"energy_TTV", "q", 1,
+                         [](M m, X q, X p, Out out, C c) { m.product_energy(HamiltonianForm::TTV, q, p, out, c); }});
+  if (plugin.has_product_energy(HamiltonianForm::VVT))
+    functions.push_back({"energy_VVT", "q", 1,
+                         [](M m, X q, X p, Out out, C c) { m.product_energy(HamiltonianForm::VVT, q, p, out, c); }});
   return functions;
 }
 
@@ -346,9 +354,11 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
         "one thread)\n";
   }
   const std::size_t states = std::min(samples.p.count, samples.q.count);
-  const KernelCheck kernels = check_kernels(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
+  const PathCheck kernels = check_kernels(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
   result.text += kernels.text;
-  result.passed = report.passed() && difference.empty() && threads.empty() && kernels.passed;
+  const PathCheck energy = check_product_energy(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
+  result.text += energy.text;
+  result.passed = report.passed() && difference.empty() && threads.empty() && kernels.passed && energy.passed;
   if (!result.passed)
     result.text += "derivative check FAILED\n";
   else if (report.comparisons == 0)

@@ -230,6 +230,8 @@ const nonsep_plugin_api api = {
     nullptr,  // hvp_K
     nullptr,  // hvp_U
     nullptr,  // chin_steps
+    nullptr,  // energy_TTV
+    nullptr,  // energy_VVT
 };
 
 }  // namespace

@@ -16,6 +16,7 @@
 //  13  none: a valid plugin of ABI version 3 (its shorter table; the entries of version 4 past it are not read)
 //  14  a separable part grad_U without value_U, which the energy of H needs
 //  15  hvp_K without grad_K
+//  16  none: a valid version-4 table that ends after chin_steps (before energy_TTV, energy_VVT), as first published
 #include <cstddef>
 #include <cstring>
 
@@ -79,6 +80,11 @@ nonsep_status zero_third_derivative(nonsep_instance*, const double*, const doubl
 }
 #endif
 const char* last_error(const nonsep_instance* instance) { return instance->last_error; }
+#if NONSEP_TEST_DEFECT == 16
+nonsep_status energy_past_the_end(nonsep_instance*, const double*, const double*, double*, size_t) {
+  return NONSEP_INTERNAL_ERROR;
+}
+#endif
 
 const nonsep_plugin_api table = {
 #if NONSEP_TEST_DEFECT == 2
@@ -92,6 +98,8 @@ const nonsep_plugin_api table = {
     static_cast<uint32_t>(sizeof(nonsep_plugin_api) - sizeof(void*)),
 #elif NONSEP_TEST_DEFECT == 13
     static_cast<uint32_t>(NONSEP_PLUGIN_V3_STRUCT_SIZE),
+#elif NONSEP_TEST_DEFECT == 16
+    static_cast<uint32_t>(NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE),
 #else
     static_cast<uint32_t>(sizeof(nonsep_plugin_api)),
 #endif
@@ -139,6 +147,12 @@ const nonsep_plugin_api table = {
 #endif
     nullptr,  // hvp_U
     nullptr,  // chin_steps
+#if NONSEP_TEST_DEFECT == 16
+    &energy_past_the_end,  // past the shorter table's end: never read
+#else
+    nullptr,  // energy_TTV
+#endif
+    nullptr,  // energy_VVT
 };
 
 }  // namespace

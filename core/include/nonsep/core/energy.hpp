@@ -4,9 +4,11 @@
 // plus K(p) + U(q) when the model has a separable part (model.hpp, ModelWithSeparablePart; added after the product
 // term, so a model without one gets the numbers of the product term alone).
 // Needs a model with Hessians (model.hpp); one with Hessian-vector products is evaluated through them instead
-// (hessian_products.hpp: one gradient and one product per state, O(n) numbers). Not part of stepping: used for
-// reporting and testing.
+// (hessian_products.hpp: one gradient and one product per state, O(n) numbers), and one that writes out the
+// product term itself (ModelWithProductEnergy below: one pass per state) through that. Not part of stepping: used
+// for reporting and testing.
 #include <algorithm>
+#include <concepts>
 #include <span>
 #include <vector>
 
@@ -14,6 +16,19 @@
 #include "nonsep/core/hessian_products.hpp"
 
 namespace nonsep {
+
+// A model that evaluates the product term of H itself (grad T . Hess V grad T for TTV, grad V . Hess T grad V for
+// VVT, without K + U), for spans q, p (count*n numbers, read) and out (count numbers, written):
+//   m.has_product_energy(form)                  whether it does, for that form, at run time
+//   m.product_energy(form, q, p, out, count)    the product term of each state
+// A sparse model's H then costs about one gradient, where a gradient and a product cost two passes over memory
+// and a third for their dot product.
+template <class M>
+concept ModelWithProductEnergy = Model<M> &&
+    requires(const M& m, HamiltonianForm form, std::span<const double> x, std::span<double> out, std::size_t count) {
+  { m.has_product_energy(form) } -> std::convertible_to<bool>;
+  m.product_energy(form, x, x, out, count);
+};
 
 class EnergyEvaluator {
  public:
@@ -26,6 +41,12 @@ class EnergyEvaluator {
     if (energies.size() != x.count())
       throw InvalidArgument("energy output has " + std::to_string(energies.size()) + " entries for " +
                             std::to_string(x.count()) + " states");
+    if constexpr (ModelWithProductEnergy<M>)
+      if (model.has_product_energy(form_)) {
+        model.product_energy(form_, x.q(), x.p(), energies, x.count());
+        add_separable_part(model, x.q(), x.p(), energies, x.count());
+        return;
+      }
     if constexpr (ModelWithHessianProducts<M>)
       if (has_hessian_products(model)) {
         energy_by_products(model, form_, x.q(), x.p(), energies, x.count(), products_);

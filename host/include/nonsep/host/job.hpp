@@ -191,9 +191,9 @@ inline constexpr std::size_t max_initial_values = 16'777'216;
 // Largest accepted nesting of objects and arrays (the document is level 1). A job needs 6; the limit bounds the
 // reader's memory and the recursion of formatting a value for a message.
 inline constexpr std::size_t max_nesting_depth = 64;
-// H is evaluated from one n x n Hessian per state (nonsep::EnergyEvaluator, a block's states a few at a time): a
-// model whose single Hessian would take more than this many numbers (1 GiB) is refused before the run when the
-// plugin has Hessians (dimension at most 11585).
+// H is evaluated from one n x n Hessian per state (nonsep::EnergyEvaluator, a block's states a few at a time) for a
+// plugin without Hessian-vector products or its own energy_TTV/energy_VVT: such a model whose single Hessian would
+// take more than this many numbers (1 GiB) is refused before the run (dimension at most 11585).
 inline constexpr std::size_t max_hessian_values = std::size_t{1} << 27;
 // Largest job file read (64 MiB); a longer file, or a device that never ends such as /dev/zero, is an issue at "".
 inline constexpr std::size_t max_job_file_bytes = std::size_t{64} << 20;

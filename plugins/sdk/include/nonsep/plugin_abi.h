@@ -1,8 +1,9 @@
 /* nonsep plugin ABI, version 4. The boundary evaluates: the host owns every scheme and crosses the boundary once
  * per batch of states for a gradient (or a Hessian, a value, a third derivative, a Hessian-vector product).
- * Version 4 adds three optional groups at the end of version 3's table: the separable part K(p) + U(q) of the
+ * Version 4 adds four optional groups at the end of version 3's table: the separable part K(p) + U(q) of the
  * solved Hamiltonian, Hessian-vector products, and a stepping kernel (n basic steps of the core's own splitting,
- * compiled into the plugin with its model inlined, the coefficients given by the host). A version-3 table is
+ * compiled into the plugin with its model inlined, the coefficients given by the host), then the product term of
+ * H in one pass (energy_TTV, energy_VVT; a table may end before them). A version-3 table is
  * the prefix of a version-4 one: such plugins are still loaded, without the new groups. Version 2 had a fused
  * stepping function integrate() with a stepper of its own; version 1 exported a function, nonsep_plugin_entry,
  * returning the table instead of the pointer below. Plugins of either are refused: rebuild them against the
@@ -18,8 +19,9 @@
  *   0. the symbol holds an aligned address inside a loaded library (refused otherwise: a library that exports
  *      the table itself under the name, instead of a pointer to it)
  *   1. abi_version is 4 (NONSEP_PLUGIN_ABI_VERSION) or 3   (refused with "expected 4 or 3, found N")
- *   2. struct_size == sizeof(nonsep_plugin_api) for 4, NONSEP_PLUGIN_V3_STRUCT_SIZE for 3
- *                                                 (refused with expected and found sizes)
+ *   2. struct_size == sizeof(nonsep_plugin_api) or NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE for 4,
+ *      NONSEP_PLUGIN_V3_STRUCT_SIZE for 3          (refused with expected and found sizes); the entries a shorter
+ *                                                 table lacks are absent
  *   3. the required functions are non-null        (metadata_json, create, destroy, dimension, grad_T, grad_V,
  *                                                   last_error)
  *   4. metadata_json() returns valid JSON of the shape below, whose capabilities match the table.
@@ -53,7 +55,8 @@
  *     "thread_safe": true,
  *     "capabilities": { "value_T": true, "value_V": true, "hessian_T": true, "hessian_V": true,
  *                       "d3T": true, "d3V": true, "grad_K": false, "grad_U": true, "value_U": true, ...,
- *                       "hvp_T": true, "hvp_V": true, "chin_steps": true }
+ *                       "hvp_T": true, "hvp_V": true, "chin_steps": true,
+ *                       "energy_TTV": false, "energy_VVT": false }
  *   }
  * "minimum", "maximum" and "unit" may be absent; "thread_safe" is required. Each capability is true exactly
  * when the table's pointer of that name is non-null (an absent capability counts as false).
@@ -169,10 +172,21 @@ typedef struct nonsep_plugin_api {
    * from (the host uses only its own). A failed evaluation returns its status (message by last_error) with q, p
    * and outer_gradient undefined: the host then redoes the steps through grad_T and grad_V. */
   nonsep_status (*chin_steps)(nonsep_instance* instance, const nonsep_chin_steps_args* args);
+
+  /* The product term of the solved H in one pass, for a model that writes it out (a sparse model: its H then
+   * costs about a gradient, where a gradient and a Hessian-vector product cost two passes and a third to take
+   * their dot product): out[b] = T'(p_b) . V''(q_b) T'(p_b) (energy_TTV), V'(q_b) . T''(p_b) V'(q_b) (energy_VVT),
+   * one number per state; K + U not included (the host adds value_K and value_U). A table may end before these
+   * two (struct_size NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE, the version-4 table as first published): the host then
+   * evaluates H through the Hessian-vector products or the Hessians. */
+  nonsep_status (*energy_TTV)(nonsep_instance* instance, const double* q, const double* p, double* out, size_t count);
+  nonsep_status (*energy_VVT)(nonsep_instance* instance, const double* q, const double* p, double* out, size_t count);
 } nonsep_plugin_api;
 
 /* The size of a version-3 table: version 4's without the entries from grad_K on. */
 #define NONSEP_PLUGIN_V3_STRUCT_SIZE offsetof(nonsep_plugin_api, grad_K)
+/* The size of a version-4 table that ends with chin_steps (without energy_TTV and energy_VVT). */
+#define NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE offsetof(nonsep_plugin_api, energy_TTV)
 
 #ifdef __cplusplus
 }

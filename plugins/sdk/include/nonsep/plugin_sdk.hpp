@@ -17,8 +17,9 @@
 // chin_steps: the core's chin_kernel_steps with the model inlined, compiled for the instruction sets of
 // kernels.hpp (metadata "kernels": {"version", "instruction_sets"}); no stepping code is written here. Its
 // metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T and
-// hvp_V, whether it is "analytic" or "automatic" (the products are always automatic: of the gradient templates
-// where the model has them, else of T and V).
+// hvp_V, whether it is "analytic" (written by the model) or "automatic" (of the gradient templates where the model
+// has them, else of T and V). A model that writes out energy_TTV or energy_VVT (the product term of H) fills that
+// entry; the other stays null.
 // A model class with K(p) or U(q) (model_adapter.hpp) also fills grad_K, value_K, hessian_K (resp. the U ones) of
 // ABI version 4, announces them as capabilities and adds them to "derivatives"; the absent part's entries are null.
 //
@@ -141,7 +142,9 @@ class PluginTable {
                                  {"d3V", true},
                                  {"hvp_T", true},
                                  {"hvp_V", true},
-                                 {"chin_steps", true}}},
+                                 {"chin_steps", true},
+                                 {"energy_TTV", Adapter::analytic_energy_TTV},
+                                 {"energy_VVT", Adapter::analytic_energy_VVT}}},
                                {"derivatives",
                                 {{"grad_T", kind(Adapter::analytic_grad_T)},
                                  {"grad_V", kind(Adapter::analytic_grad_V)},
@@ -268,6 +271,22 @@ class PluginTable {
   NONSEP_SDK_DIRECTIONAL(hvp_V)
 #undef NONSEP_SDK_DIRECTIONAL
 
+  // The product term of H written out by the model (plugin_abi.h energy_TTV, energy_VVT): q and p hold count*n
+  // numbers, out count.
+  template <HamiltonianForm form>
+  static nonsep_status product_energy(nonsep_instance* instance, const double* q, const double* p, double* out,
+                                      std::size_t count) noexcept {
+    return guarded(instance, form == HamiltonianForm::TTV ? "energy_TTV" : "energy_VVT", [&](const Instance& self) {
+      const Adapter& adapter = self.adapter;
+      const std::size_t size = count * adapter.dimension();
+      if constexpr (Adapter::analytic_energy_TTV || Adapter::analytic_energy_VVT)
+        adapter.product_energy(form, std::span<const double>(q, size), std::span<const double>(p, size),
+                               std::span<double>(out, count), count);
+      else
+        static_cast<void>(size), static_cast<void>(out);
+    });
+  }
+
   // The stepping kernel (plugin_abi.h chin_steps): the core's chin_kernel_steps with this model inlined, for the
   // instruction set the host asks for (kernels.hpp).
   static nonsep_status chin_steps(nonsep_instance* instance, const nonsep_chin_steps_args* args) noexcept {
@@ -326,6 +345,8 @@ class PluginTable {
       nullptr,  // hvp_K
       nullptr,  // hvp_U
       &chin_steps,
+      Adapter::analytic_energy_TTV ? &product_energy<HamiltonianForm::TTV> : nullptr,
+      Adapter::analytic_energy_VVT ? &product_energy<HamiltonianForm::VVT> : nullptr,
   };
 };
 

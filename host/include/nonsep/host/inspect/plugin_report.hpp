@@ -47,19 +47,28 @@ struct DerivativeCheck {
 DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin,
                                   const DerivativeCheckSettings& settings = {});
 
+// A comparison of two ways to the same numbers (the kernels and the evaluation path; a plugin's own energy and the
+// core's rule): the largest difference found, its lines of the report, and whether it passed.
+struct PathCheck {
+  bool passed = true;
+  double largest_difference = 0.0;
+  std::string text;  // lines ending in '\n'
+};
+
 // The kernel part of the check: each of the plugin's kernels this processor runs against the evaluation path on
 // `count` states (q, p: count*n numbers each), a few steps of the basic step and of MPE 4/3 in both forms. Bit for
 // bit equal for a plugin built with the host's flags; a plugin built with other flags (-march=native, -ffast-math)
 // or a wider instruction set (fused multiply-add) may round differently: the largest difference, relative to
 // max(1, |x|), is reported, and above `tolerance` (or non-finite on one side only) the check fails. A model
 // failing at the points is reported, not a failure.
-struct KernelCheck {
-  bool passed = true;
-  double largest_difference = 0.0;
-  std::string text;  // lines ending in '\n'
-};
-KernelCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
-                          std::span<const double> p, std::size_t count, double tolerance);
+PathCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                        std::span<const double> p, std::size_t count, double tolerance);
+
+// The plugin's own product term of H (plugin_abi.h energy_TTV, energy_VVT; nothing when it has neither) against H
+// from its Hessian-vector products or Hessians at the count states (q, p): the largest difference relative to
+// max(1, |H|) is reported, and above `tolerance` (or non-finite on one side only) the check fails.
+PathCheck check_product_energy(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                               std::span<const double> p, std::size_t count, double tolerance);
 
 // The number of bytes the check of a model of dimension n with these settings holds at its largest (an estimate
 // within a small factor, computed without overflow: saturates at the largest double).

@@ -24,7 +24,8 @@
 // Removing a state from a block does not change the others' numbers. An every-step observer may also ask for a
 // trajectory to stop at a step (BlockView::retire; e.g. at its last Poincare crossing).
 //
-// Energy: H (nonsep::EnergyEvaluator, needs the plugin's Hessians) is evaluated at step 0, at every event step an
+// Energy: H (nonsep::EnergyEvaluator: the plugin's own energy_TTV/energy_VVT, else its Hessian-vector products, else
+// its Hessians) is evaluated at step 0, at every event step an
 // observer asks for (needs_energy), at the last step, and for the final state of a trajectory that stops early.
 // A state whose H cannot be evaluated at an event retires as "failed".
 #include <atomic>

@@ -88,6 +88,8 @@ class Plugin {
   bool has_U() const;
   // Both hvp_T and hvp_V.
   bool has_hessian_vector_products() const;
+  // energy_TTV (resp. energy_VVT): the plugin writes out the product term of H in that form.
+  bool has_product_energy(HamiltonianForm form) const;
   // The plugin ABI version its table was built for (4, or 3 for a table without version 4's entries).
   unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
@@ -147,6 +149,15 @@ class PluginModel {
   void hvp_V(std::span<const double> q, std::span<const double> v, std::span<double> out, std::size_t count) const;
   // Whether the plugin has both products (the core's energy and gradient of H use them then: hessian_products.hpp).
   bool has_hessian_vector_products() const;
+  // The product term of H in `form` (plugin_abi.h energy_TTV, energy_VVT), one number per state into out: as a
+  // core model a nonsep::ModelWithProductEnergy (energy.hpp), whose EnergyEvaluator uses it where the plugin has it.
+  // Throws nonsep::ModelError when the plugin lacks it, or it fails.
+  bool has_product_energy(HamiltonianForm form) const;
+  void product_energy(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<double> out,
+                      std::size_t count) const;
+  // The same instance, whose has_product_energy is false: H from the products or the Hessians (`inspect --check`
+  // compares the two).
+  PluginModel without_product_energy() const;
 
   // The separable part (model.hpp). Throw nonsep::ModelError when the plugin lacks the function, or it fails.
   bool has_K() const;
@@ -180,6 +191,7 @@ class PluginModel {
   struct Instance;
   std::shared_ptr<Instance> instance_;
   std::optional<std::uint32_t> kernel_;  // the instruction set chin_steps uses; empty: the evaluation path
+  bool product_energy_ = true;           // false: has_product_energy says no
 };
 
 }  // namespace nonsep::host

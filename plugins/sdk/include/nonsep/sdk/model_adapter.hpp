@@ -24,6 +24,10 @@
 //   void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const;
 //                                     Hessian-vector products, out[i] = sum_j T_ij v_j (n entries): what the energy
 //                                     and the tangent map of a large sparse model cost (plugins/lattice_chain).
+//   double energy_TTV(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> p) const;
+//   double energy_VVT(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> p) const;
+//                                     the product term of H written out, T'(p).V''(q)T'(p) (resp. V'(q).T''(p)V'(q)),
+//                                     without K + U: one pass for a sparse model's energy (plugins/lattice_chain).
 //   template <class S> S K(nonsep::sdk::Vector<S> p) const;      a separable part: H = T_i V_ij T_j + K(p) + U(q)
 //   template <class S> S U(nonsep::sdk::Vector<S> q) const;      (either or both; the other is zero)
 //   void grad_K(...), grad_U(...), hessian_K(...), hessian_U(...)  analytic derivatives of K and U, as for T and V
@@ -68,6 +72,7 @@
 #include <utility>
 
 #include "nonsep/core/error.hpp"
+#include "nonsep/core/model.hpp"
 #include "nonsep/sdk/automatic_derivatives.hpp"
 #include "nonsep/sdk/dual.hpp"
 #include "nonsep/sdk/parameters.hpp"
@@ -208,6 +213,14 @@ template <class M>
 concept HasAnalyticHvpV = requires(const M& m, Vector<double> x, Vector<double> v, std::span<double> out) {
   m.hvp_V(x, v, out);
 };
+template <class M>
+concept HasAnalyticEnergyTTV = requires(const M& m, Vector<double> q, Vector<double> p) {
+  { m.energy_TTV(q, p) } -> std::convertible_to<double>;
+};
+template <class M>
+concept HasAnalyticEnergyVVT = requires(const M& m, Vector<double> q, Vector<double> p) {
+  { m.energy_VVT(q, p) } -> std::convertible_to<double>;
+};
 
 // The parameter table of M (empty when M declares none).
 template <class M>
@@ -282,6 +295,8 @@ class ModelAdapter {
   static constexpr bool analytic_d3V = policy == Derivatives::preferred && HasAnalyticD3V<M>;
   static constexpr bool analytic_hvp_T = policy == Derivatives::preferred && HasAnalyticHvpT<M>;
   static constexpr bool analytic_hvp_V = policy == Derivatives::preferred && HasAnalyticHvpV<M>;
+  static constexpr bool analytic_energy_TTV = policy == Derivatives::preferred && HasAnalyticEnergyTTV<M>;
+  static constexpr bool analytic_energy_VVT = policy == Derivatives::preferred && HasAnalyticEnergyVVT<M>;
   // Higher derivatives by automatic differentiation of the gradient templates (else of T and V).
   static constexpr bool differentiates_gradients = policy == Derivatives::preferred && HasGradientTemplates<M>;
   static_assert(differentiates_gradients || HasDualTV<M>,
@@ -448,6 +463,28 @@ class ModelAdapter {
     hessian_vector<analytic_hvp_V>([](const auto& m, auto x, auto w, auto d) { m.hvp_V(x, w, d); },
                                    [](const auto& m, auto y, auto g) { m.grad_V(y, g); },
                                    [](const auto& m, auto w) { return m.V(w); }, q, v, out, count);
+  }
+
+  // The model's own product term of H (nonsep::ModelWithProductEnergy, energy.hpp), one number per state; present
+  // when M writes out energy_TTV or energy_VVT (has_product_energy says which).
+  bool has_product_energy(HamiltonianForm form) const requires(analytic_energy_TTV || analytic_energy_VVT) {
+    return form == HamiltonianForm::TTV ? analytic_energy_TTV : analytic_energy_VVT;
+  }
+  void product_energy(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<double> out,
+                      std::size_t count) const requires(analytic_energy_TTV || analytic_energy_VVT) {
+    if (!has_product_energy(form))
+      throw nonsep::InvalidArgument(std::string("the model does not write out energy_") +
+                                    (form == HamiltonianForm::TTV ? "TTV" : "VVT"));
+    check_sizes(q, out, count, 1);
+    check_sizes(p, out, count, 1);
+    const std::size_t n = batch_dimension();
+    for (std::size_t b = 0; b < count; ++b) {
+      const Vector<double> qb(q.data() + b * n, n), pb(p.data() + b * n, n);
+      if constexpr (analytic_energy_TTV)
+        if (form == HamiltonianForm::TTV) out[b] = model_.energy_TTV(qb, pb);
+      if constexpr (analytic_energy_VVT)
+        if (form == HamiltonianForm::VVT) out[b] = model_.energy_VVT(qb, pb);
+    }
   }
 
  private:
