@@ -52,12 +52,16 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, (left, right) = plt.subplots(1, 2, figsize=(12, 5))
-    for name, points in rows.items():
+    # More configurations than the default cycle's ten colours: each its own colour and a marker of its own.
+    colours = plt.get_cmap("tab20").colors
+    markers = "os^vD<>pXh*P"
+    for k, (name, points) in enumerate(rows.items()):
         n = [p[0] for p in points]
         median = [p[1] for p in points]
         errors = [[p[1] - p[2] for p in points], [p[3] - p[1] for p in points]]
-        left.errorbar(n, median, yerr=errors, marker="o", capsize=2, label=name)
-        right.plot(n, [p[4] for p in points], marker="o", label=name)
+        style = dict(color=colours[(2 * k) % 20 + (2 * k) // 20 % 2], marker=markers[k % len(markers)], label=name)
+        left.errorbar(n, median, yerr=errors, capsize=2, **style)
+        right.plot(n, [p[4] for p in points], **style)
     left.set(xscale="log", yscale="log", xlabel="n (sites)", ylabel="seconds per step (median)")
     right.set(xscale="log", yscale="log", xlabel="n (sites)", ylabel="time / one gradient evaluation")
     for axis in (left, right):
