@@ -1,7 +1,7 @@
 // The stepping kernel (chin_kernel.hpp) against the evaluation path: a model offering chin_steps gets bit for bit
 // the numbers and evaluation counts of the same model without it, through every Chin scheme (basic, triplet, mpe),
-// both forms, 1, 5, 33 and 300 states, fixed and run-time dimensions, one step size or one per state; a triplet's
-// run of steps is one call (a schedule of sub-steps); and a kernel that fails leaves nothing stale.
+// both forms, 1, 2, 3, 5, 33, 35 and 300 states, fixed and run-time dimensions, one step size or one per state; a
+// triplet's run of steps is one call (a schedule of sub-steps); and a kernel that fails leaves nothing stale.
 #include <doctest/doctest.h>
 
 #include <array>
@@ -77,8 +77,10 @@ void check_scheme(const std::string& scheme, HamiltonianForm form, std::size_t c
 TEST_CASE("kernel path: every Chin scheme and form gives the evaluation path's numbers and counts bit for bit") {
   for (const char* scheme : {"basic", "triplet", "mpe"})
     for (const auto form : forms)
-      for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{33}, std::size_t{300}}) {
-        // Blocks of 32 states in local arrays; the rest in place (5; 12 of 300) or in registers (1; 1 of 33).
+      for (std::size_t count : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{5}, std::size_t{33},
+                                std::size_t{35}, std::size_t{300}}) {
+        // Blocks of 32 states in local arrays; the rest in place (5; 12 of 300) or in registers (1; 2, 3; 1 of 33;
+        // 3 of 35).
         check_scheme<Paper1D, 1>(scheme, form, count);
         check_scheme<Coupled2D, 2>(scheme, form, count);
         check_scheme<Coupled2D, 0>(scheme, form, count);  // the dimension known at run time: the caller's arrays
@@ -137,7 +139,8 @@ TEST_CASE("kernel path: a call's step sizes fit its sub-steps and states") {
 
 TEST_CASE("kernel path: states with step sizes of their own get the evaluation path's numbers bit for bit") {
   for (const auto form : forms)
-    for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{33}, std::size_t{300}}) {
+    for (std::size_t count : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{5}, std::size_t{33},
+                              std::size_t{35}, std::size_t{300}}) {
       CAPTURE(static_cast<int>(form));
       CAPTURE(count);
       std::vector<double> dt(count);

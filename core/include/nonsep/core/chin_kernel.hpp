@@ -8,9 +8,10 @@
 //   - for a dimension N known at compile time (FixedDimension = N > 0), blocks of B = block_states(N) states are
 //     copied into local arrays whose sizes the compiler knows, so that the nine flows and the gradients vectorize
 //     across the block without alias checks or loops of unknown length;
-//   - the states left over after the whole blocks go in place, as one block of the caller's arrays; one state left
-//     over (a single trajectory) goes in local arrays of one state, which keep q, p and both gradients in registers
-//     through the nine flows (dimension <= 4);
+//   - the states left over after the whole blocks go in place, as one block of the caller's arrays; up to three
+//     left over (a single trajectory, the rounds of a multi-product expansion's terms) go in local arrays of two
+//     states and of one, which keep q, p and both gradients in registers through the nine flows (dimension <= 4),
+//     a pair's two chains interleaved;
 //   - with a dimension known only at run time (FixedDimension = 0), blocks of the caller's arrays.
 // Why blocks of 32 states (docs/performance.md, "Stepping kernels"): one state's step is a chain of dependent
 // operations (a division in each grad V; about 55 ns a step in registers, twice that through memory), so a block must
@@ -63,8 +64,8 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
     std::copy_n(call.eps.begin() + static_cast<std::ptrdiff_t>(first), B, eps.begin());
     block_eps = eps;
   }
-  chin_scheduled_stages(model, ChinStepsCall{call.form, call.coefficients, block_eps, call.substeps, call.steps, B, q,
-                                             p, outer_gradient, inner_gradient});
+  chin_scheduled_stages<size>(model, ChinStepsCall{call.form, call.coefficients, block_eps, call.substeps, call.steps,
+                                                   B, q, p, outer_gradient, inner_gradient});
   std::copy_n(q.begin(), size, call.q.begin() + static_cast<std::ptrdiff_t>(offset));
   std::copy_n(p.begin(), size, call.p.begin() + static_cast<std::ptrdiff_t>(offset));
   std::copy_n(outer_gradient.begin(), size, call.outer_gradient.begin() + static_cast<std::ptrdiff_t>(offset));
@@ -94,6 +95,13 @@ void chin_kernel_steps(const M& model, const ChinStepsCall& call) {
     std::size_t first = 0;
     if constexpr (B > 1)
       for (; first + B <= count; first += B) detail::chin_steps_in_local_arrays<FixedDimension, B>(model, call, first);
+    // Up to three left over (one trajectory; the rounds of a multi-product expansion's terms): a pair, then one,
+    // in local arrays, the pair's two chains interleaved in registers.
+    if constexpr (B > 2)
+      if (count - first == 2 || count - first == 3) {
+        detail::chin_steps_in_local_arrays<FixedDimension, 2>(model, call, first);
+        first += 2;
+      }
     if (count - first == 1)
       detail::chin_steps_in_local_arrays<FixedDimension, 1>(model, call, first);
     else if (first < count)

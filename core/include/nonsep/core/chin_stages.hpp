@@ -111,7 +111,9 @@ concept ModelWithChinSteps = Model<M> && requires(const M& m, const ChinStepsCal
   { m.chin_steps(call) } -> std::same_as<bool>;
 };
 
-template <Model M, class AfterFlow = NoFlowObserver>
+// StaticSize, when not 0, is q's size known at compile time (a kernel's block in local arrays): the flows' loops then
+// have a constant trip count, unroll, and keep a small state in registers.
+template <std::size_t StaticSize = 0, Model M, class AfterFlow = NoFlowObserver>
 inline void chin_stages(const M& model, HamiltonianForm form, const ChinCoefficients& c, std::span<const double> eps,
                         std::uint64_t steps, std::size_t count, std::span<double> q, std::span<double> p,
                         std::span<double> outer_gradient, std::span<double> inner_gradient,
@@ -128,6 +130,10 @@ inline void chin_stages(const M& model, HamiltonianForm form, const ChinCoeffici
   auto flow = [&](std::span<double> y, std::span<const double> gradient, double sign, double coefficient) {
     if (eps.size() == 1) {
       const double h = sign * coefficient * eps[0];
+      if constexpr (StaticSize > 0) {
+        for (std::size_t i = 0; i < StaticSize; ++i) y[i] += h * gradient[i];
+        return;
+      }
       if (y.size() == 1) {
         y[0] += h * gradient[0];
         return;
@@ -164,17 +170,18 @@ inline void chin_stages(const M& model, HamiltonianForm form, const ChinCoeffici
 }
 
 // The steps of `call` (requires chin_eps_fit(call.eps.size(), call.substeps, call.count) and chin_stages' sizes).
-template <Model M>
+// StaticSize as for chin_stages.
+template <std::size_t StaticSize = 0, Model M>
 inline void chin_scheduled_stages(const M& model, const ChinStepsCall& call) {
   if (call.substeps == 1) {
-    chin_stages(model, call.form, call.coefficients, call.eps, call.steps, call.count, call.q, call.p,
-                call.outer_gradient, call.inner_gradient);
+    chin_stages<StaticSize>(model, call.form, call.coefficients, call.eps, call.steps, call.count, call.q, call.p,
+                            call.outer_gradient, call.inner_gradient);
     return;
   }
   for (std::uint64_t step = 0; step < call.steps; ++step)
     for (std::size_t s = 0; s < call.substeps; ++s)
-      chin_stages(model, call.form, call.coefficients, call.eps.subspan(s, 1), 1, call.count, call.q, call.p,
-                  call.outer_gradient, call.inner_gradient);
+      chin_stages<StaticSize>(model, call.form, call.coefficients, call.eps.subspan(s, 1), 1, call.count, call.q,
+                              call.p, call.outer_gradient, call.inner_gradient);
 }
 
 }  // namespace nonsep
