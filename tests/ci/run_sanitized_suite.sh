@@ -36,6 +36,12 @@ cmake --build --preset sanitize
 built=$SECONDS
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+# LeakSanitizer (clang 14) with glibc 2.36 misreads the dynamic TLS of a dlopen'ed plugin that uses thread_local
+# (the SDK's per-thread scratch of the differentiated gradient templates): its tracer dies at exit with "Tracer
+# caught signal 11" on a DTLS range starting near address 0, and the process exits 1 though nothing leaked (seen
+# with `nonsep inspect lattice_chain --check`, depending on the environment's size). Not scanning TLS avoids the
+# crash; memory reachable only from TLS would then be reported as a leak, not hidden.
+export LSAN_OPTIONS=use_tls=0
 status=0
 ctest --test-dir build-sanitize --output-on-failure -j2 -LE "slow|examples|python" -E "$exclude" || status=$?
 echo "run_sanitized_suite: build $((built - start)) s, tests $((SECONDS - built)) s"
