@@ -3,11 +3,11 @@
 // hand-written analytic gradient behind the plugin boundary) in the same run.
 //
 // Configurations: one gradient (the unit), one Hessian-vector product, the energy H of one state (the plugin's own
-// energy_TTV, and through grad T and hvp_V as for a plugin without it); Chin's basic
-// step, plain, written out by hand (HandWrittenLatticeStep: the machine's limit for the step's memory traffic; its
-// numbers are checked against the plugin's before it is timed), with the energy every step, and with one
-// tangent vector (a Lyapunov vector); MPE 4 (6 terms),
-// triplet 2 (2 levels), Tao 4 (omega 20), Gauss 6 (3 stages). Each is repeated `repeats` times (interleaved over
+// energy_TTV, and through grad T and hvp_V as for a plugin without it); Chin's basic step written out by hand
+// (HandWrittenLatticeStep: the machine's limit for the step's memory traffic; its numbers are checked against the
+// plugin's before it is timed); and the schemes Chin basic, MPE 4 (6 terms), triplet 2 (2 levels), Tao 4 (omega 20),
+// Gauss 6 (3 stages), each plain and with the energy every step, Chin's also with one tangent vector (a Lyapunov
+// vector; Tao and Gauss have no tangent map). Each is repeated `repeats` times (interleaved over
 // the configurations, so that a busy spell of the machine spreads over all of them); each repetition runs as many
 // steps as fit in about `budget` seconds of its first calibration run. Output: CSV on stdout,
 //   n, configuration, seconds per step (median), lowest, highest, median / the gradient's median
@@ -34,6 +34,8 @@
 #include "nonsep/core/gauss_legendre.hpp"
 #include "nonsep/core/multi_product_expansion.hpp"
 #include "nonsep/core/tangent_basic_step.hpp"
+#include "nonsep/core/tangent_multi_product_expansion.hpp"
+#include "nonsep/core/tangent_triplet_composition.hpp"
 #include "nonsep/core/tao_extended_phase_space.hpp"
 #include "nonsep/core/triplet_composition.hpp"
 #include "nonsep/host/plugin_loader.hpp"
@@ -144,29 +146,42 @@ std::vector<Configuration> configurations(const PluginModel& model) {
                       for (std::uint64_t k = 0; k < s; ++k) stepper->step(*state, eps);
                     }});
   }
-  {
+  // Each scheme with the energy every step; Chin's schemes also with one tangent vector (a Lyapunov vector; Tao's
+  // and Gauss's steps have no tangent map).
+  auto with_energy = [&](const std::string& name, auto stepper) {
     auto state = std::make_shared<PhaseSpaceBatch>(initial_state(n));
-    auto stepper = std::make_shared<nonsep::ChinBasicStep>();
-    list.push_back({"basic_energy_every_step", [=, &model](std::uint64_t s) {
+    auto owned = std::make_shared<decltype(stepper)>(std::move(stepper));
+    list.push_back({name + "_energy_every_step", [=, &model](std::uint64_t s) {
                       for (std::uint64_t k = 0; k < s; ++k) {
-                        stepper->step(model, *state, dt);
+                        owned->step(model, *state, dt);
                         (*out)[0] = energy->evaluate_one(model, *state);
                       }
                     }});
-  }
-  {
+  };
+  auto with_tangent = [&](const std::string& name, auto stepper) {
     auto state = std::make_shared<PhaseSpaceBatch>(initial_state(n));
     auto tangent = std::make_shared<PhaseSpaceBatch>(n, 1);
     std::fill(tangent->q().begin(), tangent->q().end(), 1.0 / static_cast<double>(n));
-    auto stepper = std::make_shared<nonsep::TangentBasicStep>();
-    list.push_back({"basic_one_tangent_vector", [=, &model](std::uint64_t s) {
-                      for (std::uint64_t k = 0; k < s; ++k) stepper->step(model, *state, *tangent, dt);
+    auto owned = std::make_shared<decltype(stepper)>(std::move(stepper));
+    list.push_back({name + "_one_tangent_vector", [=, &model](std::uint64_t s) {
+                      for (std::uint64_t k = 0; k < s; ++k) owned->step(model, *state, *tangent, dt);
                     }});
-  }
+  };
+  using nonsep::SeparableBasicStep;
+  with_energy("basic", nonsep::ChinBasicStep());
+  with_tangent("basic", nonsep::TangentBasicStep());
   stepping("mpe_4", nonsep::MultiProductExpansion<>(nonsep::ChinBasicStep(), 6));
+  with_energy("mpe_4", nonsep::MultiProductExpansion<>(nonsep::ChinBasicStep(), 6));
+  with_tangent("mpe_4", nonsep::TangentMultiProductExpansion(
+                            nonsep::MultiProductExpansion<SeparableBasicStep>(SeparableBasicStep(), 6)));
   stepping("triplet_2", nonsep::TripletComposition<>(nonsep::ChinBasicStep(), 2));
+  with_energy("triplet_2", nonsep::TripletComposition<>(nonsep::ChinBasicStep(), 2));
+  with_tangent("triplet_2", nonsep::TangentTripletComposition(
+                                nonsep::TripletComposition<SeparableBasicStep>(SeparableBasicStep(), 2)));
   stepping("tao_4", nonsep::TaoExtendedPhaseSpace(nonsep::HamiltonianForm::TTV, 4, 20.0));
+  with_energy("tao_4", nonsep::TaoExtendedPhaseSpace(nonsep::HamiltonianForm::TTV, 4, 20.0));
   stepping("gauss_6", nonsep::GaussLegendre(nonsep::HamiltonianForm::TTV, 6));
+  with_energy("gauss_6", nonsep::GaussLegendre(nonsep::HamiltonianForm::TTV, 6));
   return list;
 }
 

@@ -51,7 +51,7 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 5))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(14, 5))
     # More configurations than the default cycle's ten colours: each its own colour and a marker of its own.
     colours = plt.get_cmap("tab20").colors
     markers = "os^vD<>pXh*P"
@@ -66,7 +66,7 @@ def main():
     right.set(xscale="log", yscale="log", xlabel="n (sites)", ylabel="time / one gradient evaluation")
     for axis in (left, right):
         axis.grid(True, which="both", alpha=0.3)
-    right.legend(fontsize=8)
+    right.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     fig.suptitle("lattice_chain: cost per step against n")
     fig.tight_layout()
     fig.savefig(args.out, dpi=args.dpi)
