@@ -151,6 +151,8 @@ TEST_CASE("inspect shows the metadata, --json the raw metadata, --check the deri
   CHECK(line("energy_VVT (written out)").ends_with("(relative to max(1, |H|))"));
   result = run_nonsep({"inspect", "lattice_chain", "--check"}, folder.path());
   CHECK(result.status == 0);
+  CHECK(result.out.find("  energy:      available (the plugin has both Hessians; writes out H_TTV and H_VVT, one "
+                        "pass)\n") != std::string::npos);
   CHECK(result.out.find("energy_TTV (written out) against the products or Hessians") != std::string::npos);
   CHECK(result.out.find("derivative check passed") != std::string::npos);
 

@@ -76,9 +76,15 @@ std::string describe_plugin(const Plugin& plugin) {
                                 (kernels.chosen ? kernels.chosen_name() + " (" + kernels.note + ")" : kernels.note)
                           : std::string("none (the evaluation path)")) +
          "\n";
+  std::string written;  // the forms whose product term the plugin writes out
+  for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT})
+    if (plugin.has_product_energy(form))
+      written += std::string(written.empty() ? "" : " and ") + (form == HamiltonianForm::TTV ? "H_TTV" : "H_VVT");
   out += "  energy:      " +
-         std::string(plugin.has_hessians() ? "available (the plugin has both Hessians)"
-                                           : "not available: the plugin lacks hessian_T or hessian_V") +
+         std::string(plugin.has_hessians()
+                         ? "available (the plugin has both Hessians" +
+                               (written.empty() ? std::string() : "; writes out " + written + ", one pass") + ")"
+                         : "not available: the plugin lacks hessian_T or hessian_V") +
          "\n";
   const auto parameters = plugin.parameters();
   if (parameters.empty()) {
