@@ -69,8 +69,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (run.analysis.tangent_vectors() > 0)
     chaos.emplace(directory / LyapunovMegnoObserver::file_name,
                   run.analysis.lyapunov ? run.analysis.lyapunov->vectors : 0, run.analysis.megno,
-                  run.analysis.lyapunov ? run.analysis.lyapunov->every : 0, driver.time(), driver.records(),
-                  options.resume);
+                  run.analysis.lyapunov ? run.analysis.lyapunov->every : 0, driver.records(), options.resume);
   if (!chaos || !run.analysis.lyapunov || run.analysis.lyapunov->every == 0)
     remove_stale(directory / LyapunovMegnoObserver::file_name);
   observers.push_back(&energy);

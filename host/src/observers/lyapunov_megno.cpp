@@ -5,9 +5,9 @@
 namespace nonsep::host {
 
 LyapunovMegnoObserver::LyapunovMegnoObserver(const std::filesystem::path& path, std::size_t exponents, bool megno,
-                                             std::uint64_t every, const TimeGrid& time,
-                                             const std::vector<TrajectoryRecord>& records, bool resuming)
-    : path_(path), exponents_(exponents), megno_(megno), every_(every), time_(time), records_(records) {
+                                             std::uint64_t every, const std::vector<TrajectoryRecord>& records,
+                                             bool resuming)
+    : path_(path), exponents_(exponents), megno_(megno), every_(every), records_(records) {
   if (every_ == 0 || resuming) return;
   std::string header = "trajectory,step,t";
   std::vector<std::string> names;

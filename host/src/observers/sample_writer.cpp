@@ -10,7 +10,6 @@ namespace nonsep::host {
 SampleWriter::SampleWriter(const std::filesystem::path& path, std::size_t dimension, std::size_t trajectories,
                            std::uint64_t every, const TimeGrid& time, bool resuming)
     : path_(path),
-      dimension_(dimension),
       every_(every),
       steps_(time.steps),
       time_(time),

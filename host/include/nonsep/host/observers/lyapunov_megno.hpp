@@ -16,7 +16,6 @@
 
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/run/observer.hpp"
-#include "nonsep/host/time_grid.hpp"
 
 namespace nonsep::host {
 
@@ -25,10 +24,10 @@ class LyapunovMegnoObserver : public Observer, public CheckpointedObserver, publ
   static constexpr const char* file_name = "lyapunov.csv";
 
   // `exponents`: k columns of exponents (0 without /analysis/lyapunov); `megno`: the MEGNO columns; `every`: the
-  // series' stride (0: no lyapunov.csv). `records` (the driver's) and `time` must outlive the observer. Creates the
-  // series file unless `resuming` (then restore() opens it). Throws OutputError.
+  // series' stride (0: no lyapunov.csv). `records` (the driver's) must outlive the observer. Creates the series file
+  // unless `resuming` (then restore() opens it). Throws OutputError.
   LyapunovMegnoObserver(const std::filesystem::path& path, std::size_t exponents, bool megno, std::uint64_t every,
-                        const TimeGrid& time, const std::vector<TrajectoryRecord>& records, bool resuming);
+                        const std::vector<TrajectoryRecord>& records, bool resuming);
 
   std::uint64_t next_event(std::uint64_t step) const override;
   void on_event(const Event& event) override;
@@ -48,7 +47,6 @@ class LyapunovMegnoObserver : public Observer, public CheckpointedObserver, publ
   std::size_t exponents_;
   bool megno_;
   std::uint64_t every_;
-  const TimeGrid& time_;
   const std::vector<TrajectoryRecord>& records_;
   std::optional<CsvAppender> file_;
 };

@@ -58,7 +58,6 @@ class SampleWriter : public Observer, public ChunkObserver, public CheckpointedO
   };
   static constexpr std::uint64_t none = static_cast<std::uint64_t>(-1);
   std::filesystem::path path_;
-  std::size_t dimension_;
   std::uint64_t every_, steps_;  // steps_: the last step, always sampled
   const TimeGrid& time_;
   std::optional<CsvAppender> file_;
