@@ -1,8 +1,6 @@
 // The energy part of `nonsep inspect --check` (plugin_report.hpp, check_product_energy): a plugin's own product term
 // of H (energy_TTV, energy_VVT) against the core's rule, H from its Hessian-vector products or its Hessians.
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -30,27 +28,9 @@ PathCheck check_product_energy(const PluginModel& model, const Plugin& plugin, s
       result.text += line + "not compared (" + error.what() + ")\n";
       continue;
     }
-    double largest = 0.0;
-    bool comparable = true;
-    for (std::size_t b = 0; b < count; ++b) {
-      if (std::isfinite(own[b]) != std::isfinite(rule[b])) comparable = false;
-      if (std::isfinite(own[b]) && std::isfinite(rule[b]))
-        largest = std::max(largest, std::abs(own[b] - rule[b]) / std::max(1.0, std::abs(rule[b])));
-    }
-    if (!comparable) {
-      line += "FAILED: non-finite where the rule is finite (or the reverse)";
-      result.passed = false;
-    } else {
-      char text[64];
-      std::snprintf(text, sizeof text, "%.3g", largest);
-      line += std::string("largest difference ") + text + " (relative to max(1, |H|))";
-      if (largest > tolerance) {
-        line += ": FAILED, above the tolerance";
-        result.passed = false;
-      }
-    }
-    result.largest_difference = std::max(result.largest_difference, largest);
-    result.text += line + "\n";
+    PathDifference difference;
+    for (std::size_t b = 0; b < count; ++b) difference.add(rule[b], own[b]);
+    result.text += line + result.judge(difference, tolerance, "the rule", "relative to max(1, |H|)") + "\n";
   }
   return result;
 }

@@ -47,12 +47,25 @@ struct DerivativeCheck {
 DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin,
                                   const DerivativeCheckSettings& settings = {});
 
+// The numbers of one comparison of two ways to them: the largest difference of `found` from `expected`, relative to
+// max(1, |expected|); whether every pair is the same number (bit for bit, or both NaN); whether none is non-finite
+// on one side only.
+struct PathDifference {
+  double largest = 0.0;
+  bool identical = true, comparable = true;
+  void add(double expected, double found);
+};
+
 // A comparison of two ways to the same numbers (the kernels and the evaluation path; a plugin's own energy and the
 // core's rule): the largest difference found, its lines of the report, and whether it passed.
 struct PathCheck {
   bool passed = true;
   double largest_difference = 0.0;
   std::string text;  // lines ending in '\n'
+  // The verdict on `difference` against `reference` (what the other way is called), for a line of the report:
+  // "largest difference from REFERENCE X (RELATIVE_TO)", failed above `tolerance` or when not comparable.
+  std::string judge(const PathDifference& difference, double tolerance, const std::string& reference,
+                    const std::string& relative_to);
 };
 
 // The kernel part of the check: each of the plugin's kernels this processor runs against the evaluation path on
