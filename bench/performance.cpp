@@ -12,8 +12,8 @@
 //                          control, the gradients called through function pointers by value (registers), which tells
 //                          the cost of a call from that of passing numbers through memory. 1c: the core's
 //                          ChinBasicStep compiled in (step_n), over the hand-written loop.
-//   1t, 1m. compositions:  ns per step of run_job with triplet 4/3 and mpe 4/3 on one trajectory over the
-//                          hand-written step composed by hand (hand_written_triplet_run, hand_written_mpe_run).
+//   1t, 1m, 1m4. compositions: ns per step of run_job with triplet 4/3, mpe 4/3 and mpe 4 on one trajectory over
+//                          the hand-written step composed by hand (hand_written_triplet_run, hand_written_mpe_run).
 //   2. 1024 trajectories:  ns per basic step per trajectory, run_job on 1 thread over the faster of two hand-written
 //                          loops over 1024 states (state by state; stage by stage) compiled -march=native
 //                          (hand_written_native.cpp) whatever this build's flags: the portable build's kernels
@@ -26,6 +26,11 @@
 //                          host's blocks on std::threads, 1 over 2: what the machine itself gives two threads.
 //   7. coupled3d:          the same as 1 and 2 on a 3-D coupled model with a parameter (coupled3d.hpp), against its
 //                          own hand-written loops (one state in local arrays; 1024 stage by stage, -march=native).
+//   8. tangent map:        ns per basic step per trajectory of run_job with one Lyapunov vector (analysis.lyapunov,
+//                          renormalised every 10 steps) on 1024 trajectories, 1 thread, over the hand-written tangent
+//                          step (hand_written_tangent_run, same flags); 8h: that hand-written tangent step over the
+//                          hand-written plain step (what the tangent map costs at the limit). The exponents must
+//                          agree to 1e-9 relative.
 //   4. AD over analytic:   run_job on 1024 trajectories, paper1d_autodiff.so (T and V only, gradients by the
 //                          SDK's dual numbers) over paper1d.so (hand-written gradients), 1 thread.
 //   6b. output:            run_job on one trajectory writing trajectory.csv every 10^4 steps (with H at each
@@ -42,9 +47,8 @@
 //   --smoke         a few repetitions of short runs (< 10 s; the ctest bench.performance.smoke)
 //   --repetitions   timed repetitions per configuration (default 7; smoke 3)
 //   --scale         multiplies every run's step count (default 1; smoke 0.05)
-//   --only          one group of figures: 1 (1, 1a, 1h, 1r, 1c), 1t (1t, 1m), 2 (2, 2p, 2a, 2h, 2c), 3 (3, 3b, 3c), 4,
-//   6b or
-//                   6c (e.g. to run one under callgrind)
+//   --only          one group of figures: 1 (1, 1a, 1h, 1r, 1c), 1t (1t, 1m, 1m4), 2 (2, 2p, 2a, 2h, 2c), 3 (3, 3b,
+//                   3c), 4, 6b, 6c, 7 (7, 7e) or 8 (8, 8h) (e.g. to run one under callgrind)
 // Exit status 1 when a check fails; the figures' targets are reported, not enforced (timings on a shared machine
 // are not a test).
 #include <signal.h>
@@ -105,7 +109,7 @@ double initial_q(std::size_t b, std::size_t count) {
 nonsep::host::LoadedJob make_job(const std::filesystem::path& folder, const std::string& name,
                                  const std::string& plugin, std::size_t count, std::uint64_t steps,
                                  std::uint64_t every = 0, std::uint64_t energy_every = 0,
-                                 const json& integrator = {{"scheme", "basic"}}) {
+                                 const json& integrator = {{"scheme", "basic"}}, const json& analysis = nullptr) {
   json initial = json::array();
   const bool three = plugin.find("coupled3d") != std::string::npos;
   for (std::size_t b = 0; b < count; ++b) {
@@ -113,11 +117,12 @@ nonsep::host::LoadedJob make_job(const std::filesystem::path& folder, const std:
     initial.push_back(three ? json{{"q", {q, 0.5 * q, -0.3 * q}}, {"p", {0.0, 0.1, -0.1}}}
                             : json{{"q", {q}}, {"p", {0.0}}});
   }
-  const json job = {{"model", {{"plugin", plugin}}},
-                    {"integrator", integrator},
-                    {"initial", initial},
-                    {"time", {{"dt", dt}, {"steps", steps}}},
-                    {"output", {{"directory", name + ".out"}, {"every", every}, {"energy_every", energy_every}}}};
+  json job = {{"model", {{"plugin", plugin}}},
+              {"integrator", integrator},
+              {"initial", initial},
+              {"time", {{"dt", dt}, {"steps", steps}}},
+              {"output", {{"directory", name + ".out"}, {"every", every}, {"energy_every", energy_every}}}};
+  if (!analysis.is_null()) job["analysis"] = analysis;
   const auto file = folder / (name + ".json");
   std::ofstream(file) << job.dump();
   return nonsep::host::load_job(file);
@@ -211,6 +216,27 @@ double time_hand_written_coupled3d(const nonsep::host::LoadedJob& job, std::vect
   const std::chrono::duration<double> elapsed = Clock::now() - start;
   final_q.clear();
   for (std::size_t i = 0; i < q.size(); i += 3) final_q.push_back(q[i]);
+  return elapsed.count();
+}
+
+// Seconds for the hand-written tangent step on `job`'s states, one Lyapunov vector each, (1, 1/2) normalised as the
+// host starts it, renormalised every `renormalize_every` steps; `final_q` receives the final q and `exponents` the
+// largest Lyapunov exponents.
+double time_hand_written_tangent(const nonsep::host::LoadedJob& job, std::uint64_t renormalize_every,
+                                 std::vector<double>& final_q, std::vector<double>& exponents) {
+  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p);
+  const double norm = std::sqrt(1.25);
+  Doubles dq(q.size(), 1.0 / norm), dp(q.size(), 0.5 / norm), log_stretch(q.size(), 0.0);
+  const std::uint64_t steps = job.job.run().time.steps;
+  const auto start = Clock::now();
+  bench::hand_written_tangent_run(c, q.data(), p.data(), dq.data(), dp.data(), log_stretch.data(), q.size(), steps,
+                                  renormalize_every);
+  const std::chrono::duration<double> elapsed = Clock::now() - start;
+  final_q.assign(q.begin(), q.end());
+  exponents.clear();
+  for (double stretch : log_stretch)
+    exponents.push_back(stretch / (static_cast<double>(steps) * job.job.run().time.dt));
   return elapsed.count();
 }
 
@@ -427,12 +453,14 @@ int main(int argc, char** argv) {
     figures.push_back(
         figure("1c. one trajectory: ChinBasicStep compiled in / hand-written", "(report)", unit, t[4], t[1], per));
   }
-  if (wanted("1t")) {  // 1t, 1m. one trajectory, triplet 4/3 and mpe 4/3 against hand-written compositions
+  if (wanted("1t")) {  // 1t, 1m, 1m4. one trajectory, triplet 4/3, mpe 4/3 and mpe 4 against hand-written compositions
     for (const auto& [name, integrator, basic_steps] :
          {std::tuple{"1t. one trajectory, triplet 4/3: host / hand-written composition",
                      json{{"scheme", "triplet"}, {"order", "4/3"}}, 3.0},
           std::tuple{"1m. one trajectory, mpe 4/3: host / hand-written expansion",
-                     json{{"scheme", "mpe"}, {"order", "4/3"}}, 3.0}}) {
+                     json{{"scheme", "mpe"}, {"order", "4/3"}}, 3.0},
+          std::tuple{"1m4. one trajectory, mpe 4 (6 terms): host / hand-written expansion",
+                     json{{"scheme", "mpe"}, {"order", "4"}}, 21.0}}) {
       const auto steps = scaled(4e6 / basic_steps);
       const auto job = make_job(folder, "composition", analytic, 1, steps, 0, 0, integrator);
       const auto t = interleaved(repetitions, {[&] { return time_host(job, 1, host_q); },
@@ -455,6 +483,46 @@ int main(int argc, char** argv) {
       figures.push_back(figure(name, target, count == 1 ? "ns per basic step" : "ns per basic step per trajectory",
                                t[0], t[1], 1e9 / static_cast<double>(steps * count)));
     }
+  }
+  if (wanted("8")) {  // 8, 8h. one Lyapunov vector, 1024 trajectories, against the hand-written tangent step
+    const std::uint64_t renormalize_every = 10, steps = scaled(5000) / renormalize_every * renormalize_every;
+    const std::size_t count = 1024;
+    const auto job = make_job(folder, "tangent", analytic, count, steps, 0, 0, {{"scheme", "basic"}},
+                              {{"lyapunov", {{"vectors", 1}, {"renormalize_every", renormalize_every}}}});
+    std::vector<double> host_exponents, reference_exponents, plain_q;
+    const auto t = interleaved(
+        repetitions,
+        {[&] {
+           nonsep::host::RunOptions options;
+           options.output_directory = job.job.output_directory;
+           options.threads = 1;
+           const auto start = Clock::now();
+           const auto outcome = nonsep::host::run_job(job, options);
+           const std::chrono::duration<double> elapsed = Clock::now() - start;
+           host_q.clear();
+           host_exponents.clear();
+           for (const auto& trajectory : outcome.trajectories) {
+             host_q.push_back(trajectory.final_q.at(0));
+             host_exponents.push_back(trajectory.lyapunov.empty() ? std::nan("") : trajectory.lyapunov.at(0));
+           }
+           return elapsed.count();
+         },
+         [&] { return time_hand_written_tangent(job, renormalize_every, reference_q, reference_exponents); },
+         [&] { return time_hand_written(job, plain_q); }});
+    check("8. tangent map", host_q, reference_q);
+    bool close = host_exponents.size() == reference_exponents.size();
+    for (std::size_t b = 0; close && b < host_exponents.size(); ++b)
+      close = std::abs(host_exponents[b] - reference_exponents[b]) <=
+              1e-9 * std::max(1.0, std::abs(reference_exponents[b]));
+    if (!close) {
+      std::fprintf(stderr, "8. tangent map: the host's Lyapunov exponents differ from the hand-written ones\n");
+      agree = false;
+    }
+    const double per = 1e9 / static_cast<double>(steps * count);
+    figures.push_back(figure("8. one Lyapunov vector, 1024 trajectories: host (1 thread) / hand-written tangent step",
+                             "(report)", "ns per basic step per trajectory", t[0], t[1], per));
+    figures.push_back(figure("8h. hand-written tangent step / hand-written plain step (the tangent map's own cost)",
+                             "(report)", "ns per basic step per trajectory", t[1], t[2], per));
   }
   if (wanted("2")) {  // 2. 1024 trajectories, one thread
     const std::size_t count = 1024;

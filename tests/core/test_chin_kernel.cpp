@@ -1,7 +1,8 @@
 // The stepping kernel (chin_kernel.hpp) against the evaluation path: a model offering chin_steps gets bit for bit
-// the numbers and evaluation counts of the same model without it, through every Chin scheme (basic, triplet, mpe),
-// both forms, 1, 2, 3, 5, 33, 35 and 300 states, fixed and run-time dimensions, one step size or one per state; a
-// triplet's run of steps is one call (a schedule of sub-steps); and a kernel that fails leaves nothing stale.
+// the numbers and evaluation counts of the same model without it, through every Chin scheme (basic, triplet, mpe of
+// 2, 3 and 6 terms), both forms, 1, 2, 3, 5, 33, 35 and 300 states, fixed and run-time dimensions, one step size or one
+// per state; a triplet's run of steps is one call (a schedule of sub-steps); and a kernel that fails leaves nothing
+// stale.
 #include <doctest/doctest.h>
 
 #include <array>
@@ -18,6 +19,7 @@
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
+using nonsep::testing::VariableMass2D;
 
 namespace {
 
@@ -49,16 +51,17 @@ PhaseSpaceBatch spread_states(std::size_t n, std::size_t count) {
   return x;
 }
 
-// Runs `scheme` for 2 chunks of 4 steps and 1 chunk of 3 (the host's step_n) with and without the kernel.
+// Runs `scheme` of `order` for 2 chunks of 4 steps and 1 chunk of 3 (the host's step_n) with and without the kernel.
 template <class M, std::size_t FixedDimension>
-void check_scheme(const std::string& scheme, HamiltonianForm form, std::size_t count) {
+void check_scheme(const std::string& scheme, HamiltonianForm form, std::size_t count, Fraction order) {
   CAPTURE(scheme);
+  CAPTURE(order.value());
   CAPTURE(static_cast<int>(form));
   CAPTURE(count);
   CAPTURE(FixedDimension);
   const M plain{};
   WithKernel<M, FixedDimension> kernel{};
-  IntegratorSpec spec{scheme, Fraction(scheme == "basic" ? 2 : 4, 3)};
+  IntegratorSpec spec{scheme, order};
   spec.form = form;
   Integrator with(spec), without(spec);
   auto x = spread_states(plain.dimension(), count);
@@ -75,16 +78,68 @@ void check_scheme(const std::string& scheme, HamiltonianForm form, std::size_t c
 }  // namespace
 
 TEST_CASE("kernel path: every Chin scheme and form gives the evaluation path's numbers and counts bit for bit") {
-  for (const char* scheme : {"basic", "triplet", "mpe"})
+  // mpe of 2, 3 and 6 terms: whole expansions in the kernel (chin_expansion_stages.hpp).
+  for (const auto& [scheme, order] :
+       {std::pair{"basic", Fraction(2, 3)}, std::pair{"triplet", Fraction(4, 3)}, std::pair{"mpe", Fraction(4, 3)},
+        std::pair{"mpe", Fraction(2)}, std::pair{"mpe", Fraction(4)}})
     for (const auto form : forms)
       for (std::size_t count : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{5}, std::size_t{33},
                                 std::size_t{35}, std::size_t{300}}) {
         // Blocks of 32 states in local arrays; the rest in place (5; 12 of 300) or in registers (1; 2, 3; 1 of 33;
         // 3 of 35).
-        check_scheme<Paper1D, 1>(scheme, form, count);
-        check_scheme<Coupled2D, 2>(scheme, form, count);
-        check_scheme<Coupled2D, 0>(scheme, form, count);  // the dimension known at run time: the caller's arrays
+        check_scheme<Paper1D, 1>(scheme, form, count, order);
+        check_scheme<Coupled2D, 2>(scheme, form, count, order);
+        check_scheme<Coupled2D, 0>(scheme, form, count, order);  // the dimension known at run time: the caller's arrays
       }
+}
+
+TEST_CASE("kernel path: a run of mpe steps is one kernel call, each step the expansion of MultiProductExpansion") {
+  for (int terms : {2, 3, 6})
+    for (const auto form : forms) {
+      CAPTURE(terms);
+      CAPTURE(static_cast<int>(form));
+      WithKernel<Coupled2D, 2> kernel{};
+      MultiProductExpansion<SeparableBasicStep> with(SeparableBasicStep(ChinBasicStep(form)), terms);
+      MultiProductExpansion<ChinBasicStep> term_by_term(ChinBasicStep(form), terms);
+      auto x = spread_states(2, 7);
+      auto y = x;
+      with.step_n(kernel, x, 0.01, 6);
+      for (int k = 0; k < 6; ++k) term_by_term.step_term_by_term(Coupled2D{}, y, 0.01);
+      CHECK(x == y);
+      CHECK(with.evaluations() == term_by_term.evaluations());
+      CHECK(kernel.calls == 1);
+      // A step after the run starts from the combined point's gradient, evaluated anew, as the evaluation path does.
+      with.step(kernel, x, 0.01);
+      term_by_term.step_term_by_term(Coupled2D{}, y, 0.01);
+      CHECK(x == y);
+      CHECK(with.evaluations() == term_by_term.evaluations());
+    }
+}
+
+TEST_CASE("kernel path: mpe of a model with a separable part steps its terms through the basic steps' kernel") {
+  // The expansion's terms compose the exact flows of K and U, which the kernel does not take: no whole expansions,
+  // and the numbers of the model without a kernel.
+  WithKernel<VariableMass2D, 2> kernel{};
+  const VariableMass2D plain{};
+  IntegratorSpec spec{"mpe", Fraction(2)};
+  Integrator with(spec), without(spec);
+  auto x = spread_states(2, 3);
+  auto y = x;
+  with.step_n(kernel, x, 0.01, 5);
+  without.step_n(plain, y, 0.01, 5);
+  CHECK(x == y);
+  CHECK(with.evaluations() == without.evaluations());
+  CHECK(kernel.calls == 5 * 3);  // a call per round of the terms: 3 a step
+}
+
+TEST_CASE("kernel path: an expansion's call fits only with one step size per term") {
+  CHECK(chin_eps_fit(2, 1, 5, 2));
+  CHECK(chin_eps_fit(6, 1, 1, 6));
+  CHECK_FALSE(chin_eps_fit(1, 1, 5, 2));  // one per term, not one for all
+  CHECK_FALSE(chin_eps_fit(5, 1, 5, 2));  // nor one per state
+  CHECK_FALSE(chin_eps_fit(2, 2, 5, 2));  // one sub-step only
+  CHECK_FALSE(chin_eps_fit(1, 1, 5, 1));  // one term is a basic step: terms 0
+  CHECK_FALSE(chin_eps_fit(2, 1, 0, 2));
 }
 
 TEST_CASE("kernel path: a run of triplet steps is one kernel call, the schedule of its basic steps") {

@@ -1,10 +1,11 @@
 // The plugins' stepping kernels in the `nonsep` executable: runs through the kernel (NONSEP_INSTRUCTION_SET=
 // baseline) write byte for byte the files of runs through the evaluation path (NONSEP_INSTRUCTION_SET=evaluation),
-// for every Chin scheme and form, 1, 5 and 300 states, 1 and 2 threads, states that fail or diverge partway, and a
-// run killed and resumed; summary.json says which path ran; inspect shows and checks the kernels; a plugin of
-// another kernel version, and one without kernels, run through the evaluation path.
+// for every Chin scheme (mpe of 2 and 3 terms) and form, 1, 5 and 300 states, 1 and 2 threads, states that fail or
+// diverge partway, and a run killed and resumed; summary.json says which path ran; inspect shows and checks the
+// kernels; a plugin of another kernel version, and one without kernels, run through the evaluation path.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -72,13 +73,16 @@ TEST_CASE(
     "kernel path: every Chin scheme and form, 1, 5 and 300 states, 1 and 2 threads, the evaluation path's files") {
   TemporaryFolder folder;
   for (const json& integrator : {json{{"scheme", "basic"}}, json{{"scheme", "triplet"}, {"order", "4/3"}},
-                                 json{{"scheme", "mpe"}, {"order", "4/3"}}})
+                                 json{{"scheme", "mpe"}, {"order", "4/3"}}, json{{"scheme", "mpe"}, {"order", "2"}}})
     for (const char* form : {"TTV", "VVT"})
       for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{300}}) {
         json job = paper1d_job(states(count), {{"dt", 0.01}, {"steps", 40}}, integrator);
         job["hamiltonian"] = form;
         job["output"] = {{"every", 10}};
-        const std::string name = integrator["scheme"].get<std::string>() + "-" + form + "-" + std::to_string(count);
+        std::string order = integrator.value("order", "2/3");
+        std::replace(order.begin(), order.end(), '/', '_');
+        const std::string name =
+            integrator["scheme"].get<std::string>() + "-" + order + "-" + form + "-" + std::to_string(count);
         CAPTURE(name);
         const auto file = write_job(folder / (name + ".json"), job);
         for (const char* threads : {"1", "2"}) {
@@ -96,21 +100,24 @@ TEST_CASE("kernel path: states that fail or diverge partway are reported as the 
   // evaluation_fails: grad V refuses |q| >= 1 (a failure inside the kernel, then the evaluation path's replay).
   json failing = json::array();
   for (int i = 0; i < 40; ++i) failing.push_back(state(0.3 + 0.0175 * i, 0.05));
-  json job = {{"model", {{"plugin", std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/evaluation_fails.so"}}},
-              {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}}},
-              {"initial", failing},
-              {"time", {{"dt", 0.01}, {"steps", 60}}},
-              {"output", {{"every", 10}}}};
-  auto file = write_job(folder / "failing.json", job);
-  const auto kernel = run_with("baseline", folder, "failing-kernel", file, "2");
-  check_same_files(kernel, run_with("evaluation", folder, "failing-evaluation", file, "2"));
-  CHECK(kernel.trajectories.find("failed") != std::string::npos);
-  CHECK(kernel.trajectories.find("completed") != std::string::npos);
+  for (const char* scheme : {"triplet", "mpe"}) {
+    CAPTURE(scheme);
+    json job = {{"model", {{"plugin", std::string(NONSEP_BROKEN_PLUGIN_DIR) + "/evaluation_fails.so"}}},
+                {"integrator", {{"scheme", scheme}, {"order", "4/3"}}},
+                {"initial", failing},
+                {"time", {{"dt", 0.01}, {"steps", 60}}},
+                {"output", {{"every", 10}}}};
+    const auto file = write_job(folder / (std::string(scheme) + "-failing.json"), job);
+    const auto kernel = run_with("baseline", folder, std::string(scheme) + "-failing-kernel", file, "2");
+    check_same_files(kernel, run_with("evaluation", folder, std::string(scheme) + "-failing-evaluation", file, "2"));
+    CHECK(kernel.trajectories.find("failed") != std::string::npos);
+    CHECK(kernel.trajectories.find("completed") != std::string::npos);
+  }
   // paper1d: a state whose gradient overflows diverges in its first step, among states that go on.
   json diverging = states(20);
   diverging[7] = state(0.5, 1e200);
-  file = write_job(folder / "diverging.json",
-                   paper1d_job(diverging, {{"dt", 0.01}, {"steps", 30}}, {{"scheme", "mpe"}, {"order", "4/3"}}));
+  const auto file = write_job(folder / "diverging.json", paper1d_job(diverging, {{"dt", 0.01}, {"steps", 30}},
+                                                                     {{"scheme", "mpe"}, {"order", "4/3"}}));
   const auto diverged = run_with("baseline", folder, "diverging-kernel", file);
   check_same_files(diverged, run_with("evaluation", folder, "diverging-evaluation", file));
   CHECK(diverged.trajectories.find("diverged") != std::string::npos);

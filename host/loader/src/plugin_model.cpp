@@ -159,7 +159,8 @@ bool PluginModel::chin_steps(const ChinStepsCall& call) const {
   if (!kernel_) return false;
   const std::size_t size = call.count * instance_->dimension;
   if (call.q.size() != size || call.p.size() != size || call.outer_gradient.size() != size ||
-      call.inner_gradient.size() != size || !chin_eps_fit(call.eps.size(), call.substeps, call.count)) [[unlikely]]
+      call.inner_gradient.size() != size ||
+      !chin_eps_fit(call.eps.size(), call.substeps, call.count, call.weights.size())) [[unlikely]]
     throw_bad_spans("chin_steps", call.count, instance_->dimension, instance_->dimension, call.q.size(), call.p.size());
   const nonsep_plugin_api& api = *instance_->api;
   const nonsep_chin_steps_args args{call.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT,
@@ -177,7 +178,9 @@ bool PluginModel::chin_steps(const ChinStepsCall& call) const {
                                     call.q.data(),
                                     call.p.data(),
                                     call.outer_gradient.data(),
-                                    call.inner_gradient.data()};
+                                    call.inner_gradient.data(),
+                                    call.weights.empty() ? nullptr : call.weights.data(),
+                                    call.weights.size()};
   const nonsep_status status = api.chin_steps(instance_->handle, &args);
   if (status != NONSEP_OK) [[unlikely]]
     throw_failed(*this, instance_->handle, api, "chin_steps", status);

@@ -156,6 +156,40 @@ class ChinBasicStep {
     end_steps(x);
   }
 
+  // Advances every state of `x` by `n` steps of the multi-product expansion with `weights` (c_1..c_m, m >= 2) and
+  // step size dt, in one call of the model's kernel when it has one (ModelWithChinSteps): bit for bit what n steps of
+  // MultiProductExpansion<ChinBasicStep> give, evaluations counted alike (m (m + 1) / 2 basic steps a step, and one
+  // outer gradient at each combined point the next step starts from). Returns false, having done nothing, when no
+  // kernel is at hand (the caller takes the expansion's steps itself). Throws as step_n does; after a model
+  // exception x holds whatever the steps reached.
+  template <Model M>
+  bool step_expansion_n(const M& model, PhaseSpaceBatch& x, double dt, std::span<const double> weights,
+                        std::uint64_t n) {
+    if constexpr (!ModelWithChinSteps<M>) {
+      return false;
+    } else {
+      if (n == 0) return true;
+      check_batch_fits(model, x);
+      check_step_size(dt);
+      const std::size_t m = weights.size();
+      eps_.resize(m);
+      for (std::size_t k = 1; k <= m; ++k) eps_[k - 1] = cube_root(dt / static_cast<double>(k));
+      substeps_ = 1;
+      begin_steps(model, x);
+      const std::size_t count = x.count();
+      const ChinStepsCall call{form_, c_, eps_, 1, n, count, x.q(), x.p(), outer_gradient_, inner_gradient_, weights};
+      if (!model.chin_steps(call)) {
+        cache_valid_ = true;  // untouched: still the gradient at x's point, as prime() left it
+        return false;
+      }
+      const std::uint64_t basic_steps = n * m * (m + 1) / 2;
+      evaluations_.grad_T += 4 * basic_steps * count;
+      evaluations_.grad_V += 4 * basic_steps * count;
+      (form_ == HamiltonianForm::TTV ? evaluations_.grad_V : evaluations_.grad_T) += (n - 1) * count;
+      return true;  // the cache stays invalid: the outer gradient at the combined point is not at hand
+    }
+  }
+
   // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached).
   template <Model M>
   void prime(const M& model, const PhaseSpaceBatch& x) {
@@ -228,7 +262,8 @@ class ChinBasicStep {
   template <Model M, class StageObserver>
   void stages(const M& model, PhaseSpaceBatch& x, StageObserver& observe, std::uint64_t steps) {
     const std::size_t count = x.count();
-    const ChinStepsCall call{form_, c_, eps_, substeps_, steps, count, x.q(), x.p(), outer_gradient_, inner_gradient_};
+    const ChinStepsCall call{form_,           c_, eps_, substeps_, steps, count, x.q(), x.p(), outer_gradient_,
+                             inner_gradient_, {}};
     const std::uint64_t basic_steps = steps * substeps_;
     if constexpr (ModelWithChinSteps<M> && std::is_same_v<std::decay_t<StageObserver>, NoStageObserver>) {
       if (model.chin_steps(call)) {

@@ -18,6 +18,8 @@
 // hold enough independent states to keep the divider and the multipliers busy. Blocks of 16 ran at the chain's
 // latency whatever the vector width (GCC unrolls their loops completely and vectorizes them piecemeal); blocks of 32
 // and 64 run at the machine's throughput, as the hand-written loop over all states does.
+// A call with weights takes whole steps of a multi-product expansion (chin_expansion_stages.hpp) over the same blocks,
+// its terms one after the other, so that one trajectory's expansion stays in registers.
 // Each number sees the same operations in the same order as in the evaluation path, so a kernel compiled with the
 // evaluation path's flags gives its numbers bit for bit (tests/core/test_chin_kernel.cpp).
 //
@@ -28,15 +30,18 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
+#include "nonsep/core/chin_expansion_stages.hpp"
 #include "nonsep/core/chin_stages.hpp"
 
 namespace nonsep {
 
 // The version of what a kernel computes (the ChinStepsCall it takes, chin_stages' flows): a plugin records the
 // version it was compiled from, and a host whose core has another one steps that plugin through its evaluations.
-// Version 2: a call carries a schedule of sub-steps (ChinStepsCall::substeps).
-inline constexpr std::uint64_t chin_kernel_version = 2;
+// Version 2: a call carries a schedule of sub-steps (ChinStepsCall::substeps). Version 3: a call may carry a
+// multi-product expansion's weights (ChinStepsCall::weights).
+inline constexpr std::uint64_t chin_kernel_version = 3;
 
 // States per block of local arrays for a fixed dimension: 32 states, at most 128 numbers of each array (the four
 // arrays then take 4 KB of the first-level cache), one state from dimension 128 on.
@@ -46,8 +51,10 @@ inline std::size_t block_states_at_run_time(std::size_t dimension) { return std:
 
 namespace detail {
 
-// Whether the call's eps holds one entry per state (else one per sub-step, for every state).
-inline bool eps_per_state(const ChinStepsCall& call) { return call.substeps == 1 && call.eps.size() != 1; }
+// Whether the call's eps holds one entry per state (else one per sub-step or term, for every state).
+inline bool eps_per_state(const ChinStepsCall& call) {
+  return call.weights.empty() && call.substeps == 1 && call.eps.size() != 1;
+}
 
 // The call's steps for states [first, first + B) of dimension N, in local arrays.
 template <std::size_t N, std::size_t B, Model M>
@@ -64,8 +71,17 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
     std::copy_n(call.eps.begin() + static_cast<std::ptrdiff_t>(first), B, eps.begin());
     block_eps = eps;
   }
-  chin_scheduled_stages<size>(model, ChinStepsCall{call.form, call.coefficients, block_eps, call.substeps, call.steps,
-                                                   B, q, p, outer_gradient, inner_gradient});
+  const ChinStepsCall block{call.form, call.coefficients, block_eps,      call.substeps, call.steps, B, q,
+                            p,         outer_gradient,    inner_gradient, call.weights};
+  if (call.weights.empty()) {
+    chin_scheduled_stages<size>(model, block);
+  } else if constexpr (size <= 128) {  // the expansion's scratch on the stack too (8 KB at most)
+    std::array<double, chin_expansion_scratch(size)> scratch;
+    chin_expansion_stages<size>(model, block, scratch);
+  } else {
+    std::vector<double> scratch(chin_expansion_scratch(size));
+    chin_expansion_stages<size>(model, block, scratch);
+  }
   std::copy_n(q.begin(), size, call.q.begin() + static_cast<std::ptrdiff_t>(offset));
   std::copy_n(p.begin(), size, call.p.begin() + static_cast<std::ptrdiff_t>(offset));
   std::copy_n(outer_gradient.begin(), size, call.outer_gradient.begin() + static_cast<std::ptrdiff_t>(offset));
@@ -77,16 +93,30 @@ inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::
                                 std::size_t states) {
   const std::size_t offset = first * n, size = states * n;
   const std::span<const double> eps = eps_per_state(call) ? call.eps.subspan(first, states) : call.eps;
-  chin_scheduled_stages(
-      model, ChinStepsCall{call.form, call.coefficients, eps, call.substeps, call.steps, states,
-                           call.q.subspan(offset, size), call.p.subspan(offset, size),
-                           call.outer_gradient.subspan(offset, size), call.inner_gradient.subspan(offset, size)});
+  const ChinStepsCall part{call.form,
+                           call.coefficients,
+                           eps,
+                           call.substeps,
+                           call.steps,
+                           states,
+                           call.q.subspan(offset, size),
+                           call.p.subspan(offset, size),
+                           call.outer_gradient.subspan(offset, size),
+                           call.inner_gradient.subspan(offset, size),
+                           call.weights};
+  if (call.weights.empty()) {
+    chin_scheduled_stages(model, part);
+  } else {
+    std::vector<double> scratch(chin_expansion_scratch(size));
+    chin_expansion_stages(model, part, scratch);
+  }
 }
 
 }  // namespace detail
 
 // The steps of `call` for `model` (its dimension is FixedDimension when that is not 0). Requires the sizes of
-// chin_stages: q, p and both gradients count*n numbers, and chin_eps_fit(call.eps.size(), call.substeps, count).
+// chin_stages: q, p and both gradients count*n numbers, and chin_eps_fit(call.eps.size(), call.substeps, count,
+// call.weights.size()). Allocates scratch for an expansion's blocks in the caller's arrays (std::bad_alloc).
 template <std::size_t FixedDimension, Model M>
 void chin_kernel_steps(const M& model, const ChinStepsCall& call) {
   const std::size_t count = call.count;

@@ -80,9 +80,13 @@ inline void chin_gradient(const M& model, bool potential, std::span<const double
     model.grad_T(at, out, count);
 }
 
-// What a stepping kernel is asked to do: `steps` times a schedule of `substeps` basic steps of `count` states.
+// What a stepping kernel is asked to do: `steps` times a schedule of `substeps` basic steps of `count` states, or
+// `steps` steps of a multi-product expansion of those states.
 //   eps       cbrt(dt) of each sub-step, for every state (substeps entries); or, with one sub-step, one entry for
-//             every state or one per state (count entries)
+//             every state or one per state (count entries); with weights, cbrt(dt / k) of term k = 1..m (m entries)
+//   weights   empty: basic steps; m >= 2 entries: each step is the m-term expansion of MultiProductExpansion
+//             (multi_product_expansion.hpp), weights[k-1] = c_k, substeps 1 (chin_expansion_stages.hpp). After the
+//             call's last step the outer gradient is not that of the combined point: the caller evaluates it anew.
 //   the rest  chin_stages' arguments
 struct ChinStepsCall {
   HamiltonianForm form;
@@ -92,10 +96,13 @@ struct ChinStepsCall {
   std::uint64_t steps;
   std::size_t count;
   std::span<double> q, p, outer_gradient, inner_gradient;
+  std::span<const double> weights;
 };
 
-// Whether eps of `eps_size` entries fits a call of `substeps` sub-steps of `count` states (ChinStepsCall above).
-constexpr bool chin_eps_fit(std::size_t eps_size, std::size_t substeps, std::size_t count) {
+// Whether eps of `eps_size` entries fits a call of `substeps` sub-steps of `count` states with `terms` weights
+// (ChinStepsCall above).
+constexpr bool chin_eps_fit(std::size_t eps_size, std::size_t substeps, std::size_t count, std::size_t terms = 0) {
+  if (terms != 0) return terms >= 2 && substeps == 1 && eps_size == terms && count > 0;
   return substeps >= 1 && (eps_size == substeps || (substeps == 1 && eps_size == count && count > 0));
 }
 
@@ -104,8 +111,9 @@ constexpr bool chin_eps_fit(std::size_t eps_size, std::size_t substeps, std::siz
 //                                code built alike), false when no kernel is at hand for this call (none, another
 //                                kernel version, or turned off): the caller then runs chin_scheduled_stages.
 //                                Throws ModelError when the model fails inside; the arrays are then unspecified.
-// ChinBasicStep uses it for the steps no flow observer watches. The evaluations it performs are counted as
-// chin_stages' (4 grad T and 4 grad V per state and basic step).
+// ChinBasicStep uses it for the steps no flow observer watches, and for whole expansions (step_expansion_n). The
+// evaluations it performs are counted as chin_stages' (4 grad T and 4 grad V per state and basic step; an expansion
+// adds the outer gradient between its steps).
 template <class M>
 concept ModelWithChinSteps = Model<M> && requires(const M& m, const ChinStepsCall& call) {
   { m.chin_steps(call) } -> std::same_as<bool>;

@@ -75,9 +75,10 @@ class Integrator {
         stepper_);
   }
 
-  // n steps of dt: bit for bit n calls of step(model, x, dt). The basic step and the triplet composition do their
-  // per-step bookkeeping once (ChinBasicStep::step_n and step_schedule_n, through SeparableComposition), so that a
-  // model with a kernel takes the n steps in one call; the other schemes take their steps one by one.
+  // n steps of dt: bit for bit n calls of step(model, x, dt). The basic step, the triplet composition and the
+  // multi-product expansion do their per-step bookkeeping once (ChinBasicStep::step_n, step_schedule_n and
+  // step_expansion_n, through SeparableComposition), so that a model with a kernel takes the n steps in one call; the
+  // other schemes take their steps one by one.
   template <Model M>
   void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
     if (auto* basic = std::get_if<SeparableBasicStep>(&stepper_)) {
@@ -86,6 +87,10 @@ class Integrator {
     }
     if (auto* triplet = std::get_if<TripletComposition<SeparableBasicStep>>(&stepper_)) {
       triplet->step_n(model, x, dt, n);
+      return;
+    }
+    if (auto* mpe = std::get_if<MultiProductExpansion<SeparableBasicStep>>(&stepper_)) {
+      mpe->step_n(model, x, dt, n);
       return;
     }
     for (std::uint64_t k = 0; k < n; ++k) step(model, x, dt);

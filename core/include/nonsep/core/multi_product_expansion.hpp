@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/chin_expansion_stages.hpp"
 
 namespace nonsep {
 
@@ -164,9 +165,19 @@ class MultiProductExpansion {
     for (int k = m - 1; k >= 1; --k) {
       const double c = weights_[static_cast<std::size_t>(k - 1)];
       const std::size_t offset = static_cast<std::size_t>(m - k) * size;
-      accumulate(x.q(), c, q.subspan(offset, size), q.first(size));
-      accumulate(x.p(), c, p.subspan(offset, size), p.first(size));
+      mpe_accumulate(x.q(), c, q.subspan(offset, size), q.first(size));
+      mpe_accumulate(x.p(), c, p.subspan(offset, size), p.first(size));
     }
+  }
+
+  // n steps of dt: bit for bit n calls of step(model, x, dt), evaluations counted alike. A base that takes whole
+  // expansions to a model's kernel (step_expansion_n: ChinBasicStep, SeparableComposition without a separable part)
+  // gets the n steps in one call (chin_expansion_stages.hpp); otherwise the steps are taken one by one.
+  template <Model M>
+  void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
+    if constexpr (requires { base_.step_expansion_n(model, x, dt, std::span<const double>(weights_), n); })
+      if (terms() > 1 && base_.step_expansion_n(model, x, dt, std::span<const double>(weights_), n)) return;
+    for (std::uint64_t k = 0; k < n; ++k) step(model, x, dt);
   }
 
   // The same step, one term after the other (the reference step() is tested against).
@@ -194,8 +205,8 @@ class MultiProductExpansion {
         continue;
       }
       const double c = weights_[static_cast<std::size_t>(k - 1)];
-      accumulate(x.q(), c, term_.q(), last_.q());
-      accumulate(x.p(), c, term_.p(), last_.p());
+      mpe_accumulate(x.q(), c, term_.q(), last_.q());
+      mpe_accumulate(x.p(), c, term_.p(), last_.p());
     }
   }
   template <Model M>
@@ -204,10 +215,6 @@ class MultiProductExpansion {
   }
 
  private:
-  static void accumulate(std::span<double> sum, double c, std::span<const double> y, std::span<const double> ym) {
-    for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += c * (y[i] - ym[i]);
-  }
-
   Base base_;
   std::vector<double> weights_;
   PhaseSpaceBatch start_, term_, last_;  // step_term_by_term: the starting point, the term being run, and y_m

@@ -38,9 +38,9 @@
 // variable unchanged (TTV: no K, so q is not moved; VVT: no U); otherwise the basic step evaluates it again.
 //
 // SeparableComposition wraps a base stepper with the ChinBasicStep interface (step with one dt or one per state,
-// step_n, step_schedule_n, prime, save_cache, restore_cache, keep_cache_prefix, evaluations, describe, form,
-// coefficients); it is the base of the catalogue's triplet and MPE (scheme_catalogue.hpp). Errors: those of the base
-// step; the model's exceptions propagate and leave x unspecified but valid.
+// step_n, step_schedule_n, step_expansion_n, prime, save_cache, restore_cache, keep_cache_prefix, evaluations,
+// describe, form, coefficients); it is the base of the catalogue's triplet and MPE (scheme_catalogue.hpp). Errors:
+// those of the base step; the model's exceptions propagate and leave x unspecified but valid.
 #include <cstdint>
 #include <span>
 #include <string>
@@ -144,6 +144,15 @@ class SeparableComposition {
     }
     for (std::uint64_t s = 0; s < n; ++s)
       for (double dt : dts) step(model, x, dt);
+  }
+
+  // n steps of the multi-product expansion with `weights` in one kernel call (ChinBasicStep::step_expansion_n):
+  // without a separable part the base's; with one, false (the expansion's terms compose the separable flows, which
+  // the kernel does not take).
+  template <Model M>
+  bool step_expansion_n(const M& model, PhaseSpaceBatch& x, double dt, std::span<const double> weights,
+                        std::uint64_t n) {
+    return !has_separable_part(model) && base_.step_expansion_n(model, x, dt, weights, n);
   }
 
   // Primes the base's first-same-as-last gradient when the first half-flow leaves its point unchanged.

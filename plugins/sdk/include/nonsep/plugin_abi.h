@@ -90,15 +90,18 @@ typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin *
 #define NONSEP_FORM_TTV 0u /* H = T_i V_ij T_j (+ K + U) */
 #define NONSEP_FORM_VVT 1u /* H = V_i T_ij V_j (+ K + U) */
 
-/* The arguments of chin_steps (below): `steps` times a schedule of `substeps` basic steps of eq. (expalg) of every
- * state, in place (kernel version 2; a triplet composition's step is its schedule of 3^levels basic steps). */
+/* The arguments of chin_steps (below), kernel version 3: `steps` times a schedule of `substeps` basic steps of eq.
+ * (expalg) of every state, in place (a triplet composition's step is its schedule of 3^levels basic steps); or, with
+ * `terms` >= 2, `steps` steps of the multi-product expansion of eqs. (mpe43, mpe63): term k = m..1 takes k basic
+ * steps of eps[k-1] = cbrt(dt/k) from the step's start, the result is y_m + sum_{k<m} weights[k-1] (y_k - y_m), and
+ * the next step starts from the outer gradient evaluated at that point (core chin_expansion_stages.hpp). */
 typedef struct nonsep_chin_steps_args {
   uint32_t form;             /* NONSEP_FORM_TTV or NONSEP_FORM_VVT */
   uint32_t instruction_set;  /* index into the metadata's "kernels": {"instruction_sets": [...]} */
   double t1, t2, v0, v1, v2; /* the coefficients of eq. (expalg) */
   const double* eps;         /* cbrt(dt) of each sub-step, for every state; or, with one sub-step, one number for
                                 every state or one per state */
-  size_t eps_count;          /* substeps, or (substeps 1) 1 or count */
+  size_t eps_count;          /* substeps, or (substeps 1) 1 or count; with terms, terms */
   size_t substeps;           /* >= 1: basic steps per step, sub-step s with eps[s] */
   uint64_t steps;            /* >= 1 */
   size_t count;              /* states, in the batch layout */
@@ -107,6 +110,9 @@ typedef struct nonsep_chin_steps_args {
   double* outer_gradient;    /* count*n: in, the outer flows' gradient at the current point (grad V(q) in
                                 TTV, grad T(p) in VVT); out, the same at the final point */
   double* inner_gradient;    /* count*n, scratch */
+  const double* weights;     /* terms numbers c_1..c_m of the expansion; NULL with terms 0 */
+  size_t terms;              /* 0: basic steps; m >= 2: expansion steps (then substeps 1 and eps_count m), whose
+                                outer_gradient out is not at the final point (the host evaluates it anew) */
 } nonsep_chin_steps_args;
 
 typedef struct nonsep_plugin_api {

@@ -297,10 +297,16 @@ class PluginTable {
       if (args->form != NONSEP_FORM_TTV && args->form != NONSEP_FORM_VVT)
         throw std::invalid_argument("chin_steps: form " + std::to_string(args->form) +
                                     " is neither TTV (0) nor VVT (1)");
-      if (!chin_eps_fit(args->eps_count, args->substeps, args->count))
-        throw std::invalid_argument("chin_steps: " + std::to_string(args->eps_count) + " step sizes for " +
-                                    std::to_string(args->substeps) + " sub-steps of " + std::to_string(args->count) +
-                                    " states (expected one per sub-step, or with one sub-step 1 or one per state)");
+      if (args->terms != 0 && (args->terms < 2 || args->weights == nullptr))
+        throw std::invalid_argument("chin_steps: an expansion of " + std::to_string(args->terms) + " terms" +
+                                    (args->weights == nullptr ? " without weights" : "") +
+                                    " (expected 0 for basic steps, or at least 2 terms with their weights)");
+      if (!chin_eps_fit(args->eps_count, args->substeps, args->count, args->terms))
+        throw std::invalid_argument(
+            "chin_steps: " + std::to_string(args->eps_count) + " step sizes for " + std::to_string(args->substeps) +
+            " sub-steps of " + std::to_string(args->count) + " states and " + std::to_string(args->terms) +
+            " expansion terms (expected one per term with terms, else one per sub-step, or with one sub-step 1 or "
+            "one per state)");
       const ChinStepsCall call{args->form == NONSEP_FORM_VVT ? HamiltonianForm::VVT : HamiltonianForm::TTV,
                                ChinCoefficients{args->t1, args->t2, args->v0, args->v1, args->v2},
                                std::span<const double>(args->eps, args->eps_count),
@@ -310,7 +316,8 @@ class PluginTable {
                                std::span<double>(args->q, size),
                                std::span<double>(args->p, size),
                                std::span<double>(args->outer_gradient, size),
-                               std::span<double>(args->inner_gradient, size)};
+                               std::span<double>(args->inner_gradient, size),
+                               std::span<const double>(args->weights, args->terms)};
       if (!ChinKernels<Adapter>::run(args->instruction_set, adapter, call))
         throw std::invalid_argument("chin_steps: instruction set " + std::to_string(args->instruction_set) +
                                     " is not among this plugin's kernels (its metadata lists them)");
