@@ -56,8 +56,9 @@ inline bool eps_per_state(const ChinStepsCall& call) {
   return call.weights.empty() && call.substeps == 1 && call.eps.size() != 1;
 }
 
-// The call's steps for states [first, first + B) of dimension N, in local arrays.
-template <std::size_t N, std::size_t B, Model M>
+// The call's steps for states [first, first + B) of dimension N, in local arrays; Expansion: call.weights is not
+// empty (a separate instantiation, so that the basic steps' code is not shaped by the expansion's).
+template <std::size_t N, std::size_t B, bool Expansion, Model M>
 inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call, std::size_t first) {
   constexpr std::size_t size = B * N;
   std::array<double, size> q, p, outer_gradient, inner_gradient;
@@ -73,7 +74,7 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
   }
   const ChinStepsCall block{call.form, call.coefficients, block_eps,      call.substeps, call.steps, B, q,
                             p,         outer_gradient,    inner_gradient, call.weights};
-  if (call.weights.empty()) {
+  if constexpr (!Expansion) {
     chin_scheduled_stages<size>(model, block);
   } else if constexpr (size <= 128) {  // the expansion's scratch on the stack too (8 KB at most)
     std::array<double, chin_expansion_scratch(size)> scratch;
@@ -88,7 +89,7 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
 }
 
 // The call's steps for states [first, first + states) of dimension n, in the caller's arrays.
-template <Model M>
+template <bool Expansion, Model M>
 inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::size_t n, std::size_t first,
                                 std::size_t states) {
   const std::size_t offset = first * n, size = states * n;
@@ -104,7 +105,7 @@ inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::
                            call.outer_gradient.subspan(offset, size),
                            call.inner_gradient.subspan(offset, size),
                            call.weights};
-  if (call.weights.empty()) {
+  if constexpr (!Expansion) {
     chin_scheduled_stages(model, part);
   } else {
     std::vector<double> scratch(chin_expansion_scratch(size));
@@ -114,34 +115,45 @@ inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::
 
 }  // namespace detail
 
-// The steps of `call` for `model` (its dimension is FixedDimension when that is not 0). Requires the sizes of
-// chin_stages: q, p and both gradients count*n numbers, and chin_eps_fit(call.eps.size(), call.substeps, count,
-// call.weights.size()). Allocates scratch for an expansion's blocks in the caller's arrays (std::bad_alloc).
-template <std::size_t FixedDimension, Model M>
-void chin_kernel_steps(const M& model, const ChinStepsCall& call) {
+// chin_kernel_steps (below) for calls without weights (Expansion false) or with them (true), which the SDK
+// instantiates as separate functions (nonsep/sdk/kernels.hpp).
+template <std::size_t FixedDimension, bool Expansion, Model M>
+void chin_kernel_blocks(const M& model, const ChinStepsCall& call) {
   const std::size_t count = call.count;
   if constexpr (FixedDimension > 0) {
     constexpr std::size_t B = block_states(FixedDimension);
     std::size_t first = 0;
     if constexpr (B > 1)
-      for (; first + B <= count; first += B) detail::chin_steps_in_local_arrays<FixedDimension, B>(model, call, first);
+      for (; first + B <= count; first += B)
+        detail::chin_steps_in_local_arrays<FixedDimension, B, Expansion>(model, call, first);
     // Up to three left over (one trajectory; the rounds of a multi-product expansion's terms): a pair, then one,
     // in local arrays, the pair's two chains interleaved in registers.
     if constexpr (B > 2)
       if (count - first == 2 || count - first == 3) {
-        detail::chin_steps_in_local_arrays<FixedDimension, 2>(model, call, first);
+        detail::chin_steps_in_local_arrays<FixedDimension, 2, Expansion>(model, call, first);
         first += 2;
       }
     if (count - first == 1)
-      detail::chin_steps_in_local_arrays<FixedDimension, 1>(model, call, first);
+      detail::chin_steps_in_local_arrays<FixedDimension, 1, Expansion>(model, call, first);
     else if (first < count)
-      detail::chin_steps_in_place(model, call, FixedDimension, first, count - first);
+      detail::chin_steps_in_place<Expansion>(model, call, FixedDimension, first, count - first);
   } else {
     const std::size_t n = count == 0 ? 0 : call.q.size() / count;
     const std::size_t block = block_states_at_run_time(n);
     for (std::size_t first = 0; first < count; first += block)
-      detail::chin_steps_in_place(model, call, n, first, std::min(block, count - first));
+      detail::chin_steps_in_place<Expansion>(model, call, n, first, std::min(block, count - first));
   }
+}
+
+// The steps of `call` for `model` (its dimension is FixedDimension when that is not 0). Requires the sizes of
+// chin_stages: q, p and both gradients count*n numbers, and chin_eps_fit(call.eps.size(), call.substeps, count,
+// call.weights.size()). Allocates scratch for an expansion's blocks in the caller's arrays (std::bad_alloc).
+template <std::size_t FixedDimension, Model M>
+void chin_kernel_steps(const M& model, const ChinStepsCall& call) {
+  if (call.weights.empty())
+    chin_kernel_blocks<FixedDimension, false>(model, call);
+  else
+    chin_kernel_blocks<FixedDimension, true>(model, call);
 }
 
 }  // namespace nonsep

@@ -1,5 +1,5 @@
 #pragma once
-// The stepping kernels an SDK plugin carries (plugin_abi.h, chin_steps): nonsep::chin_kernel_steps, the core's own
+// The stepping kernels an SDK plugin carries (plugin_abi.h, chin_steps): nonsep::chin_kernel_blocks, the core's own
 // template (nonsep/core/chin_kernel.hpp), instantiated with the plugin's model adapter inlined. No stepping code is
 // written here: this header only compiles that template once per instruction set and picks one by index.
 //
@@ -54,35 +54,42 @@ struct ChinKernels {
   static constexpr std::size_t fixed_dimension =
       HasFixedDimension<typename Adapter::Model> ? dimension_capacity<typename Adapter::Model>() : 0;
 
+  // Each instruction set's kernel twice: for basic steps and for expansions (ChinStepsCall::weights), separate
+  // functions, so that the code of one does not shape the other's (registers, stack frame, layout: the basic steps of
+  // 1024 states ran 15% slower when both were one function).
+  template <bool Expansion>
   [[gnu::flatten]] static void baseline(const Adapter& adapter, const ChinStepsCall& call) {
-    chin_kernel_steps<fixed_dimension>(adapter, call);
+    chin_kernel_blocks<fixed_dimension, Expansion>(adapter, call);
   }
 #if NONSEP_SDK_KERNEL_V3
+  template <bool Expansion>
   [[gnu::target("arch=x86-64-v3"), gnu::flatten]] static void v3(const Adapter& adapter, const ChinStepsCall& call) {
-    chin_kernel_steps<fixed_dimension>(adapter, call);
+    chin_kernel_blocks<fixed_dimension, Expansion>(adapter, call);
   }
 #endif
 #if NONSEP_SDK_KERNEL_V4
+  template <bool Expansion>
   [[gnu::target("arch=x86-64-v4"), gnu::flatten]] static void v4(const Adapter& adapter, const ChinStepsCall& call) {
-    chin_kernel_steps<fixed_dimension>(adapter, call);
+    chin_kernel_blocks<fixed_dimension, Expansion>(adapter, call);
   }
 #endif
 
   static bool run(std::size_t index, const Adapter& adapter, const ChinStepsCall& call) {
+    const bool expansion = !call.weights.empty();
     std::size_t set = 0;
     if (index == set++) {
-      baseline(adapter, call);
+      expansion ? baseline<true>(adapter, call) : baseline<false>(adapter, call);
       return true;
     }
 #if NONSEP_SDK_KERNEL_V3
     if (index == set++) {
-      v3(adapter, call);
+      expansion ? v3<true>(adapter, call) : v3<false>(adapter, call);
       return true;
     }
 #endif
 #if NONSEP_SDK_KERNEL_V4
     if (index == set++) {
-      v4(adapter, call);
+      expansion ? v4<true>(adapter, call) : v4<false>(adapter, call);
       return true;
     }
 #endif
