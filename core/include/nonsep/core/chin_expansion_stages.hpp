@@ -43,7 +43,7 @@ inline void chin_expansion_stages(const M& model, const ChinStepsCall& call, std
   const auto array = [&](std::size_t i) { return scratch.subspan(i * size, size); };
   const std::span<double> start_q = array(0), start_p = array(1), start_gradient = array(2), last_q = array(3),
                           last_p = array(4), term_q = array(5), term_p = array(6), term_gradient = array(7);
-  const auto copy = [size](std::span<const double> from, std::span<double> to) {
+  const auto copy = [&](std::span<const double> from, std::span<double> to) {
     std::copy_n(from.begin(), size, to.begin());
   };
   const std::size_t m = call.weights.size();
