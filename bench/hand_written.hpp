@@ -111,62 +111,6 @@ inline void hand_written_mpe_run(double dt, double t2, const std::vector<double>
   p = y;
 }
 
-// The second derivatives of paper1d: T''(p) = p, V''(q) = 1 + q^2.
-inline double hess_T(double p) { return p; }
-inline double hess_V(double q) { return 1.0 + q * q; }
-
-// `steps` basic steps of `count` trajectories q[b], p[b] with one tangent vector each, (dq[b], dp[b]): each flow's
-// derivative applied at the point the flow starts from (kick: dp -= c eps V''(q) dq; drift: dq += c eps T''(p) dp),
-// and every `renormalize_every` steps the vector normalised with ln |v| added to log_stretch[b] (Benettin's largest
-// Lyapunov exponent: log_stretch / t). V'(q) and V''(q) of a step's last kick are kept for the next step's first.
-// The limit for a run with one Lyapunov vector (analysis.lyapunov, vectors 1): one loop over the states per step.
-inline void hand_written_tangent_run(const HandWrittenStep& c, double* q, double* p, double* dq, double* dp,
-                                     double* log_stretch, std::size_t count, std::uint64_t steps,
-                                     std::uint64_t renormalize_every) {
-  std::vector<double> gradient(count), hessian(count);
-  for (std::size_t b = 0; b < count; ++b) {
-    gradient[b] = grad_V(q[b]);
-    hessian[b] = hess_V(q[b]);
-  }
-  for (std::uint64_t k = 0; k < steps; ++k) {
-    for (std::size_t b = 0; b < count; ++b) {
-      double x = q[b], y = p[b], u = dq[b], w = dp[b], g = gradient[b], h = hessian[b];
-      const auto kick = [&](double v) {
-        y += v * g;
-        w += v * h * u;
-      };
-      const auto drift = [&](double t) {
-        x += t * grad_T(y);
-        u += t * hess_T(y) * w;
-        g = grad_V(x);
-        h = hess_V(x);
-      };
-      kick(c.v2);
-      drift(c.t2);
-      kick(c.v1);
-      drift(c.t1);
-      kick(c.v0);
-      drift(c.t1);
-      kick(c.v1);
-      drift(c.t2);
-      kick(c.v2);
-      q[b] = x;
-      p[b] = y;
-      dq[b] = u;
-      dp[b] = w;
-      gradient[b] = g;
-      hessian[b] = h;
-    }
-    if ((k + 1) % renormalize_every == 0)
-      for (std::size_t b = 0; b < count; ++b) {
-        const double norm = std::sqrt(dq[b] * dq[b] + dp[b] * dp[b]);
-        log_stretch[b] += std::log(norm);
-        dq[b] /= norm;
-        dp[b] /= norm;
-      }
-  }
-}
-
 // `steps` basic steps of `count` trajectories q[b], p[b], in place; g[b] holds V'(q[b]) (set here). The states
 // are independent: one loop over them per step, nine stages each, which the compiler vectorizes at the SIMD
 // width it is allowed (SSE2 by default, AVX2 and FMA with -march=native).
@@ -222,6 +166,54 @@ inline void hand_written_run_staged(const HandWrittenStep& c, double* q, double*
     }
   };
   for (std::uint64_t k = 0; k < steps; ++k) basic_step_stages(c, kick, drift);
+}
+
+// The second derivatives of paper1d: T''(p) = p, V''(q) = 1 + q^2.
+inline double hess_T(double p) { return p; }
+inline double hess_V(double q) { return 1.0 + q * q; }
+
+// `steps` basic steps of `count` trajectories q[b], p[b] with one tangent vector each, (dq[b], dp[b]): each flow's
+// derivative applied at the point the flow starts from (kick: dp -= c eps V''(q) dq; drift: dq += c eps T''(p) dp),
+// and every `renormalize_every` steps the vector normalised with ln |v| added to log_stretch[b] (Benettin's largest
+// Lyapunov exponent: log_stretch / t). V'(q) and V''(q) of a step's last kick are kept for the next step's first.
+// The limit for a run with one Lyapunov vector (analysis.lyapunov, vectors 1): one loop over the states per step.
+inline void hand_written_tangent_run(const HandWrittenStep& c, double* q, double* p, double* dq, double* dp,
+                                     double* log_stretch, std::size_t count, std::uint64_t steps,
+                                     std::uint64_t renormalize_every) {
+  std::vector<double> gradient(count), hessian(count);
+  for (std::size_t b = 0; b < count; ++b) {
+    gradient[b] = grad_V(q[b]);
+    hessian[b] = hess_V(q[b]);
+  }
+  for (std::uint64_t k = 0; k < steps; ++k) {
+    for (std::size_t b = 0; b < count; ++b) {
+      double x = q[b], y = p[b], u = dq[b], w = dp[b], g = gradient[b], h = hessian[b];
+      const auto kick = [&](double v) {
+        y += v * g;
+        w += v * h * u;
+      };
+      const auto drift = [&](double t) {
+        x += t * grad_T(y);
+        u += t * hess_T(y) * w;
+        g = grad_V(x);
+        h = hess_V(x);
+      };
+      basic_step_stages(c, kick, drift);
+      q[b] = x;
+      p[b] = y;
+      dq[b] = u;
+      dp[b] = w;
+      gradient[b] = g;
+      hessian[b] = h;
+    }
+    if ((k + 1) % renormalize_every == 0)
+      for (std::size_t b = 0; b < count; ++b) {
+        const double norm = std::sqrt(dq[b] * dq[b] + dp[b] * dp[b]);
+        log_stretch[b] += std::log(norm);
+        dq[b] /= norm;
+        dp[b] /= norm;
+      }
+  }
 }
 
 }  // namespace bench
