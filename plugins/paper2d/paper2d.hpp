@@ -18,7 +18,7 @@
 // Not integrable. At coupling 0.2, MEGNO and the largest Lyapunov exponent find regular orbits (<Y> -> 2,
 // exponent decaying like log(t)/t) next to chaotic ones (<Y> growing like lambda t/2, lambda ~ 0.2) at the same
 // energy, e.g. q = (0.25, 0.3), p = (-1.5, 0.2) (regular, H = 6.75) and q = (-0.75, 0.3), p = (-1.5, 0.2)
-// (chaotic, H = 7.49); tests/core/test_dynamics_chaos.cpp checks both against an independent reference.
+// (chaotic, H = 7.49); tests/core/test_chaos_against_reference.cpp checks both against an independent reference.
 // Defined everywhere. Analytic gradients and Hessians (the tangent maps of the Lyapunov and MEGNO diagnostics
 // evaluate the Hessians 8 times per basic step; automatic differentiation checks them in tests/plugins).
 #include <nonsep/plugin_sdk.hpp>

@@ -197,7 +197,7 @@ using std::tan;
 using std::tanh;
 
 // The derivatives whose special cases are rules of their own, written once for the dual numbers below and for the
-// gradients nonsep writes for formula models (formulas.md in the documentation), for double and duals alike:
+// gradients nonsep writes for formula models (docs/formula-models.md), for double and duals alike:
 //   log_derivative(x)     1/x, NaN below 0 (where log is NaN: 1/x would pretend a derivative exists there)
 //   log1p_derivative(x)   1/(1 + x), NaN below -1 (as for log)
 //   abs_derivative(x)     sign(x), NaN at 0 (|x| has no derivative there: a trajectory reaching it diverges)
