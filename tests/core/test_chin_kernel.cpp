@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -23,18 +24,31 @@ using nonsep::testing::VariableMass2D;
 
 namespace {
 
-// Model M with a kernel: chin_kernel_steps<FixedDimension> when `available`, counting the calls that used it.
-// `fail_at_call`: that call (1-based) throws ModelError instead, as a plugin's kernel failing partway does.
-template <class M, std::size_t FixedDimension>
+// Model M with a kernel: chin_kernel_steps<FixedDimension> of Kernel (M's own arithmetic unless given) when
+// `available`, counting the calls that took steps (calls) and those of no steps, which only evaluate the gradient
+// the steps start from (gradient_calls). `fail_at_call`: that call with steps (1-based) throws ModelError instead,
+// as a plugin's kernel failing partway does.
+template <class M, std::size_t FixedDimension, class Kernel = M>
 struct WithKernel : M {
   bool available = true;
   int fail_at_call = 0;
-  mutable int calls = 0;
+  mutable int calls = 0, gradient_calls = 0;
   bool chin_steps(const ChinStepsCall& call) const {
     if (!available) return false;
-    if (++calls == fail_at_call) throw ModelError("the kernel failed");
-    chin_kernel_steps<FixedDimension>(static_cast<const M&>(*this), call);
+    if (call.steps == 0)
+      ++gradient_calls;
+    else if (++calls == fail_at_call)
+      throw ModelError("the kernel failed");
+    chin_kernel_steps<FixedDimension>(Kernel{}, call);
     return true;
+  }
+};
+
+// Paper1D whose grad V rounds as a kernel compiled with fused multiply-adds may: q + q^3/3 in one rounding of the
+// sum, where the evaluation path rounds q^3/3 first.
+struct FusedPaper1D : Paper1D {
+  void grad_V(std::span<const double> q, std::span<double> out, std::size_t count) const {
+    for (std::size_t b = 0; b < count; ++b) out[b] = std::fma(q[b] * q[b], q[b] / 3.0, q[b]);
   }
 };
 static_assert(ModelWithChinSteps<WithKernel<Paper1D, 1>>);
@@ -91,6 +105,32 @@ TEST_CASE("kernel path: every Chin scheme and form gives the evaluation path's n
         check_scheme<Coupled2D, 2>(scheme, form, count, order);
         check_scheme<Coupled2D, 0>(scheme, form, count, order);  // the dimension known at run time: the caller's arrays
       }
+}
+
+TEST_CASE("kernel path: steps started again from their states give the numbers of steps that never stopped") {
+  // The kernel rounds differently from the evaluation path (a wider instruction set's fused multiply-adds): a run
+  // restarted from its states with a fresh integrator (a resume from a checkpoint) must start from the kernel's
+  // gradient, not the evaluation path's, to continue bit for bit.
+  for (const auto& [scheme, order] :
+       {std::pair{"basic", Fraction(2, 3)}, std::pair{"triplet", Fraction(4, 3)}, std::pair{"mpe", Fraction(4, 3)}})
+    for (const auto form : forms) {
+      CAPTURE(scheme);
+      CAPTURE(static_cast<int>(form));
+      WithKernel<Paper1D, 1, FusedPaper1D> kernel{};
+      IntegratorSpec spec{scheme, order};
+      spec.form = form;
+      const auto start = spread_states(1, 37);
+      auto whole = start, restarted = start, evaluation_path = start;
+      Integrator(spec).step_n(kernel, whole, 0.01, 40);
+      for (int chunk = 0; chunk < 4; ++chunk) {
+        Integrator fresh(spec);
+        fresh.step_n(kernel, restarted, 0.01, 10);
+        CHECK(kernel.gradient_calls > 0);
+      }
+      Integrator(spec).step_n(Paper1D{}, evaluation_path, 0.01, 40);
+      CHECK(restarted == whole);
+      CHECK_FALSE(evaluation_path == whole);  // the kernel does round differently: the check above can fail
+    }
 }
 
 TEST_CASE("kernel path: a run of mpe steps is one kernel call, each step the expansion of MultiProductExpansion") {

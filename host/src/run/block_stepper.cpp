@@ -24,6 +24,16 @@ void BlockStepper::watch_step(Block& block, std::size_t index, Worker& worker, s
 
 void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker, std::uint64_t from,
                                  std::uint64_t to) {
+  // Through the kernel, the chunk starts from the kernel's gradient at the block's point, kept by begin_chunk: a redo
+  // after a failure starts from it whether or not the integrator had it before (a run just restored from its
+  // checkpoint has none), as a run that never stopped does.
+  if (step_watchers.empty() && !block.tangents) {
+    try {
+      block.integrator.prime(worker.stepping, block.batch);
+    } catch (const ModelError&) {
+      // The model fails there: it fails again in the chunk's steps, which the redo below isolates.
+    }
+  }
   block.begin_chunk();
   for (StepObserver* watcher : step_watchers) watcher->save_block(view(block, index, worker));
   const double dt = time.dt;

@@ -19,7 +19,10 @@
 // on q in TTV, grad T on p in VVT). The last outer gradient of a step is kept with a copy of the point it was
 // evaluated at and reused by the next step when the state still holds that point bit for bit, whatever the
 // new dt. A run of steps therefore costs 4 grad T + 4 grad V evaluations per step, plus one at the start. step_n()
-// takes n steps in one call and compares and copies the point once for all of them instead of once per step.
+// takes n steps in one call and compares and copies the point once for all of them instead of once per step. The one
+// at the start is evaluated by the code that takes the steps: a model's kernel (below) when the steps go there, so
+// that a run started again from a state (a checkpoint, a chunk) gives the numbers of steps that never stopped even
+// where the kernel rounds differently from the evaluation path (a wider instruction set, fused multiply-adds).
 //
 // Stage observers: step() takes an optional observer, called after each of the nine flows as
 //   observe(FlowStage{kick, coefficient}, eps, x)
@@ -190,17 +193,14 @@ class ChinBasicStep {
     }
   }
 
-  // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached).
+  // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached). A model with a kernel
+  // (ModelWithChinSteps) evaluates it there, in a call of no steps (chin_stages.hpp): the gradient the kernel's steps
+  // start from is then the one its own steps would have left, bit for bit, so steps started again from a state
+  // (after a checkpoint, a new chunk, a multi-product expansion's combined point) give the numbers of steps that
+  // never stopped, on any instruction set. The evaluation path evaluates it through the model's gradient.
   template <Model M>
   void prime(const M& model, const PhaseSpaceBatch& x) {
-    const bool ttv = form_ == HamiltonianForm::TTV;
-    std::span<const double> inner = ttv ? x.q() : x.p();
-    if (cache_valid_ && cached_at_.size() == inner.size() && same_bits(cached_at_, inner)) return;
-    cache_valid_ = false;
-    outer_gradient_.resize(inner.size());
-    evaluate(model, ttv, inner, outer_gradient_, x.count());
-    cached_at_.assign(inner.begin(), inner.end());
-    cache_valid_ = true;
+    prime_for(model, x, true);
   }
 
   // The first-same-as-last gradient and the point it belongs to, for wrappers that restart from a saved state
@@ -232,19 +232,34 @@ class ChinBasicStep {
   // One basic step of every state; eps_ holds eps = cbrt(dt), one for all states or one per state.
   template <Model M, class StageObserver>
   void advance(const M& model, PhaseSpaceBatch& x, StageObserver& observe) {
-    begin_steps(model, x);
+    begin_steps(model, x, std::is_same_v<std::decay_t<StageObserver>, NoStageObserver>);
     stages(model, x, observe, 1);
     end_steps(x);
+  }
+
+  // prime(); `through_kernel` false when the steps that follow go through the evaluation path (a stage observer
+  // watches them), which then evaluates their first gradient too.
+  template <Model M>
+  void prime_for(const M& model, const PhaseSpaceBatch& x, bool through_kernel) {
+    const bool ttv = form_ == HamiltonianForm::TTV;
+    std::span<const double> inner = ttv ? x.q() : x.p();
+    if (cache_valid_ && cached_at_.size() == inner.size() && same_bits(cached_at_, inner)) return;
+    cache_valid_ = false;
+    outer_gradient_.resize(inner.size());
+    cached_at_.assign(inner.begin(), inner.end());
+    if (!through_kernel || !kernel_gradient(model, x.count()))
+      evaluate(model, ttv, cached_at_, outer_gradient_, x.count());
+    cache_valid_ = true;
   }
 
   // Before a run of steps: the outer gradient at x's point at hand, the work arrays sized. The gradient is
   // overwritten from the first inner flow on: should the model throw before the run's last evaluation, the cache
   // must not claim it belongs to any point.
   template <Model M>
-  void begin_steps(const M& model, const PhaseSpaceBatch& x) {
+  void begin_steps(const M& model, const PhaseSpaceBatch& x, bool through_kernel = true) {
     const std::size_t size = x.size();
     if (inner_gradient_.size() != size) inner_gradient_.resize(size);
-    prime(model, x);
+    prime_for(model, x, through_kernel);
     cache_valid_ = false;
   }
   // After it: the outer gradient belongs to x's inner variable, for the next step's first flow.
@@ -325,6 +340,27 @@ class ChinBasicStep {
     return root;
   }
 
+  // The outer gradient at cached_at_ (count states) into outer_gradient_ by the model's kernel, when it has one: a call
+  // of no steps, whose other variable (p in TTV, q in VVT) is scratch it leaves alone. Returns false without one.
+  template <Model M>
+  bool kernel_gradient(const M& model, std::size_t count) {
+    if constexpr (!ModelWithChinSteps<M>) {
+      return false;
+    } else {
+      const std::size_t size = cached_at_.size();
+      if (inner_gradient_.size() != size) inner_gradient_.resize(size);
+      if (other_variable_.size() != size) other_variable_.resize(size);
+      static constexpr double unused_eps[1] = {1.0};  // a call of no steps takes none
+      const bool ttv = form_ == HamiltonianForm::TTV;
+      const std::span<double> at(cached_at_), other(other_variable_);
+      const ChinStepsCall call{
+          form_, c_, unused_eps, 1, 0, count, ttv ? at : other, ttv ? other : at, outer_gradient_, inner_gradient_, {}};
+      if (!model.chin_steps(call)) return false;
+      (ttv ? evaluations_.grad_V : evaluations_.grad_T) += count;
+      return true;
+    }
+  }
+
   template <Model M>
   void evaluate(const M& model, bool potential, std::span<const double> at, std::span<double> out, std::size_t count) {
     chin_gradient(CountedModel<M>{model, evaluations_}, potential, at, out, count);
@@ -334,9 +370,10 @@ class ChinBasicStep {
   ChinCoefficients c_;
   EvaluationCounts evaluations_;
   AlignedDoubles outer_gradient_, inner_gradient_, cached_at_;  // streamed through by every stage
-  bool cache_valid_ = false;                                    // outer_gradient_ is the outer gradient at cached_at_
-  std::vector<double> eps_;   // cbrt(dt): one entry, one per state, or one per sub-step of a schedule
-  std::size_t substeps_ = 1;  // basic steps per step: eps_.size() for a schedule (step_schedule_n), else 1
+  AlignedDoubles other_variable_;  // kernel_gradient's scratch for the variable the outer gradient does not depend on
+  bool cache_valid_ = false;       // outer_gradient_ is the outer gradient at cached_at_
+  std::vector<double> eps_;        // cbrt(dt): one entry, one per state, or one per sub-step of a schedule
+  std::size_t substeps_ = 1;       // basic steps per step: eps_.size() for a schedule (step_schedule_n), else 1
   std::array<std::pair<double, double>, 4> roots_{};  // (dt, cbrt(dt)); dt = 0 never asked (check_step_size)
   std::size_t next_root_ = 0;
 };

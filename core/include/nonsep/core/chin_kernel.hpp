@@ -40,8 +40,9 @@ namespace nonsep {
 // The version of what a kernel computes (the ChinStepsCall it takes, chin_stages' flows): a plugin records the
 // version it was compiled from, and a host whose core has another one steps that plugin through its evaluations.
 // Version 2: a call carries a schedule of sub-steps (ChinStepsCall::substeps). Version 3: a call may carry a
-// multi-product expansion's weights (ChinStepsCall::weights).
-inline constexpr std::uint64_t chin_kernel_version = 3;
+// multi-product expansion's weights (ChinStepsCall::weights). Version 4: a call of no steps evaluates the outer
+// gradient at the call's point (ChinStepsCall::steps).
+inline constexpr std::uint64_t chin_kernel_version = 4;
 
 // States per block of local arrays for a fixed dimension: 32 states, at most 128 numbers of each array (the four
 // arrays then take 4 KB of the first-level cache), one state from dimension 128 on.

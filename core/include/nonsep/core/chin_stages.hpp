@@ -87,6 +87,11 @@ inline void chin_gradient(const M& model, bool potential, std::span<const double
 //   weights   empty: basic steps; m >= 2 entries: each step is the m-term expansion of MultiProductExpansion
 //             (multi_product_expansion.hpp), weights[k-1] = c_k, substeps 1 (chin_expansion_stages.hpp). After the
 //             call's last step the outer gradient is not that of the combined point: the caller evaluates it anew.
+//   steps     0: no step; the call only evaluates outer_gradient at the point (q in TTV, p in VVT), leaving q and p
+//             as they are (chin_outer_gradient below). This is how ChinBasicStep asks a kernel for the gradient its
+//             steps start from, so that every gradient a kernel's steps use is evaluated by the kernel's own code:
+//             a run restarted from its states (a checkpoint, a chunk started again) then gives the numbers of the
+//             run it continues, whichever instruction set the kernel was compiled for.
 //   the rest  chin_stages' arguments
 struct ChinStepsCall {
   HamiltonianForm form;
@@ -118,6 +123,16 @@ template <class M>
 concept ModelWithChinSteps = Model<M> && requires(const M& m, const ChinStepsCall& call) {
   { m.chin_steps(call) } -> std::same_as<bool>;
 };
+
+// A call of no steps (ChinStepsCall::steps 0): the outer gradient at the call's point into call.outer_gradient; returns
+// whether it was one (the callers below then do nothing else).
+template <Model M>
+inline bool chin_outer_gradient(const M& model, const ChinStepsCall& call) {
+  if (call.steps != 0) return false;
+  const bool ttv = call.form == HamiltonianForm::TTV;
+  chin_gradient(model, ttv, ttv ? call.q : call.p, call.outer_gradient, call.count);
+  return true;
+}
 
 // StaticSize, when not 0, is q's size known at compile time (a kernel's block in local arrays): the flows' loops then
 // have a constant trip count, unroll, and keep a small state in registers.
@@ -177,10 +192,11 @@ inline void chin_stages(const M& model, HamiltonianForm form, const ChinCoeffici
   }
 }
 
-// The steps of `call` (requires chin_eps_fit(call.eps.size(), call.substeps, call.count) and chin_stages' sizes).
-// StaticSize as for chin_stages.
+// The steps of `call` (requires chin_eps_fit(call.eps.size(), call.substeps, call.count) and chin_stages' sizes), or
+// with no steps the outer gradient alone (chin_outer_gradient). StaticSize as for chin_stages.
 template <std::size_t StaticSize = 0, Model M>
 inline void chin_scheduled_stages(const M& model, const ChinStepsCall& call) {
+  if (chin_outer_gradient(model, call)) return;
   if (call.substeps == 1) {
     chin_stages<StaticSize>(model, call.form, call.coefficients, call.eps, call.steps, call.count, call.q, call.p,
                             call.outer_gradient, call.inner_gradient);

@@ -90,11 +90,13 @@ typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin *
 #define NONSEP_FORM_TTV 0u /* H = T_i V_ij T_j (+ K + U) */
 #define NONSEP_FORM_VVT 1u /* H = V_i T_ij V_j (+ K + U) */
 
-/* The arguments of chin_steps (below), kernel version 3: `steps` times a schedule of `substeps` basic steps of eq.
+/* The arguments of chin_steps (below), kernel version 4: `steps` times a schedule of `substeps` basic steps of eq.
  * (expalg) of every state, in place (a triplet composition's step is its schedule of 3^levels basic steps); or, with
  * `terms` >= 2, `steps` steps of the multi-product expansion of eqs. (mpe43, mpe63): term k = m..1 takes k basic
  * steps of eps[k-1] = cbrt(dt/k) from the step's start, the result is y_m + sum_{k<m} weights[k-1] (y_k - y_m), and
- * the next step starts from the outer gradient evaluated at that point (core chin_expansion_stages.hpp). */
+ * the next step starts from the outer gradient evaluated at that point (core chin_expansion_stages.hpp). With
+ * `steps` 0 the call only evaluates outer_gradient at the point, q and p left as they are: the host asks the kernel
+ * for the gradient its steps start from, so that every gradient the steps use comes from the kernel's own code. */
 typedef struct nonsep_chin_steps_args {
   uint32_t form;             /* NONSEP_FORM_TTV or NONSEP_FORM_VVT */
   uint32_t instruction_set;  /* index into the metadata's "kernels": {"instruction_sets": [...]} */
@@ -103,7 +105,7 @@ typedef struct nonsep_chin_steps_args {
                                 every state or one per state */
   size_t eps_count;          /* substeps, or (substeps 1) 1 or count; with terms, terms */
   size_t substeps;           /* >= 1: basic steps per step, sub-step s with eps[s] */
-  uint64_t steps;            /* >= 1 */
+  uint64_t steps;            /* >= 1; 0: only the outer gradient at the point (above) */
   size_t count;              /* states, in the batch layout */
   double* q;                 /* count*n, advanced in place */
   double* p;                 /* count*n, advanced in place */
