@@ -10,10 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "host_test_support.hpp"
+#include "formula_test_support.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host_testing;
+using namespace nonsep::formula_testing;
 namespace fs = std::filesystem;
 
 struct Malformed {
@@ -21,68 +22,6 @@ struct Malformed {
   std::size_t column;
 };
 extern const std::vector<Malformed> malformed_formulas;  // test_formula_parser.cpp
-
-namespace {
-
-// Sets an environment variable for its lifetime, then restores the previous value.
-class Environment {
- public:
-  Environment(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    ::setenv(name, value.c_str(), 1);
-  }
-  ~Environment() {
-    if (old_)
-      ::setenv(name_, old_->c_str(), 1);
-    else
-      ::unsetenv(name_);
-  }
-  Environment(const Environment&) = delete;
-  Environment& operator=(const Environment&) = delete;
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
-
-json paper1d_formula(const std::string& name) {
-  return {{"name", name}, {"T", "p0 + p0^3/6"}, {"V", "q0^2/2 + q0^4/12"}};
-}
-
-json job_with(json model) {
-  return {{"model", std::move(model)},
-          {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}}},
-          {"initial", {{{"q", {0.5}}, {"p", {0.25}}}, {{"q", {-1.0}}, {"p", {0.75}}}}},
-          {"time", {{"dt", 0.01}, {"steps", 300}}},
-          {"output", {{"every", 0}}}};
-}
-
-// A stand-in compiler: `--version` prints one line; otherwise it appends a line to FAKE_LOG, waits FAKE_SLEEP
-// seconds and copies the shipped paper1d.so to the -o argument (or fails, with FAKE_FAIL set).
-fs::path write_fake_compiler(const TemporaryFolder& folder) {
-  const fs::path script = folder / "fake-c++";
-  write_text(script,
-             "#!/bin/sh\n"
-             "if [ \"$1\" = --version ]; then echo 'fake compiler 1'; exit 0; fi\n"
-             "echo call >> \"$FAKE_LOG\"\n"
-             "if [ -n \"$FAKE_FAIL\" ]; then echo 'model.cpp:1:1: error: fake failure' >&2; exit 1; fi\n"
-             "sleep \"${FAKE_SLEEP:-0}\"\n"
-             "out=''; previous=''\n"
-             "for a in \"$@\"; do [ \"$previous\" = -o ] && out=\"$a\"; previous=\"$a\"; done\n"
-             "cp '" NONSEP_SHIPPED_PLUGIN_DIR "/paper1d.so' \"$out\"\n");
-  fs::permissions(script, fs::perms::owner_all);
-  return script;
-}
-
-std::size_t count_lines(const fs::path& file) {
-  if (!fs::exists(file)) return 0;
-  const std::string text = read_text(file);
-  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
-}
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-}  // namespace
 
 TEST_CASE("formula commands: each malformed formula exits 2 from validate, quoting it with a caret at its column") {
   TemporaryFolder folder;

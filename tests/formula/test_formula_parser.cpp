@@ -124,6 +124,22 @@ TEST_CASE("formula parser: nesting beyond the limit and over-long text are refus
   std::string calls;
   for (int i = 0; i < 200; ++i) calls += "sin(";
   CHECK(error_of(calls + "q0").found.find("nesting deeper") != std::string::npos);
+  // Exactly max_formula_depth levels of each kind pass, one more is refused (the limit docs/formula-models.md names).
+  const auto levels = [](const std::string& open, const std::string& inner, const std::string& close, std::size_t n) {
+    std::string text;
+    for (std::size_t i = 0; i < n; ++i) text += open;
+    text += inner;
+    for (std::size_t i = 0; i < n; ++i) text += close;
+    return text;
+  };
+  for (const auto& [open, close] : std::vector<std::pair<std::string, std::string>>{
+           {"(", ")"}, {"sin(", ")"}, {"-", ""}, {"q0^", ""}, {"(-", ")"}}) {
+    CAPTURE(open);
+    const std::size_t per = open == "(-" ? 2 : 1;
+    CHECK(std::holds_alternative<Node>(parse_formula(levels(open, "q0", close, max_formula_depth / per), q_symbols)));
+    CHECK(error_of(levels(open, "q0", close, max_formula_depth / per + 1)).found ==
+          "nesting deeper than " + std::to_string(max_formula_depth) + " levels");
+  }
   std::string nested = "q0";
   for (int i = 0; i < 20; ++i) nested = "(" + nested + " + 1)";
   CHECK(tree_of(nested).kind == Node::Kind::sum);

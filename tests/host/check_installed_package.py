@@ -1,8 +1,10 @@
 """The installed package is self-contained and relocatable: `cmake --install` of the build into a temporary
 prefix, which is then moved to another folder under another name; the moved copy, with NONSEP_PLUGIN_PATH unset,
 finds its own plugins, names its own manual in --help, writes example jobs that validate against its plugins,
-and its executable holds no path of the build tree (a byte search of the whole file, which finds everything
-`strings` would).
+its executable holds no path of the build tree (a byte search of the whole file, which finds everything
+`strings` would), and a formula model compiled by the build tree's nonsep is found in the cache by the installed
+one (the cache key is what determines the plugin, not where the headers are; a stand-in compiler that copies the
+installed paper1d.so keeps the check fast).
 
     check_installed_package.py --cmake CMAKE --build BUILD_DIR
 """
@@ -14,6 +16,31 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+
+def check_shared_formula_cache(build_nonsep, installed_nonsep, plugin, folder, environment, expect):
+    fake = folder / "fake-c++"
+    log = folder / "compiles.log"
+    fake.write_text("#!/bin/sh\n"
+                    "if [ \"$1\" = --version ]; then echo 'fake compiler 1'; exit 0; fi\n"
+                    f"echo call >> '{log}'\n"
+                    "out=''; previous=''\n"
+                    "for a in \"$@\"; do [ \"$previous\" = -o ] && out=\"$a\"; previous=\"$a\"; done\n"
+                    f"cp '{plugin}' \"$out\"\n")
+    fake.chmod(0o700)
+    cache_environment = dict(environment, NONSEP_CXX=str(fake), NONSEP_CACHE_DIR=str(folder / "formula-cache"))
+    job = folder / "formula.json"
+    job.write_text(json.dumps({
+        "model": {"formula": {"name": "paper1d", "T": "p0 + p0^3/6", "V": "q0^2/2 + q0^4/12"}},
+        "integrator": {"scheme": "triplet", "order": "4/3", "t2": -2.0},
+        "initial": {"q": [0.5], "p": [0.25]}, "time": {"dt": 0.01, "steps": 10}, "output": {"every": 0}}))
+    for executable, output in ((build_nonsep, "by-build"), (installed_nonsep, "by-install")):
+        result = subprocess.run([str(executable), "run", "--quiet", "-o", str(folder / output), str(job)],
+                                cwd=folder, env=cache_environment, capture_output=True, text=True)
+        expect(result.returncode == 0, f"{executable} run formula.json: exit {result.returncode}: {result.stderr}")
+    calls = log.read_text().count("call") if log.exists() else 0
+    expect(calls == 1, f"the formula was compiled {calls} times by the build tree's and the installed nonsep, "
+           "expected once (one cache entry for both)")
 
 
 def main():
@@ -75,6 +102,9 @@ def main():
         for example in ["examples/jobs/ensemble.json", "examples/paper/figure1.json"]:
             validated = nonsep("validate", str(share / example))
             expect(validated.returncode == 0, f"nonsep validate {example}: {validated.stderr}")
+
+        check_shared_formula_cache(arguments.build / "bin" / "nonsep", executable, plugins / "paper1d.so", folder,
+                                   environment, expect)
 
         binary = executable.read_bytes()
         for tree in sorted({arguments.build.resolve(), arguments.build.absolute()}):

@@ -40,6 +40,24 @@ TEST_CASE("an output folder that cannot be created is invalid input: exit 2") {
   CHECK(result.err.find("blocker") != std::string::npos);
 }
 
+TEST_CASE("an empty --output is an error (exit 2), not the default folder, for run, example and model compile") {
+  TemporaryFolder folder;
+  json job = quickstart_job();
+  job.erase("output");
+  const auto file = write_job(folder / "orbit.json", job);
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"run", "--quiet", "--output", "", file.string()},
+        std::vector<std::string>{"run", "--quiet", "-o", "", file.string()},
+        std::vector<std::string>{"example", "--output", ""},
+        std::vector<std::string>{"model", "compile", file.string(), "-o", ""}}) {
+    CAPTURE(command[0]);
+    const auto result = run_nonsep(command, folder.path());
+    CHECK(result.status == 2);
+    CHECK(result.err.find("an empty path names no file or folder") != std::string::npos);
+  }
+  CHECK(!std::filesystem::exists(folder / "orbit.out"));
+}
+
 TEST_CASE("validate checks without running, errors go to stderr with exit 2") {
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", quickstart_job());

@@ -151,6 +151,9 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     throw CheckpointError("nothing to resume: there is no " + path.string() +
                           " (a run saves one when interrupted and as /checkpoint says; a completed run removes it)");
   json document;
+  // nlohmann's lexer takes a NUL byte for the end of the input: what follows one would be ignored unread.
+  if (const std::size_t nul = text->find('\0'); nul != std::string::npos)
+    reader(path).damaged("a NUL byte at byte offset " + std::to_string(nul) + " (counted from 0): JSON holds none");
   try {
     document = json::parse(*text);
   } catch (const json::exception& error) {

@@ -18,6 +18,19 @@ namespace nonsep::host {
 
 using namespace cli;
 
+namespace {
+
+// An empty path names no file or folder: `--output ""` (an unset variable in a script) is refused, not taken for
+// no --output at all.
+const CLI::Validator non_empty_path(
+    [](const std::string& path) {
+      return path.empty() ? std::string("an empty path names no file or folder; give a path, or leave --output out")
+                          : std::string();
+    },
+    "PATH");
+
+}  // namespace
+
 int run_command_line(int argc, char** argv) {
   try {
     CLI::App app{"nonsep " NONSEP_VERSION
@@ -43,7 +56,8 @@ int run_command_line(int argc, char** argv) {
         "study (/study): convergence.csv, work_precision.csv, and summary.json with the fitted exponents");
     run->add_option("JOB.json", arguments.job_file, "the job file")->required();
     run->add_option("--output,-o", arguments.output,
-                    "output folder, relative to the current directory (overrides the job's output.directory)");
+                    "output folder, relative to the current directory (overrides the job's output.directory)")
+        ->check(non_empty_path);
     run->add_flag("--quiet,-q", arguments.quiet, "no progress bar and no completion line");
     run->add_flag("--resume", arguments.resume,
                   "continue an interrupted run from checkpoint.json in its output folder; the outputs end as those of "
@@ -103,7 +117,8 @@ int run_command_line(int argc, char** argv) {
         "Write a starting job file: the quickstart job, or the example NAME (see --list), to standard "
         "output or FILE; it passes `nonsep validate` as written");
     example->add_option("NAME", example_arguments.name, "the example (default: quickstart)");
-    example->add_option("--output,-o", example_arguments.output, "the file to write (never overwritten)");
+    example->add_option("--output,-o", example_arguments.output, "the file to write (never overwritten)")
+        ->check(non_empty_path);
     example->add_flag("--list", example_arguments.list, "list the examples, one line each")
         ->excludes(example->get_option("NAME"))
         ->excludes(example->get_option("--output"));
@@ -121,7 +136,8 @@ int run_command_line(int argc, char** argv) {
     auto* compile = model->add_subcommand(
         "compile", "Compile a formula model file into a plugin NAME.so (NAME: the model's \"name\")");
     compile->add_option("FILE", model_arguments.model_file, "the model file (JSON: T, V, parameters)")->required();
-    compile->add_option("--output,-o", model_arguments.output, "the plugin file (default ./NAME.so)");
+    compile->add_option("--output,-o", model_arguments.output, "the plugin file (default ./NAME.so)")
+        ->check(non_empty_path);
     compile->add_flag("--print-source", model_arguments.print_source,
                       "print the C++ written from the formulas instead of compiling it");
     compile->footer(exit_status_text());

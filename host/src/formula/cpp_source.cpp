@@ -71,19 +71,34 @@ std::string emit(const Node& node, char letter) {
   return {};
 }
 
+std::size_t node_count(const Node& tree) {
+  std::size_t count = 1;
+  for (const auto& operand : tree.operands) count += node_count(operand);
+  return count;
+}
+
 // The gradient of `tree` as a template over the number type (the SDK differentiates it for the Hessians and the
-// third derivatives), one line per component: d tree / d x_i written from derivative(), 0 where it is zero.
+// third derivatives), one line per component: d tree / d x_i written from derivative(), 0 where it is zero. Nothing
+// when the written gradient would outgrow the tree (gradient_is_written): the SDK then differentiates the function
+// itself.
 std::string gradient(const char* function, const Node& tree, char letter, std::size_t dimension) {
+  std::vector<std::optional<Node>> components;
+  for (std::size_t i = 0; i < dimension; ++i) components.push_back(derivative(tree, i));
+  if (!gradient_is_written(tree, components)) return "";
   std::string text = std::string("  template <class S>\n  void ") + function +
                      "([[maybe_unused]] nonsep::sdk::Vector<S> " + letter + ", std::span<S> out) const {\n";
-  for (std::size_t i = 0; i < dimension; ++i) {
-    const auto d = derivative(tree, i);
-    text += "    out[" + std::to_string(i) + "] = S(" + (d ? emit(*d, letter) : "0.0") + ");\n";
-  }
+  for (std::size_t i = 0; i < dimension; ++i)
+    text += "    out[" + std::to_string(i) + "] = S(" + (components[i] ? emit(*components[i], letter) : "0.0") + ");\n";
   return text + "  }\n";
 }
 
 }  // namespace
+
+bool gradient_is_written(const Node& tree, const std::vector<std::optional<Node>>& components) {
+  std::size_t written = 0;
+  for (const auto& component : components) written += component ? node_count(*component) : 1;
+  return written <= max_gradient_growth * node_count(tree) + max_gradient_slack;
+}
 
 std::string cpp_source(const FormulaModel& model) {
   const std::string formulas = "T = " + model.T + ", V = " + model.V + (model.k_tree ? ", K = " + model.K : "") +

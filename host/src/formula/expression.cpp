@@ -183,21 +183,20 @@ class Parser {
   Node sum() { return chain(Node::Kind::sum, "+", "-", &Parser::product); }
   Node product() { return chain(Node::Kind::product, "*", "/", &Parser::unary); }
 
+  // Every recursion passes through one enter(): a sign, a power's exponent, a parenthesis, a call's arguments; so
+  // each of them is one level, and nothing else is.
   Node unary() {
+    if (!(at_symbol("-") || at_symbol("+"))) return power();
     if (!enter()) return {};
+    const bool negative = at_symbol("-");
+    ++position_;
     Node result;
-    if (at_symbol("-") || at_symbol("+")) {
-      const bool negative = at_symbol("-");
-      ++position_;
-      Node operand = unary();
-      if (negative) {
-        result.kind = Node::Kind::negate;
-        result.operands.push_back(std::move(operand));
-      } else {
-        result = std::move(operand);
-      }
+    Node operand = unary();
+    if (negative) {
+      result.kind = Node::Kind::negate;
+      result.operands.push_back(std::move(operand));
     } else {
-      result = power();
+      result = std::move(operand);
     }
     --depth_;
     return result;
@@ -207,9 +206,11 @@ class Parser {
     Node base = primary();
     if (error_ || !(at_symbol("^") || at_symbol("**"))) return base;
     ++position_;
+    if (!enter()) return {};
     Node node{.kind = Node::Kind::power};
     node.operands.push_back(std::move(base));
     node.operands.push_back(unary());
+    --depth_;
     return node;
   }
 

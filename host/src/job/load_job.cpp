@@ -81,7 +81,12 @@ std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<J
 }
 
 std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
-  if (job.formula && !formula::attach_formula_plugin(job, issues)) return std::nullopt;
+  if (job.formula) {
+    // What `nonsep validate` checks without the compiler comes first: a job with any problem compiles nothing.
+    check_model_parameters(job.parameters, formula::declared_parameters(*job.formula), issues);
+    check_dimension(job.initial, job.formula->dimension, issues);
+    if (!issues.empty() || !formula::attach_formula_plugin(job, issues)) return std::nullopt;
+  }
   if (job.plugin.empty()) return std::nullopt;
   LoadedJob loaded{std::move(job), {}, {}};
   const Job& checked = loaded.job;

@@ -108,6 +108,12 @@ class StrictDocumentBuilder : public nlohmann::json_sax<json> {
 
 std::optional<nlohmann::json> parse_job_text(const std::string& text, std::vector<JobIssue>& issues) {
   const std::size_t before = issues.size();
+  // nlohmann's lexer takes a NUL byte for the end of the input: whatever follows one would be ignored unread.
+  if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+    issues.push_back({"", "a NUL byte at byte offset " + std::to_string(nul) + " (counted from 0)",
+                      "JSON text, which holds no NUL byte (a file cut or joined with binary data?)"});
+    return std::nullopt;
+  }
   StrictDocumentBuilder builder(issues);
   const bool parsed = json::sax_parse(text, &builder);
   if (!parsed || issues.size() != before) return std::nullopt;

@@ -4,13 +4,27 @@
 // the trees' derivatives (derivative.hpp) as templates too (so the SDK differentiates the gradients, not T and V, for
 // the Hessians and third derivatives; the same for K and U when the model has them), a fixed dimension, the parameter
 // table (numbers with the formula's defaults) and metadata whose description and Hamiltonian are the canonical
-// formulas. Integer powers x^n (|n| <= 64) are products (the SDK's square and cube are the same products); other powers
-// are pow. The text depends on the model only, so it is the cache key's first part (plugin_cache.hpp).
+// formulas. A gradient is written out only while it stays small beside its function: at most max_gradient_growth
+// times the function's nodes plus max_gradient_slack (a product of n factors has a derivative of n(n-1) factors,
+// which grows the C++ and the compile quadratically); beyond that the plugin leaves the gradient to the SDK's
+// automatic differentiation of the function, whose C++ and compile grow linearly with the formula, so that every
+// formula within the grammar's limits compiles in bounded time and memory (docs/formula-models.md). Integer powers x^n
+// (|n| <= 64) are products (the SDK's square and cube are the same products); other powers are pow. The text depends on
+// the model only, so it is the cache key's first part (plugin_cache.hpp).
+#include <cstddef>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "nonsep/host/formula/formula_model.hpp"
 
 namespace nonsep::host::formula {
+
+inline constexpr std::size_t max_gradient_growth = 8;
+inline constexpr std::size_t max_gradient_slack = 256;
+
+// Whether the gradient `components` (derivative() of `tree` per variable; nothing where zero) is written out.
+bool gradient_is_written(const Node& tree, const std::vector<std::optional<Node>>& components);
 
 std::string cpp_source(const FormulaModel& model);
 

@@ -4,40 +4,43 @@
 // The compiler: share/nonsep/formula/toolchain.json (cmake/NonsepFormula.cmake) names the compiler and flags of the
 // build that made this executable, and where the SDK's headers are; NONSEP_CXX names another compiler. Besides the
 // baseline kernel, a formula plugin carries the one wider kernel this process would use (instruction_set_to_use):
-// each set costs compile time, and a cached plugin serves this machine.
+// each set costs compile time, and a cached plugin serves this machine. The compiler runs through
+// compiler_process.hpp: within a time limit, leaving no process behind.
 //
-// The cache: NONSEP_CACHE_DIR, else $XDG_CACHE_HOME/nonsep, else $HOME/.cache/nonsep; a folder that cannot be
-// created or written falls back to <temporary folder>/nonsep-cache-<uid> (with a note). An entry is
-// formula/<key>/ holding <name>.so, model.cpp (the source) and entry.json (the plugin's size and content hash),
-// where key is the content hash of the source, the compiler's path and --version text, the flags, the include
-// folders, nonsep's version, the plugin ABI and the kernel version. An entry is used only when model.cpp equals the
-// source and the plugin's size and hash match entry.json; anything else (a half-written or damaged entry) is
-// removed and compiled again. A compile writes into a fresh folder and renames it to formula/<key> whole, under
-// an exclusive lock on formula/<key>.lock, so two runs compiling the same model at once compile it once and
-// neither sees a partial entry.
+// The cache: the folder of cache_folder.hpp (who may write it, and how its files are opened). An entry is
+// formula/<key>/ holding <name>.so, model.cpp (the source) and entry.json (the plugin's size and content hash, the
+// compiler's identity), where key is the content hash of what determines the plugin: the source, the compiler's
+// identity (its resolved path and --version text), the flags, the content of every nonsep header the source
+// includes (not the folders holding them: a build tree's nonsep and the installed one share entries), nonsep's
+// version, the plugin ABI and the kernel version. An entry is used only when its files are regular files (checked
+// through their descriptors: a FIFO, a device or a link is never read), model.cpp equals the source and the
+// plugin's size and hash match entry.json; anything else (a half-written, damaged or planted entry) is removed and
+// compiled again. A compile builds in formula/.building-<key>-<unique>/, writes every file with each write
+// checked (a full disk is an error naming the file, and nothing is left), and renames the folder to formula/<key>
+// whole, under an exclusive lock on formula/<key>.lock, so two runs compiling the same model at once compile it
+// once and neither sees a partial entry. A .building-<key>-* folder whose key's lock is free belongs to a nonsep that
+// died: the next compile in the cache removes it.
 //
-// Errors: FormulaCompileError, with a message naming what to do (no compiler: what to install; a compiler error:
-// its output).
+// Errors: FormulaCompileError (compiler_process.hpp), with a message naming what to do (no compiler: what to
+// install; a compiler error: its output; the time limit; an unsafe cache folder).
 #include <filesystem>
 #include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "nonsep/host/formula/cache_folder.hpp"
+#include "nonsep/host/formula/compiler_process.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 
 namespace nonsep::host::formula {
-
-class FormulaCompileError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct Toolchain {
   std::string compiler;  // a path, or a name looked up in PATH
   std::vector<std::string> flags;
   std::vector<std::filesystem::path> include_directories;
-  std::string identity;  // the compiler's --version text, part of the cache key
+  std::string identity;     // the compiler's resolved path and --version text, part of the cache key
+  std::string header_hash;  // the content hash of the nonsep headers a formula plugin includes, part of the key
 };
 
 // The toolchain of this executable; throws FormulaCompileError when there is no compiler or no SDK headers.
@@ -46,11 +49,10 @@ Toolchain find_toolchain();
 // The flags choosing the formula plugin's kernels (-DNONSEP_SDK_WIDE_KERNEL_SETS=...).
 std::vector<std::string> kernel_flags();
 
-// Compiles `source` into the plugin `output` (written under a temporary name in the same folder, then renamed).
-void compile_plugin(const std::string& source, const Toolchain& toolchain, const std::filesystem::path& output);
-
-// The cache folder: the variables above, not yet checked for being writable.
-std::filesystem::path cache_directory();
+// Compiles `source` into the plugin `output`: in a fresh folder .nonsep-compile-<unique> beside it (removed
+// afterwards, and by the compiler's guard when nonsep dies, with the folders `abandon`), then renamed to `output`.
+void compile_plugin(const std::string& source, const Toolchain& toolchain, const std::filesystem::path& output,
+                    const std::vector<std::filesystem::path>& abandon = {});
 
 std::string cache_key(const std::string& source, const Toolchain& toolchain);
 

@@ -1,0 +1,93 @@
+#pragma once
+// Helpers for the formula tests that run `nonsep`: environment variables set for a scope, a formula twin of
+// paper1d, a job around a model, and a stand-in compiler that copies the shipped paper1d.so instead of compiling.
+#include <algorithm>
+#include <cstdlib>
+#include <optional>
+#include <string>
+
+#include "host_test_support.hpp"
+
+namespace nonsep::formula_testing {
+
+namespace fs = std::filesystem;
+using host_testing::read_text;
+using host_testing::TemporaryFolder;
+using host_testing::write_text;
+using nlohmann::json;
+
+// Sets an environment variable for its lifetime, then restores the previous value.
+class Environment {
+ public:
+  Environment(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~Environment() {
+    if (old_)
+      ::setenv(name_, old_->c_str(), 1);
+    else
+      ::unsetenv(name_);
+  }
+  Environment(const Environment&) = delete;
+  Environment& operator=(const Environment&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+inline json paper1d_formula(const std::string& name) {
+  return {{"name", name}, {"T", "p0 + p0^3/6"}, {"V", "q0^2/2 + q0^4/12"}};
+}
+
+inline json job_with(json model) {
+  return {{"model", std::move(model)},
+          {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}}},
+          {"initial", {{{"q", {0.5}}, {"p", {0.25}}}, {{"q", {-1.0}}, {"p", {0.75}}}}},
+          {"time", {{"dt", 0.01}, {"steps", 300}}},
+          {"output", {{"every", 0}}}};
+}
+
+// A stand-in compiler, steered by variables:
+//   --version: prints one line (FAKE_VERSION_LINES more lines of 100 characters; FAKE_VERSION_SLEEP seconds first);
+//   otherwise: appends a line to FAKE_LOG; FAKE_FAIL: fails with a compiler-like message; FAKE_PIDS: starts
+//   `sleep FAKE_SLEEP` in the background, appends its and its own process id to that file and waits for it (else
+//   sleeps FAKE_SLEEP seconds itself); FAKE_LINGER: leaves `sleep FAKE_LINGER` running in the background with the
+//   output pipe and appends its id to FAKE_PIDS; then copies the shipped paper1d.so to the -o argument (the soft
+//   file size limit lifted first: a test may limit nonsep's files, not the plugin).
+inline fs::path write_fake_compiler(const TemporaryFolder& folder) {
+  const fs::path script = folder / "fake-c++";
+  write_text(
+      script,
+      "#!/bin/sh\n"
+      "if [ \"$1\" = --version ]; then\n"
+      "  sleep \"${FAKE_VERSION_SLEEP:-0}\"; echo 'fake compiler 1'\n"
+      "  i=0; while [ \"$i\" -lt \"${FAKE_VERSION_LINES:-0}\" ]; do\n"
+      "    echo 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx';"
+      " i=$((i+1)); done\n"
+      "  exit 0\n"
+      "fi\n"
+      "echo call >> \"$FAKE_LOG\"\n"
+      "if [ -n \"$FAKE_FAIL\" ]; then echo 'model.cpp:1:1: error: fake failure' >&2; exit 1; fi\n"
+      "if [ -n \"$FAKE_PIDS\" ] && [ -n \"$FAKE_SLEEP\" ]; then\n"
+      "  sleep \"$FAKE_SLEEP\" & echo \"$! $$\" >> \"$FAKE_PIDS\"; wait\n"
+      "else sleep \"${FAKE_SLEEP:-0}\"; fi\n"
+      "if [ -n \"$FAKE_LINGER\" ]; then sleep \"$FAKE_LINGER\" & echo \"$!\" >> \"$FAKE_PIDS\"; fi\n"
+      "ulimit -S -f unlimited\n"
+      "out=''; previous=''\n"
+      "for a in \"$@\"; do [ \"$previous\" = -o ] && out=\"$a\"; previous=\"$a\"; done\n"
+      "cp '" NONSEP_SHIPPED_PLUGIN_DIR "/paper1d.so' \"$out\"\n");
+  fs::permissions(script, fs::perms::owner_all);
+  return script;
+}
+
+inline std::size_t count_lines(const fs::path& file) {
+  if (!fs::exists(file)) return 0;
+  const std::string text = read_text(file);
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace nonsep::formula_testing
