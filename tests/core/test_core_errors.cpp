@@ -209,8 +209,14 @@ TEST_CASE("comparator options: each bad value has its own message") {
   CHECK(contains(error_of([&] { comparator.step(GradientsOnly{}, x, 0.1); }), "needs a model with Hessians"));
   Integrator basic(IntegratorSpec{"basic"});
   CHECK_NOTHROW(basic.step(GradientsOnly{}, x, 0.1));
-  // No tangent map for a comparator.
-  CHECK(contains(error_of([&] { TangentIntegrator{IntegratorSpec{"tao", Fraction(2)}}; }), "has no tangent map"));
+  // A comparator's tangent map needs the directional derivative of grad H: a model without it is refused, naming it.
+  for (const IntegratorSpec& spec : {IntegratorSpec{"tao", Fraction(2)}, IntegratorSpec{"gauss", Fraction(2)}}) {
+    TangentIntegrator tangent(spec);
+    auto tangents = PhaseSpaceBatch::single(q, p);
+    CHECK(contains(error_of([&] { tangent.step(testing::Paper1D{}, x, tangents, 0.1); }),
+                   "needs a model with third derivatives and the directional derivative of grad H (the plugin entry "
+                   "hvp_H"));
+  }
 }
 
 namespace {

@@ -121,17 +121,18 @@ TEST_CASE("no plugin symbol") {
 
 TEST_CASE("a plugin of ABI version 1 (its entry function, no plugin symbol): expected and found") {
   const std::string file = (test_plugins / "version_1_entry.so").string();
-  CHECK(load_error("version_1_entry.so") ==
-        "plugin '" + file +
-            "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
-            "version 4 (expected 4 or 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) "
-            "and "
-            "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
+  CHECK(
+      load_error("version_1_entry.so") ==
+      "plugin '" + file +
+          "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
+          "version 5 (expected 5, 4 or 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) "
+          "and "
+          "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
 }
 
 TEST_CASE("a plugin of ABI version 2 (the one with integrate): expected and found, and how to rebuild") {
   const std::string message = load_error("wrong_abi_version.so");
-  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 4 (expected 4 or 3, found 2)"));
+  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 5 (expected 5, 4 or 3, found 2)"));
   CHECK(contains(message, "rebuild the plugin against the installed SDK"));
 }
 
@@ -139,7 +140,7 @@ TEST_CASE("a plugin of ABI version 3 loads: its shorter table, none of version 4
   const Plugin plugin = load_plugin("version_3_table.so", test_plugins);
   CHECK(plugin.name() == "version_3_table");
   CHECK(plugin.abi_version() == 3);
-  CHECK(load_plugin("hand_written.so", test_plugins).abi_version() == 4);
+  CHECK(load_plugin("hand_written.so", test_plugins).abi_version() == 5);
   const PluginModel model = plugin.create(nlohmann::json::object());
   const double p[] = {0.5};
   double out[1] = {0.0};
@@ -161,6 +162,31 @@ TEST_CASE("a version-4 table that ends after chin_steps loads without the energy
   const double q[] = {0.5}, p[] = {0.25};
   double out[1] = {0.0};
   CHECK_THROWS_AS(model.product_energy(nonsep::HamiltonianForm::TTV, q, p, out, 1), nonsep::ModelError);
+}
+
+TEST_CASE("a version-4 table loads without hvp_H past its end, and its calls are refused naming the entry") {
+  const Plugin plugin = load_plugin("version_4_table.so", test_plugins);
+  CHECK(plugin.abi_version() == 4);
+  // The table it was built with holds hvp_H past version 4's size: a loader reading it would refuse the plugin (a
+  // capability it does not claim).
+  CHECK_FALSE(plugin.has_hamiltonian_hessian_products());
+  const PluginModel model = plugin.create(nlohmann::json::object());
+  CHECK_FALSE(model.has_hamiltonian_hessian_products());
+  const double q[] = {0.5}, p[] = {0.25}, dq[] = {1.0}, dp[] = {0.0};
+  double out_q[1] = {0.0}, out_p[1] = {0.0};
+  try {
+    model.hvp_H(nonsep::HamiltonianForm::TTV, q, p, dq, dp, out_q, out_p, 1);
+    FAIL("hvp_H of a plugin without it did not throw");
+  } catch (const nonsep::ModelError& e) {
+    CHECK(contains(e.what(), "plugin 'version_4_table' does not provide hvp_H"));
+  }
+  // Version 4's struct sizes: the whole table and its first edition; a version-4 table of version 5's size is refused.
+  CHECK(NONSEP_PLUGIN_V4_STRUCT_SIZE + sizeof(void*) == sizeof(nonsep_plugin_api));
+}
+
+TEST_CASE("an hvp_H the metadata does not claim") {
+  CHECK(contains(load_error("unclaimed_hvp_H.so"),
+                 "says capability \"hvp_H\" is false but the table's hvp_H pointer is set"));
 }
 
 TEST_CASE("a separable part without its value: the energy of H needs it") {
@@ -185,9 +211,8 @@ TEST_CASE("wrong table size: expected and found") {
   const std::string message = load_error("wrong_table_size.so");
   CHECK(contains(message, "(expected " + std::to_string(expected) + ", found " + std::to_string(found) + ")"));
   CHECK(contains(message, "has a function table of " + std::to_string(found) + " bytes"));
-  // Version 4's two sizes are named: the whole table, and the one that ends after chin_steps.
-  CHECK(contains(message,
-                 "defines " + std::to_string(expected) + " or " + std::to_string(NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE)));
+  // Version 5 has one size.
+  CHECK(contains(message, "ABI version 5 defines " + std::to_string(expected) + " (expected"));
 }
 
 TEST_CASE("metadata that is not valid JSON") {
@@ -320,7 +345,7 @@ TEST_CASE("discovery lists good plugins and the failures with their errors, firs
   CHECK(entry("paper1d")->plugin.has_value());
   REQUIRE(entry("wrong_abi_version") != nullptr);
   CHECK_FALSE(entry("wrong_abi_version")->plugin.has_value());
-  CHECK(contains(entry("wrong_abi_version")->error, "(expected 4 or 3, found 2)"));
+  CHECK(contains(entry("wrong_abi_version")->error, "(expected 5, 4 or 3, found 2)"));
   REQUIRE(entry("not_a_library") != nullptr);
   CHECK(contains(entry("not_a_library")->error, "invalid ELF header"));
   CHECK(entry("hand_written")->path == test_plugins / "hand_written.so");

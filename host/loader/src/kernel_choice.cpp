@@ -1,6 +1,6 @@
 // Which of a plugin's stepping kernels this process uses (plugin_loader.hpp, KernelChoice): the metadata's
-// "kernels" object checked against the core's kernel version, and an instruction set chosen from the processor's
-// features or pinned by NONSEP_INSTRUCTION_SET.
+// "kernels" object (of a version-4 plugin: its kernel version checked against the one whose arguments version 5
+// has), and an instruction set chosen from the processor's features or pinned by NONSEP_INSTRUCTION_SET.
 #include <cstdlib>
 #include <string>
 
@@ -52,7 +52,7 @@ std::string instruction_set_to_use(const std::vector<std::string>& names) {
   return "";
 }
 
-KernelChoice choose_kernel(const json& metadata, const nonsep_plugin_api& api) {
+KernelChoice choose_kernel(const json& metadata, const nonsep_plugin_api& api, unsigned abi_version) {
   KernelChoice choice;
   if (api.chin_steps == nullptr) {
     choice.note = "no stepping kernels: the evaluation path";
@@ -60,7 +60,7 @@ KernelChoice choose_kernel(const json& metadata, const nonsep_plugin_api& api) {
   }
   choice.present = true;
   const json& kernels = metadata["kernels"];
-  choice.version = kernels["version"].get<std::uint64_t>();
+  choice.version = abi_version == 4 ? kernels["version"].get<std::uint64_t>() : chin_kernel_version;
   for (const json& name : kernels["instruction_sets"]) {
     choice.instruction_sets.push_back(name.get<std::string>());
     choice.usable.push_back(choice.version == chin_kernel_version && processor_runs(choice.instruction_sets.back()));

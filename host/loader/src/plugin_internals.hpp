@@ -16,7 +16,7 @@ namespace nonsep::host {
 struct Plugin::Loaded {
   boost::shared_ptr<const nonsep_plugin_api> table;  // from import_alias: owns the loaded library
   std::filesystem::path path;
-  // The plugin's table as a version-4 one: a version-3 table copied, with the entries it lacks null.
+  // The plugin's table as one of this host's version: an older table copied, with the entries it lacks null.
   nonsep_plugin_api entries{};
   unsigned abi_version = NONSEP_PLUGIN_ABI_VERSION;  // the plugin's own
   const nonsep_plugin_api* api = nullptr;            // &entries
@@ -48,12 +48,13 @@ inline std::string quoted(const std::filesystem::path& path) {
 // "ok", "invalid parameters", ...: a status of plugin_abi.h as words.
 const char* status_name(nonsep_status status);
 
-// The kernel this process uses of the plugin with checked metadata `metadata` and table `api` (kernel_choice.cpp).
-// Throws PluginError when NONSEP_INSTRUCTION_SET asks for one it cannot have.
-KernelChoice choose_kernel(const nlohmann::json& metadata, const nonsep_plugin_api& api);
+// The kernel this process uses of the plugin of ABI version `abi_version` with checked metadata `metadata` and table
+// `api` (kernel_choice.cpp). Throws PluginError when NONSEP_INSTRUCTION_SET asks for one it cannot have.
+KernelChoice choose_kernel(const nlohmann::json& metadata, const nonsep_plugin_api& api, unsigned abi_version);
 
-// The metadata checks of plugin_abi.h on the parsed metadata `m` of the plugin at `path` whose table is `api`.
-// Throws PluginError naming the field.
-void check_metadata(const nlohmann::json& m, const nonsep_plugin_api& api, const std::filesystem::path& path);
+// The metadata checks of plugin_abi.h on the parsed metadata `m` of the plugin at `path` whose table is `api`, of ABI
+// version `abi_version`. Throws PluginError naming the field.
+void check_metadata(const nlohmann::json& m, const nonsep_plugin_api& api, unsigned abi_version,
+                    const std::filesystem::path& path);
 
 }  // namespace nonsep::host

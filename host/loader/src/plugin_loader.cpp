@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 #include <system_error>
+#include <vector>
 
 #include "nonsep/plugin_abi.h"
 #include "nonsep/sdk/parameters.hpp"
@@ -32,6 +33,22 @@ namespace {
 const std::string rebuild_hint =
     "rebuild the plugin against the installed SDK (find_package(nonsep) and nonsep_add_model, or the headers of "
     "this nonsep's include/nonsep/plugin_abi.h)";
+
+// The versions this host loads, as its refusals name them, and the table sizes of each (plugin_abi.h; none for a
+// version it does not load). The first size is the version's own; version 4 also had a shorter first edition.
+const std::string accepted_versions = std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", 4 or 3";
+std::vector<std::size_t> table_sizes(std::uint32_t version) {
+  switch (version) {
+    case NONSEP_PLUGIN_ABI_VERSION:
+      return {NONSEP_PLUGIN_V5_STRUCT_SIZE};
+    case 4:
+      return {NONSEP_PLUGIN_V4_STRUCT_SIZE, NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE};
+    case 3:
+      return {NONSEP_PLUGIN_V3_STRUCT_SIZE};
+    default:
+      return {};
+  }
+}
 
 bool looks_like_path(const std::string& spec) {
   return spec.find('/') != std::string::npos || (spec.size() > 3 && spec.compare(spec.size() - 3, 3, ".so") == 0);
@@ -75,6 +92,7 @@ bool Plugin::has_hessians() const {
 }
 bool Plugin::has_K() const { return loaded_->api->grad_K != nullptr; }
 bool Plugin::has_U() const { return loaded_->api->grad_U != nullptr; }
+bool Plugin::has_hamiltonian_hessian_products() const { return loaded_->api->hvp_H != nullptr; }
 bool Plugin::has_third_derivatives() const { return loaded_->api->d3T != nullptr && loaded_->api->d3V != nullptr; }
 bool Plugin::has_hessian_vector_products() const {
   return loaded_->api->hvp_T != nullptr && loaded_->api->hvp_V != nullptr;
@@ -214,8 +232,8 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
       throw PluginError("plugin " + quoted(path) +
                         " uses plugin ABI version 1 (it exports '" NONSEP_PLUGIN_V1_ENTRY_SYMBOL
                         "') but this host uses version " +
-                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
-                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " or 3, found 1); " + rebuild_hint);
+                        std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " + accepted_versions + ", found 1); " +
+                        rebuild_hint);
     throw PluginError(
         quoted(path) +
         " is a shared library but not a nonsep plugin: it does not export the symbol '" NONSEP_PLUGIN_SYMBOL
@@ -242,20 +260,19 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                       "plugin_sdk.hpp) or NONSEP_DEFINE_PLUGIN (see plugin_abi.h)");
   }
   const std::uint32_t version = api->abi_version;
-  if (version != NONSEP_PLUGIN_ABI_VERSION && version != 3)
+  const std::vector<std::size_t> sizes = table_sizes(version);
+  if (sizes.empty())
     throw PluginError("plugin " + quoted(path) + " uses plugin ABI version " + std::to_string(version) +
                       " but this host uses version " + std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " (expected " +
-                      std::to_string(NONSEP_PLUGIN_ABI_VERSION) + " or 3, found " + std::to_string(version) + "); " +
-                      rebuild_hint);
-  // Version 4's table may end after chin_steps (before the energy entries); version 3's before grad_K.
-  const std::size_t size = version == 3 ? NONSEP_PLUGIN_V3_STRUCT_SIZE : sizeof(nonsep_plugin_api);
-  const bool shorter_v4 = version == 4 && api->struct_size == NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE;
-  if (api->struct_size != size && !shorter_v4)
+                      accepted_versions + ", found " + std::to_string(version) + "); " + rebuild_hint);
+  if (std::find(sizes.begin(), sizes.end(), api->struct_size) == sizes.end()) {
+    std::string defined;
+    for (const std::size_t size : sizes) defined += (defined.empty() ? "" : " or ") + std::to_string(size);
     throw PluginError("plugin " + quoted(path) + " has a function table of " + std::to_string(api->struct_size) +
-                      " bytes but ABI version " + std::to_string(version) + " defines " + std::to_string(size) +
-                      (version == 4 ? " or " + std::to_string(NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE) : std::string()) +
-                      " (expected " + std::to_string(size) + ", found " + std::to_string(api->struct_size) +
+                      " bytes but ABI version " + std::to_string(version) + " defines " + defined + " (expected " +
+                      std::to_string(sizes.front()) + ", found " + std::to_string(api->struct_size) +
                       "); the plugin was built against a different plugin_abi.h");
+  }
   std::memcpy(&loaded->entries, api, api->struct_size);  // the entries a shorter table lacks stay null
   loaded->abi_version = version;
   api = &loaded->entries;
@@ -279,9 +296,9 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
     throw PluginError("the metadata of plugin " + quoted(path) + " is not valid JSON: " + e.what() +
                       " (metadata begins: \"" + shown + "\")");
   }
-  check_metadata(loaded->metadata, *api, path);
+  check_metadata(loaded->metadata, *api, version, path);
   loaded->api = &loaded->entries;
-  loaded->kernels = choose_kernel(loaded->metadata, *loaded->api);
+  loaded->kernels = choose_kernel(loaded->metadata, *loaded->api, version);
   Plugin plugin;
   plugin.loaded_ = std::move(loaded);
   return plugin;

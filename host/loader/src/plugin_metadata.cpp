@@ -11,7 +11,7 @@ namespace nonsep::host {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path& path) {
+void check_metadata(const json& m, const nonsep_plugin_api& api, unsigned abi_version, const fs::path& path) {
   const std::string where = "the metadata of plugin " + quoted(path);
   auto fail = [&](const std::string& problem) { throw PluginError(where + " " + problem); };
   if (!m.is_object()) fail("must be a JSON object (found " + std::string(m.type_name()) + ")");
@@ -90,7 +90,8 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
                                                   {"hvp_U", api.hvp_U != nullptr},
                                                   {"chin_steps", api.chin_steps != nullptr},
                                                   {"energy_TTV", api.energy_TTV != nullptr},
-                                                  {"energy_VVT", api.energy_VVT != nullptr}};
+                                                  {"energy_VVT", api.energy_VVT != nullptr},
+                                                  {"hvp_H", api.hvp_H != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
@@ -117,14 +118,19 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, const fs::path&
       fail("gives grad_" + std::string(part.name) + " but not value_" + part.name +
            ": the energy of H = T_i V_ij T_j + K + U needs " + part.name + " itself");
 
-  // "kernels": {"version": K, "instruction_sets": ["x86-64", ...]}, exactly when the table has chin_steps.
+  // "kernels": {"instruction_sets": ["x86-64", ...]}, exactly when the table has chin_steps; in version 4 with the
+  // kernel version "version": K, which version 5 says by abi_version.
   if (m.contains("kernels") != (api.chin_steps != nullptr))
     fail(api.chin_steps != nullptr ? "lacks the object \"kernels\" that its chin_steps needs"
                                    : "has \"kernels\" but the table's chin_steps pointer is null");
   if (api.chin_steps != nullptr) {
     const json& kernels = m["kernels"];
-    if (!kernels.is_object() || !kernels.contains("version") || !kernels["version"].is_number_unsigned())
-      fail("gives \"kernels\" no unsigned integer \"version\"");
+    if (!kernels.is_object()) fail("gives \"kernels\" that is not an object (found " + kernels.dump() + ")");
+    if (abi_version == 4 && (!kernels.contains("version") || !kernels["version"].is_number_unsigned()))
+      fail("gives \"kernels\" no unsigned integer \"version\" (required in plugin ABI version 4)");
+    if (abi_version != 4 && kernels.contains("version"))
+      fail("gives \"kernels\" a \"version\", which plugin ABI version " + std::to_string(abi_version) +
+           " says by abi_version alone (remove it)");
     const json sets = kernels.value("instruction_sets", json());
     if (!sets.is_array() || sets.empty() ||
         std::any_of(sets.begin(), sets.end(), [](const json& s) { return !s.is_string(); }))

@@ -1,5 +1,6 @@
 // PluginModel: one instance of a plugin as a core model; each evaluation is one batched call of the plugin's
 // table, its failure a ModelError with the plugin's message.
+#include <algorithm>
 #include <string>
 
 #include "nonsep/core/error.hpp"
@@ -114,6 +115,24 @@ NONSEP_PLUGIN_MODEL_DIRECTIONAL(d3V)
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_T)
 NONSEP_PLUGIN_MODEL_DIRECTIONAL(hvp_V)
 #undef NONSEP_PLUGIN_MODEL_DIRECTIONAL
+
+bool PluginModel::has_hamiltonian_hessian_products() const {
+  return instance_->plugin.has_hamiltonian_hessian_products();
+}
+
+void PluginModel::hvp_H(HamiltonianForm form, std::span<const double> q, std::span<const double> p,
+                        std::span<const double> dq, std::span<const double> dp, std::span<double> out_q,
+                        std::span<double> out_p, std::size_t count) const {
+  const std::size_t n = instance_->dimension, size = count * n;
+  if (p.size() < size || dq.size() < size || dp.size() < size || out_p.size() < size)
+    throw_bad_spans("hvp_H", count, n, n, std::min({p.size(), dq.size(), dp.size()}), out_p.size());
+  const nonsep_plugin_api& api = *instance_->api;
+  evaluate(*this, instance_->handle, api, api.hvp_H != nullptr, "hvp_H", n, q, out_q, count, n,
+           [&](nonsep_instance* handle, const double* in, double* result, std::size_t states) {
+             return api.hvp_H(handle, form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT, in, p.data(),
+                              dq.data(), dp.data(), result, out_p.data(), states);
+           });
+}
 
 bool PluginModel::has_product_energy(HamiltonianForm form) const {
   return product_energy_ && instance_->plugin.has_product_energy(form);

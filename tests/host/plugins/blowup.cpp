@@ -31,6 +31,7 @@
 #include <thread>
 
 #include "nonsep/plugin_abi.h"
+#include "support/plugin_table.hpp"
 
 #ifndef BLOWUP_NAME
 #error "BLOWUP_NAME must be defined"
@@ -203,36 +204,17 @@ nonsep_status hessian_V(nonsep_instance* instance, const double* q, double* out,
 }
 const char* last_error(const nonsep_instance* instance) { return instance->last_error.c_str(); }
 
-const nonsep_plugin_api api = {
-    NONSEP_PLUGIN_ABI_VERSION,
-    sizeof(nonsep_plugin_api),
-    metadata,
-    create,
-    destroy,
-    dimension,
-    grad_T,
-    grad_V,
-    BLOWUP_WITH_HESSIANS ? value_T : nullptr,
-    BLOWUP_WITH_HESSIANS ? value_V : nullptr,
-    BLOWUP_WITH_HESSIANS ? hessian_T : nullptr,
-    BLOWUP_WITH_HESSIANS ? hessian_V : nullptr,
-    last_error,
-    nullptr,  // d3T: absent
-    nullptr,  // d3V: absent
-    nullptr,  // grad_K
-    nullptr,  // grad_U
-    nullptr,  // value_K
-    nullptr,  // value_U
-    nullptr,  // hessian_K
-    nullptr,  // hessian_U
-    nullptr,  // hvp_T
-    nullptr,  // hvp_V
-    nullptr,  // hvp_K
-    nullptr,  // hvp_U
-    nullptr,  // chin_steps
-    nullptr,  // energy_TTV
-    nullptr,  // energy_VVT
-};
+const nonsep_plugin_api api = [] {
+  nonsep_plugin_api table =
+      nonsep::testing::plugin_table(metadata, create, destroy, dimension, grad_T, grad_V, last_error);
+  if (BLOWUP_WITH_HESSIANS) {
+    table.value_T = value_T;
+    table.value_V = value_V;
+    table.hessian_T = hessian_T;
+    table.hessian_V = hessian_V;
+  }
+  return table;  // no third derivatives
+}();
 
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include <cstddef>
 
 #include "nonsep/plugin_abi.h"
+#include "support/plugin_table.hpp"
 
 #ifndef GLOBAL_STATE_DECLARES_SAFE
 #error "define GLOBAL_STATE_DECLARES_SAFE"
@@ -51,36 +52,8 @@ nonsep_status grad_V(nonsep_instance*, const double* q, double* out, size_t coun
 }
 const char* last_error(const nonsep_instance* instance) { return instance->last_error; }
 
-const nonsep_plugin_api table = {
-    NONSEP_PLUGIN_ABI_VERSION,
-    static_cast<uint32_t>(sizeof(nonsep_plugin_api)),
-    &metadata_json,
-    &create,
-    &destroy,
-    &dimension,
-    &grad_T,
-    &grad_V,
-    nullptr,
-    nullptr,
-    nullptr,
-    nullptr,
-    &last_error,
-    nullptr,
-    nullptr,
-    nullptr,  // grad_K
-    nullptr,  // grad_U
-    nullptr,  // value_K
-    nullptr,  // value_U
-    nullptr,  // hessian_K
-    nullptr,  // hessian_U
-    nullptr,  // hvp_T
-    nullptr,  // hvp_V
-    nullptr,  // hvp_K
-    nullptr,  // hvp_U
-    nullptr,  // chin_steps
-    nullptr,  // energy_TTV
-    nullptr,  // energy_VVT
-};
+const nonsep_plugin_api table =
+    nonsep::testing::plugin_table(&metadata_json, &create, &destroy, &dimension, &grad_T, &grad_V, &last_error);
 
 }  // namespace
 

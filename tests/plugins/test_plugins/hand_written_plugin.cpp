@@ -17,10 +17,13 @@
 //  14  a separable part grad_U without value_U, which the energy of H needs
 //  15  hvp_K without grad_K
 //  16  none: a valid version-4 table that ends after chin_steps (before energy_TTV, energy_VVT), as first published
+//  17  none: a valid version-4 table (before hvp_H of version 5)
+//  18  the table has hvp_H but the metadata does not claim it
 #include <cstddef>
 #include <cstring>
 
 #include "nonsep/plugin_abi.h"
+#include "support/plugin_table.hpp"
 
 #ifndef NONSEP_TEST_DEFECT
 #error "define NONSEP_TEST_DEFECT"
@@ -80,80 +83,51 @@ nonsep_status zero_third_derivative(nonsep_instance*, const double*, const doubl
 }
 #endif
 const char* last_error(const nonsep_instance* instance) { return instance->last_error; }
+#if NONSEP_TEST_DEFECT == 17 || NONSEP_TEST_DEFECT == 18
+nonsep_status hvp_H_past_the_end(nonsep_instance*, uint32_t, const double*, const double*, const double*, const double*,
+                                 double*, double*, size_t) {
+  return NONSEP_INTERNAL_ERROR;
+}
+#endif
 #if NONSEP_TEST_DEFECT == 16
 nonsep_status energy_past_the_end(nonsep_instance*, const double*, const double*, double*, size_t) {
   return NONSEP_INTERNAL_ERROR;
 }
 #endif
 
-const nonsep_plugin_api table = {
+nonsep_plugin_api make_table() {
+  nonsep_plugin_api table =
+      nonsep::testing::plugin_table(&metadata_json, &create, &destroy, &dimension, &identity, &identity, &last_error);
 #if NONSEP_TEST_DEFECT == 2
-    2u,
+  table.abi_version = 2u;
 #elif NONSEP_TEST_DEFECT == 13
-    3u,
-#else
-    NONSEP_PLUGIN_ABI_VERSION,
-#endif
-#if NONSEP_TEST_DEFECT == 3
-    static_cast<uint32_t>(sizeof(nonsep_plugin_api) - sizeof(void*)),
-#elif NONSEP_TEST_DEFECT == 13
-    static_cast<uint32_t>(NONSEP_PLUGIN_V3_STRUCT_SIZE),
+  table.abi_version = 3u;
+  table.struct_size = static_cast<uint32_t>(NONSEP_PLUGIN_V3_STRUCT_SIZE);
+  table.grad_K = &identity;  // past a version-3 table's end: never read
 #elif NONSEP_TEST_DEFECT == 16
-    static_cast<uint32_t>(NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE),
-#else
-    static_cast<uint32_t>(sizeof(nonsep_plugin_api)),
+  table.abi_version = 4u;
+  table.struct_size = static_cast<uint32_t>(NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE);
+  table.energy_TTV = &energy_past_the_end;  // past the shorter table's end: never read
+#elif NONSEP_TEST_DEFECT == 17
+  table.abi_version = 4u;
+  table.struct_size = static_cast<uint32_t>(NONSEP_PLUGIN_V4_STRUCT_SIZE);
+  table.hvp_H = &hvp_H_past_the_end;  // past a version-4 table's end: never read
+#elif NONSEP_TEST_DEFECT == 3
+  table.struct_size = static_cast<uint32_t>(sizeof(nonsep_plugin_api) - sizeof(void*));
+#elif NONSEP_TEST_DEFECT == 6
+  table.grad_V = nullptr;
+#elif NONSEP_TEST_DEFECT == 11
+  table.d3V = &zero_third_derivative;
+#elif NONSEP_TEST_DEFECT == 14
+  table.grad_U = &identity;
+#elif NONSEP_TEST_DEFECT == 15
+  table.hvp_K = &zero_third_derivative;  // a directional function of the same signature
+#elif NONSEP_TEST_DEFECT == 18
+  table.hvp_H = &hvp_H_past_the_end;
 #endif
-    &metadata_json,
-    &create,
-    &destroy,
-    &dimension,
-    &identity,
-#if NONSEP_TEST_DEFECT == 6
-    nullptr,
-#else
-    &identity,
-#endif
-    nullptr,
-    nullptr,
-    nullptr,
-    nullptr,
-    &last_error,
-    nullptr,  // d3T: optional, absent
-#if NONSEP_TEST_DEFECT == 11
-    &zero_third_derivative,
-#else
-    nullptr,  // d3V: optional, absent
-#endif
-#if NONSEP_TEST_DEFECT == 13
-    &identity,  // past a version-3 table's end: never read
-#else
-    nullptr,  // grad_K
-#endif
-#if NONSEP_TEST_DEFECT == 14
-    &identity,
-#else
-    nullptr,  // grad_U
-#endif
-    nullptr,  // value_K
-    nullptr,  // value_U
-    nullptr,  // hessian_K
-    nullptr,  // hessian_U
-    nullptr,  // hvp_T
-    nullptr,  // hvp_V
-#if NONSEP_TEST_DEFECT == 15
-    &zero_third_derivative,  // a directional function of the same signature
-#else
-    nullptr,  // hvp_K
-#endif
-    nullptr,  // hvp_U
-    nullptr,  // chin_steps
-#if NONSEP_TEST_DEFECT == 16
-    &energy_past_the_end,  // past the shorter table's end: never read
-#else
-    nullptr,  // energy_TTV
-#endif
-    nullptr,  // energy_VVT
-};
+  return table;
+}
+const nonsep_plugin_api table = make_table();
 
 }  // namespace
 

@@ -1,5 +1,7 @@
-// An SDK plugin whose metadata claims stepping kernels of another kernel version (999): the host must step it
-// through its evaluations, with a note saying why. Its table is the SDK's, with the metadata function replaced.
+// A plugin of ABI version 4 (whose metadata gave the kernel version) claiming stepping kernels of another kernel
+// version (999): the host must step it through its evaluations, with a note saying why. Its table is the SDK's cut to
+// version 4's size, with the metadata function replaced.
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <nonsep/plugin_sdk.hpp>
 #include <string>
@@ -19,6 +21,7 @@ const char* metadata() {
   static const std::string text = [] {
     auto metadata = nlohmann::json::parse(Table::api.metadata_json());
     metadata["kernels"]["version"] = 999;
+    metadata["capabilities"]["hvp_H"] = false;  // past version 4's table
     return metadata.dump();
   }();
   return text.c_str();
@@ -26,6 +29,8 @@ const char* metadata() {
 
 nonsep_plugin_api with_other_metadata() {
   nonsep_plugin_api api = Table::api;
+  api.abi_version = 4;
+  api.struct_size = static_cast<std::uint32_t>(NONSEP_PLUGIN_V4_STRUCT_SIZE);
   api.metadata_json = metadata;
   return api;
 }

@@ -15,6 +15,7 @@
 //
 // Layout: q, p, dH/dq and dH/dp are batches of `count` states of dimension n (component i of state b at b*n + i).
 // Model exceptions propagate; the outputs are then unspecified.
+#include <concepts>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -25,6 +26,43 @@
 #include "nonsep/core/model.hpp"
 
 namespace nonsep {
+
+// The directional derivative of grad H, for the tangent maps of the schemes that integrate H itself: the Hessian of
+// the solved H (K + U included) times one tangent (dq, dp) per state (plugin_abi.h hvp_H writes out its formula,
+// which reaches the fourth derivatives of the inner function: V in TTV, T in VVT). A type M models
+// nonsep::ModelWithHamiltonianHessian when it is a Model and moreover, for spans x (size count*n, read) and out
+// (size count*n, written):
+//   m.hvp_H(form, q, p, dq, dp, out_q, out_p, count)   writes out_q = d(dH/dq), out_p = d(dH/dp) at each state
+// A type may have the member and still lack it at run time (a plugin without hvp_H): it then has
+// `bool has_hamiltonian_hessian_products() const`, which says so.
+template <class M>
+concept ModelWithHamiltonianHessian = Model<M> &&
+    requires(const M& m, HamiltonianForm form, std::span<const double> x, std::span<double> out, std::size_t count) {
+  m.hvp_H(form, x, x, x, x, out, out, count);
+};
+
+// Whether `model` evaluates the directional derivative of grad H (its type has it and, where it says, the object).
+template <class M>
+bool has_hamiltonian_hessian(const M& model) {
+  if constexpr (!ModelWithHamiltonianHessian<M>)
+    return false;
+  else if constexpr (requires {
+                       { model.has_hamiltonian_hessian_products() } -> std::convertible_to<bool>;
+                     })
+    return model.has_hamiltonian_hessian_products();
+  else
+    return true;
+}
+
+// Throws InvalidArgument unless `model` evaluates the directional derivative of grad H, naming what is missing: the
+// tangent map of `scheme` needs it.
+template <class M>
+void require_hamiltonian_hessian(const M& model, const std::string& scheme) {
+  if (!has_hamiltonian_hessian(model))
+    throw InvalidArgument("the tangent map of the scheme '" + scheme +
+                          "' needs the directional derivative of grad H, which this model lacks (the plugin entry "
+                          "hvp_H of plugin ABI version 5: rebuild the plugin against the installed SDK)");
+}
 
 class HamiltonianGradient {
  public:

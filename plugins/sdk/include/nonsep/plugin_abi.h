@@ -1,13 +1,19 @@
-/* nonsep plugin ABI, version 4. The boundary evaluates: the host owns every scheme and crosses the boundary once
+/* nonsep plugin ABI, version 5. The boundary evaluates: the host owns every scheme and crosses the boundary once
  * per batch of states for a gradient (or a Hessian, a value, a third derivative, a Hessian-vector product).
- * Version 4 adds four optional groups at the end of version 3's table: the separable part K(p) + U(q) of the
- * solved Hamiltonian, Hessian-vector products, and a stepping kernel (n basic steps of the core's own splitting,
- * compiled into the plugin with its model inlined, the coefficients given by the host), then the product term of
- * H in one pass (energy_TTV, energy_VVT; a table may end before them). A version-3 table is
- * the prefix of a version-4 one: such plugins are still loaded, without the new groups. Version 2 had a fused
- * stepping function integrate() with a stepper of its own; version 1 exported a function, nonsep_plugin_entry,
- * returning the table instead of the pointer below. Plugins of either are refused: rebuild them against the
- * installed SDK.
+ * One number says everything a plugin offers: abi_version fixes the table's size (one struct size per version) and
+ * the arguments of the stepping kernel. Each version appends optional entries to the previous one's table, so an
+ * older table is a prefix of this one and still loads, without the entries it lacks:
+ *   3  the required entries, values, Hessians, directional third derivatives     NONSEP_PLUGIN_V3_STRUCT_SIZE
+ *   4  + the separable part K(p) + U(q), Hessian-vector products, the stepping kernel chin_steps (its argument
+ *        layout then given by "kernels": {"version": K} in the metadata; the host steps these plugins through
+ *        their gradients, since version 5's kernels also evaluate the gradient their steps start from), the product
+ *        term of H in one pass (energy_TTV, energy_VVT)                           NONSEP_PLUGIN_V4_STRUCT_SIZE
+ *        (a version-4 table as first published ends before energy_TTV: NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE)
+ *   5  + the directional derivative of grad H, hvp_H (the tangent maps of the comparators); chin_steps takes the
+ *        arguments below and the metadata's "kernels" has no "version"          NONSEP_PLUGIN_V5_STRUCT_SIZE
+ * docs/plugin-abi.md lists the versions and their entries. Version 2 had a fused stepping function integrate() with
+ * a stepper of its own; version 1 exported a function, nonsep_plugin_entry, returning the table instead of the
+ * pointer below. Plugins of either are refused: rebuild them against the installed SDK.
  *
  * A plugin is a shared library that exports one C symbol, NONSEP_PLUGIN_SYMBOL ("nonsep_plugin"): a constant
  * pointer to a constant, statically allocated function table (nonsep_plugin_api) that stays valid while the
@@ -18,10 +24,9 @@
  * Checks the host makes, in this order, before using anything else in the table:
  *   0. the symbol holds an aligned address inside a loaded library (refused otherwise: a library that exports
  *      the table itself under the name, instead of a pointer to it)
- *   1. abi_version is 4 (NONSEP_PLUGIN_ABI_VERSION) or 3   (refused with "expected 4 or 3, found N")
- *   2. struct_size == sizeof(nonsep_plugin_api) or NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE for 4,
- *      NONSEP_PLUGIN_V3_STRUCT_SIZE for 3          (refused with expected and found sizes); the entries a shorter
- *                                                 table lacks are absent
+ *   1. abi_version is 5 (NONSEP_PLUGIN_ABI_VERSION), 4 or 3   (refused with "expected 5, 4 or 3, found N")
+ *   2. struct_size is the size of that version's table (the list above; refused with expected and found sizes);
+ *      the entries an older table lacks are absent
  *   3. the required functions are non-null        (metadata_json, create, destroy, dimension, grad_T, grad_V,
  *                                                   last_error)
  *   4. metadata_json() returns valid JSON of the shape below, whose capabilities match the table.
@@ -56,7 +61,8 @@
  *     "capabilities": { "value_T": true, "value_V": true, "hessian_T": true, "hessian_V": true,
  *                       "d3T": true, "d3V": true, "grad_K": false, "grad_U": true, "value_U": true, ...,
  *                       "hvp_T": true, "hvp_V": true, "chin_steps": true,
- *                       "energy_TTV": false, "energy_VVT": false }
+ *                       "energy_TTV": false, "energy_VVT": false, "hvp_H": true },
+ *     "kernels": { "instruction_sets": ["x86-64", ...] }          exactly when chin_steps is non-null
  *   }
  * "minimum", "maximum" and "unit" may be absent; "thread_safe" is required. Each capability is true exactly
  * when the table's pointer of that name is non-null (an absent capability counts as false).
@@ -71,7 +77,7 @@
 extern "C" {
 #endif
 
-#define NONSEP_PLUGIN_ABI_VERSION 4u
+#define NONSEP_PLUGIN_ABI_VERSION 5u
 #define NONSEP_PLUGIN_SYMBOL "nonsep_plugin"
 /* The symbol of ABI version 1 (a function returning the table); the host names it when refusing such a plugin. */
 #define NONSEP_PLUGIN_V1_ENTRY_SYMBOL "nonsep_plugin_entry"
@@ -90,13 +96,15 @@ typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin *
 #define NONSEP_FORM_TTV 0u /* H = T_i V_ij T_j (+ K + U) */
 #define NONSEP_FORM_VVT 1u /* H = V_i T_ij V_j (+ K + U) */
 
-/* The arguments of chin_steps (below), kernel version 4: `steps` times a schedule of `substeps` basic steps of eq.
- * (expalg) of every state, in place (a triplet composition's step is its schedule of 3^levels basic steps); or, with
- * `terms` >= 2, `steps` steps of the multi-product expansion of eqs. (mpe43, mpe63): term k = m..1 takes k basic
- * steps of eps[k-1] = cbrt(dt/k) from the step's start, the result is y_m + sum_{k<m} weights[k-1] (y_k - y_m), and
- * the next step starts from the outer gradient evaluated at that point (core chin_expansion_stages.hpp). With
- * `steps` 0 the call only evaluates outer_gradient at the point, q and p left as they are: the host asks the kernel
- * for the gradient its steps start from, so that every gradient the steps use comes from the kernel's own code. */
+/* The arguments of chin_steps (below): `steps` times a schedule of `substeps` basic steps of eq. (expalg) of every
+ * state, in place (a triplet composition's step is its schedule of 3^levels basic steps); or, with `terms` >= 2,
+ * `steps` steps of the multi-product expansion of eqs. (mpe43, mpe63): term k = m..1 takes k basic steps of eps[k-1] =
+ * cbrt(dt/k) from the step's start, the result is y_m + sum_{k<m} weights[k-1] (y_k - y_m), and the next step starts
+ * from the outer gradient evaluated at that point (core chin_expansion_stages.hpp). With `steps` 0 the call only
+ * evaluates outer_gradient at the point, q and p left as they are: the host asks the kernel for the gradient its steps
+ * start from, so that every gradient the steps use comes from the kernel's own code. Version 4 with "kernels":
+ * {"version": 3} took the same arguments without the call of no steps; the host steps such plugins through their
+ * gradients. */
 typedef struct nonsep_chin_steps_args {
   uint32_t form;             /* NONSEP_FORM_TTV or NONSEP_FORM_VVT */
   uint32_t instruction_set;  /* index into the metadata's "kernels": {"instruction_sets": [...]} */
@@ -176,25 +184,43 @@ typedef struct nonsep_plugin_api {
    * triplet composition's steps whole, its sub-steps' eps in turn), the stages those of the
    * core's own template with this model's gradients inlined, so that with the baseline instruction set the
    * numbers are bit for bit those of the host stepping through grad_T and grad_V. Announced with the metadata
-   * object "kernels": {"version": K, "instruction_sets": [...]}, K the core's kernel version it was compiled
-   * from (the host uses only its own). A failed evaluation returns its status (message by last_error) with q, p
+   * object "kernels": {"instruction_sets": [...]} (version 4: {"version": K, ...}, not used by this host). A failed evaluation returns its status (message by last_error) with q, p
    * and outer_gradient undefined: the host then redoes the steps through grad_T and grad_V. */
   nonsep_status (*chin_steps)(nonsep_instance* instance, const nonsep_chin_steps_args* args);
 
   /* The product term of the solved H in one pass, for a model that writes it out (a sparse model: its H then
    * costs about a gradient, where a gradient and a Hessian-vector product cost two passes and a third to take
    * their dot product): out[b] = T'(p_b) . V''(q_b) T'(p_b) (energy_TTV), V'(q_b) . T''(p_b) V'(q_b) (energy_VVT),
-   * one number per state; K + U not included (the host adds value_K and value_U). A table may end before these
-   * two (struct_size NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE, the version-4 table as first published): the host then
-   * evaluates H through the Hessian-vector products or the Hessians. */
+   * one number per state; K + U not included (the host adds value_K and value_U). Without them the host evaluates
+   * H through the Hessian-vector products or the Hessians. */
   nonsep_status (*energy_TTV)(nonsep_instance* instance, const double* q, const double* p, double* out, size_t count);
   nonsep_status (*energy_VVT)(nonsep_instance* instance, const double* q, const double* p, double* out, size_t count);
+
+  /* ---- Version 5. Optional (NULL when absent). ---- */
+
+  /* The directional derivative of grad H: the Hessian of the solved H (K + U included) times a tangent (dq, dp),
+   * for `form` NONSEP_FORM_TTV or NONSEP_FORM_VVT: out_q = d(dH/dq), out_p = d(dH/dp), each count*n numbers in the
+   * gradient layout, one tangent (dq, dp) per state. With g = T'(p), dg = T''(p) dp, w = V''(q) g (TTV):
+   *   out_q_k = V''''_ijkl g_i g_j dq_l + 2 V'''_ijk g_i dg_j + U''_kl dq_l
+   *   out_p_k = 2 T'''_kil dp_l w_i + 2 T''_ki (V'''_ijl g_j dq_l + V''_ij dg_j) + K''_kl dp_l
+   * (fourth derivatives of V, third of T; sums over repeated indices); VVT the same with (T, p, K) and (V, q, U)
+   * swapped: g = V'(q), dg = V''(q) dq, w = T''(p) g,
+   *   out_p_k = T''''_ijkl g_i g_j dp_l + 2 T'''_ijk g_i dg_j + K''_kl dp_l
+   *   out_q_k = 2 V'''_kil dq_l w_i + 2 V''_ki (T'''_ijl g_j dp_l + T''_ij dg_j) + U''_kl dq_l.
+   * The tangent maps of the schemes that integrate H itself (Gauss-Legendre, Tao's extended phase space) need it;
+   * the host refuses them a plugin without it. Another form returns NONSEP_UNSUPPORTED. */
+  nonsep_status (*hvp_H)(nonsep_instance* instance, uint32_t form, const double* q, const double* p, const double* dq,
+                         const double* dp, double* out_q, double* out_p, size_t count);
 } nonsep_plugin_api;
 
-/* The size of a version-3 table: version 4's without the entries from grad_K on. */
+/* The size of a version-3 table: the entries before grad_K. */
 #define NONSEP_PLUGIN_V3_STRUCT_SIZE offsetof(nonsep_plugin_api, grad_K)
-/* The size of a version-4 table that ends with chin_steps (without energy_TTV and energy_VVT). */
+/* The size of a version-4 table: the entries before hvp_H. */
+#define NONSEP_PLUGIN_V4_STRUCT_SIZE offsetof(nonsep_plugin_api, hvp_H)
+/* The size of a version-4 table as first published, ending with chin_steps: also loaded as version 4. */
 #define NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE offsetof(nonsep_plugin_api, energy_TTV)
+/* The size of a version-5 table. */
+#define NONSEP_PLUGIN_V5_STRUCT_SIZE sizeof(nonsep_plugin_api)
 
 #ifdef __cplusplus
 }

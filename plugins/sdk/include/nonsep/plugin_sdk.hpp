@@ -15,7 +15,9 @@
 // metadata name differs from its file name. Every SDK plugin provides all optional functions of plugin_abi.h
 // for T and V (values, Hessians, directional third derivatives, Hessian-vector products) and the stepping kernel
 // chin_steps: the core's chin_kernel_steps with the model inlined, compiled for the instruction sets of
-// kernels.hpp (metadata "kernels": {"version", "instruction_sets"}); no stepping code is written here. Its
+// kernels.hpp (metadata "kernels": {"instruction_sets"}); no stepping code is written here; and, where the model's
+// T and V (or gradient templates) compile for one more level of dual numbers, the directional derivative of grad H,
+// hvp_H, by automatic differentiation (model_adapter.hpp; capability "hvp_H"). Its
 // metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T and
 // hvp_V, whether it is "analytic" (written by the model) or "automatic" (of the gradient templates where the model
 // has them, else of T and V). A model that writes out energy_TTV or energy_VVT (the product term of H) fills that
@@ -144,7 +146,8 @@ class PluginTable {
                                  {"hvp_V", true},
                                  {"chin_steps", true},
                                  {"energy_TTV", Adapter::analytic_energy_TTV},
-                                 {"energy_VVT", Adapter::analytic_energy_VVT}}},
+                                 {"energy_VVT", Adapter::analytic_energy_VVT},
+                                 {"hvp_H", Adapter::has_hamiltonian_hessian}}},
                                {"derivatives",
                                 {{"grad_T", kind(Adapter::analytic_grad_T)},
                                  {"grad_V", kind(Adapter::analytic_grad_V)},
@@ -154,7 +157,7 @@ class PluginTable {
                                  {"d3V", kind(Adapter::analytic_d3V)},
                                  {"hvp_T", kind(Adapter::analytic_hvp_T)},
                                  {"hvp_V", kind(Adapter::analytic_hvp_V)}}},
-                               {"kernels", {{"version", chin_kernel_version}, {"instruction_sets", kernel_sets}}}};
+                               {"kernels", {{"instruction_sets", kernel_sets}}}};
     for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
     for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
     if constexpr (HasK<M>) {
@@ -287,6 +290,30 @@ class PluginTable {
     });
   }
 
+  // The directional derivative of grad H (plugin_abi.h hvp_H): q, p, dq, dp, out_q and out_p each hold count*n
+  // numbers. A form other than TTV and VVT is NONSEP_UNSUPPORTED.
+  static nonsep_status hvp_H(nonsep_instance* instance, std::uint32_t form, const double* q, const double* p,
+                             const double* dq, const double* dp, double* out_q, double* out_p,
+                             std::size_t count) noexcept {
+    if (instance != nullptr && form != NONSEP_FORM_TTV && form != NONSEP_FORM_VVT) {
+      record_error(*instance, "hvp_H: form " + std::to_string(form) + " is neither TTV (0) nor VVT (1)");
+      return NONSEP_UNSUPPORTED;
+    }
+    return guarded(instance, "hvp_H", [&](const Instance& self) {
+      if constexpr (Adapter::has_hamiltonian_hessian) {
+        const Adapter& adapter = self.adapter;
+        const std::size_t size = count * adapter.dimension();
+        adapter.hvp_H(form == NONSEP_FORM_VVT ? HamiltonianForm::VVT : HamiltonianForm::TTV,
+                      std::span<const double>(q, size), std::span<const double>(p, size),
+                      std::span<const double>(dq, size), std::span<const double>(dp, size),
+                      std::span<double>(out_q, size), std::span<double>(out_p, size), count);
+      } else {
+        static_cast<void>(self), static_cast<void>(q), static_cast<void>(p), static_cast<void>(dq);
+        static_cast<void>(dp), static_cast<void>(out_q), static_cast<void>(out_p);
+      }
+    });
+  }
+
   // The stepping kernel (plugin_abi.h chin_steps): the core's chin_kernel_steps with this model inlined, for the
   // instruction set the host asks for (kernels.hpp).
   static nonsep_status chin_steps(nonsep_instance* instance, const nonsep_chin_steps_args* args) noexcept {
@@ -354,6 +381,7 @@ class PluginTable {
       &chin_steps,
       Adapter::analytic_energy_TTV ? &product_energy<HamiltonianForm::TTV> : nullptr,
       Adapter::analytic_energy_VVT ? &product_energy<HamiltonianForm::VVT> : nullptr,
+      Adapter::has_hamiltonian_hessian ? &hvp_H : nullptr,
   };
 };
 

@@ -54,7 +54,7 @@ class PluginModel;
 // without it the widest of the plugin's that this processor runs.
 struct KernelChoice {
   bool present = false;                       // the plugin carries kernels
-  std::uint64_t version = 0;                  // the kernel version it was built with
+  std::uint64_t version = 0;                  // the kernel version it was built with (version 5: the one it implies)
   std::vector<std::string> instruction_sets;  // as the metadata lists them (index 0 the baseline)
   std::vector<bool> usable;                   // per instruction set: right kernel version, and this processor runs it
   std::optional<std::size_t> chosen;          // the index used; empty: the evaluation path
@@ -82,6 +82,8 @@ class Plugin {
   bool has_hessians() const;
   bool has_values() const;             // both value_T and value_V
   bool has_third_derivatives() const;  // both d3T and d3V
+  // hvp_H (plugin_abi.h version 5): the directional derivative of grad H the comparators' tangent maps need.
+  bool has_hamiltonian_hessian_products() const;
   // The separable part K(p) + U(q) of the solved H (plugin_abi.h version 4): grad_K (resp. grad_U) present. The
   // loader has checked that its value is too.
   bool has_K() const;
@@ -90,7 +92,7 @@ class Plugin {
   bool has_hessian_vector_products() const;
   // energy_TTV (resp. energy_VVT): the plugin writes out the product term of H in that form.
   bool has_product_energy(HamiltonianForm form) const;
-  // The plugin ABI version its table was built for (4, or 3 for a table without version 4's entries).
+  // The plugin ABI version its table was built for (5, or 4 or 3 for an older table without the later entries).
   unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
   bool thread_safe() const;
@@ -109,8 +111,8 @@ class Plugin {
 
 // Throws PluginError: NONSEP_INSTRUCTION_SET naming an instruction set the plugin lacks or this processor cannot
 // run; file not found (listing every place tried), not a shared library, no plugin symbol,
-// ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 4 or 3, found N"
-// and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
+// ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 5, 4 or 3, found
+// N" and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
 // (including capabilities that disagree with the table and a missing "thread_safe").
 Plugin load_plugin(const std::string& name_or_path, const std::filesystem::path& base_directory);
 
@@ -149,6 +151,13 @@ class PluginModel {
   void hvp_V(std::span<const double> q, std::span<const double> v, std::span<double> out, std::size_t count) const;
   // Whether the plugin has both products (the core's energy and gradient of H use them then: hessian_products.hpp).
   bool has_hessian_vector_products() const;
+  // The directional derivative of grad H (plugin_abi.h hvp_H, version 5): out_q = d(dH/dq), out_p = d(dH/dp) along
+  // (dq, dp), every span count*n numbers; as a core model a nonsep::ModelWithHamiltonianHessian
+  // (hamiltonian_gradient.hpp), whose has_hamiltonian_hessian_products says whether the plugin has it. Throws
+  // nonsep::ModelError when the plugin lacks it, or it fails.
+  void hvp_H(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<const double> dq,
+             std::span<const double> dp, std::span<double> out_q, std::span<double> out_p, std::size_t count) const;
+  bool has_hamiltonian_hessian_products() const;
   // The product term of H in `form` (plugin_abi.h energy_TTV, energy_VVT), one number per state into out: as a
   // core model a nonsep::ModelWithProductEnergy (energy.hpp), whose EnergyEvaluator uses it where the plugin has it.
   // Throws nonsep::ModelError when the plugin lacks it, or it fails.

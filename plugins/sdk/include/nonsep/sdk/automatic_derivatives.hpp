@@ -13,6 +13,10 @@
 //                               is formed.
 //   hessian_vector_by_dual      out = H(x) v, one column pass of hessian_by_dual with the outer slot seeded with v
 //                               instead of e_j: the cost of a single Hessian column.
+//   mixed_third_by_dual         out_k = sum_ij f_kij(x) a_i b_j, one pass of ThirdDerivativeDual<K> with the outer
+//                               slots seeded with a and b
+//   mixed_fourth_by_dual        out_k = sum_ijl f_kijl(x) a_i b_j c_l, one pass of FourthDerivativeDual<K> with the
+//                               three outer slots seeded with a, b and c: 8 (K+1) doubles per number
 // Each returns f(x) (the value computed alongside), which poison_if_not_finite uses.
 //
 // For a model whose gradient g is written as a template over the number type (model_adapter.hpp), the
@@ -22,6 +26,9 @@
 //   hessian_by_gradient             the n x n Hessian, row-major: n such passes (column j along e_j)
 //   directional_third_by_gradient   out_k = sum_ij f_kij u_i u_j, one pass of g on Dual<Dual<double, 1>, 1> with
 //                                   both slots seeded with u
+//   mixed_third_by_gradient         out_k = sum_ij f_kij a_i b_j, the same pass with the slots seeded with a and b
+//   mixed_fourth_by_gradient        out_k = sum_ijl f_kijl a_i b_j c_l, one pass of g on
+//                                   Dual<Dual<Dual<double, 1>, 1>, 1> seeded with a, b and c: O(n) for a sparse g
 // These return nothing (g gives no value); the callers poison their results by the value of f where they need to.
 #include <array>
 #include <cmath>
@@ -45,6 +52,8 @@ template <std::size_t K>
 using HessianDual = Dual<Dual<double, K>, 1>;
 template <std::size_t K>
 using ThirdDerivativeDual = Dual<Dual<Dual<double, K>, 1>, 1>;
+template <std::size_t K>
+using FourthDerivativeDual = Dual<ThirdDerivativeDual<K>, 1>;
 
 namespace detail {
 
@@ -96,6 +105,41 @@ double directional_third_by_dual(const F& f, const double* x, const double* u, s
   const D y = f(Vector<D>(xs.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[k];
   return y.value.value.value;
+}
+
+template <std::size_t K, class F>
+double mixed_third_by_dual(const F& f, const double* x, const double* a, const double* b, std::size_t n, double* out) {
+  using Inner = Dual<double, K>;
+  using Middle = Dual<Inner, 1>;
+  using D = ThirdDerivativeDual<K>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i].value.value = Inner::variable(x[i], i);
+    xs[i].value.derivative[0] = Inner(a[i]);
+    xs[i].derivative[0] = Middle(b[i]);
+  }
+  const D y = f(Vector<D>(xs.data(), n));
+  for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[k];
+  return y.value.value.value;
+}
+
+template <std::size_t K, class F>
+double mixed_fourth_by_dual(const F& f, const double* x, const double* a, const double* b, const double* c,
+                            std::size_t n, double* out) {
+  using Inner = Dual<double, K>;
+  using Second = Dual<Inner, 1>;
+  using Third = ThirdDerivativeDual<K>;
+  using D = FourthDerivativeDual<K>;
+  std::array<D, K> xs;
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i].value.value.value = Inner::variable(x[i], i);
+    xs[i].value.value.derivative[0] = Inner(a[i]);
+    xs[i].value.derivative[0] = Second(b[i]);
+    xs[i].derivative[0] = Third(c[i]);
+  }
+  const D y = f(Vector<D>(xs.data(), n));
+  for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[0].derivative[k];
+  return y.value.value.value.value;
 }
 
 template <std::size_t K, class F>
@@ -154,6 +198,29 @@ void directional_third_by_gradient(const G& gradient, const double* x, const dou
   for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(Inner(x[i], {u[i]}), {Inner(u[i])});
   gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = scratch.g[k].derivative[0].derivative[0];
+}
+
+template <class G>
+void mixed_third_by_gradient(const G& gradient, const double* x, const double* a, const double* b, std::size_t n,
+                             double* out) {
+  using Inner = Dual<double, 1>;
+  using D = Dual<Inner, 1>;
+  auto& scratch = GradientScratch<D>::of_size(n);
+  for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(Inner(x[i], {a[i]}), {Inner(b[i])});
+  gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
+  for (std::size_t k = 0; k < n; ++k) out[k] = scratch.g[k].derivative[0].derivative[0];
+}
+
+template <class G>
+void mixed_fourth_by_gradient(const G& gradient, const double* x, const double* a, const double* b, const double* c,
+                              std::size_t n, double* out) {
+  using Inner = Dual<double, 1>;
+  using Second = Dual<Inner, 1>;
+  using D = Dual<Second, 1>;
+  auto& scratch = GradientScratch<D>::of_size(n);
+  for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(Second(Inner(x[i], {a[i]}), {Inner(b[i])}), {Second(c[i])});
+  gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
+  for (std::size_t k = 0; k < n; ++k) out[k] = scratch.g[k].derivative[0].derivative[0].derivative[0];
 }
 
 }  // namespace detail

@@ -129,6 +129,28 @@ concept HasGradientTemplates = requires(const M& m, Vector<DirectionalDual> d, s
   m.template grad_V<SecondDirectionalDual>(dd, dd_out);
 };
 
+// The number type and the concepts of the fourth derivatives the directional derivative of grad H needs (hvp_H).
+using ThirdDirectionalDual = Dual<SecondDirectionalDual, 1>;
+template <class M>
+concept HasFourthOrderGradientTemplates = requires(const M& m, Vector<ThirdDirectionalDual> d,
+                                                   std::span<ThirdDirectionalDual> out) {
+  m.template grad_T<ThirdDirectionalDual>(d, out);
+  m.template grad_V<ThirdDirectionalDual>(d, out);
+};
+template <class M>
+concept HasFourthOrderTV = requires(const M& m, Vector<FourthDerivativeDual<dimension_capacity<M>()>> d) {
+  m.template T<FourthDerivativeDual<dimension_capacity<M>()>>(d);
+  m.template V<FourthDerivativeDual<dimension_capacity<M>()>>(d);
+};
+template <class M>
+concept HasGradientTemplateK = requires(const M& m, Vector<DirectionalDual> d, std::span<DirectionalDual> out) {
+  m.template grad_K<DirectionalDual>(d, out);
+};
+template <class M>
+concept HasGradientTemplateU = requires(const M& m, Vector<DirectionalDual> d, std::span<DirectionalDual> out) {
+  m.template grad_U<DirectionalDual>(d, out);
+};
+
 template <class M>
 concept HasDualTV = requires(const M& m, Vector<GradientDual<dimension_capacity<M>()>> d,
                              Vector<HessianDual<dimension_capacity<M>()>> dd,
@@ -301,6 +323,10 @@ class ModelAdapter {
   static constexpr bool differentiates_gradients = policy == Derivatives::preferred && HasGradientTemplates<M>;
   static_assert(differentiates_gradients || HasDualTV<M>,
                 "Derivatives::automatic needs T and V that compile for the dual numbers of automatic_derivatives.hpp");
+  // The fourth derivatives of hvp_H: of the gradient templates where they compile for ThirdDirectionalDual, else of
+  // T and V on FourthDerivativeDual; a model with neither has no hvp_H.
+  static constexpr bool fourth_by_gradients = differentiates_gradients && HasFourthOrderGradientTemplates<M>;
+  static constexpr bool has_hamiltonian_hessian = fourth_by_gradients || HasFourthOrderTV<M>;
 
   static constexpr bool analytic_grad_K = policy == Derivatives::preferred && HasAnalyticGradK<M>;
   static constexpr bool analytic_grad_U = policy == Derivatives::preferred && HasAnalyticGradU<M>;
@@ -465,6 +491,55 @@ class ModelAdapter {
                                    [](const auto& m, auto w) { return m.V(w); }, q, v, out, count);
   }
 
+  // The directional derivative of grad H (plugin_abi.h hvp_H, which writes out the formula): the Hessian of the
+  // solved H, K + U included, times the tangent (dq, dp) of each state, into out_q = d(dH/dq), out_p = d(dH/dp); all
+  // six spans in the gradient layout. Per state: the gradient and two Hessian-vector products of the outer function
+  // (T in TTV), two of the inner, one mixed third derivative of each and one mixed fourth of the inner, each one
+  // pass over the gradient templates (O(n) for a sparse model) or over T and V; plus K'' dp and U'' dq.
+  void hvp_H(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<const double> dq,
+             std::span<const double> dp, std::span<double> out_q, std::span<double> out_p,
+             std::size_t count) const requires has_hamiltonian_hessian {
+    const std::size_t size = count * dimension_;
+    for (const std::size_t found : {q.size(), p.size(), dq.size(), dp.size(), out_q.size(), out_p.size()})
+      if (found < size) [[unlikely]]
+        throw_bad_sizes(count, dimension_, std::min({q.size(), p.size(), dq.size(), dp.size()}),
+                        std::min(out_q.size(), out_p.size()));
+    const std::size_t n = batch_dimension();
+    auto& scratch = detail::GradientScratch<double>::of_size(3 * n);
+    double* g = scratch.x.data();
+    double* dg = g + n;
+    double* w = dg + n;
+    double* third = scratch.g.data();
+    double* sum = third + n;
+    const bool ttv = form == HamiltonianForm::TTV;
+    for (std::size_t b = 0; b < count; ++b) {
+      const std::size_t at = b * n;
+      // X the outer function (T at p in TTV), Y the inner (V at q), each with its point, tangent and output.
+      const double* x = (ttv ? p : q).data() + at;
+      const double* dx = (ttv ? dp : dq).data() + at;
+      const double* y = (ttv ? q : p).data() + at;
+      const double* dy = (ttv ? dq : dp).data() + at;
+      double* out_x = (ttv ? out_p : out_q).data() + at;
+      double* out_y = (ttv ? out_q : out_p).data() + at;
+      gradient_of(ttv, x, g, n);
+      product_of(ttv, x, dx, dg, n);
+      product_of(!ttv, y, g, w, n);
+      // out_y = Y''''[g, g, dy] + 2 Y'''[g, dg]
+      mixed_fourth_of(!ttv, y, g, g, dy, out_y, n);
+      mixed_third_of(!ttv, y, g, dg, third, n);
+      for (std::size_t i = 0; i < n; ++i) out_y[i] += 2.0 * third[i];
+      // out_x = 2 X'''[dx, w] + 2 X'' (Y'''[g, dy] + Y'' dg)
+      mixed_third_of(!ttv, y, g, dy, sum, n);
+      product_of(!ttv, y, dg, third, n);
+      for (std::size_t i = 0; i < n; ++i) sum[i] += third[i];
+      product_of(ttv, x, sum, out_x, n);
+      mixed_third_of(ttv, x, dx, w, third, n);
+      for (std::size_t i = 0; i < n; ++i) out_x[i] = 2.0 * (third[i] + out_x[i]);
+      if constexpr (HasK<M>) add_separable_product<true>(p.data() + at, dp.data() + at, out_p.data() + at, n);
+      if constexpr (HasU<M>) add_separable_product<false>(q.data() + at, dq.data() + at, out_q.data() + at, n);
+    }
+  }
+
   // The model's own product term of H (nonsep::ModelWithProductEnergy, energy.hpp), one number per state; present
   // when M writes out energy_TTV or energy_VVT (has_product_energy says which).
   bool has_product_energy(HamiltonianForm form) const requires(analytic_energy_TTV || analytic_energy_VVT) {
@@ -488,6 +563,68 @@ class ModelAdapter {
   }
 
  private:
+  // One state's derivatives of T (kinetic) or V, for hvp_H: the gradient and the Hessian-vector product as grad_T and
+  // hvp_T compute them, the mixed third and fourth derivatives by automatic differentiation.
+  void gradient_of(bool kinetic, const double* x, double* out, std::size_t n) const {
+    if (kinetic)
+      grad_T(std::span<const double>(x, n), std::span<double>(out, n), 1);
+    else
+      grad_V(std::span<const double>(x, n), std::span<double>(out, n), 1);
+  }
+  void product_of(bool kinetic, const double* x, const double* v, double* out, std::size_t n) const {
+    if (kinetic)
+      hvp_T(std::span<const double>(x, n), std::span<const double>(v, n), std::span<double>(out, n), 1);
+    else
+      hvp_V(std::span<const double>(x, n), std::span<const double>(v, n), std::span<double>(out, n), 1);
+  }
+  void mixed_third_of(bool kinetic, const double* x, const double* a, const double* b, double* out,
+                      std::size_t n) const {
+    if constexpr (differentiates_gradients) {
+      if (kinetic)
+        detail::mixed_third_by_gradient([this](auto v, auto g) { model_.grad_T(v, g); }, x, a, b, n, out);
+      else
+        detail::mixed_third_by_gradient([this](auto v, auto g) { model_.grad_V(v, g); }, x, a, b, n, out);
+    } else {
+      const double value =
+          kinetic ? detail::mixed_third_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, a, b, n, out)
+                  : detail::mixed_third_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, a, b, n, out);
+      detail::poison_if_not_finite(value, out, n);
+    }
+  }
+  void mixed_fourth_of(bool kinetic, const double* x, const double* a, const double* b, const double* c, double* out,
+                       std::size_t n) const requires has_hamiltonian_hessian {
+    if constexpr (fourth_by_gradients) {
+      if (kinetic)
+        detail::mixed_fourth_by_gradient([this](auto v, auto g) { model_.grad_T(v, g); }, x, a, b, c, n, out);
+      else
+        detail::mixed_fourth_by_gradient([this](auto v, auto g) { model_.grad_V(v, g); }, x, a, b, c, n, out);
+    } else {
+      const double value =
+          kinetic ? detail::mixed_fourth_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, a, b, c, n, out)
+                  : detail::mixed_fourth_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, a, b, c, n, out);
+      detail::poison_if_not_finite(value, out, n);
+    }
+  }
+  // out += K''(x) v (kinetic) or U''(x) v: one directional pass over grad_K (grad_U) where it is a template, else
+  // one Hessian-column pass over K (U).
+  template <bool kinetic>
+  void add_separable_product(const double* x, const double* v, double* out, std::size_t n) const {
+    double* product = detail::GradientScratch<double>::of_size(3 * n).g.data() + 2 * n;  // past hvp_H's use
+    if constexpr (kinetic && HasGradientTemplateK<M> && policy == Derivatives::preferred)
+      detail::hessian_vector_by_gradient([this](auto y, auto g) { model_.grad_K(y, g); }, x, v, n, product);
+    else if constexpr (!kinetic && HasGradientTemplateU<M> && policy == Derivatives::preferred)
+      detail::hessian_vector_by_gradient([this](auto y, auto g) { model_.grad_U(y, g); }, x, v, n, product);
+    else if constexpr (kinetic)
+      detail::poison_if_not_finite(
+          detail::hessian_vector_by_dual<capacity>([this](auto w) { return model_.K(w); }, x, v, n, product), product,
+          n);
+    else
+      detail::poison_if_not_finite(
+          detail::hessian_vector_by_dual<capacity>([this](auto w) { return model_.U(w); }, x, v, n, product), product,
+          n);
+    for (std::size_t i = 0; i < n; ++i) out[i] += product[i];
+  }
+
   // f (T, V, K or U) at each state of x, one number per state.
   template <class F>
   void values(std::span<const double> x, std::span<double> out, std::size_t count, const F& f) const {
