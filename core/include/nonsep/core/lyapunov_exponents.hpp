@@ -14,7 +14,9 @@
 // the tangent vectors; restoring both bit for bit continues the run bit for bit). The record is trivially
 // copyable and holds no pointers. Besides the sums it keeps ln |v_1| since the last orthonormalisation, so that
 // after_step() can hand out the step's growth of the first vector, ln(|v_1(t_k)| / |v_1(t_{k-1})|), which
-// MEGNO needs (megno.hpp), whether or not the step renormalised.
+// MEGNO needs (megno.hpp), whether or not the step renormalised; only when asked (a logarithm per state and step).
+// SALI and GALI come from the same vectors and the triangular factors of the orthonormalisations
+// (alignment_indices.hpp).
 //
 // Errors: InvalidArgument for k outside 1 .. min(2n, max_exponents), renormalize_every == 0, or spans whose
 // sizes disagree with the batch. A tangent vector that has become zero, infinite or NaN (an overflow of the
@@ -22,9 +24,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 
+#include "nonsep/core/alignment_indices.hpp"
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/phase_space_batch.hpp"
 
@@ -47,8 +51,10 @@ struct LyapunovRecord {
 
 // Modified Gram-Schmidt of the k vectors of state b of `tangents` (layout above), in place: afterwards they are
 // orthonormal, and log_norms[j] = ln R_jj (the length of vector j after the projections onto vectors 0 .. j-1
-// were removed), j < k.
-inline void orthonormalize_state(PhaseSpaceBatch& tangents, std::size_t k, std::size_t b, std::span<double> log_norms) {
+// were removed), j < k. When `r` is not empty (k*k numbers) it gets the whole triangular factor of V = Q R,
+// row-major (R_ij at i*k + j, zeros below the diagonal), for alignment_indices.hpp.
+inline void orthonormalize_state(PhaseSpaceBatch& tangents, std::size_t k, std::size_t b, std::span<double> log_norms,
+                                 std::span<double> r = {}) {
   const std::size_t n = tangents.dimension();
   double* q = tangents.q().data() + b * k * n;
   double* p = tangents.p().data() + b * k * n;
@@ -60,6 +66,7 @@ inline void orthonormalize_state(PhaseSpaceBatch& tangents, std::size_t k, std::
   for (std::size_t j = 0; j < k; ++j) {
     for (std::size_t i = 0; i < j; ++i) {
       const double projection = dot(i, j);
+      if (!r.empty()) r[i * k + j] = projection;
       for (std::size_t m = 0; m < n; ++m) {
         q[j * n + m] -= projection * q[i * n + m];
         p[j * n + m] -= projection * p[i * n + m];
@@ -67,6 +74,10 @@ inline void orthonormalize_state(PhaseSpaceBatch& tangents, std::size_t k, std::
     }
     const double norm = std::sqrt(dot(j, j));
     log_norms[j] = std::log(norm);
+    if (!r.empty()) {
+      r[j * k + j] = norm;
+      for (std::size_t i = j + 1; i < k; ++i) r[i * k + j] = 0.0;
+    }
     const double inverse = 1.0 / norm;
     for (std::size_t m = 0; m < n; ++m) {
       q[j * n + m] *= inverse;
@@ -99,37 +110,59 @@ class LyapunovExponents {
     }
   }
 
-  // To be called after each step of dt of the states and their tangent vectors. Writes first_growth[b] =
-  // ln(|v_1| after / |v_1| before) of state b for this step (records.size() entries), and re-orthonormalises
-  // the vectors of the states that reached renormalize_every steps since their last orthonormalisation.
+  // To be called after each step of dt of the states and their tangent vectors: re-orthonormalises the vectors of
+  // the states that reached renormalize_every steps since their last orthonormalisation. Two optional outputs, each
+  // either empty (not computed) or sized for every state:
+  //   first_growth: records.size() numbers, ln(|v_1| after / |v_1| before) of state b over this step (for MEGNO);
+  //     empty: the first vector's norm and logarithm are not computed, and record.log_norm_first stays 0;
+  //   alignment: records.size() factors of AlignmentIndices(k) (alignment_indices.hpp), updated with the
+  //     triangular factor of each orthonormalisation (k >= 2).
+  // The exponents are the same bit for bit whichever outputs are asked for.
   void after_step(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt,
-                  std::span<double> first_growth) {
+                  std::span<double> first_growth, std::span<double> alignment = {}) {
     check(tangents, records);
-    if (first_growth.size() != records.size())
+    if (!first_growth.empty() && first_growth.size() != records.size())
       throw InvalidArgument("first_growth has " + std::to_string(first_growth.size()) + " entries for " +
                             std::to_string(records.size()) + " states");
+    std::optional<AlignmentIndices> indices;
+    if (!alignment.empty()) {
+      indices.emplace(k_);
+      if (alignment.size() != records.size() * indices->factor_size())
+        throw InvalidArgument("SALI/GALI: " + std::to_string(alignment.size()) + " numbers of factors for " +
+                              std::to_string(records.size()) + " states of " + std::to_string(k_) +
+                              " vectors (expected " + std::to_string(records.size() * indices->factor_size()) + ")");
+    }
     const std::size_t n = tangents.dimension();
     std::array<double, LyapunovRecord::max_exponents> log_norms{};
+    std::array<double, LyapunovRecord::max_exponents * LyapunovRecord::max_exponents> r;  // written before read
+    const std::span<double> triangle = indices ? std::span<double>(r.data(), k_ * k_) : std::span<double>();
     for (std::size_t b = 0; b < records.size(); ++b) {
-      LyapunovRecord& r = records[b];
-      const std::size_t first = b * k_ * n;
-      double squared = 0.0;
-      for (std::size_t i = 0; i < n; ++i)
-        squared +=
-            tangents.q()[first + i] * tangents.q()[first + i] + tangents.p()[first + i] * tangents.p()[first + i];
-      const double log_norm = 0.5 * std::log(squared);
-      first_growth[b] = log_norm - r.log_norm_first;
-      r.log_norm_first = log_norm;
-      ++r.steps;
-      r.time_since_renormalization += dt;
-      if (++r.steps_since_renormalization < renormalize_every_) continue;
-      orthonormalize_state(tangents, k_, b, log_norms);
-      for (std::size_t j = 0; j < k_; ++j) r.log_stretch[j] += log_norms[j];
-      r.time += r.time_since_renormalization;
-      r.time_since_renormalization = 0.0;
-      r.steps_since_renormalization = 0;
-      r.log_norm_first = 0.0;
+      LyapunovRecord& record = records[b];
+      if (!first_growth.empty()) {
+        const std::size_t first = b * k_ * n;
+        double squared = 0.0;
+        for (std::size_t i = 0; i < n; ++i)
+          squared +=
+              tangents.q()[first + i] * tangents.q()[first + i] + tangents.p()[first + i] * tangents.p()[first + i];
+        const double log_norm = 0.5 * std::log(squared);
+        first_growth[b] = log_norm - record.log_norm_first;
+        record.log_norm_first = log_norm;
+      }
+      ++record.steps;
+      record.time_since_renormalization += dt;
+      if (++record.steps_since_renormalization < renormalize_every_) continue;
+      orthonormalize_state(tangents, k_, b, log_norms, triangle);
+      for (std::size_t j = 0; j < k_; ++j) record.log_stretch[j] += log_norms[j];
+      if (indices) indices->update(alignment.subspan(b * indices->factor_size(), indices->factor_size()), triangle);
+      record.time += record.time_since_renormalization;
+      record.time_since_renormalization = 0.0;
+      record.steps_since_renormalization = 0;
+      record.log_norm_first = 0.0;
     }
+  }
+  // Without first_growth and alignment.
+  void after_step(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt) {
+    after_step(tangents, records, dt, {}, {});
   }
 
  private:
