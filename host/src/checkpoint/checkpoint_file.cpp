@@ -98,6 +98,13 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   for (double x : job.initial.q) append_bits(initial, x);
   for (double x : job.initial.p) append_bits(initial, x);
   parts.emplace_back("initial", std::move(initial));
+  if (!job.sweep.empty()) {  // each trajectory's parameters: every set's first trajectory and parameters
+    std::string sweep;
+    const std::vector<std::size_t>& sets = job.initial.parameter_set;
+    for (std::size_t b = 0; b < sets.size(); ++b)
+      if (b == 0 || sets[b] != sets[b - 1]) sweep += std::to_string(b) + ' ' + job.parameter_set(sets[b]).dump() + '\n';
+    parts.emplace_back("sweep", std::move(sweep));
+  }
   std::string time;
   append_bits(time, run.time.dt);
   append_bits(time, run.time.t_end);

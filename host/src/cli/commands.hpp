@@ -49,6 +49,9 @@ int command_model_compile(const ModelCompileArguments& arguments);
 // job with a plugin); throws InvalidJob.
 std::optional<Job> read_formula_job(const std::string& job_file);
 int report_formula_job(const std::string& job_file, const Job& job);
+// The "  sweep: ..." line of `nonsep validate` (empty without a sweep): the swept parameters, the parameter sets
+// and the trajectories they make; `loaded`: the job's states are those of load_model (every set's, on its shell).
+std::string sweep_text(const Job& job, bool loaded);
 int command_schema();
 
 // Texts of --help, generated from the scheme catalogue and the exit statuses.

@@ -54,6 +54,7 @@ std::optional<Job> read_formula_job(const std::string& job_file) {
   if (!job || !job->formula) return std::nullopt;
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
   check_model_parameters(job->parameters, formula::declared_parameters(*job->formula), issues);
+  check_swept_parameters(*job, formula::declared_parameters(*job->formula), issues);
   check_dimension(job->initial, job->formula->dimension, issues);
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
   return job;
@@ -66,7 +67,8 @@ int report_formula_job(const std::string& job_file, const Job& job) {
             << (model.file.empty() ? "" : " (" + model.file.string() + ")") << "\n"
             << "    T = " << model.T << "\n"
             << "    V = " << model.V << "\n"
-            << "  parameters:  " << job.parameters.dump() << "\n"
+            << "  parameters:  " << job.parameters.dump() << (job.sweep.empty() ? "" : " and the sweep") << "\n"
+            << sweep_text(job, false)
             << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "
                "(initial states on an energy shell, the gradient check) is checked then\n";
   return to_int(ExitStatus::success);

@@ -10,15 +10,37 @@ namespace {
 
 // "grid on the energy shell H = 7, p1 solved for; 36 of its 144 states cannot reach it and are left out": without
 // it, a grid of 144 points that validates as "108 states (grid)" looks like a mistake in the grid.
-std::string initial_shell_text(const InitialStates& initial) {
+std::string initial_shell_text(const InitialStates& initial, bool sweep) {
   if (!initial.shell) return "";
   const EnergyShell& shell = *initial.shell;
   return " on the energy shell H = " + format_number(shell.energy) + ", " + shell.solve_for + " solved for; " +
          std::to_string(shell.left_out) + " of its " + std::to_string(initial.count + shell.left_out) +
-         " states cannot reach it and are left out";
+         (sweep ? " (parameter set, state) pairs" : " states") + " cannot reach it and are left out";
+}
+
+// The parameters in effect, a swept one as its list of values.
+std::string parameters_text(const LoadedJob& loaded) {
+  nlohmann::json parameters = loaded.model.parameters();
+  for (const SweptParameter& swept : loaded.job.sweep) parameters[swept.name] = swept.values;
+  return parameters.dump();
 }
 
 }  // namespace
+
+std::string sweep_text(const Job& job, bool loaded) {
+  if (job.sweep.empty()) return "";
+  std::string text = "  sweep:       ";
+  for (const SweptParameter& swept : job.sweep)
+    text += (&swept == &job.sweep.front() ? "" : " x ") + swept.name + " (" + std::to_string(swept.values.size()) +
+            " values)";
+  const std::size_t sets = job.parameter_sets();
+  const std::size_t states =
+      loaded ? (job.initial.count + (job.initial.shell ? job.initial.shell->left_out : 0)) / sets : job.initial.count;
+  text += ": " + std::to_string(sets) + " parameter sets x " + std::to_string(states) + " states = ";
+  if (loaded) return text + std::to_string(job.initial.count) + " trajectories\n";
+  return text + std::to_string(sets * states) + " trajectories" +
+         (job.initial.shell ? " before the energy shell leaves out those that cannot reach it" : "") + "\n";
+}
 
 int command_validate(const std::string& job_file) {
   try {
@@ -46,13 +68,15 @@ int command_validate(const std::string& job_file) {
     std::cout << "valid: " << job_file << "\n"
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
-              << "  parameters:  " << loaded.model.parameters().dump() << "\n"
+              << "  parameters:  " << parameters_text(loaded) << "\n"
               << "  integrator:  " << spec.scheme << ", order " << spec.order.to_string()
               << ", t2 = " << format_number(spec.t2) << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT")
               << "\n"
-              << "  initial:     " << job.initial.count << " state" << (job.initial.count == 1 ? "" : "s") << " ("
-              << job.initial.shape << initial_shell_text(job.initial) << ")\n"
-              << "  time:        " << time_text(run.time) << "\n"
+              << "  initial:     " << job.initial.count
+              << (job.sweep.empty() ? (job.initial.count == 1 ? " state" : " states")
+                                    : (job.initial.count == 1 ? " trajectory" : " trajectories"))
+              << " (" << job.initial.shape << initial_shell_text(job.initial, !job.sweep.empty()) << ")\n"
+              << sweep_text(job, true) << "  time:        " << time_text(run.time) << "\n"
               << "  output:      " << job.output_directory.string() << ", trajectory every " << run.every
               << (run.every == 0 ? " (none)" : " steps") << "\n";
     return to_int(ExitStatus::success);

@@ -61,6 +61,9 @@ LoadedJob unit_job(const LoadedJob& loaded, std::size_t first, std::size_t size)
   initial.p.assign(loaded.job.initial.p.begin() + static_cast<std::ptrdiff_t>(first * n),
                    loaded.job.initial.p.begin() + static_cast<std::ptrdiff_t>((first + size) * n));
   initial.count = size;
+  if (const auto& sets = loaded.job.initial.parameter_set; !sets.empty())
+    initial.parameter_set.assign(sets.begin() + static_cast<std::ptrdiff_t>(first),
+                                 sets.begin() + static_cast<std::ptrdiff_t>(first + size));
   return unit;
 }
 

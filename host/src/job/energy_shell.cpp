@@ -46,34 +46,28 @@ void read_energy_shell(Checker& check, const json& initial, InitialStates& state
 
 }  // namespace job_reader
 
-void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues) {
-  InitialStates& initial = loaded.job.initial;
-  if (!initial.shell) return;
-  EnergyShell& shell = *initial.shell;
-  if (!loaded.plugin.has_hessians()) {
-    issues.push_back({"/initial/energy", "the plugin '" + loaded.plugin.name() + "', which has no Hessians",
-                      "a plugin with Hessians (hessian_T and hessian_V): H needs them"});
-    return;
-  }
-  const std::size_t n = initial.dimension, c = shell.component;
-  EnergyEvaluator evaluator(loaded.job.is_study() ? loaded.job.study().form : loaded.job.run().integrator.form);
+std::size_t solve_on_energy_shell(const PluginModel& model, HamiltonianForm form, const EnergyShell& shell,
+                                  std::size_t n, std::vector<double>& states_q, std::vector<double>& states_p) {
+  const std::size_t c = shell.component, count = states_q.size() / n;
+  EnergyEvaluator evaluator(form);
   std::vector<double> q, p, kept_q, kept_p;
   // H - E at p_c = x for the state being solved.
   auto excess = [&](double x) {
     p[c] = shell.negative ? -x : x;
     double h = 0.0;
     try {
-      evaluator.evaluate(loaded.model, PhaseSpaceBatch::single(q, p), std::span<double>(&h, 1));
+      evaluator.evaluate(model, PhaseSpaceBatch::single(q, p), std::span<double>(&h, 1));
     } catch (const ModelError&) {
       return std::nan("");  // not bracketed: the state is left out
     }
     return h - shell.energy;
   };
-  for (std::size_t b = 0; b < initial.count; ++b) {
-    q.assign(initial.q.begin() + static_cast<std::ptrdiff_t>(b * n),
-             initial.q.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
-    p.assign(initial.p.begin() + static_cast<std::ptrdiff_t>(b * n),
-             initial.p.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
+  std::size_t left_out = 0;
+  for (std::size_t b = 0; b < count; ++b) {
+    q.assign(states_q.begin() + static_cast<std::ptrdiff_t>(b * n),
+             states_q.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
+    p.assign(states_p.begin() + static_cast<std::ptrdiff_t>(b * n),
+             states_p.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
     double lower = 0.0, g_lower = excess(0.0), upper = 1.0, g_upper = 0.0;
     bool bracketed = false;
     if (std::isfinite(g_lower) && g_lower <= 0.0) {
@@ -89,7 +83,7 @@ void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues) {
       }
     }
     if (!bracketed) {
-      ++shell.left_out;
+      ++left_out;
       continue;
     }
     double root = g_lower == 0.0 ? lower : upper;
@@ -103,15 +97,9 @@ void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues) {
     kept_q.insert(kept_q.end(), q.begin(), q.end());
     kept_p.insert(kept_p.end(), p.begin(), p.end());
   }
-  if (kept_q.empty()) {
-    issues.push_back({"/initial/energy", format_number(shell.energy) + ", which no state of the grid reaches",
-                      "an energy that some states of the grid reach by solving for " + shell.solve_for + " (H at " +
-                          shell.solve_for.substr(shell.negative ? 1 : 0) + " = 0 must not exceed it)"});
-    return;
-  }
-  initial.q = std::move(kept_q);
-  initial.p = std::move(kept_p);
-  initial.count = initial.q.size() / n;
+  states_q = std::move(kept_q);
+  states_p = std::move(kept_p);
+  return left_out;
 }
 
 }  // namespace nonsep::host

@@ -17,7 +17,8 @@ std::size_t array_size(const json& value, const char* key) {
   return it != value.end() && it->is_array() ? it->size() : 0;
 }
 
-// One axis of a grid: a number, {"from", "to", "count"} or {"values": [...]}.
+}  // namespace
+
 std::optional<std::vector<double>> read_axis(Checker& check, const json& value, const std::string& path) {
   const std::string what =
       "a number (a fixed value), {\"from\": a, \"to\": b, \"count\": n} (n evenly spaced values from a to b) or "
@@ -61,6 +62,8 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
     values[i] = i + 1 == n && n > 1 ? *to : *from + (*to - *from) * static_cast<double>(i) / static_cast<double>(n - 1);
   return values;
 }
+
+namespace {
 
 // Fills `states` with every combination of `axes` (q0, q1, ..., p0, p1, ...), row-major: the last axis varies
 // fastest. `count` is the product of the axes' sizes, count * n within max_initial_values.

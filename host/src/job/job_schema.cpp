@@ -194,11 +194,20 @@ schema_json definitions() {
   defs["parameters"] = {
       {"type", "object"},
       {"additionalProperties",
-       {{"type", {"number", "boolean"}},
+       {{"oneOf",
+         {{{"type", {"number", "boolean"}}},
+          {{"type", "array"},
+           {"minItems", 1},
+           {"maxItems", max_initial_states},
+           {"items", {{"type", {"number", "boolean"}}}}},
+          object_schema(range_axis_keys(), "A sweep over count evenly spaced values from `from` to `to`."),
+          object_schema(values_axis_keys(), "A sweep over the values listed.")}},
         {"description",
          "A parameter of the plugin by its name (`nonsep inspect PLUGIN` lists them): checked against the plugin's "
          "metadata (known name, type, minimum and maximum); an integer parameter takes an integral number of "
-         "magnitude at most 2^53."}}}};
+         "magnitude at most 2^53. Several values (an array, {\"values\": [...]} or {\"from\", \"to\", "
+         "\"count\"}) make a sweep: the run takes every parameter set of the product of the swept parameters with "
+         "every initial state (docs/dynamics.md)."}}}};
   defs["vector"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("finite")}};
   defs["state"] = object_schema(state_keys());
   defs["initial"] = {{"oneOf",

@@ -99,12 +99,13 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   }
   const std::size_t before = issues.size();
   check_model_parameters(checked.parameters, loaded.plugin.parameters(), issues);
+  check_swept_parameters(checked, loaded.plugin.parameters(), issues);
   if (issues.size() != before) return std::nullopt;
   try {
-    loaded.model = loaded.plugin.create(checked.parameters);
+    loaded.model = loaded.plugin.create(checked.parameter_set(0));
   } catch (const std::exception& error) {
     issues.push_back({"/model/parameters",
-                      job_reader::describe(checked.parameters) + ", refused by the plugin: " + error.what(),
+                      job_reader::describe(checked.parameter_set(0)) + ", refused by the plugin: " + error.what(),
                       "parameters the plugin accepts (see `nonsep inspect " + checked.plugin + "`)"});
     return std::nullopt;
   }
@@ -117,7 +118,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
                           gibibytes(n * n * sizeof(double)) + " GiB",
                       "a dimension whose n x n Hessian fits in 1 GiB (n <= 11585) when the plugin has Hessians and no "
                       "Hessian-vector products (hvp_T, hvp_V)"});
-  if (issues.size() == before) place_on_energy_shell(loaded, issues);
+  if (issues.size() == before) make_trajectories(loaded, issues);
   if (issues.size() == before) check_gradients_at_initial_states(loaded, issues);
   if (!checked.is_study())
     if (const Analysis& analysis = checked.run().analysis;

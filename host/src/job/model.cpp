@@ -29,7 +29,52 @@ void read_model(Checker& check, const json& document, Job& job) {
     job.formula = formula::read_formula_model(*formula, "/model/formula", job.directory, check.issues());
   if (const json* parameters = check.member(*model, "/model", "parameters", false, ""))
     if (check.object(*parameters, "/model/parameters", "an object of the plugin's parameters (see `nonsep inspect`)"))
-      job.parameters = *parameters;
+      for (const auto& [name, value] : parameters->items()) {
+        if (!value.is_array() && !value.is_object()) {
+          job.parameters[name] = value;
+        } else if (auto swept = read_swept_parameter(check, name, value, child("/model/parameters", name))) {
+          job.sweep.push_back(std::move(*swept));
+        }
+      }
+}
+
+}  // namespace nonsep::host::job_reader
+
+namespace nonsep::host::job_reader {
+
+const PluginParameter* find_parameter(Checker& check, const std::vector<PluginParameter>& declared,
+                                      const std::string& name, const std::string& path) {
+  const auto it = std::find_if(declared.begin(), declared.end(),
+                               [&](const PluginParameter& parameter) { return parameter.name == name; });
+  if (it != declared.end()) return &*it;
+  std::string names;
+  for (const auto& parameter : declared) names += (names.empty() ? "" : ", ") + parameter.name;
+  check.issue(path, "the unknown parameter \"" + name + "\"",
+              names.empty() ? "none: this plugin has no parameters" : "the plugin's parameters " + names);
+  return nullptr;
+}
+
+void check_parameter_value(Checker& check, const PluginParameter& parameter, const json& value, const std::string& path,
+                           const std::string& found) {
+  std::string range;
+  if (parameter.minimum) range += " >= " + format_number(*parameter.minimum);
+  if (parameter.minimum && parameter.maximum) range += " and";
+  if (parameter.maximum) range += " <= " + format_number(*parameter.maximum);
+  if (!parameter.unit.empty()) range += " (" + parameter.unit + ")";
+  const std::string type_text = parameter.type == "boolean"   ? "true or false"
+                                : parameter.type == "integer" ? "an integer" + range
+                                                              : "a finite number" + range;
+  switch (sdk::parameter_fault(parameter.type, parameter.minimum, parameter.maximum, value)) {
+    case sdk::ParameterFault::none:
+      break;
+    case sdk::ParameterFault::wrong_type:
+      check.issue(path, found, type_text + ": " + parameter.description);
+      break;
+    case sdk::ParameterFault::below_minimum:
+    case sdk::ParameterFault::above_maximum:
+      check.issue(path, found, "a value" + range + ": " + parameter.description);
+      break;
+  }
 }
 
 }  // namespace nonsep::host::job_reader
@@ -39,36 +84,10 @@ namespace nonsep::host {
 void check_model_parameters(const nlohmann::json& given, const std::vector<PluginParameter>& declared,
                             std::vector<JobIssue>& issues) {
   job_reader::Checker check(issues);
-  std::string names;
-  for (const auto& parameter : declared) names += (names.empty() ? "" : ", ") + parameter.name;
   for (const auto& [name, value] : given.items()) {
     const std::string path = job_reader::child("/model/parameters", name);
-    const auto it = std::find_if(declared.begin(), declared.end(),
-                                 [&key = name](const PluginParameter& parameter) { return parameter.name == key; });
-    if (it == declared.end()) {
-      check.issue(path, "the unknown parameter \"" + name + "\"",
-                  names.empty() ? "none: this plugin has no parameters" : "the plugin's parameters " + names);
-      continue;
-    }
-    std::string range;
-    if (it->minimum) range += " >= " + format_number(*it->minimum);
-    if (it->minimum && it->maximum) range += " and";
-    if (it->maximum) range += " <= " + format_number(*it->maximum);
-    if (!it->unit.empty()) range += " (" + it->unit + ")";
-    const std::string type_text = it->type == "boolean"   ? "true or false"
-                                  : it->type == "integer" ? "an integer" + range
-                                                          : "a finite number" + range;
-    switch (sdk::parameter_fault(it->type, it->minimum, it->maximum, value)) {
-      case sdk::ParameterFault::none:
-        break;
-      case sdk::ParameterFault::wrong_type:
-        check.issue(path, job_reader::describe(value), type_text + ": " + it->description);
-        break;
-      case sdk::ParameterFault::below_minimum:
-      case sdk::ParameterFault::above_maximum:
-        check.issue(path, job_reader::describe(value), "a value" + range + ": " + it->description);
-        break;
-    }
+    if (const PluginParameter* parameter = job_reader::find_parameter(check, declared, name, path))
+      job_reader::check_parameter_value(check, *parameter, value, path, job_reader::describe(value));
   }
 }
 

@@ -34,6 +34,9 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     Study& study = job.plan.emplace<Study>(read_study(check, *study_value, form, t_end));
     study.form = form;
     study.t_end = t_end;
+    for (const SweptParameter& swept : job.sweep)
+      check.issue(child("/model/parameters", swept.name), std::to_string(swept.values.size()) + " values (a sweep)",
+                  "one value: a study runs one parameter set (write one study per value)");
     if (job.initial.count > 1)
       check.issue("/initial", std::to_string(job.initial.count) + " states",
                   "one state: a study runs every integrator from the same initial state");
@@ -46,6 +49,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     run.time = read_time(check, document);
     if (const json* analysis = check.member(document, "", "analysis", false, ""))
       run.analysis = read_analysis(check, *analysis, job.initial.dimension);
+    check_sweep_size(check, job);
   }
   read_output(check, document, job);
   if (const json* checkpoint = check.member(document, "", "checkpoint", false, "")) {

@@ -13,8 +13,21 @@
 
 namespace nonsep::host::job_reader {
 
-// /model (model.cpp): sets job.plugin and job.parameters.
+// /model (model.cpp): sets job.plugin, job.parameters and job.sweep.
 void read_model(Checker& check, const json& document, Job& job);
+// The declared parameter `name` (model.cpp), or nothing and an issue at `path` naming the plugin's parameters.
+const PluginParameter* find_parameter(Checker& check, const std::vector<PluginParameter>& declared,
+                                      const std::string& name, const std::string& path);
+// One value of `parameter` at `path` (model.cpp), by the rule of nonsep::sdk::parameter_fault; `found` describes it.
+void check_parameter_value(Checker& check, const PluginParameter& parameter, const json& value, const std::string& path,
+                           const std::string& found);
+// /model/parameters/<name> given as an array, {"values": [...]} or {"from", "to", "count"} (sweep.cpp): a swept
+// parameter, or nothing and an issue.
+std::optional<SweptParameter> read_swept_parameter(Checker& check, const std::string& name, const json& value,
+                                                   const std::string& path);
+// The trajectories of a run, the job's states times its parameter sets, within max_initial_states and
+// max_initial_values (sweep.cpp); an issue at /model/parameters otherwise.
+void check_sweep_size(Checker& check, const Job& job);
 
 // /hamiltonian and /integrator (integrator.cpp). read_integrator_object reads one integrator object at `path`
 // (a run's /integrator or a study's /study/integrators/<i>); `extra_keys` are keys its caller reads itself.
@@ -31,6 +44,9 @@ TimeGrid read_study_time(Checker& check, const json& document);
 std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt, const std::string& path,
                                         const std::string& found);
 
+// One axis of a grid (initial.cpp): a number, {"from", "to", "count"} or {"values": [...]}; nothing and an issue
+// when invalid.
+std::optional<std::vector<double>> read_axis(Checker& check, const json& value, const std::string& path);
 // /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
 // `first_path` names the state whose dimension the others must have.
 InitialStates read_initial(Checker& check, const json& document);

@@ -12,6 +12,15 @@ namespace {
 // An earlier run's file that this run does not write would mislead.
 void remove_stale(const std::filesystem::path& path) { remove_file(path); }
 
+// A sweep's trajectories grouped by parameter set (InitialStates::parameter_set), for the driver.
+std::vector<ParameterSet> parameter_sets(const Job& job) {
+  std::vector<ParameterSet> sets;
+  const std::vector<std::size_t>& set_of = job.initial.parameter_set;
+  for (std::size_t b = 0; b < set_of.size(); ++b)
+    if (b == 0 || set_of[b] != set_of[b - 1]) sets.push_back({b, job.parameter_set(set_of[b])});
+  return sets;
+}
+
 EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
   const Job& job = loaded.job;
   const SingleRun& run = job.run();
@@ -24,7 +33,8 @@ EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
           options.stop_requested,
           run.analysis.tangent_vectors(),
           run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1,
-          run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count)};
+          run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count),
+          parameter_sets(job)};
 }
 
 std::optional<Checkpoint> resumed_state(const LoadedJob& loaded, const RunOptions& options) {

@@ -34,7 +34,7 @@ void write_results_file(const std::filesystem::path& path, bool has_samples, con
   attribute("format_version", results_format_version);
   attribute("model", loaded.plugin.name());
   attribute("plugin_version", loaded.plugin.version());
-  attribute("parameters", nlohmann::json(loaded.model.parameters()).dump());
+  attribute("parameters", summary["model"]["parameters"].dump());  // a sweep's parameters with their values
   attribute("integrator", summary["integrator"].dump());
   attribute("hamiltonian", summary["hamiltonian"].get<std::string>());
   attribute("dt", run.time.dt);

@@ -72,6 +72,20 @@ json run_summary(const RunFacts& facts) {
                       {"path", facts.loaded.plugin.path().string()},
                       {"dimension", job.initial.dimension},
                       {"parameters", json(facts.loaded.model.parameters())}};
+  if (!job.sweep.empty()) {
+    json swept = json::object();
+    for (const SweptParameter& parameter : job.sweep) {
+      summary["model"]["parameters"][parameter.name] = parameter.values;
+      swept[parameter.name] = parameter.values.size();
+    }
+    summary["sweep"] = {
+        {"parameters", swept},
+        {"parameter_sets", job.parameter_sets()},
+        {"order",
+         "every parameter set (the product of the swept values, the parameters by name, the last varying fastest) "
+         "with every initial state, set after set"},
+        {"columns", "trajectories.csv: one column per swept parameter, after the others"}};
+  }
   if (job.formula) summary["model"]["formula"] = formula::formula_record(*job.formula, job.formula_cache_key);
   summary["hamiltonian"] = run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
   summary["integrator"] = {{"scheme", description.scheme},
@@ -135,7 +149,22 @@ void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& f
   std::vector<std::string> columns;
   for (const TrajectoryColumns* observer : observers) observer->columns(columns);
   for (const std::string& column : columns) text += "," + column;
+  const Job& job = facts.loaded.job;
+  for (const SweptParameter& swept : job.sweep) text += "," + swept.name;
   text += '\n';
+  // A sweep's cells of each parameter set, once.
+  std::vector<std::string> set_cells(job.sweep.empty() ? 0 : job.parameter_sets());
+  for (std::size_t s = 0; s < set_cells.size(); ++s) {
+    const nlohmann::json parameters = job.parameter_set(s);
+    for (const SweptParameter& swept : job.sweep) {
+      const nlohmann::json& value = parameters[swept.name];
+      set_cells[s] += ',';
+      if (value.is_number_float())
+        append_number(set_cells[s], value.get<double>());
+      else
+        set_cells[s] += value.dump();
+    }
+  }
   AtomicFile file(path);
   const auto& records = facts.outcome.trajectories;
   for (std::size_t index = 0; index < records.size(); ++index) {
@@ -171,6 +200,7 @@ void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& f
     text += ',';
     append_csv_text(text, record.message);
     for (const TrajectoryColumns* observer : observers) observer->cells(index, text);
+    if (!set_cells.empty()) text += set_cells[job.initial.parameter_set[index]];
     text += '\n';
     if (text.size() >= (1 << 16)) {
       file.write(text);

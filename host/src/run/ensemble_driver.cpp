@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <optional>
 #include <tuple>
@@ -25,7 +26,12 @@ struct EnsembleDriver::Impl {
   std::vector<TrajectoryRecord> records;
   std::vector<Block> blocks;
   std::size_t block_size = run_block_size;  // trajectories per block (the last may have fewer)
-  std::vector<Worker> workers;
+  std::vector<std::size_t> block_first;     // each block's first trajectory
+  std::vector<std::size_t> block_set;       // each block's parameter set
+  std::vector<nlohmann::json> set_parameters;
+  // workers[thread][set]: created on first use by that thread (make_worker), thread 0's of set 0 from `model`.
+  std::vector<std::vector<std::unique_ptr<Worker>>> workers;
+  std::mutex creating;  // Plugin::create from several threads
   std::vector<Observer*> observers;
   std::vector<ChunkObserver*> chunk_observers;
   std::vector<StepObserver*> step_watchers;
@@ -44,8 +50,17 @@ struct EnsembleDriver::Impl {
                                : setup.threads > 0   ? setup.threads
                                                      : static_cast<unsigned>(omp_get_max_threads());
     block_size = setup.block_size > 0 ? setup.block_size : run_block_size_for(count);
-    for (std::size_t first = 0; first < count; first += block_size) {
-      const std::size_t size = std::min(block_size, count - first);
+    const bool own_sets = !setup.parameter_sets.empty();
+    if (!own_sets) setup.parameter_sets.push_back({0, model.parameters()});
+    for (const ParameterSet& set : setup.parameter_sets) set_parameters.push_back(set.parameters);
+    std::size_t set = 0;
+    for (std::size_t first = 0; first < count;) {
+      while (set + 1 < setup.parameter_sets.size() && setup.parameter_sets[set + 1].first <= first) ++set;
+      std::size_t end = std::min(count, (first / block_size + 1) * block_size);
+      if (set + 1 < setup.parameter_sets.size()) end = std::min(end, setup.parameter_sets[set + 1].first);
+      const std::size_t size = end - first;
+      block_first.push_back(first);
+      block_set.push_back(set);
       std::vector<std::size_t> members(size);
       std::iota(members.begin(), members.end(), first);
       blocks.emplace_back(setup.integrator, n, members, setup.q.subspan(first * n, size * n),
@@ -54,12 +69,27 @@ struct EnsembleDriver::Impl {
         blocks.back().tangents.emplace(setup.integrator, setup.tangent_vectors, setup.renormalize_every, n, size);
         blocks.back().tangents->start();
       }
+      first = end;
     }
     const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(requested, blocks.size()));
-    workers.push_back(Worker{model, EnergyEvaluator(setup.integrator.form)});
-    for (std::size_t t = 1; t < threads; ++t)
-      workers.push_back(Worker{plugin.create(model.parameters()), EnergyEvaluator(setup.integrator.form)});
+    workers.resize(threads);
+    for (auto& sets : workers) sets.resize(set_parameters.size());
+    if (!own_sets) workers[0][0] = std::make_unique<Worker>(Worker{model, EnergyEvaluator(setup.integrator.form)});
     pool = std::make_unique<WorkerPool>(workers.size());
+  }
+
+  // Thread `thread`'s instance of parameter set `set`, created on its first use.
+  Worker& worker(std::size_t thread, std::size_t set) {
+    std::unique_ptr<Worker>& worker = workers[thread][set];
+    if (!worker) {
+      PluginModel model;
+      {
+        const std::lock_guard lock(creating);
+        model = plugin.create(set_parameters[set]);
+      }
+      worker = std::make_unique<Worker>(Worker{std::move(model), EnergyEvaluator(setup.integrator.form)});
+    }
+    return *worker;
   }
 
   // Runs `action(block, worker)` on every block with a state left, blocks spread over the workers' threads.
@@ -71,7 +101,7 @@ struct EnsembleDriver::Impl {
       Block& block = blocks[index];
       if (block.empty()) return;
       try {
-        action(block, workers[thread]);
+        action(block, worker(thread, block_set[index]));
       } catch (...) {
         block.error = std::current_exception();
       }
@@ -279,7 +309,10 @@ void EnsembleDriver::restore(DriverState state) {
   Impl& d = *impl_;
   const std::size_t n = d.setup.dimension;
   std::vector<std::vector<std::size_t>> members(d.blocks.size());
-  for (std::size_t k = 0; k < state.active.size(); ++k) members[state.active[k] / d.block_size].push_back(k);
+  for (std::size_t k = 0; k < state.active.size(); ++k) {
+    const auto after = std::upper_bound(d.block_first.begin(), d.block_first.end(), state.active[k]);
+    members[static_cast<std::size_t>(after - d.block_first.begin()) - 1].push_back(k);
+  }
   for (std::size_t b = 0; b < d.blocks.size(); ++b) {
     std::vector<std::size_t> trajectories;
     std::vector<double> q, p, energies;
@@ -342,7 +375,9 @@ std::vector<SchemeFigure> EnsembleDriver::scheme_report() const {
 }
 std::uint64_t EnsembleDriver::kernel_calls() const {
   std::uint64_t calls = 0;
-  for (const Worker& worker : impl_->workers) calls += worker.stepping.kernel_calls();
+  for (const auto& sets : impl_->workers)
+    for (const auto& worker : sets)
+      if (worker) calls += worker->stepping.kernel_calls();
   return calls;
 }
 std::uint64_t EnsembleDriver::steps_completed() const { return impl_->completed; }

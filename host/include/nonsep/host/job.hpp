@@ -80,6 +80,20 @@ struct InitialStates {
   std::size_t count = 0;
   std::vector<double> q, p;
   std::optional<EnergyShell> shell;  // set by the reader; the states are solved when the model is loaded
+  // A sweep (Job::sweep), set by load_model: state b belongs to parameter set parameter_set[b] (non-decreasing:
+  // the job's states once per set, set after set); empty without a sweep.
+  std::vector<std::size_t> parameter_set;
+};
+
+// A parameter of /model/parameters given as several values (a sweep): an array of values, {"values": [...]} or
+// {"from": a, "to": b, "count": n}. The run takes every parameter set of the product of the swept parameters (in
+// the order of their names, the last one varying fastest) with every initial state: one trajectory per pair, set
+// after set.
+struct SweptParameter {
+  std::string name;
+  std::vector<nlohmann::json> values;
+  // JSON Pointer of values[i]: `values_path` + "/" + i for a list; empty for a range (the parameter's own path).
+  std::string values_path;
 };
 
 // A convergence study (/study): the job's model and initial state are run to /time/t_end by each integrator at
@@ -169,14 +183,18 @@ struct Job {
   // to the plugin's path and `formula_cache_key` to its cache entry (formula/plugin_cache.hpp).
   std::shared_ptr<const formula::FormulaModel> formula;
   std::string formula_cache_key;
-  nlohmann::json parameters = nlohmann::json::object();  // /model/parameters as written
-  InitialStates initial;                                 // a study has exactly one state
-  std::filesystem::path output_directory;                // /output/directory resolved against `directory`
+  nlohmann::json parameters = nlohmann::json::object();  // /model/parameters with a single value (not swept)
+  std::vector<SweptParameter> sweep;  // /model/parameters with several values, by name (as the document orders them)
+  InitialStates initial;              // a study has exactly one state
+  std::filesystem::path output_directory;  // /output/directory resolved against `directory`
   // What the job does: a single run, or a convergence study (/study, which has no /integrator, /analysis or
   // /checkpoint and a /time of its own).
   std::variant<SingleRun, Study> plan;
 
   bool is_study() const { return std::holds_alternative<Study>(plan); }
+  // The parameter sets of the sweep (1 without one), and set s: `parameters` with the swept values of set s.
+  std::size_t parameter_sets() const;
+  nlohmann::json parameter_set(std::size_t s) const;
   // The plan as the kind the caller has checked it is (std::bad_variant_access otherwise: a programming error).
   const SingleRun& run() const { return std::get<SingleRun>(plan); }
   const Study& study() const { return std::get<Study>(plan); }
@@ -213,19 +231,34 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
 void check_model_parameters(const nlohmann::json& given, const std::vector<PluginParameter>& declared,
                             std::vector<JobIssue>& issues);
 
+// Pass 3 (sweep). Checks every value of job.sweep as check_model_parameters checks a single value; an issue names
+// the value and where it is (/model/parameters/<name>/<i>, or the range's /model/parameters/<name>).
+void check_swept_parameters(const Job& job, const std::vector<PluginParameter>& declared,
+                            std::vector<JobIssue>& issues);
+
 // Pass 3 (dimension). Checks the initial states against the model's dimension.
 void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues);
 
-// A job ready to run: the checked job, its plugin and a model instance created with the job's parameters.
+// A job ready to run: the checked job, its plugin and a model instance created with the job's parameters (those of
+// the first parameter set of a sweep).
 struct LoadedJob {
   Job job;
   Plugin plugin;
   PluginModel model;
 };
 
-// Puts loaded.job.initial on its energy shell (when /initial/energy is given; see EnergyShell), with the model's H.
-// Adds an issue at /initial/energy when the plugin has no Hessians, or no state of the grid reaches the shell.
-void place_on_energy_shell(LoadedJob& loaded, std::vector<JobIssue>& issues);
+// Puts the `q`, `p` (states of dimension n, state-major) on `shell` with `model`'s H of the form `form`, keeping in
+// place the states that reach it; returns how many were left out.
+std::size_t solve_on_energy_shell(const PluginModel& model, HamiltonianForm form, const EnergyShell& shell,
+                                  std::size_t n, std::vector<double>& q, std::vector<double>& p);
+
+// The run's trajectories (pass 3, sweep.cpp): loaded.job.initial becomes the job's states once per parameter set
+// (Job::parameter_sets; InitialStates::parameter_set says whose), each set's states put on the energy shell (when
+// /initial/energy is given; EnergyShell::left_out is then the total over the sets) with an instance of the set's
+// own parameters. Issues: a value outside the plugin's range (/model/parameters/<name>/<i>, naming the value), a
+// set the plugin refuses (/model/parameters), too many trajectories (/model/parameters), a plugin without Hessians
+// or a shell no state of any set reaches (/initial/energy).
+void make_trajectories(LoadedJob& loaded, std::vector<JobIssue>& issues);
 
 // Checks the plugin's grad T and grad V against finite differences of its value_T and value_V at up to 16 of the
 // job's initial states (evenly spread), on an instance of its own, when the plugin has values and a dimension of at

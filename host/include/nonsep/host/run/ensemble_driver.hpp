@@ -58,6 +58,13 @@ inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chun
 // distributed run (multiples of run_block_size) cut no block.
 std::size_t run_block_size_for(std::size_t trajectories);
 
+// Consecutive trajectories evaluated with parameters of their own (a parameter sweep): from `first` up to the next
+// set's first trajectory.
+struct ParameterSet {
+  std::size_t first = 0;
+  nlohmann::json parameters;  // as given to Plugin::create
+};
+
 // What the driver integrates.
 struct EnsembleSetup {
   IntegratorSpec integrator;
@@ -73,6 +80,11 @@ struct EnsembleSetup {
   // Trajectories per block: run_block_size_for of the whole ensemble, which a distributed run's work unit is part of
   // (its blocks are then those of the whole run); 0: run_block_size_for of these states.
   std::size_t block_size = 0;
+  // The parameter sets, by increasing `first` (the first at 0); empty: every trajectory has `model`'s parameters.
+  // A block never spans two sets (blocks are cut at every set's first trajectory as well as at the multiples of
+  // block_size), and each thread creates its own instance of a set's parameters when it first steps one of its
+  // blocks: one instance per set and thread (`model` is then not stepped).
+  std::vector<ParameterSet> parameter_sets = {};
 };
 
 // The driver's state between two steps, for checkpoints.
