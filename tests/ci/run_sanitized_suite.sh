@@ -24,6 +24,7 @@ long_runs=(
   '^kernel path: a run killed and resumed gives'
   '^a Tao run killed and resumed continues its copies'
   '^resume after SIGKILL and after SIGINT'
+  '^resume on the'
   '^a separable model killed and resumed'
   '^max_initial_values applies to every kind of initial state'
   '^paper2d, chaotic orbit: the long-time exponent'

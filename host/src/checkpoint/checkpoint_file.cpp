@@ -13,6 +13,7 @@
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
+#include "nonsep/host/output/run_folder.hpp"
 
 namespace nonsep::host {
 
@@ -146,6 +147,26 @@ std::string fingerprint_difference(const std::string& a, const std::string& b) {
   return differ.empty() ? "the job's identity" : differ;
 }
 
+std::string stepping_identity(const LoadedJob& job) {
+  const std::string set = job.plugin.kernels().chosen_name();
+  return set.empty() ? "evaluation" : set;
+}
+
+void check_stepping(const std::string& recorded, const LoadedJob& job, const std::filesystem::path& written) {
+  const std::string current = stepping_identity(job);
+  if (recorded == current) return;
+  const auto path_of = [](const std::string& stepping) {
+    return stepping == "evaluation" ? std::string("the evaluation path (no kernel)")
+                                    : "the plugin's " + stepping + " kernel";
+  };
+  const KernelChoice& kernels = job.plugin.kernels();
+  throw CheckpointError(written.string() + " was written by a run stepping through " + path_of(recorded) +
+                        ", and this one would step through " + path_of(current) + " (" + kernels.note +
+                        "): the two may round differently, so a resumed run could equal neither uninterrupted "
+                        "run. Resume with NONSEP_INSTRUCTION_SET=" +
+                        recorded + " (the variable that chooses the stepping), or run with --force to start over");
+}
+
 Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded) {
   const Job& job = loaded.job;
   std::optional<std::string> text;
@@ -155,8 +176,10 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     throw CheckpointError(error.what());
   }
   if (!text)
-    throw CheckpointError("nothing to resume: there is no " + path.string() +
-                          " (a run saves one when interrupted and as /checkpoint says; a completed run removes it)");
+    throw CheckpointError(
+        "nothing to resume: there is no " + path.string() + " (a run saves one when interrupted and " +
+        "as /checkpoint says; a completed run removes it), nor the work units of a run on MPI ranks " +
+        "(which it saves in " + (path.parent_path() / units_folder).string() + " before its first unit starts)");
   json document;
   // nlohmann's lexer takes a NUL byte for the end of the input: what follows one would be ignored unread.
   if (const std::size_t nul = text->find('\0'); nul != std::string::npos)
@@ -180,6 +203,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
         " differ (the plugin part covers the plugin file's bytes, integrator.NAME is the integrator's option NAME, "
         "output covers output.every, energy_every and format); run with --force to start over, or resume with the "
         "job that wrote it");
+  check_stepping(read.string(read.member(document, "stepping"), "stepping"), loaded, path);
   Checkpoint checkpoint;
   DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;

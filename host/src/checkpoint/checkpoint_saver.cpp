@@ -38,7 +38,7 @@ json encode(const MegnoRecord& record) {
 
 // Writes checkpoint.json (checkpoint_file.hpp describes it) atomically. Throws OutputError.
 void save_checkpoint(const std::filesystem::path& path, const DriverState& state, const json& observers,
-                     const std::string& fingerprint) {
+                     const std::string& fingerprint, const std::string& stepping) {
   json records = json::array();
   for (const TrajectoryRecord& record : state.records)
     records.push_back({{"status", to_string(record.status)},
@@ -68,6 +68,7 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
   }
   json document = {{"format", checkpoint_format},
                    {"job_fingerprint", fingerprint},
+                   {"stepping", stepping},
                    {"step", state.step},
                    {"evaluations", evaluations},
                    {"active",
@@ -93,10 +94,12 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
 
 }  // namespace
 
-CheckpointSaver::CheckpointSaver(std::filesystem::path path, std::string fingerprint, const CheckpointPolicy& policy,
-                                 const EnsembleDriver& driver, std::vector<Observer*> observers)
+CheckpointSaver::CheckpointSaver(std::filesystem::path path, std::string fingerprint, std::string stepping,
+                                 const CheckpointPolicy& policy, const EnsembleDriver& driver,
+                                 std::vector<Observer*> observers)
     : path_(std::move(path)),
       fingerprint_(std::move(fingerprint)),
+      stepping_(std::move(stepping)),
       policy_(policy),
       driver_(driver),
       observers_(std::move(observers)),
@@ -126,7 +129,7 @@ void CheckpointSaver::save_now() {
   for (Observer* each : observers_)
     if (auto* observer = dynamic_cast<CheckpointedObserver*>(each); observer && !observer->name().empty())
       observers[observer->name()] = observer->save();
-  save_checkpoint(path_, driver_.state(), observers, fingerprint_);
+  save_checkpoint(path_, driver_.state(), observers, fingerprint_, stepping_);
   next_save_ =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(policy_.every_seconds));
 }

@@ -352,7 +352,8 @@ int command_run(const RunArguments& arguments) {
   // A study, or the resume of a one-process run: rank 0 does it, the others wait for its exit status.
   int status = 0;
   if (ranks->rank() == 0) {
-    if (ranks->size() > 1)
+    if (ranks->size() > 1 &&
+        (loaded->job.is_study() || std::filesystem::exists(options.output_directory / checkpoint_file_name)))
       std::cerr << "nonsep: note: "
                 << (loaded->job.is_study() ? "a convergence study" : "a one-process run's checkpoint")
                 << " runs on rank 0 alone; the other " << ranks->size() - 1 << " rank(s) wait\n";

@@ -22,7 +22,7 @@ namespace {
 
 using json = nlohmann::ordered_json;
 constexpr const char* plan_name = "plan.json";
-constexpr int plan_format = 1;
+constexpr int plan_format = 2;            // 2: "stepping"
 constexpr std::size_t target_units = 64;  // enough to balance a few dozen ranks; each unit costs a folder and a merge
 
 std::filesystem::path unit_folder(const std::filesystem::path& directory, std::size_t unit) {
@@ -43,12 +43,11 @@ struct Plan {
   std::size_t size(std::size_t unit) const { return std::min(unit_size, trajectories - first(unit)); }
 };
 
-json plan_json(const Plan& plan, const std::string& fingerprint) {
-  return {{"format", plan_format},
-          {"trajectories", plan.trajectories},
-          {"unit_size", plan.unit_size},
-          {"units", plan.units},
-          {"job_fingerprint", fingerprint}};
+// With how the ranks step (stepping_identity, checkpoint_file.hpp): a unit started on a resume computes its numbers
+// as the finished ones did.
+json plan_json(const Plan& plan, const std::string& fingerprint, const std::string& stepping) {
+  return {{"format", plan_format}, {"trajectories", plan.trajectories}, {"unit_size", plan.unit_size},
+          {"units", plan.units},   {"job_fingerprint", fingerprint},    {"stepping", stepping}};
 }
 
 // The job restricted to `size` trajectories from `first`.
@@ -79,7 +78,7 @@ void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Pl
                     std::optional<RunFolder>& folder) {
   const std::filesystem::path& directory = options.output_directory;
   folder.emplace(directory, "run", loaded.job.file, folder_use(options));
-  const std::string fingerprint = job_fingerprint(loaded);
+  const std::string fingerprint = job_fingerprint(loaded), stepping = stepping_identity(loaded);
   const auto path = directory / units_folder / plan_name;
   if (options.resume) {
     check_real_folder(directory / units_folder, false);
@@ -89,7 +88,9 @@ void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Pl
     } catch (const std::exception&) {
       throw CheckpointError(path.string() + " is missing or damaged: there is no distributed run to resume here");
     }
-    if (saved != plan_json(plan, fingerprint))
+    if (saved.contains("stepping") && saved["stepping"].is_string())
+      check_stepping(saved["stepping"].get<std::string>(), loaded, path);
+    if (saved != plan_json(plan, fingerprint, stepping))
       throw CheckpointError(
           path.string() + " was written by another job, or by this job before it was changed" +
           (saved.contains("job_fingerprint") && saved["job_fingerprint"].is_string()
@@ -107,7 +108,7 @@ void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Pl
   std::error_code error;
   std::filesystem::create_directories(directory / units_folder, error);
   if (error) throw OutputError("cannot create " + (directory / units_folder).string() + ": " + error.message());
-  write_file_atomically(path, plan_json(plan, fingerprint).dump(2) + "\n");
+  write_file_atomically(path, plan_json(plan, fingerprint, stepping).dump(2) + "\n");
 }
 
 enum class UnitState { fresh, checkpointed, done };

@@ -90,7 +90,8 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (hdf5_samples) observers.push_back(&*hdf5_samples);
 #endif
   if (poincare) observers.push_back(&*poincare);
-  saver.emplace(directory / checkpoint_file_name, job_fingerprint(loaded), run.checkpoint, driver, observers);
+  saver.emplace(directory / checkpoint_file_name, job_fingerprint(loaded), stepping_identity(loaded), run.checkpoint,
+                driver, observers);
   progress.emplace(options.show_progress, driver, &energy);
   for (Observer* observer : observers) driver.add_observer(*observer);
   driver.add_observer(*saver);

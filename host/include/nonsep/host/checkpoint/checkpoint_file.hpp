@@ -11,6 +11,10 @@
 // ("0.1", "nan", "-inf"), so reading one back gives the same bits. The file is replaced atomically
 // (write_file_atomically): a crash while saving leaves the previous checkpoint.
 //
+// It also records how the steps were computed (stepping_identity below): the instruction set of the plugin's stepping
+// kernel, or the evaluation path. A resume that would step another way is refused (check_stepping): the wider sets
+// fuse multiplications and additions, so its numbers would be those of neither uninterrupted run.
+//
 // The fingerprint covers what determines the numbers: the plugin (name, version and its file's bytes), the model's
 // parameters, the integrator (its scheme, form and every option of its catalogue entry), the initial states, the time
 // grid, output.every, output.energy_every, output.format (hdf5 only) and /analysis. It leaves out the output folder and
@@ -46,19 +50,31 @@ std::string job_fingerprint(const LoadedJob& job);
 // The names of the parts in which two fingerprints differ ("plugin, integrator.omega, time").
 std::string fingerprint_difference(const std::string& a, const std::string& b);
 
+// How this process steps `job`'s plugin, which decides the last bits of the numbers: the instruction set of the
+// plugin's kernel it uses ("x86-64-v4", Plugin::kernels()), or "evaluation" for the evaluation path (the plugin has
+// no kernel of this nonsep's version, this processor runs none, or NONSEP_INSTRUCTION_SET=evaluation). Fixed when the
+// plugin is loaded, whether or not the job's steps reach the kernel (every-step observers and tangent vectors step
+// through the evaluation path).
+std::string stepping_identity(const LoadedJob& job);
+// Throws CheckpointError when `recorded`, the stepping_identity that `written` (a checkpoint, a distributed run's
+// plan) was written with, differs from this process's: the message names both and NONSEP_INSTRUCTION_SET, which
+// chooses the stepping.
+void check_stepping(const std::string& recorded, const LoadedJob& job, const std::filesystem::path& written);
+
 // The file name inside a run's output folder.
 inline constexpr const char* checkpoint_file_name = "checkpoint.json";
 
 // The value of the file's "format" key; a checkpoint with another is refused.
-inline constexpr const char* checkpoint_format = "nonsep checkpoint 4";  // 4: the scheme's private state, grad H
+// 4: the scheme's private state, grad H; 5: "stepping" (stepping_identity).
+inline constexpr const char* checkpoint_format = "nonsep checkpoint 5";
 // The value of the file's "checksum" key: the content hash of everything else, as dumped (keys sorted, numbers as
 // strings), so that an edited or damaged checkpoint is refused instead of changing the results.
 inline std::string checkpoint_checksum(const nlohmann::json& document) {
   return content_hash_hex(content_hash(document.dump()));
 }
 
-// Reads the checkpoint at `path` and checks it against the job (fingerprint, number of trajectories, dimension,
-// steps). The observers' states are checked by the observers' restore(). Throws CheckpointError.
+// Reads the checkpoint at `path` and checks it against the job (fingerprint, stepping, number of trajectories,
+// dimension, steps). The observers' states are checked by the observers' restore(). Throws CheckpointError.
 Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& job);
 
 }  // namespace nonsep::host

@@ -16,9 +16,10 @@ namespace nonsep::host {
 
 class CheckpointSaver : public Observer, public ChunkObserver {
  public:
-  // `observers`: those whose state goes into the checkpoint (not owned).
-  CheckpointSaver(std::filesystem::path path, std::string fingerprint, const CheckpointPolicy& policy,
-                  const EnsembleDriver& driver, std::vector<Observer*> observers);
+  // `fingerprint` and `stepping`: the job's (job_fingerprint, stepping_identity: checkpoint_file.hpp). `observers`:
+  // those whose state goes into the checkpoint (not owned).
+  CheckpointSaver(std::filesystem::path path, std::string fingerprint, std::string stepping,
+                  const CheckpointPolicy& policy, const EnsembleDriver& driver, std::vector<Observer*> observers);
 
   std::uint64_t next_event(std::uint64_t step) const override;
   void after_chunk(std::uint64_t step) override;
@@ -30,7 +31,7 @@ class CheckpointSaver : public Observer, public ChunkObserver {
  private:
   using Clock = std::chrono::steady_clock;
   std::filesystem::path path_;
-  std::string fingerprint_;
+  std::string fingerprint_, stepping_;
   CheckpointPolicy policy_;
   const EnsembleDriver& driver_;
   std::vector<Observer*> observers_;
