@@ -64,7 +64,8 @@ int chin_index(const IntegratorSpec& spec, int highest, const char* name) {
 
 const std::string comparator_cost_note =
     " Needs the plugin's Hessians and third derivatives (one grad H = grad T or V, two Hessians, one d3 "
-    "contraction); no tangent map (no Lyapunov/MEGNO).";
+    "contraction); its tangent map (Lyapunov/MEGNO) also the directional derivative of grad H (hvp_H, plugin ABI "
+    "version 5).";
 
 constexpr int triplet_orders = TripletComposition<>::max_levels + 1;  // order 2j/3 has j - 1 levels
 constexpr int mpe_orders = MultiProductExpansion<>::max_terms;        // order 2m/3 has m terms

@@ -105,6 +105,11 @@ class GaussLegendre {
   void add_evaluations(const EvaluationCounts& counts) { evaluations_ += counts; }
   // Iterations each state of the last step took (failed states: the iterations tried).
   std::span<const int> iterations() const { return iterations_; }
+  // The stage points z + Z_i of the last step at which f was evaluated for the step's result, stage-major: stage i,
+  // component k of state b at i*count*n + b*n + k (q and p apart); those of failed states are unspecified. The
+  // tangent map (tangent_gauss_legendre.hpp) linearises there.
+  std::span<const double> stage_points_q() const { return final_q_; }
+  std::span<const double> stage_points_p() const { return final_p_; }
 
   ComparatorDescription describe() const {
     ComparatorDescription d;
@@ -155,6 +160,7 @@ class GaussLegendre {
     for (auto* v : {&stage_q_, &stage_p_}) v->assign(s * size, 0.0);
     for (auto* v : {&next_q_, &next_p_, &dH_dq_, &dH_dp_}) v->resize(s * size);
     for (auto* v : {&change_, &scale_, &finite_probe_}) v->resize(size);
+    for (auto* v : {&final_q_, &final_p_}) v->resize(s * size);
     keep_points_.assign(size, 0);
     iterations_.assign(count, 0);
     last_change_.assign(count, std::numeric_limits<double>::infinity());
@@ -191,9 +197,10 @@ class GaussLegendre {
           continue;
         }
         std::fill_n(keep_points_.begin() + static_cast<std::ptrdiff_t>(b * n), n, ~std::uint64_t{0});
-        if (finite)
+        if (finite) {
+          keep_stage_points(b, n, s, size);
           advance(x, b, s, size, dt);
-        else
+        } else
           failures.push_back({b, "an iterate is not finite after " + std::to_string(iterations_[b]) + " iterations"});
       }
       active_.swap(still_);
@@ -325,6 +332,15 @@ class GaussLegendre {
   // vectorizing the loop.
   static double larger(double a, double b) { return a < b ? b : a; }
 
+  // The points z + Z^m_i of state b's last evaluation (the same sums as the evaluation's) into final_q_, final_p_.
+  void keep_stage_points(std::size_t b, std::size_t n, std::size_t s, std::size_t size) {
+    for (std::size_t i = 0; i < s; ++i)
+      for (std::size_t e = b * n; e < b * n + n; ++e) {
+        final_q_[i * size + e] = start_q_[e] + stage_q_[i * size + e];
+        final_p_[i * size + e] = start_p_[e] + stage_p_[i * size + e];
+      }
+  }
+
   // z' = z + dt sum_i b_i f(z + Z_i) for state b, with the gradients of its last iteration.
   void advance(PhaseSpaceBatch& x, std::size_t b, std::size_t s, std::size_t size, double dt) const {
     const std::size_t n = x.dimension();
@@ -346,6 +362,7 @@ class GaussLegendre {
   std::vector<double> start_q_, start_p_;  // z, the states at the start of the step
   std::vector<double> stage_q_, stage_p_, next_q_, next_p_, q_, p_, dH_dq_, dH_dp_, gathered_dH_dq_, gathered_dH_dp_;
   std::vector<double> change_, scale_, finite_probe_;
+  std::vector<double> final_q_, final_p_;   // the stage points of each converged state's last evaluation
   std::vector<std::uint64_t> keep_points_;  // per component: 0 while its state iterates, then all ones
   std::vector<int> iterations_;
   std::vector<double> last_change_;          // per state: the relative change of its last iteration

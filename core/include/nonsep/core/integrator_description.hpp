@@ -27,7 +27,7 @@ struct SchemeDescription {
   std::string equations;  // where in the paper: "eq. (expalg)"
   std::string summary;    // one paragraph
   // "chin" (the paper's schemes) or "comparator" (Tao, Gauss-Legendre: need the gradient of H, i.e. the plugin's
-  // Hessians and third derivatives; no tangent map).
+  // Hessians and third derivatives; their tangent maps the directional derivative of grad H).
   std::string family = "chin";
   bool symplectic = true;
   bool time_reversible = true;

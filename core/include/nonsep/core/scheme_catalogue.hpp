@@ -4,12 +4,12 @@
 // what `nonsep --help` and `nonsep schema` print) and the factory that builds its stepper over a basic step.
 // Integrator (integrator.hpp) builds from it, TangentIntegrator (tangent_integrator.hpp) from an Integrator.
 // Adding a scheme is one entry in scheme_catalogue.cpp; a new stepper type also joins SchemeStepper, and gets a
-// tangent_map_of overload in tangent_integrator.hpp or is listed there as having none (a comparator: refused).
+// tangent_map_of overload in tangent_integrator.hpp.
 //
 // Two families (SchemeDescription::family): "chin", the paper's splittings of T(p) + V(q), and "comparator",
 // Tao's extended phase space (tao_extended_phase_space.hpp) and Gauss-Legendre collocation (gauss_legendre.hpp),
 // which integrate H itself from its gradient (hamiltonian_gradient.hpp): they need a model with Hessians and third
-// derivatives, and have no tangent map.
+// derivatives, and their tangent maps the directional derivative of grad H.
 #include <span>
 #include <string>
 #include <type_traits>
@@ -31,7 +31,8 @@ namespace nonsep {
 using SchemeStepper = std::variant<SeparableBasicStep, TripletComposition<SeparableBasicStep>,
                                    MultiProductExpansion<SeparableBasicStep>, TaoExtendedPhaseSpace, GaussLegendre>;
 
-// The comparator stepper types: they need ModelWithThirdDerivatives and have no tangent map.
+// The comparator stepper types: they need ModelWithThirdDerivatives (and their tangent maps the directional
+// derivative of grad H, ModelWithHamiltonianHessian).
 template <class S>
 inline constexpr bool is_comparator_stepper =
     std::is_same_v<S, TaoExtendedPhaseSpace> || std::is_same_v<S, GaussLegendre>;

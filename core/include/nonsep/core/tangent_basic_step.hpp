@@ -41,6 +41,7 @@ struct HessianCounts {
   std::uint64_t hessian_V = 0;
   std::uint64_t hessian_K = 0;  // the separable part's flows (tangent_separable_composition.hpp)
   std::uint64_t hessian_U = 0;
+  std::uint64_t hvp_H = 0;  // directional derivatives of grad H, per tangent vector (the comparators' tangent maps)
   friend bool operator==(const HessianCounts&, const HessianCounts&) = default;
 };
 

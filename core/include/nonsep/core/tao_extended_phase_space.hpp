@@ -51,6 +51,19 @@
 
 namespace nonsep {
 
+// One exact sub-flow of the Strang step, as a step's observer sees it (tangent_tao_extended_phase_space.hpp), called
+// after the flow with the states and copies as it left them: phi_A and phi_B of time h (their points (q, y) and
+// (x, p), which they leave unchanged), phi_C of its turn by the angle 2 omega dt (cos, sin).
+struct TaoFlow {
+  enum class Kind { A, B, C };
+  Kind kind = Kind::A;
+  double h = 0.0;
+  double cos = 1.0, sin = 0.0;
+};
+struct NoTaoObserver {
+  void operator()(const TaoFlow&, const PhaseSpaceBatch&, const PhaseSpaceBatch&) const {}
+};
+
 class TaoExtendedPhaseSpace {
  public:
   static constexpr double default_omega = 20.0;
@@ -91,22 +104,24 @@ class TaoExtendedPhaseSpace {
   // Advances every state of x, and its copy, by dt (finite, non-zero). Throws InvalidArgument on a bad dt, a
   // batch whose dimension differs from the model's or copies of another shape than x; propagates the model's
   // exceptions (x and copies are then unspecified).
-  template <ModelWithThirdDerivatives M>
-  void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt) {
+  // With an observer: observer(const TaoFlow&, const PhaseSpaceBatch& x, const PhaseSpaceBatch& copies) after each
+  // sub-flow, in order.
+  template <ModelWithThirdDerivatives M, class Observer = NoTaoObserver>
+  void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt, Observer&& observer = {}) {
     check_step_size(dt);
     check_batch_fits(model, x);
     if (copies.dimension() != x.dimension() || copies.count() != x.count())
       throw InvalidArgument("the extended copies hold " + std::to_string(copies.count()) + " states of dimension " +
                             std::to_string(copies.dimension()) + " for a batch of " + std::to_string(x.count()) +
                             " states of dimension " + std::to_string(x.dimension()));
-    compose(order_ / 2 - 1, model, x, copies, dt);
+    compose(order_ / 2 - 1, model, x, copies, dt, observer);
   }
 
   // The same with the copies held by the stepper (initialised to x when empty); tracks the largest copy distance.
-  template <ModelWithThirdDerivatives M>
-  void step(const M& model, PhaseSpaceBatch& x, double dt) {
+  template <ModelWithThirdDerivatives M, class Observer = NoTaoObserver>
+  void step(const M& model, PhaseSpaceBatch& x, double dt, Observer&& observer = {}) {
     if (copies_.count() == 0) copies_ = x;
-    step(model, x, copies_, dt);
+    step(model, x, copies_, dt, observer);
     track_copy_distance(x, copies_);
   }
 
@@ -114,11 +129,11 @@ class TaoExtendedPhaseSpace {
   // first + part.count() - 1 of a batch of `total` states whose step `before` (this stepper as it was before the
   // step) was to take. Their copies come from `before` (from the states when it held none yet) and are written
   // back into this stepper's copies.
-  template <ModelWithThirdDerivatives M>
+  template <ModelWithThirdDerivatives M, class Observer = NoTaoObserver>
   void step_part(const M& model, PhaseSpaceBatch& part, const TaoExtendedPhaseSpace& before, std::size_t first,
-                 std::size_t total, double dt) {
+                 std::size_t total, double dt, Observer&& observer = {}) {
     PhaseSpaceBatch copies = before.copies_.count() == total ? slice(before.copies_, first, part.count()) : part;
-    step(model, part, copies, dt);
+    step(model, part, copies, dt, observer);
     PhaseSpaceBatch all = copies_.count() == total ? copies_ : PhaseSpaceBatch(part.dimension(), total);
     for (std::size_t b = 0; b < part.count(); ++b) {
       std::copy(copies.q(b).begin(), copies.q(b).end(), all.q(first + b).begin());
@@ -222,22 +237,22 @@ class TaoExtendedPhaseSpace {
     for (double d : distances_) max_copy_distance_ = std::max(max_copy_distance_, d);
   }
 
-  template <ModelWithThirdDerivatives M>
-  void compose(int level, const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt) {
+  template <ModelWithThirdDerivatives M, class Observer>
+  void compose(int level, const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt, Observer& observer) {
     if (level == 0) {
-      strang(model, x, copies, dt);
+      strang(model, x, copies, dt, observer);
       return;
     }
     const double r = std::pow(2.0, 1.0 / (2.0 * level + 1.0));
     const double outer = dt / (2.0 - r);
-    compose(level - 1, model, x, copies, outer);
-    compose(level - 1, model, x, copies, -r * outer);
-    compose(level - 1, model, x, copies, outer);
+    compose(level - 1, model, x, copies, outer, observer);
+    compose(level - 1, model, x, copies, -r * outer, observer);
+    compose(level - 1, model, x, copies, outer, observer);
   }
 
   // phi_A(dt/2) phi_B(dt/2) phi_C(dt) phi_B(dt/2) phi_A(dt/2).
-  template <ModelWithThirdDerivatives M>
-  void strang(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt) {
+  template <ModelWithThirdDerivatives M, class Observer>
+  void strang(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt, Observer& observer) {
     const std::size_t size = x.size();
     const double h = dt / 2.0;
     std::span<double> q = x.q(), p = x.p(), xq = copies.q(), yp = copies.p();
@@ -259,7 +274,9 @@ class TaoExtendedPhaseSpace {
     };
     if (!cached_at(q, yp)) evaluate_at_a(model, q, yp, x.count());
     flow_a();
+    observer(TaoFlow{TaoFlow::Kind::A, h}, std::as_const(x), std::as_const(copies));
     flow_b();
+    observer(TaoFlow{TaoFlow::Kind::B, h}, std::as_const(x), std::as_const(copies));
     const double c = std::cos(2.0 * omega_ * dt), s = std::sin(2.0 * omega_ * dt);
     for (std::size_t i = 0; i < size; ++i) {
       const double sum_q = q[i] + xq[i], sum_p = p[i] + yp[i], dq = q[i] - xq[i], dp = p[i] - yp[i];
@@ -269,9 +286,12 @@ class TaoExtendedPhaseSpace {
       p[i] = (sum_p + turned_p) / 2.0;
       yp[i] = (sum_p - turned_p) / 2.0;
     }
+    observer(TaoFlow{TaoFlow::Kind::C, dt, c, s}, std::as_const(x), std::as_const(copies));
     flow_b();
+    observer(TaoFlow{TaoFlow::Kind::B, h}, std::as_const(x), std::as_const(copies));
     evaluate_at_a(model, q, yp, x.count());
     flow_a();
+    observer(TaoFlow{TaoFlow::Kind::A, h}, std::as_const(x), std::as_const(copies));
   }
 
   bool cached_at(std::span<const double> q, std::span<const double> y) const {
