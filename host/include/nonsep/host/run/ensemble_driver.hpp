@@ -73,6 +73,10 @@ struct EnsembleSetup {
   // Trajectories per block: run_block_size_for of the whole ensemble, which a distributed run's work unit is part of
   // (its blocks are then those of the whole run); 0: run_block_size_for of these states.
   std::size_t block_size = 0;
+  // With tangent vectors: whether the run computes MEGNO (the first vector's log-growth at every step), and whether
+  // it keeps the factors of SALI and GALI (nonsep/core/alignment_indices.hpp; tangent_vectors >= 2).
+  bool megno = false;
+  bool alignment_indices = false;
 };
 
 // The driver's state between two steps, for checkpoints.
@@ -88,6 +92,8 @@ struct DriverState {
   std::vector<double> tangent_q, tangent_p;
   std::vector<LyapunovRecord> lyapunov;
   std::vector<MegnoRecord> megno;
+  // With SALI or GALI: the active trajectories' factors (AlignmentIndices::factor_size(k) numbers each); else empty.
+  std::vector<double> alignment;
   // The scheme's private state of the active trajectories (its columns in the order of `active`) and its numbers
   // about the run (nonsep::SchemeState): stored and handed back, never read; empty for most schemes.
   SchemeState scheme;
