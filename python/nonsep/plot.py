@@ -186,6 +186,10 @@ def _value_label(column):
         return "MEGNO $Y$"
     if column.startswith("lyapunov") and column[8:].isdigit():
         return f"finite-time Lyapunov exponent $\\lambda_{{{column[8:]}}}$ ({column})"
+    if column == "sali":
+        return "SALI (-> 0: chaotic)"
+    if column.startswith("gali") and column[4:].isdigit():
+        return f"GALI$_{{{column[4:]}}}$"
     return column
 
 

@@ -11,7 +11,7 @@ Files read (docs/outputs.md); each is optional except summary.json:
   convergence.csv    Result.convergence (a study); Result.fits and Result.exponents come from summary.json's "fits"
   poincare.csv       Result.poincare (every crossing, rows in (step, trajectory) order; None without the file) and
                      Result.crossings(i) (trajectory i's crossings in order): read on first use and kept
-  lyapunov.csv       Result.lyapunov (the running Lyapunov and MEGNO estimates; None without the file) and
+  lyapunov.csv       Result.lyapunov (the running Lyapunov, MEGNO, SALI and GALI estimates; None without the file) and
                      Result.lyapunov_series(i): read on first use and kept
   other *.csv        Result.dynamics[name] (poincare.csv and lyapunov.csv too, the same arrays): read by header on
                      first use, as tables.read_table types columns
@@ -67,12 +67,15 @@ class Crossings(NamedTuple):
 class LyapunovSeries(NamedTuple):
     """The running estimates of one trajectory (lyapunov.csv), in step order: exponents is [rows, k] (columns
     lyapunov0 .. lyapunov<k-1>, k = 0 when only MEGNO was asked for); megno (Y) and mean_megno (<Y>) are None when
-    the run did not compute MEGNO."""
+    the run did not compute MEGNO; sali is None without analysis.sali; gali is [rows, k - 1] (columns gali2 ..
+    gali<k>: gali[:, j - 2] is GALI_j) or None without analysis.gali."""
     step: np.ndarray
     t: np.ndarray
     exponents: np.ndarray
     megno: object
     mean_megno: object
+    sali: object = None
+    gali: object = None
 
 
 class Result:
@@ -153,7 +156,7 @@ class Result:
     @property
     def lyapunov(self):
         """Every row of lyapunov.csv as a structured array (trajectory, step, t, lyapunov0, ..., and megno,
-        mean_megno when computed), in the file's order; None when the run wrote none (analysis.lyapunov.every 0)."""
+        mean_megno, sali, gali2, ... when computed), in the file's order; None when the run wrote none (analysis.lyapunov.every 0)."""
         return self.dynamics.get("lyapunov")
 
     @property
@@ -170,7 +173,7 @@ class Result:
         return Crossings(rows["crossing"], rows["step"], rows["t"], q, p, rows["H"])
 
     def lyapunov_series(self, index):
-        """The running Lyapunov / MEGNO estimates of trajectory `index` as a LyapunovSeries. Raises
+        """The running Lyapunov / MEGNO / SALI / GALI estimates of trajectory `index` as a LyapunovSeries. Raises
         FileNotFoundError when the run wrote no lyapunov.csv, KeyError for an index that is not a trajectory."""
         rows = self._rows_of("lyapunov", index)
         names = rows.dtype.names
@@ -178,7 +181,10 @@ class Result:
         exponents = np.column_stack([rows[f"lyapunov{j}"] for j in range(k)]) if k else np.empty((len(rows), 0))
         megno = rows["megno"] if "megno" in names else None
         mean_megno = rows["mean_megno"] if "mean_megno" in names else None
-        return LyapunovSeries(rows["step"], rows["t"], exponents, megno, mean_megno)
+        sali = rows["sali"] if "sali" in names else None
+        k_gali = sum(1 for name in names if re.fullmatch(r"gali\d+", name)) + 1
+        gali = np.column_stack([rows[f"gali{j}"] for j in range(2, k_gali + 1)]) if k_gali > 1 else None
+        return LyapunovSeries(rows["step"], rows["t"], exponents, megno, mean_megno, sali, gali)
 
     def initial_states(self):
         """(q, p), each [trajectories, dimension]: every trajectory's state at step 0, from trajectory.csv (the host

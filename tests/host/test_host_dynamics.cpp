@@ -213,7 +213,8 @@ TEST_CASE("tangent vectors do not change the states: trajectory.csv is the same 
 
 namespace {
 
-// 300 states (two blocks of 256) on a grid, put on the shell H = 7, with every diagnostic; trajectories stop inside
+// 300 states (two blocks of 256) on a grid, put on the shell H = 7, with every diagnostic (three tangent vectors
+// for GALI_3, two Lyapunov exponents of them); trajectories stop inside
 // chunks at their max_crossings-th crossing. The basic step with t2 = -3 (cheap; accuracy does not matter here).
 json ensemble_job(std::uint64_t steps, std::uint64_t max_crossings) {
   json job = paper2d_job({{"grid",
@@ -224,7 +225,9 @@ json ensemble_job(std::uint64_t steps, std::uint64_t max_crossings) {
                          {{"dt", 0.002}, {"steps", steps}},
                          {{"poincare", {{"component", "q1"}, {"direction", "+"}, {"max_crossings", max_crossings}}},
                           {"lyapunov", {{"vectors", 2}, {"renormalize_every", 5}, {"every", 500}}},
-                          {"megno", true}});
+                          {"megno", true},
+                          {"sali", true},
+                          {"gali", 3}});
   job["output"]["every"] = 250;
   job["integrator"] = {{"scheme", "basic"}, {"t2", -3.0}};
   return job;
@@ -283,16 +286,19 @@ TEST_CASE("killed and resumed: poincare.csv, lyapunov.csv and trajectories.csv b
   CHECK(*std::max_element(stops.begin(), stops.end()) > double(step));
 }
 
-TEST_CASE("Lyapunov exponents and MEGNO are refused, naming /analysis, for a plugin without Hessians") {
+TEST_CASE("Lyapunov exponents, MEGNO, SALI and GALI are refused, naming their key, for a plugin without Hessians") {
   use_test_plugins();
   TemporaryFolder folder;
-  for (const char* key : {"lyapunov", "megno"}) {
+  for (const char* key : {"lyapunov", "megno", "sali", "gali"}) {
     CAPTURE(key);
     json job = {{"model", {{"plugin", "blowup_gradients_only"}}},
                 {"integrator", {{"scheme", "basic"}}},
                 {"initial", {{"q", {0.5}}, {"p", {0.1}}}},
                 {"time", {{"dt", 0.005}, {"steps", 10}}},
-                {"analysis", {{key, std::string(key) == "megno" ? json(true) : json::object()}}}};
+                {"analysis",
+                 {{key, std::string(key) == "lyapunov" ? json::object()
+                        : std::string(key) == "gali"   ? json(2)
+                                                       : json(true)}}}};
     const auto result = run_named(folder, key, job);
     CHECK(result.status == 2);
     CHECK(result.err.find(std::string("/analysis/") + key) != std::string::npos);

@@ -31,6 +31,7 @@ def ensemble_job(output_format):
                         "energy": 7.0, "solve_for": "p1"},
             "time": {"dt": 0.005, "t_end": 12.0}, "output": {"every": EVERY, "format": output_format},
             "analysis": {"lyapunov": {"vectors": 2, "renormalize_every": 10, "every": 150}, "megno": True,
+                         "sali": True, "gali": 3,
                          "poincare": {"component": "q1", "value": 0.0, "direction": "+", "max_crossings": 3}}}
 
 

@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "nonsep/core/alignment_indices.hpp"
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
@@ -129,6 +130,8 @@ std::string job_fingerprint(const LoadedJob& loaded) {
     analysis += "|lyapunov " + std::to_string(lyapunov->vectors) + ' ' + std::to_string(lyapunov->renormalize_every) +
                 ' ' + std::to_string(lyapunov->every);
   if (run.analysis.megno) analysis += "|megno";
+  if (run.analysis.sali) analysis += "|sali";
+  if (run.analysis.gali > 0) analysis += "|gali " + std::to_string(run.analysis.gali);
   parts.emplace_back("analysis", std::move(analysis));
   std::string fingerprint;
   for (const auto& [name, text] : parts)
@@ -260,9 +263,14 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     state.lyapunov.push_back(record);
     state.megno.push_back(MegnoRecord{m[0], m[1], m[2]});
   }
+  const std::size_t factor_size = job.run().analysis.alignment_indices() ? AlignmentIndices(k).factor_size() : 0;
+  if (factor_size > 0 || active.contains("alignment"))
+    state.alignment =
+        read.numbers(read.member(active, "alignment"), state.active.size() * factor_size, "active.alignment");
   const json& records = read.member(document, "records");
   if (!records.is_array() || records.size() != job.initial.count)
     read.damaged("it does not have one record per trajectory");
+  const std::size_t gali_size = factor_size > 0 ? k - 1 : 0;  // GALI_2 .. GALI_k
   for (const auto& entry : records) {
     TrajectoryRecord record;
     const auto status = trajectory_status_from_string(read.string(read.member(entry, "status"), "status"));
@@ -284,6 +292,9 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     record.lyapunov = read.numbers(exponents, exponents.is_array() && exponents.empty() ? 0 : k, "lyapunov");
     record.megno = read.optional_number(read.member(entry, "megno"), "megno");
     record.mean_megno = read.optional_number(read.member(entry, "mean_megno"), "mean_megno");
+    // Written only when known (checkpoints of runs without SALI and GALI have neither).
+    if (entry.contains("sali")) record.sali = read.number(entry["sali"], "sali");
+    if (entry.contains("gali")) record.gali = read.numbers(entry["gali"], gali_size, "gali");
     state.records.push_back(std::move(record));
   }
   check_consistency(read, state, n);

@@ -55,6 +55,11 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
                        {"lyapunov", encode(record.lyapunov)},
                        {"megno", encode(record.megno)},
                        {"mean_megno", encode(record.mean_megno)}});
+  // SALI and GALI only where known, so that the records of other runs keep their form.
+  for (std::size_t i = 0; i < state.records.size(); ++i) {
+    if (state.records[i].sali) records[i]["sali"] = encode(*state.records[i].sali);
+    if (!state.records[i].gali.empty()) records[i]["gali"] = encode(state.records[i].gali);
+  }
   json lyapunov = json::array(), megno = json::array();
   const std::size_t k = state.active.empty() ? 0 : state.tangent_q.size() / std::max<std::size_t>(1, state.q.size());
   for (const LyapunovRecord& record : state.lyapunov) lyapunov.push_back(encode(record, k));
@@ -84,6 +89,7 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
                    {"observers", observers}};
   // The scheme's private state, under the names it gives: its columns with the active trajectories', its numbers
   // about the run at the top.
+  if (!state.alignment.empty()) document["active"]["alignment"] = encode(state.alignment);
   for (const SchemeState::Column& column : state.scheme.columns)
     document["active"][column.name] = encode(column.values);
   for (const SchemeState::Largest& number : state.scheme.largest) document[number.name] = encode(number.value);

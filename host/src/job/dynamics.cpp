@@ -1,4 +1,5 @@
-// /analysis/poincare, /analysis/lyapunov and /analysis/megno: the dynamics diagnostics of a run
+// /analysis/poincare, /analysis/lyapunov, /analysis/megno, /analysis/sali and /analysis/gali: the dynamics
+// diagnostics of a run
 // (docs/dynamics.md). Whether the plugin has the Hessians the tangent map
 // needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
 #include <limits>
@@ -22,6 +23,11 @@ std::optional<std::size_t> component_index(const std::string& name, std::size_t 
   }
   if (index >= dimension) return std::nullopt;
   return (name[0] == 'q' ? 0 : dimension) + index;
+}
+
+// The most tangent vectors a trajectory can have: 2n, at most LyapunovRecord::max_exponents (2 when n is unknown).
+std::size_t most_tangent_vectors(std::size_t dimension) {
+  return std::min<std::size_t>(LyapunovRecord::max_exponents, dimension > 0 ? 2 * dimension : 2);
 }
 
 std::optional<PoincareSection> read_poincare(Checker& check, const json& value, std::size_t dimension) {
@@ -96,7 +102,7 @@ std::optional<LyapunovAnalysis> read_lyapunov(Checker& check, const json& value,
   check.known_keys(value, path, lyapunov_keys().names());
   const std::size_t issues = check.issue_count();
   LyapunovAnalysis lyapunov;
-  const std::size_t most = std::min<std::size_t>(LyapunovRecord::max_exponents, dimension > 0 ? 2 * dimension : 2);
+  const std::size_t most = most_tangent_vectors(dimension);
   if (const json* k = check.member(value, path, "vectors", false, ""))
     if (auto n = check.integer(*k, child(path, "vectors"), 1, static_cast<std::int64_t>(most),
                                "an integer from 1 to " + std::to_string(most) +
@@ -130,6 +136,21 @@ void read_dynamics(Checker& check, const json& value, std::size_t dimension, Ana
     else
       check.issue(child(path, "megno"), describe(*megno),
                   "true or false: MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)");
+  }
+  if (const json* sali = check.member(value, path, "sali", false, "")) {
+    if (sali->is_boolean())
+      analysis.sali = sali->get<bool>();
+    else
+      check.issue(child(path, "sali"), describe(*sali),
+                  "true or false: SALI of the first two tangent vectors (trajectories.csv sali)");
+  }
+  if (const json* gali = check.member(value, path, "gali", false, "")) {
+    const std::size_t most = most_tangent_vectors(dimension);
+    if (auto k = check.integer(*gali, child(path, "gali"), 2, static_cast<std::int64_t>(most),
+                               "an integer from 2 to " + std::to_string(most) +
+                                   " (2n, at most 32): GALI_2 .. GALI_k of the first k tangent vectors "
+                                   "(trajectories.csv gali2 .. gali<k>)"))
+      analysis.gali = static_cast<std::size_t>(*k);
   }
 }
 

@@ -37,6 +37,20 @@ const KeyTable& analysis_keys() {
        .description = "MEGNO of the first tangent vector (Cincotta and Simo): trajectories.csv columns megno (Y) and "
                       "mean_megno (<Y>: -> 2 on quasi-periodic orbits, ~ lambda t / 2 on chaotic ones). The plugin "
                       "must have Hessians."},
+      {.name = "sali",
+       .type = ValueType::boolean,
+       .default_value = false,
+       .description = "SALI of the first two tangent vectors (Skokos 2001), min(|u1 + u2|, |u1 - u2|) of their unit "
+                      "vectors: trajectories.csv column sali (-> 0 exponentially on chaotic orbits, stays away from 0 "
+                      "on regular ones). Shares the vectors of lyapunov (at least 2). The plugin must have Hessians."},
+      {.name = "gali",
+       .type = ValueType::integer,
+       .minimum = 2,
+       .maximum = static_cast<std::int64_t>(LyapunovRecord::max_exponents),
+       .description = "k (at most 2n): GALI_2 .. GALI_k (Skokos, Bountis and Antonopoulos 2007), the volume spanned "
+                      "by the unit vectors of the first j tangent vectors: trajectories.csv columns gali2 .. gali<k> "
+                      "(exponential decay on chaotic orbits; constant for j <= N, ~ t^(-2(j-N)) on an N-torus). Shares "
+                      "the vectors of lyapunov. The plugin must have Hessians."},
   }};
   return table;
 }
@@ -95,7 +109,7 @@ const KeyTable& lyapunov_keys() {
        .maximum = steps_limit,
        .default_value = 0,
        .description = "Write the running estimates to lyapunov.csv every n-th step (with megno and mean_megno when "
-                      "megno is true); 0: no time series."},
+                      "megno is true, sali and gali2 .. gali<k> when asked); 0: no time series."},
   }};
   return table;
 }

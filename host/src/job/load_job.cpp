@@ -123,7 +123,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   if (!checked.is_study())
     if (const Analysis& analysis = checked.run().analysis;
         analysis.tangent_vectors() > 0 && !loaded.plugin.has_hessians())
-      issues.push_back({analysis.lyapunov ? "/analysis/lyapunov" : "/analysis/megno",
+      issues.push_back({analysis.tangent_key(),
                         "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
                         "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them "
                         "by automatic differentiation)"});
@@ -147,7 +147,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   } else {
     check_comparator(checked.run().integrator, "/integrator/scheme");
     if (checked.run().analysis.tangent_vectors() > 0 && Integrator(checked.run().integrator).is_comparator())
-      issues.push_back({checked.run().analysis.lyapunov ? "/analysis/lyapunov" : "/analysis/megno",
+      issues.push_back({checked.run().analysis.tangent_key(),
                         "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme + "\"",
                         "a Chin scheme (basic, triplet, mpe): the comparators have no tangent map"});
   }

@@ -59,7 +59,7 @@ Analysis read_analysis(Checker& check, const json& value, std::size_t dimension)
   const std::string path = "/analysis";
   if (!check.object(value, path,
                     "an object {\"closest_return_after\": t, \"max_relative_energy_error\": e, \"poincare\": {...}, "
-                    "\"lyapunov\": {...}, \"megno\": true}"))
+                    "\"lyapunov\": {...}, \"megno\": true, \"sali\": true, \"gali\": k}"))
     return analysis;
   check.known_keys(value, path, analysis_keys().names());
   read_dynamics(check, value, dimension, analysis);

@@ -62,6 +62,15 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
                          {"every", l->every}};
   if (analysis.megno)
     facts["megno"] = {{"columns", "trajectories.csv megno (Y), mean_megno (<Y>, -> 2 on quasi-periodic orbits)"}};
+  if (analysis.sali) facts["sali"] = {{"columns", "trajectories.csv sali, of the first two vectors"}};
+  if (analysis.gali > 0)
+    facts["gali"] = {{"vectors", analysis.gali},
+                     {"columns", "trajectories.csv gali2 .. gali" + std::to_string(analysis.gali) +
+                                     ", GALI_j of the first j vectors"}};
+  if (analysis.alignment_indices())
+    facts["alignment_indices"] =
+        "the vectors of the Lyapunov exponents, with the triangular factors of their orthonormalisations "
+        "(core/alignment_indices.hpp), at the last orthonormalisation";
   return facts;
 }
 

@@ -34,7 +34,9 @@ EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
           run.analysis.tangent_vectors(),
           run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1,
           run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count),
-          parameter_sets(job)};
+          parameter_sets(job),
+          run.analysis.megno,
+          run.analysis.alignment_indices()};
 }
 
 std::optional<Checkpoint> resumed_state(const LoadedJob& loaded, const RunOptions& options) {
@@ -77,9 +79,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   else
     remove_stale(directory / PoincareSectionObserver::file_name);
   if (run.analysis.tangent_vectors() > 0)
-    chaos.emplace(directory / LyapunovMegnoObserver::file_name,
-                  run.analysis.lyapunov ? run.analysis.lyapunov->vectors : 0, run.analysis.megno,
-                  run.analysis.lyapunov ? run.analysis.lyapunov->every : 0, driver.records(), options.resume);
+    chaos.emplace(directory / LyapunovMegnoObserver::file_name, run.analysis, driver.records(), options.resume);
   if (!chaos || !run.analysis.lyapunov || run.analysis.lyapunov->every == 0)
     remove_stale(directory / LyapunovMegnoObserver::file_name);
   observers.push_back(&energy);

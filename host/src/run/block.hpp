@@ -34,6 +34,8 @@ struct Departure {
   std::optional<double> energy;  // H of the final state, when known
   std::vector<double> lyapunov;  // the final estimates, when the block follows tangent vectors
   std::optional<double> megno, mean_megno;
+  std::optional<double> sali;
+  std::vector<double> gali;
 };
 
 // The first non-finite variable of state `slot` ("q[0]", "p[2]"), or "".
@@ -142,14 +144,21 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
     return tangents ? tangents->integrator.evaluations() : integrator.evaluations();
   }
 
-  // The final Lyapunov and MEGNO estimates of `slot` into `departure` (nothing without tangents).
+  // The final Lyapunov, MEGNO, SALI and GALI estimates of `slot` into `departure` (each when computed).
   template <class Record>
   void final_estimates(std::size_t slot, Record& departure) const {
     if (!tangents) return;
     departure.lyapunov.clear();
     for (std::size_t j = 0; j < tangents->k; ++j) departure.lyapunov.push_back(tangents->lyapunov[slot].exponent(j));
-    departure.megno = tangents->megno[slot].y();
-    departure.mean_megno = tangents->megno[slot].mean_y();
+    if (tangents->with_megno) {
+      departure.megno = tangents->megno[slot].y();
+      departure.mean_megno = tangents->megno[slot].mean_y();
+    }
+    if (tangents->factor_size == 0) return;
+    const auto factor = tangents->factor(slot);
+    departure.sali = AlignmentIndices::sali(factor);
+    departure.gali.clear();
+    for (std::size_t j = 2; j <= tangents->k; ++j) departure.gali.push_back(AlignmentIndices::gali(factor, j));
   }
   void clear() { trajectories.clear(); }
 

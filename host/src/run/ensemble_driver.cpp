@@ -66,7 +66,7 @@ struct EnsembleDriver::Impl {
       blocks.emplace_back(setup.integrator, n, members, setup.q.subspan(first * n, size * n),
                           setup.p.subspan(first * n, size * n));
       if (setup.tangent_vectors > 0) {
-        blocks.back().tangents.emplace(setup.integrator, setup.tangent_vectors, setup.renormalize_every, n, size);
+        blocks.back().tangents.emplace(setup, size);
         blocks.back().tangents->start();
       }
       first = end;
@@ -166,6 +166,8 @@ struct EnsembleDriver::Impl {
       record.lyapunov = departure.lyapunov;
       record.megno = departure.megno;
       record.mean_megno = departure.mean_megno;
+      record.sali = departure.sali;
+      record.gali = departure.gali;
       retire(departure.trajectory, departure.final_step, departure.q, departure.p, departure.energy);
     }
   }
@@ -180,7 +182,8 @@ struct EnsembleDriver::Impl {
                           block.energy_step == step ? block.energy(slot) : std::nullopt,
                           &records[block.trajectories[slot]],
                           block.tangents ? &block.tangents->lyapunov[slot] : nullptr,
-                          block.tangents ? &block.tangents->megno[slot] : nullptr});
+                          block.tangents ? &block.tangents->megno[slot] : nullptr,
+                          block.tangents ? block.tangents->factor(slot) : std::span<const double>()});
     std::vector<RetirementRequest> requests;
     const Event event{step, setup.time.time_at(step), states, energy_evaluated, &requests};
     for (Observer* observer : observers) observer->on_event(event);
@@ -325,10 +328,8 @@ void EnsembleDriver::restore(DriverState state) {
       energies.push_back(state.energies[k]);
     }
     d.blocks[b] = Block(d.setup.integrator, n, trajectories, q, p);
-    if (const std::size_t k = d.setup.tangent_vectors; k > 0)
-      d.blocks[b]
-          .tangents.emplace(d.setup.integrator, k, d.setup.renormalize_every, n, trajectories.size())
-          .restore(members[b], state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
+    if (d.setup.tangent_vectors > 0)
+      d.blocks[b].tangents.emplace(d.setup, trajectories.size()).restore(members[b], state);
     d.blocks[b].energies = std::move(energies);
     d.blocks[b].energy_step = state.step;
     if (!members[b].empty()) d.blocks[b].integrator.restore_state(state.scheme.select(members[b]));
@@ -350,7 +351,7 @@ DriverState EnsembleDriver::state() const {
     state.p.insert(state.p.end(), block.batch.p().begin(), block.batch.p().end());
     for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
       state.energies.push_back(block.energy_step == d.completed ? block.energies[slot] : std::nan(""));
-    if (block.tangents) block.tangents->save(state.tangent_q, state.tangent_p, state.lyapunov, state.megno);
+    if (block.tangents) block.tangents->save(state);
     state.scheme.append(block.integrator.save_state(block.batch));
   }
   state.records = d.records;

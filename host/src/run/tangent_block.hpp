@@ -1,10 +1,11 @@
 #pragma once
 // Internal to the ensemble driver: the tangent vectors of one block's trajectories, for /analysis/lyapunov and
-// /analysis/megno. When a run asks for them, the block steps with nonsep::TangentIntegrator instead of
-// nonsep::Integrator: the states get the same numbers bit for bit (tangent_integrator.hpp), and k vectors per
-// state follow the exact tangent map of each step. After every step LyapunovExponents::after_step takes the
-// growth of the first vector (for MEGNO) and re-orthonormalises every `renormalize_every` steps
-// (lyapunov_exponents.hpp); MegnoRecord::add_step sums Y and <Y> (megno.hpp).
+// /analysis/megno, /analysis/sali and /analysis/gali. When a run asks for them, the block steps with
+// nonsep::TangentIntegrator instead of nonsep::Integrator: the states get the same numbers bit for bit
+// (tangent_integrator.hpp), and k vectors per state follow the exact tangent map of each step. After every step
+// LyapunovExponents::after_step takes the growth of the first vector (only for MEGNO) and re-orthonormalises every
+// `renormalize_every` steps (lyapunov_exponents.hpp); MegnoRecord::add_step sums Y and <Y> (megno.hpp); with SALI or
+// GALI each slot keeps the triangular factor of alignment_indices.hpp, updated at the orthonormalisations.
 //
 // Initial vectors (the same for every trajectory, fixed so that results are reproducible): vector 0 is
 // w = (1, 1/2, 1/3, ..., 1/(2n)) over (dq_0 .. dq_(n-1), dp_0 .. dp_(n-1)), a generic direction (not along the flow
@@ -19,6 +20,7 @@
 #include "nonsep/core/lyapunov_exponents.hpp"
 #include "nonsep/core/megno.hpp"
 #include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
 
 namespace nonsep::host {
 
@@ -34,20 +36,26 @@ struct BlockTangents {
   TangentIntegrator integrator;
   LyapunovExponents exponents;
   std::size_t k;
+  bool with_megno;                       // EnsembleSetup::megno
   PhaseSpaceBatch vectors;               // k per slot: vector j of slot s at entry s*k + j
   std::vector<LyapunovRecord> lyapunov;  // per slot
-  std::vector<MegnoRecord> megno;        // per slot
-  std::vector<double> growth;            // scratch: ln-growth of vector 0 over the last step, per slot
+  std::vector<MegnoRecord> megno;        // per slot (zeros unless MEGNO is asked)
+  std::vector<double> growth;            // scratch: ln-growth of vector 0 over the last step, per slot (MEGNO)
+  std::size_t factor_size;               // numbers per slot in `alignment`; 0 without SALI and GALI
+  std::vector<double> alignment;         // per slot: the factor of alignment_indices.hpp
 
-  BlockTangents(const IntegratorSpec& spec, std::size_t vectors_per_state, std::uint64_t renormalize_every,
-                std::size_t n, std::size_t slots)
-      : integrator(spec),
-        exponents(vectors_per_state, renormalize_every),
-        k(vectors_per_state),
-        vectors(n, slots * vectors_per_state),
+  // setup.tangent_vectors per state, `slots` states.
+  BlockTangents(const EnsembleSetup& setup, std::size_t slots)
+      : integrator(setup.integrator),
+        exponents(setup.tangent_vectors, setup.renormalize_every),
+        k(setup.tangent_vectors),
+        with_megno(setup.megno),
+        vectors(setup.dimension, slots * setup.tangent_vectors),
         lyapunov(slots),
         megno(slots),
-        growth(slots) {}
+        growth(setup.megno ? slots : 0),
+        factor_size(setup.alignment_indices ? AlignmentIndices(k).factor_size() : 0),
+        alignment(slots * factor_size) {}
 
   // Every slot at time 0: the initial vectors, orthonormalised, and zeroed sums.
   void start() {
@@ -59,6 +67,7 @@ struct BlockTangents {
     }
     exponents.start(vectors, lyapunov);
     std::fill(megno.begin(), megno.end(), MegnoRecord{});
+    if (factor_size > 0) AlignmentIndices(k).start(alignment);
   }
 
   // Steps the states of `x`, which are slots first .. first + x.count() - 1 of the block, with their vectors as
@@ -82,23 +91,29 @@ struct BlockTangents {
     after_step(dt);
   }
 
-  // The Lyapunov and MEGNO sums after a step of dt of every slot.
+  // The Lyapunov and MEGNO sums and the SALI/GALI factors after a step of dt of every slot.
   void after_step(double dt) {
-    exponents.after_step(vectors, lyapunov, dt, growth);
-    add_megno_step(megno, growth, dt);
+    exponents.after_step(vectors, lyapunov, dt, growth, alignment);
+    if (with_megno) add_megno_step(megno, growth, dt);
+  }
+  // The factor of alignment_indices.hpp of `slot` (empty without SALI and GALI).
+  std::span<const double> factor(std::size_t slot) const {
+    return std::span<const double>(alignment).subspan(slot * factor_size, factor_size);
   }
 
-  // Checkpoints (DriverState): appends every slot's vectors and sums; restore() takes slot s from entry
+  // Checkpoints (DriverState): appends every slot's vectors, sums and factors; restore() takes slot s from entry
   // entries[s] of such lists (the block's members among the active trajectories of a checkpoint).
-  void save(std::vector<double>& q, std::vector<double>& p, std::vector<LyapunovRecord>& l,
-            std::vector<MegnoRecord>& m) const {
-    q.insert(q.end(), vectors.q().begin(), vectors.q().end());
-    p.insert(p.end(), vectors.p().begin(), vectors.p().end());
-    l.insert(l.end(), lyapunov.begin(), lyapunov.end());
-    m.insert(m.end(), megno.begin(), megno.end());
+  void save(DriverState& state) const {
+    state.tangent_q.insert(state.tangent_q.end(), vectors.q().begin(), vectors.q().end());
+    state.tangent_p.insert(state.tangent_p.end(), vectors.p().begin(), vectors.p().end());
+    state.lyapunov.insert(state.lyapunov.end(), lyapunov.begin(), lyapunov.end());
+    state.megno.insert(state.megno.end(), megno.begin(), megno.end());
+    state.alignment.insert(state.alignment.end(), alignment.begin(), alignment.end());
   }
-  void restore(std::span<const std::size_t> entries, std::span<const double> q, std::span<const double> p,
-               std::span<const LyapunovRecord> l, std::span<const MegnoRecord> m) {
+  void restore(std::span<const std::size_t> entries, const DriverState& state) {
+    const std::span<const double> q = state.tangent_q, p = state.tangent_p;
+    const std::span<const LyapunovRecord> l = state.lyapunov;
+    const std::span<const MegnoRecord> m = state.megno;
     const std::size_t size = k * vectors.dimension();
     for (std::size_t slot = 0; slot < entries.size(); ++slot) {
       std::copy_n(q.begin() + static_cast<std::ptrdiff_t>(entries[slot] * size), size,
@@ -107,6 +122,8 @@ struct BlockTangents {
                   vectors.p().begin() + static_cast<std::ptrdiff_t>(slot * size));
       lyapunov[slot] = l[entries[slot]];
       megno[slot] = m[entries[slot]];
+      std::copy_n(state.alignment.begin() + static_cast<std::ptrdiff_t>(entries[slot] * factor_size), factor_size,
+                  alignment.begin() + static_cast<std::ptrdiff_t>(slot * factor_size));
     }
   }
 
@@ -123,6 +140,8 @@ struct BlockTangents {
                     vectors.p().begin() + static_cast<std::ptrdiff_t>(kept * k * n));
         lyapunov[kept] = lyapunov[s];
         megno[kept] = megno[s];
+        std::copy_n(alignment.begin() + static_cast<std::ptrdiff_t>(s * factor_size), factor_size,
+                    alignment.begin() + static_cast<std::ptrdiff_t>(kept * factor_size));
       }
       ++kept;
     }
@@ -133,7 +152,8 @@ struct BlockTangents {
     vectors = std::move(next);
     lyapunov.resize(kept);
     megno.resize(kept);
-    growth.resize(kept);
+    growth.resize(with_megno ? kept : 0);
+    alignment.resize(kept * factor_size);
   }
 };
 

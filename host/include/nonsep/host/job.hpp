@@ -12,6 +12,7 @@
 // read_job is passes 1 and 2 on a file (at most max_job_file_bytes); load_job is all three, reporting the
 // problems of every pass together. Every issue names a JSON Pointer (RFC 6901) into the job file, what was found
 // there and what is allowed. The reader is split by the job file's sections, host/src/job/*.cpp.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -141,8 +142,23 @@ struct Analysis {
   std::optional<PoincareSection> poincare;   // /analysis/poincare
   std::optional<LyapunovAnalysis> lyapunov;  // /analysis/lyapunov
   bool megno = false;                        // /analysis/megno: MEGNO of the first tangent vector
-  // Tangent vectors per trajectory the run must follow: lyapunov's k, or 1 for MEGNO alone; 0 for none.
-  std::size_t tangent_vectors() const { return lyapunov ? lyapunov->vectors : megno ? 1 : 0; }
+  bool sali = false;                         // /analysis/sali: SALI of the first two tangent vectors
+  std::size_t gali = 0;                      // /analysis/gali: GALI_2 .. GALI_gali of the first vectors; 0: none
+  // Tangent vectors per trajectory the run must follow, shared by every analysis: the most any of them needs
+  // (lyapunov's k, 1 for MEGNO, 2 for SALI, gali's k); 0 for none.
+  std::size_t tangent_vectors() const {
+    return std::max({lyapunov ? lyapunov->vectors : 0, megno ? std::size_t{1} : 0, sali ? std::size_t{2} : 0, gali});
+  }
+  // Whether the run keeps the factors of SALI and GALI (nonsep/core/alignment_indices.hpp).
+  bool alignment_indices() const { return sali || gali > 0; }
+  // The job file's key of the first analysis that needs tangent vectors, for messages ("" for none).
+  std::string tangent_key() const {
+    return lyapunov ? "/analysis/lyapunov"
+           : megno  ? "/analysis/megno"
+           : sali   ? "/analysis/sali"
+           : gali   ? "/analysis/gali"
+                    : "";
+  }
   // /analysis/closest_return_after: from this time on, the smallest Euclidean phase-space distance
   // |(q, p) - (q0, p0)| to the trajectory's initial state is tracked at every step (summary: closest_return).
   std::optional<double> closest_return_after;

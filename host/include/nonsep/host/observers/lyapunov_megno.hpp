@@ -1,19 +1,25 @@
 #pragma once
-// The results of /analysis/lyapunov and /analysis/megno, which the ensemble driver computes with the tangent
-// vectors it follows (run/tangent_block.hpp, EnsembleSetup::tangent_vectors):
+// The results of /analysis/lyapunov, /analysis/megno, /analysis/sali and /analysis/gali, which the ensemble driver
+// computes with the tangent vectors it follows (run/tangent_block.hpp, EnsembleSetup::tangent_vectors):
 //   trajectories.csv  columns lyapunov0 .. lyapunov<k-1> (Benettin's finite-time exponents at the last
-//                     re-orthonormalisation) and/or megno, mean_megno (Y and <Y> of the first tangent vector:
+//                     re-orthonormalisation), megno, mean_megno (Y and <Y> of the first tangent vector:
 //                     <Y> -> 2 on a quasi-periodic orbit, ~ lambda t / 2 on a chaotic one, 0 on a stable periodic
-//                     one); empty for a trajectory that diverged or failed.
+//                     one), sali and gali2 .. gali<k> (at the last re-orthonormalisation,
+//                     nonsep/core/alignment_indices.hpp), each when asked for; empty for a trajectory that diverged
+//                     or failed.
 //   lyapunov.csv      with /analysis/lyapunov/every = s > 0, the running estimates every s-th step:
-//                     trajectory,step,t,lyapunov0,...[,megno,mean_megno], in (step, trajectory) order.
+//                     trajectory,step,t,lyapunov0,...[,megno,mean_megno][,sali][,gali2,...], in (step, trajectory)
+//                     order.
 // Checkpoints: lyapunov.csv's size and content hash, like trajectory.csv; the estimates themselves are the driver's.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
+#include <string>
 #include <vector>
 
+#include "nonsep/host/job.hpp"
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/run/observer.hpp"
 
@@ -23,10 +29,10 @@ class LyapunovMegnoObserver : public Observer, public CheckpointedObserver, publ
  public:
   static constexpr const char* file_name = "lyapunov.csv";
 
-  // `exponents`: k columns of exponents (0 without /analysis/lyapunov); `megno`: the MEGNO columns; `every`: the
-  // series' stride (0: no lyapunov.csv). `records` (the driver's) must outlive the observer. Creates the series file
-  // unless `resuming` (then restore() opens it). Throws OutputError.
-  LyapunovMegnoObserver(const std::filesystem::path& path, std::size_t exponents, bool megno, std::uint64_t every,
+  // The columns of `analysis`'s lyapunov (its k exponents), megno, sali and gali; the series every
+  // analysis.lyapunov.every steps (0 or no lyapunov: no lyapunov.csv). `records` (the driver's) must outlive the
+  // observer. Creates the series file unless `resuming` (then restore() opens it). Throws OutputError.
+  LyapunovMegnoObserver(const std::filesystem::path& path, const Analysis& analysis,
                         const std::vector<TrajectoryRecord>& records, bool resuming);
 
   std::uint64_t next_event(std::uint64_t step) const override;
@@ -44,8 +50,14 @@ class LyapunovMegnoObserver : public Observer, public CheckpointedObserver, publ
 
  private:
   std::filesystem::path path_;
+  // The cells of columns() after a row's first cells (lyapunov.csv: trajectory,step,t): a comma and a value (empty
+  // where unknown) each.
+  void append_values(std::string& row, std::span<const double> exponents, std::optional<double> megno,
+                     std::optional<double> mean_megno, std::optional<double> sali, std::span<const double> gali) const;
+
   std::size_t exponents_;
-  bool megno_;
+  bool megno_, sali_;
+  std::size_t gali_;
   std::uint64_t every_;
   const std::vector<TrajectoryRecord>& records_;
   std::optional<CsvAppender> file_;

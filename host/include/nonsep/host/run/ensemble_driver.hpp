@@ -85,6 +85,10 @@ struct EnsembleSetup {
   // block_size), and each thread creates its own instance of a set's parameters when it first steps one of its
   // blocks: one instance per set and thread (`model` is then not stepped).
   std::vector<ParameterSet> parameter_sets = {};
+  // With tangent vectors: whether the run computes MEGNO (the first vector's log-growth at every step), and whether
+  // it keeps the factors of SALI and GALI (nonsep/core/alignment_indices.hpp; tangent_vectors >= 2).
+  bool megno = false;
+  bool alignment_indices = false;
 };
 
 // The driver's state between two steps, for checkpoints.
@@ -100,6 +104,8 @@ struct DriverState {
   std::vector<double> tangent_q, tangent_p;
   std::vector<LyapunovRecord> lyapunov;
   std::vector<MegnoRecord> megno;
+  // With SALI or GALI: the active trajectories' factors (AlignmentIndices::factor_size(k) numbers each); else empty.
+  std::vector<double> alignment;
   // The scheme's private state of the active trajectories (its columns in the order of `active`) and its numbers
   // about the run (nonsep::SchemeState): stored and handed back, never read; empty for most schemes.
   SchemeState scheme;

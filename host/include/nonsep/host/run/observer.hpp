@@ -62,6 +62,8 @@ struct StateView {
   // The running Lyapunov and MEGNO sums, when the run follows tangent vectors (EnsembleSetup::tangent_vectors).
   const LyapunovRecord* lyapunov = nullptr;
   const MegnoRecord* megno = nullptr;
+  // With SALI or GALI: the state's factor of nonsep/core/alignment_indices.hpp; else empty.
+  std::span<const double> alignment;
 };
 
 // A retirement an observer asks for at an event: the trajectory stops there with `status` and `message`.

@@ -46,6 +46,9 @@ struct TrajectoryRecord {
   // follows tangent vectors retires the trajectory; empty for one that diverged or failed, and when not computed.
   std::vector<double> lyapunov;
   std::optional<double> megno, mean_megno;
+  // SALI and GALI_2 .. GALI_k (gali[j - 2] = GALI_j) at the last orthonormalisation, likewise, when asked for.
+  std::optional<double> sali;
+  std::vector<double> gali;
 };
 
 // (H - H0) / H0, unknown when either is unknown or H0 = 0: trajectory.csv's and trajectories.csv's
