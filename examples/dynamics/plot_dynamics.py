@@ -1,5 +1,6 @@
 """Render the dynamics pictures of paper2d from the outputs the nonsep runs wrote, with nonsep.load and
-nonsep.plot.poincare / nonsep.plot.chaos_map (python/nonsep, found from this file when not on PYTHONPATH).
+nonsep.plot.poincare / chaos_map / stability_map / indicator_series (python/nonsep, found from this file when not on
+PYTHONPATH).
 
     /usr/bin/python3 examples/dynamics/plot_dynamics.py OUT_DIR
 
@@ -8,13 +9,18 @@ OUT_DIR is the folder `examples/dynamics/run_dynamics.sh` fills:
     poincare_portrait/trajectories.csv   each orbit's MEGNO <Y> (mean_megno), which colours its points
     chaos_map/trajectory.csv             each trajectory's first state (its place on the map)
     chaos_map/trajectories.csv           each trajectory's <Y> and largest exponent
+    stability_map/trajectories.csv       each trajectory's coupling (a column of the sweep) and <Y>
+    stability_map/trajectory.csv         each trajectory's first state (its q0 on the map)
+    stability_map/lyapunov.csv           the running <Y> of every trajectory, for the time series beside the map
     */summary.json                       the energy shell, the integrator and the time, for the titles
-Writes dynamics_poincare and dynamics_chaos_map into OUT_DIR, each as a PNG at DPI dots per inch and as a PDF.
+Writes dynamics_poincare, dynamics_chaos_map and dynamics_stability_map into OUT_DIR, each as a PNG at DPI dots per
+inch and as a PDF.
 """
 import sys
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -85,12 +91,34 @@ def chaos_map(out):
     save(fig, out, "dynamics_chaos_map")
 
 
+def stability_map(out):
+    result = nonsep.load(out / "stability_map")
+    fig, (ax, series) = plt.subplots(1, 2, figsize=(12.0, 5.2), gridspec_kw={"width_ratios": [1.15, 1]})
+    nonsep.plot.stability_map(result, ax=ax, value="mean_megno", x="coupling", y="q0", colorbar=False, **COLOURS)
+    ax.set_ylabel("q0 (initial; q1 = p0 = 0, p1 >= 0 on the shell)")
+    ax.set_title(f"Stability map: MEGNO <Y> of {len(result.trajectories)} orbits (grey: off the shell)\n"
+                 f"{subtitle(result.summary)}", fontsize=10)
+    fig.colorbar(ax.images[0], ax=ax).set_label(f"<Y> {BAR}")
+    # Beside it, <Y>(t) of the most chaotic orbit and of the most regular one with its coupling.
+    table = result.trajectories
+    chaotic = int(np.nanargmax(table["mean_megno"]))
+    same = np.flatnonzero(table["coupling"] == table["coupling"][chaotic])
+    regular = int(same[np.nanargmin(np.abs(table["mean_megno"][same] - 2.0))])
+    nonsep.plot.indicator_series(result, i=[regular, chaotic], value="mean_megno", ax=series)
+    series.axhline(2.0, color="grey", linewidth=0.8, linestyle="--")
+    series.set_title(f"<Y>(t) of the most chaotic orbit and the most regular one at its coupling\n"
+                     f"(lyapunov.csv; dashed: 2, the quasi-periodic limit)", fontsize=10)
+    fig.tight_layout()
+    save(fig, out, "dynamics_stability_map")
+
+
 def main():
     if len(sys.argv) != 2:
         raise SystemExit(__doc__)
     out = Path(sys.argv[1])
     portrait(out)
     chaos_map(out)
+    stability_map(out)
 
 
 if __name__ == "__main__":

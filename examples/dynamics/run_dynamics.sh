@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Runs the dynamics examples of paper2d and draws them: a Poincare phase portrait and a MEGNO chaos map on one
-# energy shell.
+# Runs the dynamics examples of paper2d and draws them: a Poincare phase portrait, a MEGNO chaos map on one energy
+# shell, and a stability map (MEGNO over the coupling, a parameter sweep, and q0 on that shell).
 #
 #   bash examples/dynamics/run_dynamics.sh [OUT_DIR] [BUILD_DIR] [--small]
 #
-# OUT_DIR (default build/dynamics) receives one folder per job (poincare_portrait/, chaos_map/) and
-# dynamics_poincare and dynamics_chaos_map as .png and .pdf. BUILD_DIR (default build) holds bin/nonsep.
+# OUT_DIR (default build/dynamics) receives one folder per job (poincare_portrait/, chaos_map/, stability_map/) and
+# dynamics_poincare, dynamics_chaos_map and dynamics_stability_map as .png and .pdf. BUILD_DIR (default build) holds bin/nonsep.
 # --small runs the same jobs on coarser grids for a shorter time (the examples test; a few seconds): the job files
 # are rewritten into OUT_DIR/jobs. docs/dynamics_*.png are the full-size pictures. Exits non-zero if any step fails.
 set -euo pipefail
@@ -17,7 +17,7 @@ small="${3:-}"
 python="${PYTHON:-/usr/bin/python3}"  # the system interpreter, which has python3-matplotlib
 
 mkdir -p "$out/jobs"
-for job in poincare_portrait chaos_map; do
+for job in poincare_portrait chaos_map stability_map; do
   file="$here/$job.json"
   if [ "$small" = "--small" ]; then
     file="$out/jobs/$job.json"
@@ -26,7 +26,13 @@ import json, sys
 job = json.load(open(sys.argv[1]))
 job["$schema"] = sys.argv[3]
 grid = job["initial"]["grid"]
-grid["q"][0]["count"] = grid["p"][0]["count"] = 9 if "poincare" in job["analysis"] else 15
+if "poincare" in job["analysis"]:
+    grid["q"][0]["count"] = grid["p"][0]["count"] = 9
+elif isinstance(grid["p"][0], dict):
+    grid["q"][0]["count"] = grid["p"][0]["count"] = 15
+else:  # the stability map: 9 couplings x 15 starting points
+    job["model"]["parameters"]["coupling"]["count"] = 9
+    grid["q"][0]["count"] = 15
 job["time"]["t_end"] = 100 if "poincare" in job["analysis"] else 40
 json.dump(job, open(sys.argv[2], "w"), indent=2)
 PY

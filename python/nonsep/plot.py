@@ -1,6 +1,7 @@
 """Figures of a Result with matplotlib (imported here, not by `import nonsep`): orbit, energy_error, convergence,
-and for the dynamics outputs poincare (the crossings of poincare.csv) and chaos_map (MEGNO or a Lyapunov exponent
-over the grid of initial conditions). Each function draws into `ax` (a new figure's axes when None) and returns
+and for the dynamics outputs poincare (the crossings of poincare.csv), chaos_map (MEGNO or a Lyapunov exponent
+over the grid of initial conditions), stability_map (the same over a parameter sweep's plane) and
+indicator_series (the running estimates of lyapunov.csv against t). Each function draws into `ax` (a new figure's axes when None) and returns
 the axes, labelled with the quantities and with a legend when it shows more than one series (and at most
 MAX_LEGEND; an ensemble's hundred lines get none). Choose the backend before importing pyplot, e.g.
 matplotlib.use("Agg") for files only.
@@ -222,22 +223,105 @@ def chaos_map(result, ax=None, value="mean_megno", x=None, y=None, cmap=None, co
     drawn with ax.imshow, another with ax.pcolormesh; `style` goes there (e.g. vmin, vmax). Returns the axes, with a
     colour bar labelled with the quantity when `colorbar`."""
     values = _per_trajectory(result, value)
-    q, p = result.initial_states()
-    names = _component_names(q.shape[1])
-    columns = dict(zip(names, np.column_stack([q, p]).T))
+    columns = _initial_columns(result)
     if x is None or y is None:
         x, y = _grid_axes(columns, len(values))
+    return _grid_image(_axes(ax), columns, x, y, values, value, None, cmap, colorbar, style)
+
+
+def stability_map(result, ax=None, value="mean_megno", x=None, y=None, reduce=None, cmap=None, colorbar=True,
+                  **style):
+    """An image of `value` (a column of trajectories.csv) over a plane of a parameter sweep: a swept parameter
+    against an initial-condition component ("coupling" x "q0"), or two swept parameters against each other. x and
+    y name swept parameters (summary.json's sweep, columns of trajectories.csv) or components of the initial state
+    (step-0 rows of trajectory.csv, as in chaos_map); they default to the two swept parameters, or to the one swept
+    parameter and the initial component that, with it, tells the trajectories apart with the fewest cells. When
+    several trajectories fall in one cell (a parameter x parameter plane over several initial states) `reduce`
+    combines them ("mean", "median", "max", "min" or a function of an array); without it that is an error. Cells
+    without a value are grey; `style` goes to imshow or pcolormesh as in chaos_map. Returns the axes."""
+    swept = list((result.summary.get("sweep") or {}).get("parameters", {}))
+    if not swept:
+        raise ValueError(f"{result.directory} is not a parameter sweep (summary.json has no \"sweep\"): use chaos_map")
+    values = _per_trajectory(result, value)
+    columns = {name: _per_trajectory(result, name) for name in swept}
+    needs_states = any(name not in columns for name in (x, y)) or (x is None and len(swept) == 1)
+    if needs_states:
+        columns.update(_initial_columns(result))
+    if x is None or y is None:
+        if len(swept) >= 2:
+            x, y = swept[0], swept[1]
+        else:
+            others = {name: c for name, c in columns.items() if name != swept[0]}
+            y = min(others, key=lambda name: _cells(columns[swept[0]], others[name], len(values)))
+            x = swept[0]
+    for name in (x, y):
+        if name not in columns:
+            raise ValueError(f"no parameter or initial component {name!r} (choose from {', '.join(columns)})")
+    return _grid_image(_axes(ax), columns, x, y, values, value, reduce, cmap, colorbar, style)
+
+
+def indicator_series(result, i=None, value="mean_megno", ax=None, **style):
+    """The running estimate `value` of lyapunov.csv ("mean_megno", the default, "megno", "lyapunov0", ...) against t,
+    one line per trajectory (`i`: an index, a list, or None for all in the file), labelled with the trajectory and,
+    in a parameter sweep, its swept parameters. Needs analysis.lyapunov.every > 0. Returns the axes."""
+    table = result.lyapunov
+    if table is None:
+        raise FileNotFoundError(f"{result.directory} holds no lyapunov.csv: run with analysis.lyapunov.every > 0")
+    if value not in table.dtype.names:
+        raise ValueError(f"lyapunov.csv has no column {value!r} (its columns: {', '.join(table.dtype.names)})")
+    indices = [int(k) for k in np.unique(table["trajectory"])] if i is None else \
+        ([int(i)] if np.isscalar(i) else [int(k) for k in i])
+    swept = list((result.summary.get("sweep") or {}).get("parameters", {}))
+    ax = _axes(ax)
+    for index in indices:
+        rows = result._rows_of("lyapunov", index)
+        label = f"trajectory {index}" + "".join(
+            f", {name} = {result.trajectories[name][index]:g}" for name in swept)
+        ax.plot(rows["t"], rows[value], label=label, **style)
+    ax.set_xlabel("$t$")
+    ax.set_ylabel(_value_label(value))
+    if 1 < len(indices) <= MAX_LEGEND:
+        ax.legend(fontsize="small")
+    return ax
+
+
+def _axis_label(name):
+    """q0 -> "$q_0$ (initial)"; a parameter's name as it is."""
+    return f"{_math(name)} (initial)" if name[:1] in "qp" and name[1:].isdigit() else name
+
+
+def _initial_columns(result):
+    q, p = result.initial_states()
+    return dict(zip(_component_names(q.shape[1]), np.column_stack([q, p]).T))
+
+
+def _cells(a, b, count):
+    """The cells of the plane (a, b), or infinity when two trajectories share one."""
+    pairs = np.unique(np.column_stack([a, b]), axis=0)
+    return len(np.unique(a)) * len(np.unique(b)) if len(pairs) == count else np.inf
+
+
+REDUCTIONS = {"mean": np.mean, "median": np.median, "max": np.max, "min": np.min}
+
+
+def _grid_image(ax, columns, x, y, values, value, reduce, cmap, colorbar, style):
+    """`values` as an image over the distinct values of columns[x] and columns[y]; see chaos_map."""
     xs, column_of = np.unique(columns[x], return_inverse=True)
     ys, row_of = np.unique(columns[y], return_inverse=True)
     grid = np.full((len(ys), len(xs)), np.nan)
-    grid[row_of, column_of] = values
     counts = np.zeros(grid.shape, dtype=int)
     np.add.at(counts, (row_of, column_of), 1)
+    if counts.max() > 1 and reduce is None:
+        raise ValueError(f"several trajectories start at the same ({x}, {y}): not a grid over them (give reduce)")
     if counts.max() > 1:
-        raise ValueError(f"several trajectories start at the same ({x}, {y}): not a grid over them")
+        combine = REDUCTIONS[reduce] if isinstance(reduce, str) else reduce
+        cell = row_of * len(xs) + column_of
+        for c in np.unique(cell):
+            grid.flat[c] = combine(values[cell == c])
+    else:
+        grid[row_of, column_of] = values
     colours = _colour_map(cmap, "viridis").copy()
     colours.set_bad("#d9d9d9")
-    ax = _axes(ax)
     if _uniform(xs) and _uniform(ys):
         half_x = (xs[-1] - xs[0]) / (len(xs) - 1) / 2 if len(xs) > 1 else 0.5
         half_y = (ys[-1] - ys[0]) / (len(ys) - 1) / 2 if len(ys) > 1 else 0.5
@@ -246,8 +330,8 @@ def chaos_map(result, ax=None, value="mean_megno", x=None, y=None, cmap=None, co
                           extent=(xs[0] - half_x, xs[-1] + half_x, ys[0] - half_y, ys[-1] + half_y), **style)
     else:
         image = ax.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(grid), cmap=colours, **style)
-    ax.set_xlabel(f"{_math(x)} (initial)")
-    ax.set_ylabel(f"{_math(y)} (initial)")
+    ax.set_xlabel(_axis_label(x))
+    ax.set_ylabel(_axis_label(y))
     if colorbar:
         ax.figure.colorbar(image, ax=ax).set_label(_value_label(value))
     return ax

@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """Checks what examples/dynamics/run_dynamics.sh produced in OUT_DIR (the examples test runs it with --small):
 
-  - dynamics_poincare and dynamics_chaos_map exist as PNG files of at least 150 dpi (their pHYs chunk) and 800
+  - dynamics_poincare, dynamics_chaos_map and dynamics_stability_map exist as PNG files of at least 150 dpi (their pHYs chunk) and 800
     pixels wide, and as PDF files;
   - the portrait's crossings lie on the section q1 = 0 (to 1e-12 relative) with H on the shell H = 7;
   - every starting point was put on the shell (H0 = 7), some were left out, and the chaos map has both regular
-    (<Y> within 10% of 2) and chaotic (<Y> > 4) orbits, as the picture claims.
+    (<Y> within 10% of 2) and chaotic (<Y> > 4) orbits, as the picture claims;
+  - the stability map swept every coupling of its job, put each coupling's starting points on H = 7 with that
+    coupling, and has regular and chaotic orbits; lyapunov.csv ends at each orbit's <Y> of trajectories.csv.
 
     /usr/bin/python3 tests/examples/check_dynamics_figures.py OUT_DIR
 """
@@ -37,7 +39,7 @@ def png_chunks(data):
 
 
 def check_pictures(out):
-    for name in ("dynamics_poincare", "dynamics_chaos_map"):
+    for name in ("dynamics_poincare", "dynamics_chaos_map", "dynamics_stability_map"):
         path = out / f"{name}.png"
         check(path.exists(), f"{path} was not produced")
         if path.exists():
@@ -60,7 +62,7 @@ def check_numbers(out):
         v = [float(r[k]) for k in ("q0", "q1", "p0", "p1")]
         check(abs(v[1]) <= 1e-12 * math.hypot(*v), f"crossing {r['trajectory']}/{r['crossing']} is off q1 = 0: {v[1]}")
         check(abs(float(r["H"]) / 7.0 - 1.0) < 1e-3, f"crossing {r['trajectory']}/{r['crossing']} has H = {r['H']}")
-    for folder in ("poincare_portrait", "chaos_map"):
+    for folder in ("poincare_portrait", "chaos_map", "stability_map"):
         summary = json.loads((out / folder / "summary.json").read_text())
         check(summary["status"] == "completed", f"{folder}: status {summary['status']}")
         check(summary["energy_shell"]["left_out"] > 0, f"{folder}: no starting point was left out")
@@ -69,6 +71,20 @@ def check_numbers(out):
     megno = [float(r["mean_megno"]) for r in rows(out / "chaos_map/trajectories.csv")]
     check(any(abs(y - 2.0) < 0.2 for y in megno), "the chaos map has no regular orbit (<Y> near 2)")
     check(any(y > 4.0 for y in megno), "the chaos map has no chaotic orbit (<Y> > 4)")
+    summary = json.loads((out / "stability_map/summary.json").read_text())
+    table = rows(out / "stability_map/trajectories.csv")
+    couplings = sorted({float(r["coupling"]) for r in table})
+    swept = summary["model"]["parameters"]["coupling"]
+    check(couplings == sorted(swept) and summary["sweep"]["parameter_sets"] == len(swept) > 1,
+          f"the stability map has trajectories of every swept coupling ({len(couplings)} of {len(swept)})")
+    megno = [float(r["mean_megno"]) for r in table]
+    check(any(abs(y - 2.0) < 0.2 for y in megno) and any(y > 4.0 for y in megno),
+          "the stability map has regular (<Y> near 2) and chaotic (<Y> > 4) orbits")
+    last = {}
+    for r in rows(out / "stability_map/lyapunov.csv"):
+        last[int(r["trajectory"])] = r["mean_megno"]
+    check(len(last) == len(table) and all(last[int(r["trajectory"])] == r["mean_megno"] for r in table),
+          "lyapunov.csv's last <Y> of every orbit is its <Y> in trajectories.csv")
 
 
 def main():

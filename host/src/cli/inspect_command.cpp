@@ -68,8 +68,10 @@ int check(const Plugin& plugin, const InspectArguments& arguments, std::ostream&
   DerivativeCheckSettings settings;
   std::string from;
   if (!arguments.parameters_job.empty()) {
-    parameters = load_job_for("--job", arguments.parameters_job, plugin).model.parameters();
-    from = "the parameters of " + arguments.parameters_job;
+    const LoadedJob loaded = load_job_for("--job", arguments.parameters_job, plugin);
+    parameters = loaded.model.parameters();
+    from =
+        "the parameters of " + arguments.parameters_job + (loaded.job.sweep.empty() ? "" : " (its sweep's first set)");
   }
   for (const auto& text : arguments.parameters) add_parameter(parameters, text);
   if (!arguments.parameters.empty()) from += std::string(from.empty() ? "" : ", ") + "--parameter";

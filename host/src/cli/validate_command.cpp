@@ -36,10 +36,11 @@ std::string sweep_text(const Job& job, bool loaded) {
   const std::size_t sets = job.parameter_sets();
   const std::size_t states =
       loaded ? (job.initial.count + (job.initial.shell ? job.initial.shell->left_out : 0)) / sets : job.initial.count;
-  text += ": " + std::to_string(sets) + " parameter sets x " + std::to_string(states) + " states = ";
-  if (loaded) return text + std::to_string(job.initial.count) + " trajectories\n";
-  return text + std::to_string(sets * states) + " trajectories" +
-         (job.initial.shell ? " before the energy shell leaves out those that cannot reach it" : "") + "\n";
+  text += ": " + std::to_string(sets) + " parameter sets x " + std::to_string(states) +
+          " states = " + std::to_string(sets * states) + " trajectories";
+  if (!job.initial.shell) return text + "\n";
+  if (!loaded) return text + ", less those the energy shell leaves out\n";
+  return text + ", " + std::to_string(job.initial.count) + " of them on the energy shell\n";
 }
 
 int command_validate(const std::string& job_file) {

@@ -56,6 +56,8 @@ const PluginParameter* find_parameter(Checker& check, const std::vector<PluginPa
 
 void check_parameter_value(Checker& check, const PluginParameter& parameter, const json& value, const std::string& path,
                            const std::string& found) {
+  const auto fault = sdk::parameter_fault(parameter.type, parameter.minimum, parameter.maximum, value);
+  if (fault == sdk::ParameterFault::none) return;
   std::string range;
   if (parameter.minimum) range += " >= " + format_number(*parameter.minimum);
   if (parameter.minimum && parameter.maximum) range += " and";
@@ -64,7 +66,7 @@ void check_parameter_value(Checker& check, const PluginParameter& parameter, con
   const std::string type_text = parameter.type == "boolean"   ? "true or false"
                                 : parameter.type == "integer" ? "an integer" + range
                                                               : "a finite number" + range;
-  switch (sdk::parameter_fault(parameter.type, parameter.minimum, parameter.maximum, value)) {
+  switch (fault) {
     case sdk::ParameterFault::none:
       break;
     case sdk::ParameterFault::wrong_type:

@@ -1,10 +1,13 @@
 // Parameter sweeps: /model/parameters/<name> given as several values (pass 2: read_swept_parameter,
 // check_sweep_size), their values against the plugin's metadata (pass 3: check_swept_parameters), and the run's
 // trajectories, the job's states once per parameter set, each set's on its own energy shell (make_trajectories).
+#include <algorithm>
+#include <cstdint>
 #include <utility>
 
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/sdk/parameters.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host {
@@ -61,7 +64,10 @@ void check_sweep_size(Checker& check, const Job& job) {
 
 std::size_t Job::parameter_sets() const {
   std::size_t sets = 1;
-  for (const SweptParameter& swept : sweep) sets *= swept.values.size();
+  for (const SweptParameter& swept : sweep) {
+    if (swept.values.size() > 0 && sets > SIZE_MAX / swept.values.size()) return SIZE_MAX;  // refused by the reader
+    sets *= swept.values.size();
+  }
   return sets;
 }
 
@@ -84,6 +90,9 @@ void check_swept_parameters(const Job& job, const std::vector<PluginParameter>& 
     if (!parameter) continue;
     for (std::size_t i = 0; i < swept.values.size(); ++i) {
       const nlohmann::json& value = swept.values[i];
+      if (sdk::parameter_fault(parameter->type, parameter->minimum, parameter->maximum, value) ==
+          sdk::ParameterFault::none)
+        continue;  // the texts below only for a fault: a sweep may have a million values
       if (swept.values_path.empty())
         job_reader::check_parameter_value(
             check, *parameter, value, path,
@@ -100,6 +109,10 @@ void make_trajectories(LoadedJob& loaded, std::vector<JobIssue>& issues) {
   InitialStates& initial = job.initial;
   const std::size_t sets = job.parameter_sets(), n = initial.dimension;
   if (!initial.shell && sets == 1) return;
+  // Too many trajectories: check_sweep_size reported it (this pass runs after a reader's issues too).
+  if (n == 0 || sets > max_initial_states / std::max<std::size_t>(1, initial.count) ||
+      sets * initial.count > max_initial_values / n)
+    return;
   if (initial.shell && !loaded.plugin.has_hessians()) {
     issues.push_back({"/initial/energy", "the plugin '" + loaded.plugin.name() + "', which has no Hessians",
                       "a plugin with Hessians (hessian_T and hessian_V): H needs them"});
