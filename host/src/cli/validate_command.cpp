@@ -4,6 +4,7 @@
 #include "cli/commands.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/study/scheme_choice.hpp"
 
 namespace nonsep::host::cli {
 namespace {
@@ -47,9 +48,11 @@ int command_validate(const std::string& job_file) {
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
               << "  parameters:  " << loaded.model.parameters().dump() << "\n"
-              << "  integrator:  " << spec.scheme << ", order " << spec.order.to_string()
-              << ", t2 = " << format_number(spec.t2) << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT")
-              << "\n"
+              << "  integrator:  "
+              << (run.auto_scheme
+                      ? describe_auto(loaded)
+                      : spec.scheme + ", order " + spec.order.to_string() + ", t2 = " + format_number(spec.t2))
+              << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT") << "\n"
               << "  initial:     " << job.initial.count << " state" << (job.initial.count == 1 ? "" : "s") << " ("
               << job.initial.shape << initial_shell_text(job.initial) << ")\n"
               << "  time:        " << time_text(run.time) << "\n"
