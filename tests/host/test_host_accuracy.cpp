@@ -204,9 +204,10 @@ TEST_CASE("the error estimate on paper2d: a regular orbit against Gauss 6 at a t
     const json initial = {{"q", {0.0, 0.0}}, {"p", {0.5, 2.0}}};
     const auto reference =
         end_of("reference", run_of(model, {{"scheme", "gauss"}, {"stages", 3}}, initial, 2.0 / 4096, 2.0, 0));
-    for (const json& integrator :
-         {json{{"scheme", "mpe"}, {"order", "4"}}, json{{"scheme", "triplet"}, {"order", "2"}}}) {
-      json job = run_of(model, integrator, initial, 2.0 / 256, 2.0, 0);
+    // Triplet 2's error constant is large here: at 2048 steps its error is 0.28, beyond the horizon.
+    for (const auto& [integrator, steps] : {std::pair{json{{"scheme", "mpe"}, {"order", "4"}}, 256},
+                                            std::pair{json{{"scheme", "triplet"}, {"order", "2"}}, 8192}}) {
+      json job = run_of(model, integrator, initial, 2.0 / steps, 2.0, 0);
       job["analysis"] = {{"error_estimate", true}};
       const auto row = end_of("regular-" + integrator["scheme"].get<std::string>(), job);
       const double actual = actual_against(row, reference);
@@ -217,9 +218,9 @@ TEST_CASE("the error estimate on paper2d: a regular orbit against Gauss 6 at a t
       CHECK(number(row, "estimated_phase_error") >= actual / 3);
     }
   }
-  SUBCASE("chaotic: q = (0.5, 0), p = (0, 2.5) to t = 200") {
+  SUBCASE("chaotic: q = (0.5, 0), p = (0, 2.5) to t = 40") {
     json job =
-        run_of(model, {{"scheme", "mpe"}, {"order", "4"}}, {{"q", {0.5, 0.0}}, {"p", {0.0, 2.5}}}, 0.02, 200.0, 0);
+        run_of(model, {{"scheme", "gauss"}, {"stages", 3}}, {{"q", {0.5, 0.0}}, {"p", {0.0, 2.5}}}, 0.01, 40.0, 0);
     job["analysis"] = {{"error_estimate", true}};
     const auto ran = run_job(folder, "chaotic", job);
     REQUIRE(ran.status == 0);
@@ -227,7 +228,7 @@ TEST_CASE("the error estimate on paper2d: a regular orbit against Gauss 6 at a t
     CHECK(row.at("error_estimate") == "separated");
     const double horizon = number(row, "error_estimate_horizon");
     CHECK(horizon > 0.0);
-    CHECK(horizon < 200.0);
+    CHECK(horizon < 40.0);
     const json summary = read_json(ran.folder / "summary.json");
     CHECK(summary["analysis"]["error_estimate"]["separated"] == 1);
     CHECK(summary["analysis"]["error_estimate"]["earliest_horizon"].get<double>() == horizon);
