@@ -6,11 +6,11 @@ Usage: /usr/bin/python3 -m nonsep.work_precision STUDY_DIR --out FILE.png [--tit
 Two panels: the error against the median wall time, and against the evaluations (grad_T + grad_V +
 grad_H per trajectory), log-log: the phase-space error at t_end, or with --error energy the largest relative
 energy error |dH/H0| over the run (column max_abs_relative_energy_error; a study written before that column
-existed gives the error at t_end, and the axis says so). Each curve is one integrator's Pareto front over its step counts: the smallest
-error reached at that cost or less. Failed or diverged runs are left out. --error relative-phase divides the phase-space error by the length
-|(q, p)_ref| of the study's reference state (summary.json study.reference), so that an accuracy means the same per
-degree of freedom whatever the dimension. With --peers, the rows of
-bench/peers' work_precision.csv for --problem (GSL rk2imp/rk4imp, Odeint dopri5/rk4; columns method, problem,
+existed gives the error at t_end, and the axis says so). Each curve is one integrator's Pareto front over its
+step counts: the smallest error reached at that cost or less. Failed or diverged runs are left out. --error
+relative-phase divides the phase-space error by the length |(q, p)_ref| of the study's reference state
+(summary.json study.reference), so that an accuracy means the same per degree of freedom whatever the dimension.
+With --peers, the rows of bench/peers' work_precision.csv for --problem (GSL rk2imp/rk4imp, Odeint dopri5/rk4; columns method, problem,
 wall_seconds_median, evaluations, energy_error, phase_error, status) join both panels as dashed fronts.
 Needs matplotlib (Debian's python3-matplotlib: /usr/bin/python3).
 """
