@@ -13,6 +13,9 @@ Files read (docs/outputs.md); each is optional except summary.json:
                      Result.crossings(i) (trajectory i's crossings in order): read on first use and kept
   lyapunov.csv       Result.lyapunov (the running Lyapunov, MEGNO, SALI and GALI estimates; None without the file) and
                      Result.lyapunov_series(i): read on first use and kept
+  error_estimate.csv Result.error_estimate (analysis.error_estimate: the estimated errors at every comparison step,
+                     rows in (step, trajectory) order; None without the file) and Result.error_estimates(i);
+                     trajectories.csv has each trajectory's last estimate and its horizon
   other *.csv        Result.dynamics[name] (poincare.csv and lyapunov.csv too, the same arrays): read by header on
                      first use, as tables.read_table types columns
   results.h5         also Result.dynamics["results.h5/<dataset path>"]: every dataset, read with h5py on first use
@@ -76,6 +79,17 @@ class LyapunovSeries(NamedTuple):
     mean_megno: object
     sali: object = None
     gali: object = None
+
+
+class ErrorEstimates(NamedTuple):
+    """The estimated global errors of one trajectory (error_estimate.csv), in step order: the Richardson estimates
+    of its phase-space error and relative energy error, and whether the run and its half-step twin had separated
+    there (then the estimate no longer holds)."""
+    step: np.ndarray
+    t: np.ndarray
+    phase_error: np.ndarray
+    relative_energy_error: np.ndarray
+    separated: np.ndarray
 
 
 class Result:
@@ -158,6 +172,19 @@ class Result:
         """Every row of lyapunov.csv as a structured array (trajectory, step, t, lyapunov0, ..., and megno,
         mean_megno, sali, gali2, ... when computed), in the file's order; None when the run wrote none (analysis.lyapunov.every 0)."""
         return self.dynamics.get("lyapunov")
+
+    @property
+    def error_estimate(self):
+        """Every row of error_estimate.csv as a structured array (trajectory, step, t, estimated_phase_error,
+        estimated_relative_energy_error, separated); None when the run wrote none (no analysis.error_estimate)."""
+        return self.dynamics.get("error_estimate")
+
+    def error_estimates(self, index):
+        """The error estimates of trajectory `index` as ErrorEstimates. Raises FileNotFoundError when the run wrote
+        no error_estimate.csv, KeyError for an index that is not a trajectory."""
+        rows = self._rows_of("error_estimate", index)
+        return ErrorEstimates(rows["step"], rows["t"], rows["estimated_phase_error"],
+                              rows["estimated_relative_energy_error"], rows["separated"])
 
     @property
     def section(self):

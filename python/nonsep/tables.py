@@ -4,8 +4,8 @@ Column types are decided by the column's name, never by its position, so that fi
 reordered columns load alike:
   - integers (int64): trajectory, step, steps, basic_steps, grad_T, grad_V, crossing, poincare_crossings (never
     empty in nonsep's files);
-  - text (fixed-width str): status, stop_variable, message, integrator, scheme, order;
-  - booleans: symplectic ("true" / "false");
+  - text (fixed-width str): status, stop_variable, message, integrator, scheme, order, error_estimate;
+  - booleans: symplectic, separated ("true" / "false"; an empty cell is false);
   - every other column is a float64 column, where an empty cell is NaN; a column of another name that holds
     something that is not a number (a file this module does not know) is read as text.
 Files are read by numpy's C reader (np.loadtxt, with RFC 4180 quotes), and numbers are converted by numpy, which
@@ -19,8 +19,8 @@ import numpy as np
 
 INTEGER_COLUMNS = frozenset({"trajectory", "step", "steps", "basic_steps", "grad_T", "grad_V", "crossing",
                              "poincare_crossings"})
-TEXT_COLUMNS = frozenset({"status", "stop_variable", "message", "integrator", "scheme", "order"})
-BOOLEAN_COLUMNS = frozenset({"symplectic"})
+TEXT_COLUMNS = frozenset({"status", "stop_variable", "message", "integrator", "scheme", "order", "error_estimate"})
+BOOLEAN_COLUMNS = frozenset({"symplectic", "separated"})
 
 
 def read_table(path):

@@ -3,12 +3,14 @@
 Usage: /usr/bin/python3 -m nonsep.work_precision STUDY_DIR --out FILE.png [--title TEXT]
            [--peers PEERS_CSV --problem NAME] [--error phase|energy|relative-phase] [--dpi N]
 
-Two panels: the error at t_end against the median wall time, and against the evaluations (grad_T + grad_V +
-grad_H per trajectory), log-log. Each curve is one integrator's Pareto front over its step counts: the smallest
-error reached at that cost or less. Failed or diverged runs are left out. --error relative-phase divides the phase-space error by the length
-|(q, p)_ref| of the study's reference state (summary.json study.reference), so that an accuracy means the same per
-degree of freedom whatever the dimension. With --peers, the rows of
-bench/peers' work_precision.csv for --problem (GSL rk2imp/rk4imp, Odeint dopri5/rk4; columns method, problem,
+Two panels: the error against the median wall time, and against the evaluations (grad_T + grad_V +
+grad_H per trajectory), log-log: the phase-space error at t_end, or with --error energy the largest relative
+energy error |dH/H0| over the run (column max_abs_relative_energy_error; a study written before that column
+existed gives the error at t_end, and the axis says so). Each curve is one integrator's Pareto front over its
+step counts: the smallest error reached at that cost or less. Failed or diverged runs are left out. --error
+relative-phase divides the phase-space error by the length |(q, p)_ref| of the study's reference state
+(summary.json study.reference), so that an accuracy means the same per degree of freedom whatever the dimension.
+With --peers, the rows of bench/peers' work_precision.csv for --problem (GSL rk2imp/rk4imp, Odeint dopri5/rk4; columns method, problem,
 wall_seconds_median, evaluations, energy_error, phase_error, status) join both panels as dashed fronts.
 Needs matplotlib (Debian's python3-matplotlib: /usr/bin/python3).
 """
@@ -84,6 +86,21 @@ def peer_curves(path, problem, error_column):
     return curves
 
 
+def energy_column(study_dir):
+    """The largest |dH/H0| over each run when the study has it, else the error at t_end."""
+    with open(os.path.join(study_dir, "work_precision.csv"), newline="") as f:
+        header = next(csv.reader(f), [])
+    return "max_abs_relative_energy_error" if "max_abs_relative_energy_error" in header else "relative_energy_error"
+
+
+def title(text, families):
+    """The figure's title and the line styles of the families it shows (peers only when there are some)."""
+    names = [(family, style) for family, style in (("chin", "solid: Chin"), ("comparator", "dash-dot: comparators"),
+                                                   ("peer", "dashed: peers")) if family in families]
+    legend = ", ".join(style for _, style in names)
+    return (text + " (" + legend + ")").strip() if legend else text
+
+
 STYLE = {"chin": "-", "comparator": "-.", "peer": "--"}
 MARKER = {"chin": "o", "comparator": "s", "peer": "^"}
 
@@ -98,7 +115,7 @@ def main():
     parser.add_argument("--error", choices=["phase", "energy", "relative-phase"], default="phase")
     parser.add_argument("--dpi", type=int, default=150)
     args = parser.parse_args()
-    column = "relative_energy_error" if args.error == "energy" else "phase_error"
+    column = energy_column(args.study_dir) if args.error == "energy" else "phase_error"
     scale = reference_length(args.study_dir) if args.error == "relative-phase" else 1.0
     curves = study_curves(os.path.join(args.study_dir, "work_precision.csv"), column, scale)
     if args.peers:
@@ -119,13 +136,15 @@ def main():
                         marker=MARKER.get(family, "x"), markersize=3, label=label,
                         color=colors[index_curve % len(colors)])
             axis.set_xlabel(name)
-    ylabel = {"phase": "phase-space error at t_end", "energy": "relative energy error at t_end",
+    ylabel = {"phase": "phase-space error at t_end",
+              "energy": ("largest |dH/H0| over the run" if column == "max_abs_relative_energy_error"
+                         else "relative energy error at t_end"),
               "relative-phase": "relative phase-space error at t_end"}[args.error]
     for axis in axes:
         axis.set_ylabel(ylabel)
         axis.grid(True, which="major", alpha=0.3)
     axes[1].legend(fontsize=7, ncol=2)
-    figure.suptitle(args.title + " (solid: Chin, dash-dot: comparators, dashed: peers)")
+    figure.suptitle(title(args.title, {family for family, _ in curves.values()}))
     figure.tight_layout()
     figure.savefig(args.out, dpi=args.dpi)
     print("wrote " + args.out)

@@ -123,7 +123,8 @@ TEST_CASE("a study's rows are the core's runs bit for bit, and its fit is the sl
   REQUIRE(run.rows.size() == 1 + 2 + 3);
   CHECK(run.rows[0] == std::vector<std::string>{"integrator", "scheme", "order", "t2", "symplectic", "dt", "steps",
                                                 "basic_steps", "grad_T", "grad_V", "relative_energy_error",
-                                                "phase_error", "status", "family", "grad_H"});
+                                                "phase_error", "status", "family", "grad_H",
+                                                "max_abs_relative_energy_error"});
   const PluginPaper1D model;
   nonsep::EnergyEvaluator energy(nonsep::HamiltonianForm::TTV);
   const double q0[] = {2.0}, p0[] = {0.0};

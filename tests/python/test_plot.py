@@ -98,6 +98,23 @@ class WorkPrecisionTest(FolderTestCase):
                                str(self.folder / "wp.png")], capture_output=True, text=True, env=os.environ)
         self.assertEqual(done.returncode, 0, done.stderr)
         self.assertGreater((self.folder / "wp.png").stat().st_size, 1000)
+        # --error energy plots the largest |dH/H0| over each run, which is at least its value at t_end.
+        table = str(self.folder / "study" / "work_precision.csv")
+        self.assertEqual(nonsep.work_precision.energy_column(str(self.folder / "study")),
+                         "max_abs_relative_energy_error")
+        largest = nonsep.work_precision.study_curves(table, "max_abs_relative_energy_error")
+        at_end = nonsep.work_precision.study_curves(table, "relative_energy_error")
+        for label in ("triplet 2", "gauss 4"):
+            for (_, _, m), (_, _, e) in zip(largest[label][1], at_end[label][1]):
+                self.assertGreaterEqual(m, e)
+
+    def test_the_title_names_only_the_families_it_shows(self):
+        title = nonsep.work_precision.title
+        self.assertEqual(title("paper1d", {"chin", "comparator"}),
+                         "paper1d (solid: Chin, dash-dot: comparators)")
+        self.assertNotIn("peers", title("paper1d", {"chin"}))
+        self.assertEqual(title("x", {"chin", "comparator", "peer"}),
+                         "x (solid: Chin, dash-dot: comparators, dashed: peers)")
 
     def test_the_relative_phase_error_is_the_phase_error_over_the_reference_length(self):
         job = {"model": {"plugin": "paper2d"}, "initial": {"q": [0.5, 0.2], "p": [0.3, -0.4]}, "time": {"t_end": 0.5},

@@ -22,6 +22,7 @@
 #include "nonsep/host/observers/progress_bar.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/study/convergence_study.hpp"
+#include "nonsep/host/study/scheme_choice.hpp"
 
 namespace nonsep::host::cli {
 
@@ -128,8 +129,8 @@ std::string four_digits(double x) {
 }
 
 // What makes a study's fit unreliable, with what to do: runs left out at the round-off floor, an energy error that
-// changes sign in the range, one that reaches round-off or flattens at the smallest dt. One sentence each; none for
-// a clean fit.
+// reaches round-off or flattens at the smallest dt, errors that rise as dt shrinks (a non-monotone ladder). One
+// sentence each; none for a clean fit.
 std::vector<std::string> fit_warnings(const StudyFit& fit) {
   std::vector<std::string> warnings;
   if (fit.points_at_round_off > 0)
@@ -152,14 +153,17 @@ std::vector<std::string> fit_warnings(const StudyFit& fit) {
     warnings.push_back(fit.integrator + ": the energy error reaches round-off: " + round_off +
                        (fit.dt_min ? " (dt_min = " + four_digits(*fit.dt_min) + ")" : std::string()) +
                        "; move its step range to larger dt (fewer steps) so that every point is above it");
-  if (fit.energy_error_changes_sign)
-    warnings.push_back(fit.integrator +
-                       ": the energy error changes sign within the fitted range, so the fit mixes a "
-                       "zero crossing into the power law; move its step range to where the error keeps one sign (" +
-                       (round_off.empty() ? std::string("smaller dt, more steps, when the larger dt are not yet "
-                                                        "asymptotic")
-                                          : std::string("larger dt, fewer steps, away from round-off")) +
-                       ")");
+  const auto rises = [&](const std::optional<NonMonotoneStep>& rise, const std::string& what) {
+    if (!rise) return;
+    warnings.push_back(fit.integrator + ": the " + what + " is not monotone in dt: " + four_digits(rise->error_fine) +
+                       " at " + std::to_string(rise->steps_fine) + " steps against " + four_digits(rise->error_coarse) +
+                       " at " + std::to_string(rise->steps_coarse) +
+                       " (a larger dt), so no power law describes the ladder and the fitted exponent is not the "
+                       "order: the larger dt are pre-asymptotic, or the error oscillates with dt; move its step "
+                       "range to smaller dt (more steps), where the error falls at every halving");
+  };
+  rises(fit.energy_error_rises, "largest |dH/H0| over the run");
+  rises(fit.phase_error_rises, "phase error at t_end");
   return warnings;
 }
 
@@ -289,12 +293,41 @@ int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& ar
                 << (arguments.output.empty() ? "" : " --output " + arguments.output)
                 << " --resume` continues from there\n";
   }
-  for (const std::string& note : outcome.notes) std::cerr << "nonsep: note: " << note << "\n";
+  for (const std::string& note : outcome.notes)
+    std::cerr << "nonsep: " << (note.starts_with("warning: ") ? "" : "note: ") << note << "\n";
   report_trajectories(outcome, directory);
   if (const std::size_t stopped = c.diverged + c.failed + c.inaccurate; outcome.distributed && stopped > 0)
     std::cerr << "nonsep: " << stopped << " trajectories stopped early; " << (directory / "trajectories.csv").string()
               << " says where and why\n";
   return to_int(outcome.exit_status);
+}
+
+// Scheme "auto": runs the pilots, puts the choice into the job and `options` and says what was chosen. False, after
+// saying why on stderr, when no scheme could be chosen (or the pilots were interrupted).
+bool choose(LoadedJob& loaded, RunOptions& options, const RunArguments& arguments) {
+  if (options.resume) {
+    std::cerr << "nonsep: cannot resume " << arguments.job_file
+              << ": scheme \"auto\" chooses from timed pilot runs, which a resumed run would repeat and might answer "
+                 "differently; write the chosen integrator (summary.json scheme_choice.chosen, integrator) into the "
+                 "job to resume it\n";
+    return false;
+  }
+  try {
+    const SchemeChoice choice = choose_scheme(loaded, options);
+    apply_choice(loaded.job, choice);
+    options.scheme_choice = to_json(choice);
+    if (!arguments.quiet) {
+      const PilotResult& chosen = choice.pilots[choice.chosen];
+      std::cout << "auto: " << chosen.candidate.label << " with dt = " << format_number(loaded.job.run().time.dt)
+                << " (" << loaded.job.run().time.steps << " steps), predicted error "
+                << format_number(chosen.predicted_error) << " for tolerance " << format_number(choice.tolerance)
+                << "; pilots " << format_number(choice.pilot_seconds) << " s\n";
+    }
+    return true;
+  } catch (const ChoiceFailed& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+    return false;
+  }
 }
 
 }  // namespace
@@ -340,6 +373,13 @@ int command_run(const RunArguments& arguments) {
   // Work units over the ranks: a fresh run on several ranks, or the resume of such a run on any number.
   const bool plain_checkpoint = arguments.resume && !has_units(options.output_directory);
   if (!loaded->job.is_study() && (arguments.resume ? !plain_checkpoint : ranks->size() > 1)) {
+    if (loaded->job.run().analysis.error_estimate || loaded->job.run().auto_scheme) {
+      std::cerr << "nonsep: " << arguments.job_file << ": "
+                << (loaded->job.run().auto_scheme ? "scheme \"auto\" (its pilots)"
+                                                  : "/analysis/error_estimate (its half-step run)")
+                << " runs in one process, not split over ranks or resumed from work units; run it without mpirun\n";
+      return to_int(ExitStatus::invalid_input);
+    }
     try {
       auto outcome = run_guarded([&] { return run_distributed(*loaded, options, *ranks); });
       return outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
@@ -362,6 +402,7 @@ int command_run(const RunArguments& arguments) {
       status = outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
                        : to_int(ExitStatus::invalid_input);
     } else {
+      if (loaded->job.run().auto_scheme && !choose(*loaded, options, arguments)) return to_int(ExitStatus::run_failed);
       auto outcome = run_guarded([&] { return run_job(*loaded, options); });
       status = outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
                        : to_int(ExitStatus::invalid_input);

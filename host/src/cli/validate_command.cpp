@@ -4,6 +4,7 @@
 #include "cli/commands.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/study/scheme_choice.hpp"
 
 namespace nonsep::host::cli {
 namespace {
@@ -70,9 +71,11 @@ int command_validate(const std::string& job_file) {
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
               << "  parameters:  " << parameters_text(loaded) << "\n"
-              << "  integrator:  " << spec.scheme << ", order " << spec.order.to_string()
-              << ", t2 = " << format_number(spec.t2) << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT")
-              << "\n"
+              << "  integrator:  "
+              << (run.auto_scheme
+                      ? describe_auto(loaded)
+                      : spec.scheme + ", order " + spec.order.to_string() + ", t2 = " + format_number(spec.t2))
+              << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT") << "\n"
               << "  initial:     " << job.initial.count
               << (job.sweep.empty() ? (job.initial.count == 1 ? " state" : " states")
                                     : (job.initial.count == 1 ? " trajectory" : " trajectories"))

@@ -6,7 +6,9 @@
 #include <stdexcept>
 #include <variant>
 
+#include "job_keys.hpp"
 #include "nonsep/core/error.hpp"
+#include "nonsep/host/number_format.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -113,15 +115,41 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
   return spec;
 }
 
-IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form) {
-  const json* integrator =
-      check.member(document, "", "integrator", true, "an object with \"scheme\" (" + scheme_names() + ") and options");
-  if (!integrator || !check.object(*integrator, "/integrator", "an object with \"scheme\" and the scheme's options")) {
-    IntegratorSpec spec;
-    spec.form = form;
+IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form,
+                               std::optional<AutoScheme>& auto_scheme) {
+  const json* integrator = check.member(document, "", "integrator", true,
+                                        "an object with \"scheme\" (" + scheme_names() + " or \"auto\") and options");
+  IntegratorSpec spec;
+  spec.form = form;
+  if (!integrator || !check.object(*integrator, "/integrator", "an object with \"scheme\" and the scheme's options"))
     return spec;
+  if (!integrator->contains("scheme") || (*integrator)["scheme"] != "auto")
+    return read_integrator_object(check, *integrator, "/integrator", form);
+  const KeyTable& keys = auto_integrator_keys();
+  std::vector<std::string> names{"scheme"};
+  for (const auto& name : keys.names()) names.push_back(name);
+  check.known_keys(*integrator, "/integrator", names);
+  AutoScheme chosen;
+  const std::string range = "a number from " + format_number(auto_tolerance_min) + " to " +
+                            format_number(auto_tolerance_max) + ": " + keys["tolerance"].description;
+  if (const json* value = check.member(*integrator, "/integrator", "tolerance", true, range))
+    if (const auto x = check.finite_number(*value, "/integrator/tolerance", range)) {
+      if (*x < auto_tolerance_min || *x > auto_tolerance_max)
+        check.issue("/integrator/tolerance", describe(*value), range);
+      else
+        chosen.tolerance = *x;
+    }
+  if (const json* value = check.member(*integrator, "/integrator", "measure", false, "")) {
+    if (*value == "energy")
+      chosen.measure = AutoScheme::Measure::energy;
+    else if (*value != "phase")
+      check.issue("/integrator/measure", describe(*value),
+                  "\"phase\" (the phase-space error at t_end, the default) or \"energy\" (the largest |dH/H0|)");
   }
-  return read_integrator_object(check, *integrator, "/integrator", form);
+  auto_scheme = chosen;
+  spec.scheme = "triplet";  // a valid spec until the choice replaces it
+  spec.order = Fraction(4, 3);
+  return spec;
 }
 
 }  // namespace nonsep::host::job_reader

@@ -81,6 +81,8 @@ const KeyTable& poincare_keys();  // /analysis/poincare
 const KeyTable& lyapunov_keys();  // /analysis/lyapunov
 const KeyTable& checkpoint_keys();
 const KeyTable& study_keys();  // at most one of "steps", "dt"
+// /integrator {"scheme": "auto", ...}: the keys besides "scheme" (study/scheme_choice.hpp).
+const KeyTable& auto_integrator_keys();
 // The keys a study's integrator has besides the scheme's options (at most one of "steps", "dt").
 const KeyTable& study_integrator_keys();
 // /initial and the states of /study/reference.

@@ -51,6 +51,35 @@ const KeyTable& analysis_keys() {
                       "by the unit vectors of the first j tangent vectors: trajectories.csv columns gali2 .. gali<k> "
                       "(exponential decay on chaotic orbits; constant for j <= N, ~ t^(-2(j-N)) on an N-torus). Shares "
                       "the vectors of lyapunov. The plugin must have Hessians."},
+      {.name = "error_estimate",
+       .type = ValueType::boolean,
+       .default_value = false,
+       .description = "Integrates every trajectory a second time with half the step and estimates the run's global "
+                      "error by Richardson extrapolation with the scheme's order, at the samples (or 100 evenly "
+                      "spaced steps without samples) and at the end: error_estimate.csv, trajectories.csv columns "
+                      "estimated_phase_error, estimated_relative_energy_error, error_estimate_t, "
+                      "error_estimate_horizon, error_estimate. Where the two runs separate (their difference above "
+                      "0.1 of |(q, p)|: a chaotic orbit) the estimate ends: error_estimate_horizon is that time. "
+                      "Costs twice the run."},
+  }};
+  return table;
+}
+
+const KeyTable& auto_integrator_keys() {
+  static const KeyTable table{{
+      {.name = "tolerance",
+       .type = ValueType::positive,
+       .required = true,
+       .description = "The accuracy asked for: the global error at the end of the run (phase), or the largest "
+                      "relative energy error |dH/H0| over the run (energy), between 1e-14 and 0.1. Pilot runs on "
+                      "the job's own model and states choose the scheme and the step that meet it at the least "
+                      "predicted cost; time.dt is then the output grid, which the chosen step divides."},
+      {.name = "measure",
+       .type = ValueType::choice,
+       .default_value = "phase",
+       .description = "\"phase\": the phase-space error |(q, p) - (q, p)_exact| at t_end; \"energy\": the largest "
+                      "|dH/H0| over the run (needs the plugin's Hessians).",
+       .choices = {"phase", "energy"}},
   }};
   return table;
 }

@@ -145,6 +145,21 @@ schema_json integrator_schema(const KeyTable* extra, const std::string& descript
     if (!required.empty()) then["required"] = std::move(required);
     branches.push_back({{"if", {{"properties", {{"scheme", {{"const", scheme.name}}}}}}}, {"then", std::move(then)}});
   }
+  if (!extra) {  // a run's integrator may also be chosen: {"scheme": "auto", ...}
+    names.push_back("auto");
+    schema_json properties = {{"scheme", true}};
+    for (const auto& rule : auto_integrator_keys().rules) properties[rule.name] = value_schema(rule);
+    branches.push_back(
+        {{"if", {{"properties", {{"scheme", {{"const", "auto"}}}}}}},
+         {"then",
+          {{"description",
+            "A scheme and step chosen by pilot runs for the accuracy asked for (docs/user-guide.md, \"Scheme "
+            "auto\"): among the schemes the plugin allows, the one that meets the tolerance at the least "
+            "predicted cost."},
+           {"properties", std::move(properties)},
+           {"additionalProperties", false},
+           {"required", auto_integrator_keys().required()}}}});
+  }
   schema_json schema = {{"type", "object"}, {"description", description}, {"required", {"scheme"}}};
   schema["properties"] = {
       {"scheme",

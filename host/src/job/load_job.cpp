@@ -5,6 +5,7 @@
 
 #include "checker.hpp"
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/core/tangent_integrator.hpp"
 #include "nonsep/host/formula/plugin_cache.hpp"
 
 namespace nonsep::host {
@@ -127,6 +128,21 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
                         "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
                         "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them "
                         "by automatic differentiation)"});
+  // /analysis/error_estimate keeps the half-step run's states at every comparison (observers/error_estimate.hpp).
+  if (!checked.is_study() && checked.run().analysis.error_estimate) {
+    const SingleRun& run = checked.run();
+    const double points = run.every > 0 ? static_cast<double>(run.time.steps / run.every + 1) : 101.0;
+    const double bytes = points * static_cast<double>(checked.initial.count) *
+                         static_cast<double>(2 * loaded.model.dimension() + 2) * sizeof(double);
+    if (bytes > 1073741824.0)
+      issues.push_back({"/analysis/error_estimate",
+                        "true with " + std::to_string(checked.initial.count) + " trajectories and " +
+                            std::to_string(static_cast<std::uint64_t>(points)) +
+                            " comparison steps, whose half-step states would take " +
+                            gibibytes(static_cast<std::size_t>(bytes)) + " GiB",
+                        "a run whose trajectories x samples x (2n + 2) doubles fit in 1 GiB: a larger output.every "
+                        "(fewer samples) or fewer trajectories"});
+  }
   // Comparators integrate H from its gradient: Hessians and third derivatives of the plugin (ABI 3).
   const bool has_gradient_of_h = loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives();
   const auto check_comparator = [&](const IntegratorSpec& spec, const std::string& path) {
@@ -145,8 +161,14 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
     if (const auto& reference = checked.study().reference_run)
       check_comparator(reference->spec, "/study/reference_run/scheme");
   } else {
-    check_comparator(checked.run().integrator, "/integrator/scheme");
-    if (checked.run().analysis.tangent_vectors() > 0 && Integrator(checked.run().integrator).is_comparator())
+    if (!checked.run().auto_scheme) check_comparator(checked.run().integrator, "/integrator/scheme");
+    if (checked.run().auto_scheme && checked.run().auto_scheme->measure == AutoScheme::Measure::energy &&
+        !loaded.plugin.has_hessians())
+      issues.push_back({"/integrator/measure",
+                        "\"energy\" with the plugin '" + loaded.plugin.name() + "', which has no Hessians",
+                        "\"phase\": the energy H = T_i V_ij T_j needs the Hessians (hessian_T, hessian_V)"});
+    if (checked.run().analysis.tangent_vectors() > 0 && !checked.run().auto_scheme &&
+        !has_tangent_map(checked.run().integrator))
       issues.push_back({checked.run().analysis.tangent_key(),
                         "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme + "\"",
                         "a Chin scheme (basic, triplet, mpe): the comparators have no tangent map"});

@@ -59,7 +59,7 @@ Analysis read_analysis(Checker& check, const json& value, std::size_t dimension)
   const std::string path = "/analysis";
   if (!check.object(value, path,
                     "an object {\"closest_return_after\": t, \"max_relative_energy_error\": e, \"poincare\": {...}, "
-                    "\"lyapunov\": {...}, \"megno\": true, \"sali\": true, \"gali\": k}"))
+                    "\"lyapunov\": {...}, \"megno\": true, \"sali\": true, \"gali\": k, \"error_estimate\": true}"))
     return analysis;
   check.known_keys(value, path, analysis_keys().names());
   read_dynamics(check, value, dimension, analysis);
@@ -72,6 +72,13 @@ Analysis read_analysis(Checker& check, const json& value, std::size_t dimension)
         check.positive_number(*bound, child(path, "max_relative_energy_error"),
                               "a finite number > 0: a trajectory whose |H - H0| / |H0| exceeds it stops with status "
                               "\"inaccurate\"");
+  if (const json* estimate = check.member(value, path, "error_estimate", false, "")) {
+    if (estimate->is_boolean())
+      analysis.error_estimate = estimate->get<bool>();
+    else
+      check.issue(child(path, "error_estimate"), describe(*estimate),
+                  "true or false: estimate each trajectory's global error by a second run with half the step");
+  }
   return analysis;
 }
 

@@ -45,7 +45,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
                   std::to_string(job.initial.dimension) + ", as many as the initial state has");
   } else {
     SingleRun& run = job.plan.emplace<SingleRun>();
-    run.integrator = read_integrator(check, document, form);
+    run.integrator = read_integrator(check, document, form, run.auto_scheme);
     run.time = read_time(check, document);
     if (const json* analysis = check.member(document, "", "analysis", false, ""))
       run.analysis = read_analysis(check, *analysis, job.initial.dimension);

@@ -32,7 +32,9 @@ void check_sweep_size(Checker& check, const Job& job);
 // /hamiltonian and /integrator (integrator.cpp). read_integrator_object reads one integrator object at `path`
 // (a run's /integrator or a study's /study/integrators/<i>); `extra_keys` are keys its caller reads itself.
 HamiltonianForm read_hamiltonian(Checker& check, const json& document);
-IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form);
+// /integrator of a run; with "scheme": "auto", also its tolerance and measure into `auto_scheme`.
+IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form,
+                               std::optional<AutoScheme>& auto_scheme);
 IntegratorSpec read_integrator_object(Checker& check, const json& integrator, const std::string& path,
                                       HamiltonianForm form, const std::vector<std::string>& extra_keys = {});
 

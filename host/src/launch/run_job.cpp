@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "launch/run_plan.hpp"
+#include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "output/run_summary.hpp"
@@ -74,6 +75,57 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
   return facts;
 }
 
+nlohmann::ordered_json error_estimate_facts(const ErrorEstimateObserver& estimate, double order) {
+  const auto totals = estimate.totals();
+  const auto number = [](const std::optional<double>& x) { return x ? nlohmann::ordered_json(*x) : nullptr; };
+  nlohmann::ordered_json stopped = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < estimate.fine().trajectories(); ++i)
+    if (!estimate.fine().stopped(i).empty())
+      stopped.push_back({{"trajectory", i}, {"finer_run", estimate.fine().stopped(i)}});
+  return {{"method",
+           "a second run with half the step; Richardson extrapolation: error = |(q, p)_dt - (q, p)_dt/2| / (1 - "
+           "2^-order)"},
+          {"order", order},
+          {"factor", richardson_factor(order)},
+          {"file", ErrorEstimateObserver::file_name},
+          {"separation", "|estimated error| > " + format_number(error_estimate_separation) +
+                             " max(|(q, p)(t)|, |(q, p)(0)|): the estimate holds only before that time"},
+          {"largest_estimated_phase_error", number(totals.largest_phase_error)},
+          {"largest_estimated_relative_energy_error", number(totals.largest_energy_error)},
+          {"separated", totals.separated},
+          {"earliest_horizon", number(totals.earliest_horizon)},
+          {"unavailable", totals.unavailable},
+          {"finer_run_stopped", std::move(stopped)}};
+}
+
+// Scheme "auto": the choice, and what the run itself shows against the tolerance: the largest |dH/H0| where it
+// evaluated H (measure "energy"), the largest estimated phase error of /analysis/error_estimate (measure "phase",
+// when asked for); without them the pilots' prediction alone. A note for the user when it is not met.
+nlohmann::ordered_json checked_choice(nlohmann::ordered_json choice, const RunOutcome& outcome,
+                                      const ErrorEstimateObserver* estimate, std::vector<std::string>& notes) {
+  const double tolerance = choice["tolerance"].get<double>();
+  const bool energy = choice["measure"] == "energy";
+  std::optional<double> measured;
+  std::string how = "the pilots' prediction";
+  if (energy && outcome.largest_energy_error) {
+    measured = outcome.largest_energy_error->value;
+    how = "the run's largest |dH/H0| where it evaluated H";
+  } else if (!energy && estimate) {
+    measured = estimate->totals().largest_phase_error;
+    how = "the run's error estimate (analysis.error_estimate)";
+  }
+  const double predicted = choice["estimated_error"].get<double>();
+  const double judged = measured ? std::max(*measured, predicted) : predicted;
+  choice["measured_error"] = measured ? nlohmann::ordered_json(*measured) : nullptr;
+  choice["measured_by"] = measured ? how : "nothing (the pilots' prediction alone)";
+  choice["tolerance_met"] = judged <= tolerance;
+  if (!(judged <= tolerance))
+    notes.push_back("warning: scheme auto did not meet the tolerance " + format_number(tolerance) + ": " +
+                    (measured ? how + " is " + format_number(*measured) + ", the prediction " : "the prediction is ") +
+                    format_number(predicted));
+  return choice;
+}
+
 }  // namespace
 
 TrajectoryStatus run_status(DriverEnd end, const StatusCounts& counts) {
@@ -118,6 +170,9 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   if (!loaded.plugin.thread_safe() && options.threads != 1)
     outcome.notes.push_back("ran on one thread: the plugin '" + loaded.plugin.name() +
                             "' declares \"thread_safe\": false (plugin_abi.h)");
+  nlohmann::ordered_json choice;
+  if (!options.scheme_choice.is_null())
+    choice = checked_choice(options.scheme_choice, outcome, plan.estimate ? &*plan.estimate : nullptr, outcome.notes);
   const RunFacts facts{loaded,
                        directory,
                        driver,
@@ -127,6 +182,10 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   outcome.summary = run_summary(facts);
   if (plan.poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *plan.poincare);
   if (plan.chaos) outcome.summary["analysis"]["tangent_map"] = tangent_facts(run.analysis);
+  if (!choice.is_null()) outcome.summary["scheme_choice"] = std::move(choice);
+  if (plan.estimate)
+    outcome.summary["analysis"]["error_estimate"] =
+        error_estimate_facts(*plan.estimate, Integrator(run.integrator).describe().order.value());
   if (const auto& shell = job.initial.shell)
     outcome.summary["energy_shell"] = {{"energy", shell->energy},
                                        {"solve_for", shell->solve_for},
@@ -144,6 +203,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
     if (plan.closest) columns.push_back(&*plan.closest);
     if (plan.poincare) columns.push_back(&*plan.poincare);
     if (plan.chaos) columns.push_back(&*plan.chaos);
+    if (plan.estimate) columns.push_back(&*plan.estimate);
     write_trajectories_csv(directory / trajectories_file_name, facts, columns);
   } catch (const OutputError& error) {
     fail(error);

@@ -39,6 +39,23 @@ EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
           run.analysis.alignment_indices()};
 }
 
+// /analysis/error_estimate's second run: every trajectory with half the step (2N steps), recorded at the steps that
+// the run compares (error_estimate.hpp). Throws std::runtime_error when it fails as a whole.
+FineRun run_finer(const LoadedJob& loaded, const RunOptions& options) {
+  const SingleRun& run = loaded.job.run();
+  const TimeGrid& time = run.time;
+  EnsembleSetup setup = driver_setup(loaded, options);
+  setup.time = time.from_t_end ? TimeGrid::to_end(time.t_end, time.dt_requested / 2, 2 * time.steps)
+                               : TimeGrid::of_steps(2 * time.steps, time.dt / 2);
+  setup.tangent_vectors = 0;
+  FineRun fine(loaded.job.initial.count, loaded.job.initial.dimension, error_estimate_steps(time.steps, run.every));
+  EnsembleDriver driver(loaded.plugin, loaded.model, setup);
+  driver.add_observer(fine);
+  if (driver.run() == DriverEnd::failed)
+    throw std::runtime_error("the error estimate's run with half the step failed: " + driver.error());
+  return fine;
+}
+
 std::optional<Checkpoint> resumed_state(const LoadedJob& loaded, const RunOptions& options) {
   if (!options.resume) return std::nullopt;
   return load_checkpoint(options.output_directory / checkpoint_file_name, loaded);
@@ -82,6 +99,11 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
     chaos.emplace(directory / LyapunovMegnoObserver::file_name, run.analysis, driver.records(), options.resume);
   if (!chaos || !run.analysis.lyapunov || run.analysis.lyapunov->every == 0)
     remove_stale(directory / LyapunovMegnoObserver::file_name);
+  if (run.analysis.error_estimate)
+    estimate.emplace(directory / ErrorEstimateObserver::file_name, run_finer(loaded, options),
+                     Integrator(run.integrator).describe().order.value(), job.initial.dimension, options.resume);
+  else
+    remove_stale(directory / ErrorEstimateObserver::file_name);
   observers.push_back(&energy);
   if (chaos) observers.push_back(&*chaos);
   if (closest) observers.push_back(&*closest);
@@ -90,6 +112,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (hdf5_samples) observers.push_back(&*hdf5_samples);
 #endif
   if (poincare) observers.push_back(&*poincare);
+  if (estimate) observers.push_back(&*estimate);
   saver.emplace(directory / checkpoint_file_name, job_fingerprint(loaded), stepping_identity(loaded), run.checkpoint,
                 driver, observers);
   progress.emplace(options.show_progress, driver, &energy);

@@ -1,7 +1,8 @@
 #pragma once
 // A loaded job made ready to run, built once and in the order its data flows: the output folder (taken,
 // run_folder.hpp), the state a resumed run continues from (checkpoint.json, read here and nowhere else:
-// checkpoint_file.hpp), the driver, the observers the job asks for (their files opened; earlier runs' files this run
+// checkpoint_file.hpp), the driver, the finer run of /analysis/error_estimate (run here, before the run), the
+// observers the job asks for (their files opened; earlier runs' files this run
 // does not write removed), the resumed state handed to the driver and to each observer, then the checkpoint saver (the
 // one writer of checkpoint.json: checkpoint_saver.hpp) and the progress bar. run_job (run_job.hpp) runs the driver and
 // writes the run's files from what the plan's observers hold. Internal to src/launch/.
@@ -15,6 +16,7 @@
 #include "nonsep/host/launch/run_job.hpp"
 #include "nonsep/host/observers/closest_return.hpp"
 #include "nonsep/host/observers/energy_error.hpp"
+#include "nonsep/host/observers/error_estimate.hpp"
 #include "nonsep/host/observers/lyapunov_megno.hpp"
 #include "nonsep/host/observers/poincare_section.hpp"
 #include "nonsep/host/observers/progress.hpp"
@@ -51,6 +53,7 @@ class RunPlan {
 #endif
   std::optional<PoincareSectionObserver> poincare;
   std::optional<LyapunovMegnoObserver> chaos;
+  std::optional<ErrorEstimateObserver> estimate;  // /analysis/error_estimate: its finer run is done by the plan
   // The observers above that the driver tells, in the order it tells them; the saver and the progress bar follow.
   std::vector<Observer*> observers;
   std::optional<CheckpointSaver> saver;

@@ -12,6 +12,7 @@
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/observers/energy_error.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/output/run_folder.hpp"
@@ -40,10 +41,11 @@ class StudyExecution {
         energy_available_(loaded.plugin.has_hessians()),
         csv_(options.output_directory / "convergence.csv",
              "integrator,scheme,order,t2,symplectic,dt,steps,basic_steps,grad_T,grad_V,relative_energy_error,"
-             "phase_error,status,family,grad_H"),
+             "phase_error,status,family,grad_H,max_abs_relative_energy_error"),
         work_precision_csv_(options.output_directory / "work_precision.csv",
                             "integrator,scheme,family,options,order,symplectic,dt,steps,evaluations,grad_T,grad_V,"
-                            "grad_H,wall_seconds,repeats,relative_energy_error,phase_error,status") {}
+                            "grad_H,wall_seconds,repeats,relative_energy_error,phase_error,status,"
+                            "max_abs_relative_energy_error") {}
   StudyExecution(const StudyExecution&) = delete;
   StudyExecution& operator=(const StudyExecution&) = delete;
 
@@ -78,7 +80,7 @@ class StudyExecution {
       for (const auto& run : list) ++outcome.run_counts[run.status];
     for (std::size_t i = 0; i < runs_.size(); ++i)
       outcome.fits.push_back(fit_study(study_.integrators[i], Integrator(study_.integrators[i].spec).describe(),
-                                       runs_[i], !reference_q_.empty()));
+                                       runs_[i], !reference_q_.empty(), reference_length()));
     outcome.runs = std::move(runs_);
     outcome.summary = summary(outcome, std::chrono::duration<double>(Clock::now() - start).count());
     try {
@@ -113,27 +115,31 @@ class StudyExecution {
     const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
     run.dt = time.dt;
     run.basic_steps = steps * Integrator(study_integrator.spec).describe().basic_steps_per_step;
-    // Each repeat is a fresh driver doing the same work; the first one's results are kept, the others only timed.
+    // The timed runs (study.repeats of them) evaluate H only at step 0 and the last step, as a plain run does; one
+    // more run, not timed, evaluates it at every step for the largest |dH/H0| over the run (a symplectic scheme's
+    // energy error oscillates, so its value at t_end may be far below the maximum). Its numbers are those of the
+    // timed runs bit for bit: the energy observer does not change the steps.
+    const EnsembleSetup setup{study_integrator.spec, time, job_.initial.dimension, job_.initial.q,
+                              job_.initial.p,        1,    options_.stop_requested};
     std::vector<double> seconds;
-    for (int r = 1; r < study_.repeats && !interrupted_; ++r) {
-      EnsembleDriver repeat(loaded_.plugin, loaded_.model,
-                            {study_integrator.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
-                             options_.stop_requested});
+    for (int r = 0; r < study_.repeats && !interrupted_; ++r) {
+      EnsembleDriver timed(loaded_.plugin, loaded_.model, setup);
       const auto start = Clock::now();
-      if (repeat.run() != DriverEnd::completed) break;
+      if (timed.run() != DriverEnd::completed) break;
       seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+      run.evaluations = timed.evaluations();
     }
-    EnsembleDriver driver(loaded_.plugin, loaded_.model,
-                          {study_integrator.spec, time, job_.initial.dimension, job_.initial.q, job_.initial.p, 1,
-                           options_.stop_requested});
-    const auto start = Clock::now();
+    EnsembleDriver driver(loaded_.plugin, loaded_.model, setup);
+    EnergyErrorObserver energy_every_step(1, 1, std::nullopt);
+    if (energy_available_) driver.add_observer(energy_every_step);
     const DriverEnd end = driver.run();
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    if (seconds.empty()) seconds.push_back(std::nan(""));
     std::sort(seconds.begin(), seconds.end());
     const std::size_t middle = seconds.size() / 2;
     run.wall_seconds = seconds.size() % 2 ? seconds[middle] : (seconds[middle - 1] + seconds[middle]) / 2.0;
     run.repeats = static_cast<int>(seconds.size());
-    run.evaluations = driver.evaluations();
+    if (run.evaluations.grad_T + run.evaluations.grad_V + run.evaluations.grad_H == 0)
+      run.evaluations = driver.evaluations();
     const TrajectoryRecord& record = driver.records().front();
     if (!energy_initial_) energy_initial_ = record.energy_initial;
     if (end == DriverEnd::failed) throw std::runtime_error(driver.error());
@@ -145,6 +151,7 @@ class StudyExecution {
       run.error = record.message;
     if (record.status != TrajectoryStatus::completed) return run;
     run.relative_energy_error = relative_energy_error(record.energy_final, record.energy_initial);
+    run.max_abs_relative_energy_error = energy_every_step.max_abs(0);
     if (!reference_q_.empty()) {
       double sum = 0.0;
       for (std::size_t i = 0; i < record.final_q.size(); ++i) {
@@ -172,6 +179,7 @@ class StudyExecution {
     row += ",";
     row += to_string(run.status);
     row += "," + description.family + "," + std::to_string(run.evaluations.grad_H);
+    append_csv_number(row.append(","), run.max_abs_relative_energy_error);
     csv_.end_row();
     write_work_precision_row(integrator, description, run);
   }
@@ -199,6 +207,7 @@ class StudyExecution {
     if (run.phase_error) append_number(row, *run.phase_error);
     row += ",";
     row += to_string(run.status);
+    append_csv_number(row.append(","), run.max_abs_relative_energy_error);
     work_precision_csv_.end_row();
   }
 
@@ -216,6 +225,14 @@ class StudyExecution {
       text += (text.empty() ? "" : " ") + parameter.name + "=" + value;
     }
     return text;
+  }
+
+  // |(q, p)_ref|, at least 1: the scale of the phase errors.
+  double reference_length() const {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < reference_q_.size(); ++i)
+      sum += reference_q_[i] * reference_q_[i] + reference_p_[i] * reference_p_[i];
+    return std::max(1.0, std::sqrt(sum));
   }
 
   TrajectoryStatus status() const {

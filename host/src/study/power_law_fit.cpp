@@ -1,5 +1,5 @@
-// The fits of a convergence study (convergence_study.hpp): a power law through each integrator's errors at t_end, and
-// the fit as summary.json's "fits" entry.
+// The fits of a convergence study (convergence_study.hpp): a power law through each integrator's largest energy errors
+// over the run and its phase errors at t_end, and the fit as summary.json's "fits" entry.
 #include <algorithm>
 #include <cmath>
 
@@ -57,6 +57,28 @@ json or_null(const std::optional<T>& value) {
 
 bool usable_error(double e) { return std::isfinite(e) && e != 0.0; }
 
+// The first place where |error| grows as dt shrinks (errors in order of decreasing |dt|), over the usable ones at
+// or above `floor` (below it round-off, not the method, moves them).
+std::optional<NonMonotoneStep> first_rise(const std::vector<std::uint64_t>& steps, const std::vector<double>& error,
+                                          double floor) {
+  std::optional<std::size_t> previous;
+  for (std::size_t i = 0; i < error.size(); ++i) {
+    if (!usable_error(error[i]) || std::abs(error[i]) < floor) continue;
+    if (previous && std::abs(error[i]) > std::abs(error[*previous]))
+      return NonMonotoneStep{steps[*previous], std::abs(error[*previous]), steps[i], std::abs(error[i])};
+    previous = i;
+  }
+  return std::nullopt;
+}
+
+json to_json(const std::optional<NonMonotoneStep>& rise) {
+  if (!rise) return nullptr;
+  return {{"steps", rise->steps_coarse},
+          {"error", rise->error_coarse},
+          {"steps_finer", rise->steps_fine},
+          {"error_finer", rise->error_fine}};
+}
+
 }  // namespace
 
 std::size_t round_off_floor_start(std::span<const double> dt, std::span<const double> error, double order) {
@@ -78,16 +100,16 @@ std::size_t round_off_floor_start(std::span<const double> dt, std::span<const do
 }
 
 StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescription& description,
-                   const std::vector<StudyRun>& runs, bool with_reference) {
+                   const std::vector<StudyRun>& runs, bool with_reference, double phase_scale) {
   std::vector<double> all_dts, all_energy_errors;
   for (const auto& run : runs)
     if (run.status == TrajectoryStatus::completed) {
       all_dts.push_back(run.dt);
-      all_energy_errors.push_back(run.relative_energy_error.value_or(std::nan("")));
+      all_energy_errors.push_back(run.max_abs_relative_energy_error.value_or(std::nan("")));
     }
   const std::size_t floor = round_off_floor_start(all_dts, all_energy_errors, description.order.value());
   StudyFit fit;
-  std::vector<double> dts, energy_errors, phase_errors;
+  std::vector<double> dts, energy_errors, end_energy_errors, phase_errors;
   std::vector<std::uint64_t> steps;
   int positive = 0, negative = 0;
   std::size_t completed = 0;
@@ -96,16 +118,17 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
     if (completed++ >= floor) {
       ++fit.points_at_round_off;
       fit.round_off_dt_max = fit.round_off_dt_max.value_or(run.dt);
-      const double e = std::abs(run.relative_energy_error.value_or(INFINITY));
+      const double e = run.max_abs_relative_energy_error.value_or(INFINITY);
       fit.round_off_error_smallest = std::min(fit.round_off_error_smallest.value_or(INFINITY), e);
       continue;
     }
     dts.push_back(run.dt);
     steps.push_back(run.steps);
-    const double e = run.relative_energy_error.value_or(std::nan(""));
-    energy_errors.push_back(e);
-    if (e > 0) ++positive;
-    if (e < 0) ++negative;
+    const double at_end = run.relative_energy_error.value_or(std::nan(""));
+    end_energy_errors.push_back(at_end);
+    if (at_end > 0) ++positive;
+    if (at_end < 0) ++negative;
+    energy_errors.push_back(run.max_abs_relative_energy_error.value_or(std::nan("")));
     phase_errors.push_back(run.phase_error.value_or(std::nan("")));
   }
   fit.integrator = integrator.label;
@@ -113,11 +136,11 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
   fit.steps_from = integrator.steps_from;
   fit.points = static_cast<std::size_t>(
       std::count_if(energy_errors.begin(), energy_errors.end(), [](double e) { return std::isfinite(e) && e != 0.0; }));
-  // The sign of the energy error at the smallest dt fitted (the largest step count).
+  // The sign of the energy error at t_end at the smallest dt fitted (the largest step count).
   double sign = 1.0;
   for (std::size_t i = dts.size(); i-- > 0;)
-    if (std::isfinite(energy_errors[i]) && energy_errors[i] != 0.0) {
-      sign = energy_errors[i] < 0 ? -1.0 : 1.0;
+    if (usable_error(energy_errors[i]) && usable_error(end_energy_errors[i])) {
+      sign = end_energy_errors[i] < 0 ? -1.0 : 1.0;
       break;
     }
   if (const auto energy_fit = fit_power_law(dts, energy_errors)) {
@@ -147,7 +170,10 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
     fit.steps_min = *std::min_element(steps.begin(), steps.end());
     fit.steps_max = *std::max_element(steps.begin(), steps.end());
   }
+  fit.energy_error_rises = first_rise(steps, energy_errors, round_off_energy_error);
   fit.with_reference = with_reference;
+  // Phase errors have the scale of the state: below 1e-12 of it they are round-off too.
+  if (with_reference) fit.phase_error_rises = first_rise(steps, phase_errors, 1e-12 * phase_scale);
   if (with_reference)
     if (const auto phase_fit = fit_power_law(dts, phase_errors)) {
       fit.phase_exponent = phase_fit->exponent;
@@ -174,6 +200,7 @@ json to_json(const StudyFit& fit) {
   entry["energy_error_excess_at_smallest_dt"] = or_null(fit.energy_error_excess_at_smallest_dt);
   entry["n_points_at_round_off"] = fit.points_at_round_off;
   entry["round_off_dt_max"] = or_null(fit.round_off_dt_max);
+  entry["energy_error_rises"] = to_json(fit.energy_error_rises);
   if (fit.dt_min) {
     entry["dt_min"] = *fit.dt_min;
     entry["dt_max"] = or_null(fit.dt_max);
@@ -186,6 +213,7 @@ json to_json(const StudyFit& fit) {
   if (fit.with_reference) {
     entry["phase_exponent"] = or_null(fit.phase_exponent);
     entry["phase_constant"] = or_null(fit.phase_constant);
+    entry["phase_error_rises"] = to_json(fit.phase_error_rises);
   }
   return entry;
 }

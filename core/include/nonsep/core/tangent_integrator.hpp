@@ -41,6 +41,13 @@ inline TangentTaoExtendedPhaseSpace tangent_map_of(const TaoExtendedPhaseSpace& 
   return TangentTaoExtendedPhaseSpace(stepper, k);
 }
 
+// Whether the scheme `spec` names has a tangent map (TangentIntegrator builds one): the one place that says so, for
+// the job reader and scheme "auto". Throws InvalidArgument as Integrator(spec) does.
+inline bool has_tangent_map(const IntegratorSpec& spec) {
+  return std::visit([](const auto& stepper) { return !is_comparator_stepper<std::decay_t<decltype(stepper)>>; },
+                    Integrator(spec).stepper());
+}
+
 class TangentIntegrator {
  public:
   // Throws InvalidArgument as Integrator(spec) does (bad t2, unknown scheme, an order the scheme does not have).

@@ -165,6 +165,9 @@ struct Analysis {
   // /analysis/max_relative_energy_error: a trajectory whose |H - H0| / |H0| exceeds it where H is evaluated retires
   // as "inaccurate"; absent: no bound.
   std::optional<double> max_relative_energy_error;
+  // /analysis/error_estimate: a second run with half the step estimates every trajectory's global error
+  // (observers/error_estimate.hpp).
+  bool error_estimate = false;
 };
 
 // When a run saves checkpoint.json (host/include/nonsep/host/checkpoint/checkpoint_file.hpp) so that `nonsep run
@@ -180,9 +183,22 @@ struct CheckpointPolicy {
 // (kept as well) copied into it at the end. A study refuses hdf5 (it writes convergence.csv only).
 enum class OutputFormat { csv, hdf5 };
 
+// /integrator {"scheme": "auto", "tolerance": e, "measure": "phase" | "energy"}: the scheme and step are chosen by
+// pilot runs before the run (study/scheme_choice.hpp), which then replaces SingleRun::integrator and divides its
+// time grid.
+struct AutoScheme {
+  enum class Measure { phase, energy };
+  double tolerance = 1e-6;
+  Measure measure = Measure::phase;
+};
+inline constexpr double auto_tolerance_min = 1e-14, auto_tolerance_max = 0.1;
+
 // A single run (a job without /study): one integrator over one time grid for every initial state.
 struct SingleRun {
-  IntegratorSpec integrator;  // /hamiltonian and /integrator, defaults filled in from the catalogue
+  // /hamiltonian and /integrator, defaults filled in from the catalogue; with "auto", the chosen one once
+  // choose_scheme has run (until then the first candidate).
+  IntegratorSpec integrator;
+  std::optional<AutoScheme> auto_scheme;  // /integrator/scheme "auto"
   TimeGrid time;
   std::uint64_t every = 1;                  // /output/every; 0: no trajectory file
   std::uint64_t energy_every = 0;           // /output/energy_every; 0: H only at samples, start and end

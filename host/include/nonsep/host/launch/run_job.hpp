@@ -45,6 +45,9 @@ struct RunOptions {
   // A distributed run's work unit: the size of the whole ensemble it is part of, whose blocks (run_block_size_for)
   // the unit keeps, so that it counts evaluations as one process does. 0: the job's states are the whole.
   std::size_t whole_ensemble = 0;
+  // Scheme "auto": what the pilots chose (study/scheme_choice.hpp to_json), written to summary.json as
+  // "scheme_choice" with the run's own measurement against the tolerance; null for a run without "auto".
+  nlohmann::ordered_json scheme_choice;
 };
 
 // How many trajectories ended with each status.

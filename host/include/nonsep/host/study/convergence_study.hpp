@@ -1,17 +1,20 @@
 #pragma once
 // Convergence studies: a job with /study (docs/studies.md) runs its model from its one
-// initial state to time.t_end once per integrator and step count, and measures at t_end
-//   - the relative energy error (H - H0) / H0 (needs the plugin's Hessians; empty otherwise), and
-//   - the phase-space error |(q, p) - (q_ref, p_ref)| (Euclidean) against /study/reference, when given.
+// initial state to time.t_end once per integrator and step count, and measures
+//   - the relative energy error (H - H0) / H0 at t_end and the largest |(H - H0) / H0| over the run, H evaluated at
+//     every step (needs the plugin's Hessians; empty otherwise), and
+//   - the phase-space error |(q, p) - (q_ref, p_ref)| (Euclidean) at t_end against /study/reference, when given.
 // Outputs, in the output folder:
 //   convergence.csv  one row per run, header
-//     integrator,scheme,order,t2,symplectic,dt,steps,basic_steps,grad_T,grad_V,relative_energy_error,phase_error,status
+//     integrator,scheme,order,t2,symplectic,dt,steps,basic_steps,grad_T,grad_V,relative_energy_error,phase_error,status,
+//     family,grad_H,max_abs_relative_energy_error
 //     (numbers shortest round-trip; errors empty when unknown; status completed, diverged or failed)
+//   work_precision.csv  the same runs with their cost (docs/studies.md)
 //   summary.json     the study, and under "fits" one entry per integrator: the least-squares line through
-//     (log dt, log |relative energy error|) over the completed runs, as error = constant * dt^exponent, where the
-//     constant's sign is that of the energy error at the smallest dt (also the constant with the exponent fixed
-//     at the nominal order); the same for the phase error when a
-//     reference is given; the range of dt and steps fitted and whether the energy error changed sign in it.
+//     (log dt, log max |relative energy error|) over the completed runs, as error = constant * dt^exponent, where the
+//     constant's sign is that of the energy error at t_end at the smallest dt (also the constant with the exponent
+//     fixed at the nominal order); the same for the phase error when a reference is given; the range of dt and steps
+//     fitted and whether the energy error changed sign in it.
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -59,8 +62,19 @@ struct StudyRun {
   std::uint64_t basic_steps = 0;
   EvaluationCounts evaluations;
   std::optional<double> relative_energy_error, phase_error;  // at t_end; completed runs only
+  // The largest |dH/H0| over the run, H evaluated at every step (completed runs with Hessians only).
+  std::optional<double> max_abs_relative_energy_error;
   double wall_seconds = 0.0;  // the median over the repeats (/study/repeats) of the driver's run
   int repeats = 0;            // how many runs the median is over
+};
+
+// Where a study's errors grow as dt shrinks (a ladder that is not monotone): the first pair of fitted runs, in step
+// order, whose finer run has the larger |error|.
+struct NonMonotoneStep {
+  std::uint64_t steps_coarse = 0;
+  double error_coarse = 0.0;
+  std::uint64_t steps_fine = 0;
+  double error_fine = 0.0;
 };
 
 // The fits of one integrator over its completed runs above the round-off floor (round_off_floor_start: those at
@@ -83,6 +97,9 @@ struct StudyFit {
   std::optional<double> energy_error_smallest, energy_error_excess_at_smallest_dt;
   std::optional<double> dt_min, dt_max;  // by |dt|, over the runs fitted
   std::optional<std::uint64_t> steps_min, steps_max;
+  // Where the largest |dH/H0| (the phase error) rises from one fitted run to the next finer one: the power law
+  // does not describe such a ladder (pre-asymptotic errors, or errors that oscillate in dt); nothing when monotone.
+  std::optional<NonMonotoneStep> energy_error_rises, phase_error_rises;
   bool with_reference = false;
   std::optional<double> phase_exponent, phase_constant;
 };
@@ -99,9 +116,10 @@ struct StudyOutcome {
   nlohmann::ordered_json summary;           // what summary.json holds
 };
 
-// The fits of `runs`, the runs of `integrator` (described by `description`); `with_reference` adds the phase fit.
+// The fits of `runs`, the runs of `integrator` (described by `description`); `with_reference` adds the phase fit,
+// `phase_scale` (|(q, p)_ref|, 1 when unknown) sets the round-off level of its phase errors.
 StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescription& description,
-                   const std::vector<StudyRun>& runs, bool with_reference);
+                   const std::vector<StudyRun>& runs, bool with_reference, double phase_scale = 1.0);
 // fit as summary.json's "fits" entry.
 nlohmann::ordered_json to_json(const StudyFit& fit);
 

@@ -1,0 +1,104 @@
+#pragma once
+// Scheme "auto" (/integrator {"scheme": "auto", "tolerance": e, "measure": "phase" | "energy"}): pilot runs on the
+// job's own model and states choose the scheme and the step that meet the tolerance at the least predicted cost.
+//
+// Candidates (auto_candidates): what the plugin and the job allow, fastest first by docs/work-precision.md. With
+// Hessians and third derivatives the comparators Gauss-Legendre 6 and 4; Chin's schemes, which need gradients
+// only: MPE 4 (not symplectic), triplet 8/3, triplet 2. Tangent vectors (/analysis/lyapunov, /megno) keep only the
+// schemes that have a tangent map (nonsep::has_tangent_map). A separable part K(p) + U(q) is solved by every one of
+// them.
+//
+// Pilots: up to auto_pilot_states of the job's states (evenly spread), from t = 0 to the pilot horizon t_p, each
+// candidate at n, 2n and 4n steps (n = 4, doubled until the three are in the
+// scheme's asymptotic range: their differences fall by 2^order within a factor 2.5, or the finest is at round-off;
+// at most auto_pilot_max_steps steps). The error at t_p of the 4n run is, by Richardson extrapolation,
+//   phase:  |(q, p)_2n - (q, p)_4n| / (2^p - 1)          energy: max |dH/H0| over [0, t_p] of the 4n run
+// (the largest over the pilot states), and its growth from t_p / 2 to t_p gives an exponent a (phase: 1 to 3,
+// energy: 0 to 3), so that the error at t_end with step h is predicted as
+//   e(h) = e_p (h / h_p)^r (t_end / t_p)^a,
+// r the order, or the rate the pilots showed (log2 of their error ratio) where that predicts the larger error.
+// The pilot horizon is t_end itself (then a = 0 plays no part) unless no candidate is usable there (a long run, at
+// whose horizon even 2^14 steps are not asymptotic): then t_end / 8, then t_end / 64 (auto_pilot_fractions).
+// The step is the largest h = |time.dt| / m (m a whole number, so that the output grid of time.dt is kept) with
+// e(h) <= tolerance / auto_safety; the cost is the pilot's measured seconds per step times t_end / h. The candidate
+// with the least cost is chosen. The pilots' cost is bounded: a candidate whose pilots have taken longer than the
+// least predicted run so far is left out, so that they cost at most about that run per candidate. A candidate that
+// diverges, fails, or does not reach its asymptotic range is left out with the reason. When none is left the choice
+// fails (ChoiceFailed).
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "nonsep/core/integrator.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/launch/run_job.hpp"
+
+namespace nonsep::host {
+
+// The pilots run to t_end / each of these in turn, until some candidate is usable.
+inline constexpr double auto_pilot_fractions[] = {1.0, 8.0, 64.0};
+inline constexpr std::size_t auto_pilot_states = 8;
+inline constexpr std::uint64_t auto_pilot_max_steps = 1 << 14;  // the finest pilot of one candidate at most
+inline constexpr double auto_safety = 3.0;                      // the prediction aims at tolerance / this
+
+struct AutoCandidate {
+  std::string label;  // "gauss 6", "triplet 8/3"
+  IntegratorSpec spec;
+};
+
+// The candidates of `loaded` (a single run with /integrator "auto"), in the order they are tried.
+std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded);
+
+// What the pilots measured of one candidate.
+struct PilotResult {
+  AutoCandidate candidate;
+  std::string excluded;           // why it was left out; "" when it can be chosen
+  std::uint64_t pilot_steps = 0;  // n of the accepted ladder (its runs: n, 2n, 4n steps to t_p)
+  double pilot_dt = 0.0;          // t_p / 4n
+  double pilot_error = 0.0;       // e_p: the 4n run's error at t_p
+  double ratio = 0.0;             // how much the error fell from 2n to 4n (2^order in the asymptotic range)
+  double growth = 0.0;            // a
+  double seconds_per_step = 0.0;  // of the pilot states together
+  std::uint64_t steps = 0;        // of the final run, predicted
+  double predicted_error = 0.0;   // e(h) at t_end
+  double predicted_seconds = 0.0;
+};
+
+struct SchemeChoice {
+  double tolerance = 0.0;
+  AutoScheme::Measure measure = AutoScheme::Measure::phase;
+  double pilot_horizon = 0.0;
+  std::size_t pilot_states = 0;
+  std::vector<PilotResult> pilots;  // one per candidate
+  std::size_t chosen = 0;           // index into pilots
+  std::uint64_t subdivision = 1;    // m: steps of the final run per step of time.dt
+  double pilot_seconds = 0.0;
+  EvaluationCounts pilot_evaluations;
+  std::uint64_t pilot_state_steps = 0;
+};
+
+class ChoiceFailed : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Runs the pilots of `loaded` and returns the choice. Throws ChoiceFailed when no candidate is left (with every
+// candidate's reason), or when interrupted (options.stop_requested).
+SchemeChoice choose_scheme(const LoadedJob& loaded, const RunOptions& options);
+
+// The run `loaded` would make with `choice`: the chosen integrator, the time grid divided by the subdivision m, and
+// the strides counted in steps (output.every, checkpoint.every_steps, the Lyapunov strides) times m, so that every
+// output stays at the same times; output.energy_every keeps counting the run's steps (1: H at every step).
+void apply_choice(Job& job, const SchemeChoice& choice);
+
+// summary.json's "scheme_choice": the tolerance, the candidates with their pilot measurements (or why they were
+// left out), the choice, its predicted error and the pilots' cost.
+nlohmann::ordered_json to_json(const SchemeChoice& choice);
+
+// What `nonsep validate` says auto would try, one line.
+std::string describe_auto(const LoadedJob& loaded);
+
+}  // namespace nonsep::host

@@ -1,0 +1,388 @@
+// Scheme "auto": the pilots, the prediction and the choice (scheme_choice.hpp).
+#include "nonsep/host/study/scheme_choice.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "nonsep/core/scheme_catalogue.hpp"
+#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+
+namespace nonsep::host {
+
+using json = nlohmann::ordered_json;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Below this a pilot's error is round-off (relative to the state's length for the phase error).
+constexpr double pilot_round_off = 1e-13;
+// The asymptotic range: the error falls by 2^order per halving of the step, within this factor.
+constexpr double asymptotic_within = 2.5;
+
+// The catalogue's scheme `name` with its defaults, and `order` or `stages` for the option of that name.
+IntegratorSpec spec_of(const std::string& name, Fraction order, double stages, HamiltonianForm form) {
+  IntegratorSpec spec;
+  spec.scheme = name;
+  spec.form = form;
+  for (const auto& parameter : find_scheme(name)->parameters) {
+    if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
+    if (parameter.name == "order") set_option(spec, parameter, order);
+    if (parameter.name == "stages") set_option(spec, parameter, stages);
+  }
+  return spec;
+}
+
+// One pilot run: its states at t_p / 2 and t_p and its largest |dH/H0| up to each (energy evaluated at every step
+// when the measure is the energy).
+class PilotObserver : public Observer {
+ public:
+  PilotObserver(std::size_t count, std::size_t dimension, std::uint64_t steps, bool energy)
+      : dimension_(dimension), steps_(steps), energy_(energy), half_(count * 2 * dimension), end_(half_) {}
+
+  std::uint64_t next_event(std::uint64_t step) const override {
+    if (energy_) return step < steps_ ? step + 1 : no_event;
+    return step < steps_ / 2 ? steps_ / 2 : step < steps_ ? steps_ : no_event;
+  }
+  bool needs_energy(std::uint64_t) const override { return energy_; }
+  void on_event(const Event& event) override {
+    for (const StateView& state : event.states) {
+      if (energy_ && state.energy && state.record->energy_initial && *state.record->energy_initial != 0.0) {
+        const double e = std::abs((*state.energy - *state.record->energy_initial) / *state.record->energy_initial);
+        max_end_ = std::max(max_end_, e);
+        if (event.step <= steps_ / 2) max_half_ = std::max(max_half_, e);
+      }
+      if (event.step != steps_ / 2 && event.step != steps_) continue;
+      std::vector<double>& into = event.step == steps_ ? end_ : half_;
+      std::copy(state.q.begin(), state.q.end(),
+                into.begin() + static_cast<std::ptrdiff_t>(state.trajectory * 2 * dimension_));
+      std::copy(state.p.begin(), state.p.end(),
+                into.begin() + static_cast<std::ptrdiff_t>(state.trajectory * 2 * dimension_ + dimension_));
+    }
+  }
+  void on_retire(std::size_t trajectory, const TrajectoryRecord& record) override {
+    if (stopped_early(record.status) && problem_.empty())
+      problem_ = std::string(to_string(record.status)) + " at step " + std::to_string(record.stop_step) +
+                 " (pilot state " + std::to_string(trajectory) + ")";
+  }
+
+  std::size_t dimension_;
+  std::uint64_t steps_;
+  bool energy_;
+  std::vector<double> half_, end_;
+  double max_half_ = 0.0, max_end_ = 0.0;
+  std::string problem_;
+};
+
+struct PilotRun {
+  std::string problem;  // "" when every pilot state completed
+  std::vector<double> half, end;
+  double max_half = 0.0, max_end = 0.0;
+  double seconds = 0.0;
+};
+
+// The largest distance between the pilot states of two runs, and the largest length of a state.
+double largest_distance(const std::vector<double>& a, const std::vector<double>& b, std::size_t width) {
+  double largest = 0.0;
+  for (std::size_t s = 0; s * width < a.size(); ++s) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < width; ++i)
+      sum += (a[s * width + i] - b[s * width + i]) * (a[s * width + i] - b[s * width + i]);
+    largest = std::max(largest, std::sqrt(sum));
+  }
+  return largest;
+}
+
+double largest_length(const std::vector<double>& a, std::size_t width) {
+  return largest_distance(a, std::vector<double>(a.size(), 0.0), width);
+}
+
+class Pilots {
+ public:
+  Pilots(const LoadedJob& loaded, const RunOptions& options, SchemeChoice& choice, double fraction)
+      : loaded_(loaded), options_(options), choice_(choice), run_(loaded.job.run()) {
+    const InitialStates& initial = loaded.job.initial;
+    const std::size_t n = initial.dimension, count = std::min(initial.count, auto_pilot_states);
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t index = k * initial.count / count;
+      q_.insert(q_.end(), initial.q.begin() + static_cast<std::ptrdiff_t>(index * n),
+                initial.q.begin() + static_cast<std::ptrdiff_t>(index * n + n));
+      p_.insert(p_.end(), initial.p.begin() + static_cast<std::ptrdiff_t>(index * n),
+                initial.p.begin() + static_cast<std::ptrdiff_t>(index * n + n));
+    }
+    choice_.pilot_states = count;
+    choice_.pilot_horizon = run_.time.t_end / fraction;
+  }
+
+  // `bound`: the least predicted cost of the candidates measured so far; a candidate whose pilots take longer is
+  // left out (its run could not be cheaper than that one's pilots and run together).
+  PilotResult measure(const AutoCandidate& candidate, std::optional<double> bound) {
+    const double spent_before = choice_.pilot_seconds;
+    PilotResult result;
+    result.candidate = candidate;
+    const double order = Integrator(candidate.spec).describe().order.value();
+    const bool energy = choice_.measure == AutoScheme::Measure::energy;
+    const std::size_t width = 2 * loaded_.job.initial.dimension;
+    std::map<std::uint64_t, PilotRun> runs;
+    const auto run = [&](std::uint64_t steps) -> const PilotRun& {
+      auto found = runs.find(steps);
+      if (found == runs.end()) found = runs.emplace(steps, pilot(candidate.spec, steps, energy)).first;
+      return found->second;
+    };
+    std::string last;
+    for (std::uint64_t n = 4; 4 * n <= auto_pilot_max_steps; n *= 2) {
+      if (bound && choice_.pilot_seconds - spent_before > *bound) {
+        result.excluded = "its pilots took " + format_number(choice_.pilot_seconds - spent_before) +
+                          " s, more than the predicted run of a candidate before it (" + format_number(*bound) + " s)";
+        return result;
+      }
+      const PilotRun &r1 = run(n), &r2 = run(2 * n), &r4 = run(4 * n);
+      if (!r1.problem.empty() || !r2.problem.empty() || !r4.problem.empty()) {
+        last = "its pilot with " +
+               std::to_string(!r1.problem.empty()   ? n
+                              : !r2.problem.empty() ? 2 * n
+                                                    : 4 * n) +
+               " steps " +
+               (!r1.problem.empty()   ? r1.problem
+                : !r2.problem.empty() ? r2.problem
+                                      : r4.problem);
+        continue;
+      }
+      const double coarse = energy ? r2.max_end : largest_distance(r1.end, r2.end, width);
+      const double fine = energy ? r4.max_end : largest_distance(r2.end, r4.end, width);
+      const double floor = pilot_round_off * (energy ? 1.0 : std::max(1.0, largest_length(r4.end, width)));
+      const double ratio = coarse / fine, expected = std::pow(2.0, order);
+      const bool round_off = fine <= floor;
+      if (!round_off && !(ratio >= expected / asymptotic_within && ratio <= expected * asymptotic_within)) {
+        last = "its error fell by " + format_number(ratio) + " from " + std::to_string(2 * n) + " to " +
+               std::to_string(4 * n) + " pilot steps, not by 2^order = " + format_number(expected);
+        continue;
+      }
+      result.pilot_steps = n;
+      result.pilot_dt = choice_.pilot_horizon / static_cast<double>(4 * n);
+      result.ratio = ratio;
+      // At round-off the difference bounds the error; in the asymptotic range Richardson gives it.
+      result.pilot_error = energy || round_off ? std::max(fine, floor) : fine / (expected - 1.0);
+      const double half = energy ? r4.max_half : largest_distance(r2.half, r4.half, width);
+      const double raw = half > 0.0 && fine > 0.0 ? std::log2(fine / half) : 1.0;
+      result.growth = std::clamp(std::isfinite(raw) ? raw : 1.0, energy ? 0.0 : 1.0, 3.0);
+      result.seconds_per_step = r4.seconds > r1.seconds ? (r4.seconds - r1.seconds) / static_cast<double>(3 * n)
+                                                        : r4.seconds / static_cast<double>(4 * n);
+      predict(result, order);
+      return result;
+    }
+    result.excluded = "no usable pilot up to " + std::to_string(auto_pilot_max_steps) + " steps: " + last;
+    return result;
+  }
+
+ private:
+  // The largest step |time.dt| / m that meets tolerance / auto_safety by the prediction, and its cost.
+  void predict(PilotResult& result, double order) const {
+    const TimeGrid& time = run_.time;
+    const double growth = std::pow(std::abs(time.t_end / choice_.pilot_horizon), result.growth);
+    const double h_pilot = std::abs(result.pilot_dt);
+    // Where the pilots' errors fell more slowly than 2^order per halving (not yet asymptotic), extrapolating to a
+    // smaller step uses the slower observed rate; to a larger step the order (either way the larger prediction).
+    const double observed = result.ratio > 1.0 ? std::log2(result.ratio) : order;
+    const double smaller = std::min(order, observed), larger = std::max(order, observed);
+    double rate = smaller;
+    double h_max = h_pilot * std::pow(choice_.tolerance / (auto_safety * result.pilot_error * growth), 1.0 / rate);
+    if (h_max > h_pilot) {
+      rate = larger;
+      h_max = std::max(h_pilot,
+                       h_pilot * std::pow(choice_.tolerance / (auto_safety * result.pilot_error * growth), 1.0 / rate));
+    }
+    const double m = std::max(1.0, std::ceil(std::abs(time.dt) / h_max * (1.0 - 1e-12)));
+    const double steps = static_cast<double>(time.steps) * m;
+    if (!(steps <= static_cast<double>(max_steps))) {
+      result.excluded = "it would need " + format_number(steps) + " steps, more than " + std::to_string(max_steps);
+      return;
+    }
+    result.steps = static_cast<std::uint64_t>(steps);
+    const double h = std::abs(time.dt) / m;
+    result.predicted_error = result.pilot_error * std::pow(h / h_pilot, h < h_pilot ? smaller : larger) * growth;
+    result.predicted_seconds = result.seconds_per_step * steps * static_cast<double>(loaded_.job.initial.count) /
+                               static_cast<double>(choice_.pilot_states);
+  }
+
+  PilotRun pilot(const IntegratorSpec& spec, std::uint64_t steps, bool energy) {
+    const std::size_t count = choice_.pilot_states;
+    const double t_p = choice_.pilot_horizon;
+    EnsembleSetup setup{spec,
+                        TimeGrid::to_end(t_p, t_p / static_cast<double>(steps), steps),
+                        loaded_.job.initial.dimension,
+                        q_,
+                        p_,
+                        options_.threads,
+                        options_.stop_requested};
+    EnsembleDriver driver(loaded_.plugin, loaded_.model, setup);
+    PilotObserver observer(count, loaded_.job.initial.dimension, steps, energy);
+    driver.add_observer(observer);
+    const auto start = Clock::now();
+    const DriverEnd end = driver.run();
+    PilotRun result;
+    result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    choice_.pilot_seconds += result.seconds;
+    choice_.pilot_state_steps += steps * count;
+    const EvaluationCounts e = driver.evaluations();
+    EvaluationCounts& total = choice_.pilot_evaluations;
+    total.grad_T += e.grad_T;
+    total.grad_V += e.grad_V;
+    total.grad_H += e.grad_H;
+    total.grad_K += e.grad_K;
+    total.grad_U += e.grad_U;
+    if (end == DriverEnd::interrupted) throw ChoiceFailed("interrupted during the pilot runs of scheme auto");
+    if (end == DriverEnd::failed) result.problem = "failed: " + driver.error();
+    if (result.problem.empty()) result.problem = observer.problem_;
+    result.half = std::move(observer.half_);
+    result.end = std::move(observer.end_);
+    result.max_half = observer.max_half_;
+    result.max_end = observer.max_end_;
+    return result;
+  }
+
+  const LoadedJob& loaded_;
+  const RunOptions& options_;
+  SchemeChoice& choice_;
+  const SingleRun& run_;
+  std::vector<double> q_, p_;
+};
+
+json number_or_null(double x, bool known) { return known && std::isfinite(x) ? json(x) : json(nullptr); }
+
+}  // namespace
+
+std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
+  const SingleRun& run = loaded.job.run();
+  const HamiltonianForm form = run.integrator.form;
+  // In the order of docs/work-precision.md's fastest first, so that the pilots of slower ones are cut short.
+  std::vector<AutoCandidate> all{
+      {"gauss 6", spec_of("gauss", Fraction(2, 3), 3, form)},
+      {"gauss 4", spec_of("gauss", Fraction(2, 3), 2, form)},
+      {"mpe 4", spec_of("mpe", Fraction(4), 2, form)},
+      {"triplet 8/3", spec_of("triplet", Fraction(8, 3), 2, form)},
+      {"triplet 2", spec_of("triplet", Fraction(2), 2, form)},
+  };
+  const bool gradient_of_h = loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives();
+  std::vector<AutoCandidate> usable;
+  for (auto& candidate : all) {
+    if (Integrator(candidate.spec).is_comparator() && !gradient_of_h) continue;
+    if (run.analysis.tangent_vectors() > 0 && !has_tangent_map(candidate.spec)) continue;
+    usable.push_back(std::move(candidate));
+  }
+  return usable;
+}
+
+SchemeChoice choose_scheme(const LoadedJob& loaded, const RunOptions& options) {
+  const AutoScheme& asked = *loaded.job.run().auto_scheme;
+  SchemeChoice choice;
+  choice.tolerance = asked.tolerance;
+  choice.measure = asked.measure;
+  std::optional<std::size_t> best;
+  std::string reasons;
+  for (const double fraction : auto_pilot_fractions) {
+    choice.pilots.clear();
+    Pilots pilots(loaded, options, choice, fraction);
+    std::optional<double> bound;
+    for (const AutoCandidate& candidate : auto_candidates(loaded)) {
+      choice.pilots.push_back(pilots.measure(candidate, bound));
+      if (const PilotResult& last = choice.pilots.back(); last.excluded.empty())
+        bound = std::min(bound.value_or(last.predicted_seconds), last.predicted_seconds);
+    }
+    reasons = "; pilots to t = " + format_number(choice.pilot_horizon);
+    for (std::size_t i = 0; i < choice.pilots.size(); ++i) {
+      const PilotResult& pilot = choice.pilots[i];
+      if (!pilot.excluded.empty()) {
+        reasons += "; " + pilot.candidate.label + ": " + pilot.excluded;
+        continue;
+      }
+      if (!best || pilot.predicted_seconds < choice.pilots[*best].predicted_seconds) best = i;
+    }
+    if (best) break;
+  }
+  if (!best)
+    throw ChoiceFailed("scheme auto found no scheme for tolerance " + format_number(choice.tolerance) + reasons);
+  choice.chosen = *best;
+  choice.subdivision = choice.pilots[*best].steps / loaded.job.run().time.steps;
+  return choice;
+}
+
+void apply_choice(Job& job, const SchemeChoice& choice) {
+  SingleRun& run = std::get<SingleRun>(job.plan);
+  const std::uint64_t m = choice.subdivision;
+  run.integrator = choice.pilots[choice.chosen].candidate.spec;
+  const TimeGrid& time = run.time;
+  run.time = time.from_t_end ? TimeGrid::to_end(time.t_end, time.dt_requested / static_cast<double>(m), time.steps * m)
+                             : TimeGrid::of_steps(time.steps * m, time.dt / static_cast<double>(m));
+  run.every *= m;  // energy_every keeps counting the run's own steps: 1 is still every step
+  run.checkpoint.every_steps *= m;
+  if (run.analysis.lyapunov) {
+    run.analysis.lyapunov->every *= m;
+    run.analysis.lyapunov->renormalize_every *= m;
+  }
+}
+
+json to_json(const SchemeChoice& choice) {
+  json candidates = json::array();
+  for (const PilotResult& pilot : choice.pilots) {
+    const bool usable = pilot.excluded.empty();
+    const double order = Integrator(pilot.candidate.spec).describe().order.value();
+    candidates.push_back({{"label", pilot.candidate.label},
+                          {"scheme", pilot.candidate.spec.scheme},
+                          {"order", Integrator(pilot.candidate.spec).describe().order.to_string()},
+                          {"excluded", usable ? json(nullptr) : json(pilot.excluded)},
+                          {"pilot_steps", pilot.pilot_steps ? json(4 * pilot.pilot_steps) : json(nullptr)},
+                          {"pilot_dt", number_or_null(pilot.pilot_dt, pilot.pilot_steps > 0)},
+                          {"pilot_error", number_or_null(pilot.pilot_error, pilot.pilot_steps > 0)},
+                          {"error_ratio_per_halving", number_or_null(pilot.ratio, pilot.pilot_steps > 0)},
+                          {"expected_ratio", std::pow(2.0, order)},
+                          {"growth_exponent", number_or_null(pilot.growth, pilot.pilot_steps > 0)},
+                          {"seconds_per_step", number_or_null(pilot.seconds_per_step, pilot.pilot_steps > 0)},
+                          {"steps", usable ? json(pilot.steps) : json(nullptr)},
+                          {"predicted_error", number_or_null(pilot.predicted_error, usable)},
+                          {"predicted_seconds", number_or_null(pilot.predicted_seconds, usable)}});
+  }
+  const PilotResult& chosen = choice.pilots[choice.chosen];
+  const EvaluationCounts& e = choice.pilot_evaluations;
+  return {{"tolerance", choice.tolerance},
+          {"measure", choice.measure == AutoScheme::Measure::phase ? "phase" : "energy"},
+          {"method",
+           "pilots at n, 2n, 4n steps to the pilot horizon; error at t_end predicted as e_p (h / h_p)^order "
+           "(t_end / t_p)^growth_exponent, aimed at tolerance / " +
+               format_number(auto_safety)},
+          {"pilot_horizon", choice.pilot_horizon},
+          {"pilot_states", choice.pilot_states},
+          {"candidates", std::move(candidates)},
+          {"chosen", chosen.candidate.label},
+          {"subdivision", choice.subdivision},
+          {"estimated_error", chosen.predicted_error},
+          {"estimated_error_meets_tolerance", chosen.predicted_error <= choice.tolerance},
+          {"pilot_cost",
+           {{"wall_seconds", choice.pilot_seconds},
+            {"state_steps", choice.pilot_state_steps},
+            {"evaluations",
+             {{"grad_T", e.grad_T},
+              {"grad_V", e.grad_V},
+              {"grad_H", e.grad_H},
+              {"grad_K", e.grad_K},
+              {"grad_U", e.grad_U}}}}}};
+}
+
+std::string describe_auto(const LoadedJob& loaded) {
+  const AutoScheme& asked = *loaded.job.run().auto_scheme;
+  std::string names;
+  for (const AutoCandidate& candidate : auto_candidates(loaded)) names += (names.empty() ? "" : ", ") + candidate.label;
+  const std::size_t states = std::min(loaded.job.initial.count, auto_pilot_states);
+  return "scheme auto: tolerance " + format_number(asked.tolerance) + " on the " +
+         (asked.measure == AutoScheme::Measure::phase ? "phase-space error at t_end" : "largest |dH/H0|") +
+         "; would try " + names + " with pilot runs of " + std::to_string(states) +
+         " state(s) to t = " + format_number(loaded.job.run().time.t_end) + " (at most " +
+         std::to_string(auto_pilot_max_steps) +
+         " steps each; to t_end / 8, then t_end / 64, when none is usable), then run the cheapest that meets it";
+}
+
+}  // namespace nonsep::host

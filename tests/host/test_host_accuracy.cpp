@@ -1,0 +1,312 @@
+// Accuracy on request: studies report the largest |dH/H0| over each run (checked against the core stepping the same
+// model with H at every step), /analysis/error_estimate (against exact solutions and a Gauss 6 reference at a tiny
+// step; a chaotic orbit flagged after its runs separate) and scheme "auto" (its choice meets the tolerance against
+// exact solutions; its bad inputs).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "host_test_support.hpp"
+#include "nonsep/core.hpp"
+#include "nonsep/host/study/convergence_study.hpp"
+#include "nonsep/reference/mathews_lakshmanan_exact.hpp"
+#include "nonsep/sdk/model_adapter.hpp"
+#include "paper1d/paper1d.hpp"
+
+using json = nlohmann::json;
+using namespace nonsep::host_testing;
+
+namespace {
+
+constexpr double quarter_period = 0.3863765573361232;
+constexpr double p_at_quarter = -1.5723027555148466;
+const nonsep::reference::MathewsLakshmanan oscillator{0.5, 1.0};
+
+// trajectories.csv (or any of a run's CSV files) as one map per row, empty cells NaN.
+std::vector<std::map<std::string, std::string>> table(const std::filesystem::path& path) {
+  const auto rows = read_csv(path);
+  std::vector<std::map<std::string, std::string>> result;
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    std::map<std::string, std::string> row;
+    for (std::size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = c < rows[r].size() ? rows[r][c] : "";
+    result.push_back(std::move(row));
+  }
+  return result;
+}
+double number(const std::map<std::string, std::string>& row, const std::string& name) {
+  const std::string& text = row.at(name);
+  return text.empty() ? std::nan("") : std::stod(text);
+}
+
+struct Ran {
+  int status;
+  std::string out, err;
+  std::filesystem::path folder;
+};
+Ran run_job(const TemporaryFolder& folder, const std::string& name, const json& job,
+            std::vector<std::string> extra = {"--quiet"}) {
+  const auto file = write_job(folder / (name + ".json"), job);
+  std::vector<std::string> args{"run"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  args.insert(args.end(), {"--output", (folder / name).string(), file.string()});
+  const auto result = run_nonsep(args, folder.path());
+  return {result.status, result.out, result.err, folder / name};
+}
+
+json run_of(json model, json integrator, json initial, double dt, double t_end, std::uint64_t every) {
+  return {{"model", std::move(model)},
+          {"integrator", std::move(integrator)},
+          {"initial", std::move(initial)},
+          {"time", {{"dt", dt}, {"t_end", t_end}}},
+          {"output", {{"every", every}}}};
+}
+
+double distance(double q0, double p0, double q1, double p1) { return std::hypot(q0 - q1, p0 - p1); }
+
+}  // namespace
+
+TEST_CASE("a study reports the largest |dH/H0| over each run, which the core finds stepping with H at every step") {
+  const TemporaryFolder folder;
+  // A full period of paper1d: at t_end the energy error of a symplectic scheme is back near its start, its
+  // largest value was in between.
+  const double t_end = 4 * quarter_period;
+  const json job = {{"model", {{"plugin", "paper1d"}}},
+                    {"initial", {{"q", {2.0}}, {"p", {0.0}}}},
+                    {"time", {{"t_end", t_end}}},
+                    {"study", {{"integrators", {{{"scheme", "triplet"}, {"order", "8/3"}, {"steps", {64, 128}}}}}}}};
+  const auto ran = run_job(folder, "study", job);
+  REQUIRE(ran.status == 0);
+  const auto rows = table(ran.folder / "work_precision.csv");
+  REQUIRE(rows.size() == 2);
+  const nonsep::sdk::ModelAdapter<::Paper1D> model;
+  nonsep::EnergyEvaluator energy(nonsep::HamiltonianForm::TTV);
+  const double q0[] = {2.0}, p0[] = {0.0};
+  for (const auto& row : rows) {
+    const auto steps = std::stoull(row.at("steps"));
+    nonsep::Integrator integrator({"triplet", nonsep::Fraction(8, 3)});
+    auto x = nonsep::PhaseSpaceBatch::single(q0, p0);
+    const double h0 = energy.evaluate_one(model, x);
+    double largest = 0.0, at_end = 0.0;
+    for (std::uint64_t k = 0; k < steps; ++k) {
+      integrator.step(model, x, t_end / static_cast<double>(steps));
+      at_end = (energy.evaluate_one(model, x) - h0) / h0;
+      largest = std::max(largest, std::abs(at_end));
+    }
+    CAPTURE(steps);
+    CHECK(number(row, "max_abs_relative_energy_error") == doctest::Approx(largest).epsilon(1e-9));
+    CHECK(number(row, "relative_energy_error") == doctest::Approx(at_end).epsilon(1e-9));
+    CHECK(largest > 2 * std::abs(at_end));  // the case that made the maximum necessary
+  }
+  const json summary = read_json(ran.folder / "summary.json");
+  const auto& fit = summary["fits"][0];
+  const double e64 = number(rows[0], "max_abs_relative_energy_error"),
+               e128 = number(rows[1], "max_abs_relative_energy_error");
+  CHECK(fit["exponent"].get<double>() == doctest::Approx(std::log(e64 / e128) / std::log(2.0)).epsilon(1e-9));
+  CHECK(fit["energy_error_rises"].is_null());
+}
+
+TEST_CASE("a fit over a ladder whose largest energy error rises as dt shrinks says so") {
+  nonsep::host::StudyIntegrator integrator;
+  integrator.label = "basic";
+  integrator.spec.scheme = "basic";
+  const auto description = nonsep::Integrator(integrator.spec).describe();
+  std::vector<nonsep::host::StudyRun> runs;
+  for (const auto& [steps, error] :
+       std::vector<std::pair<std::uint64_t, double>>{{100, 1e-2}, {200, 2e-2}, {400, 4e-3}}) {
+    nonsep::host::StudyRun run;
+    run.steps = steps;
+    run.dt = 1.0 / static_cast<double>(steps);
+    run.relative_energy_error = -error / 2;
+    run.max_abs_relative_energy_error = error;
+    runs.push_back(run);
+  }
+  const auto fit = nonsep::host::fit_study(integrator, description, runs, false);
+  REQUIRE(fit.energy_error_rises);
+  CHECK(fit.energy_error_rises->steps_coarse == 100);
+  CHECK(fit.energy_error_rises->steps_fine == 200);
+  CHECK(fit.energy_error_rises->error_fine == 2e-2);
+  runs[1].max_abs_relative_energy_error = 5e-3;
+  CHECK_FALSE(nonsep::host::fit_study(integrator, description, runs, false).energy_error_rises);
+}
+
+TEST_CASE("the error estimate is within a factor 3 of the error against exact solutions") {
+  const TemporaryFolder folder;
+  SUBCASE("paper1d at its exact quarter period") {
+    for (const json& integrator : {json{{"scheme", "triplet"}, {"order", "2"}}, json{{"scheme", "mpe"}, {"order", "4"}},
+                                   json{{"scheme", "gauss"}, {"stages", 3}}}) {
+      json job = run_of({{"plugin", "paper1d"}}, integrator, {{"q", {2.0}}, {"p", {0.0}}}, quarter_period / 64,
+                        quarter_period, 0);
+      job["analysis"] = {{"error_estimate", true}};
+      const auto ran = run_job(folder, "paper1d", job, {"--quiet", "--force"});
+      REQUIRE(ran.status == 0);
+      const auto row = table(ran.folder / "trajectories.csv").at(0);
+      const double actual = distance(number(row, "q0"), number(row, "p0"), 0.0, p_at_quarter);
+      CAPTURE(integrator.dump());
+      CAPTURE(actual);
+      CHECK(row.at("error_estimate") == "within_horizon");
+      CHECK(number(row, "error_estimate_t") == quarter_period);
+      CHECK(number(row, "estimated_phase_error") / actual == doctest::Approx(1.0).epsilon(2.0 / 3.0));
+      CHECK(number(row, "estimated_phase_error") <= 3 * actual);
+      CHECK(number(row, "estimated_phase_error") >= actual / 3);
+      // The energy error is known exactly; its estimate agrees with it where the estimate holds.
+      const double energy = number(row, "relative_energy_error");
+      CHECK(std::abs(number(row, "estimated_relative_energy_error")) <= 3 * std::abs(energy));
+      CHECK(std::abs(number(row, "estimated_relative_energy_error")) >= std::abs(energy) / 3);
+    }
+  }
+  SUBCASE("mathews_lakshmanan over three periods, at every sample") {
+    const double amplitude = 1.5, period = oscillator.period(amplitude);
+    json job = run_of({{"plugin", "mathews_lakshmanan"}, {"parameters", {{"lambda", 0.5}, {"alpha", 1.0}}}},
+                      {{"scheme", "triplet"}, {"order", "8/3"}}, {{"q", {amplitude}}, {"p", {0.0}}}, period / 256,
+                      3 * period, 32);
+    job["analysis"] = {{"error_estimate", true}};
+    const auto ran = run_job(folder, "ml", job);
+    REQUIRE(ran.status == 0);
+    const auto rows = table(ran.folder / "error_estimate.csv");
+    const auto samples = table(ran.folder / "trajectory.csv");
+    REQUIRE(rows.size() == 24);
+    std::size_t checked = 0;
+    for (const auto& row : rows) {
+      const auto sample =
+          std::find_if(samples.begin(), samples.end(), [&](const auto& s) { return s.at("step") == row.at("step"); });
+      REQUIRE(sample != samples.end());
+      const double t = number(row, "t");
+      const auto exact = oscillator.at(amplitude, std::acos(-1.0) / 2, t);
+      const double actual = distance(number(*sample, "q0"), number(*sample, "p0"), exact.q, exact.p);
+      CAPTURE(t);
+      CHECK(row.at("separated") == "false");
+      CHECK(number(row, "estimated_phase_error") <= 3 * actual);
+      CHECK(number(row, "estimated_phase_error") >= actual / 3);
+      ++checked;
+    }
+    CHECK(checked == 24);
+  }
+}
+
+TEST_CASE("the error estimate on paper2d: a regular orbit against Gauss 6 at a tiny step, a chaotic one flagged") {
+  const TemporaryFolder folder;
+  const auto end_of = [&](const std::string& name, const json& job) {
+    const auto ran = run_job(folder, name, job);
+    REQUIRE(ran.status == 0);
+    return table(ran.folder / "trajectories.csv").at(0);
+  };
+  const auto actual_against = [](const auto& row, const auto& reference) {
+    double sum = 0.0;
+    for (const char* c : {"q0", "q1", "p0", "p1"}) sum += std::pow(number(row, c) - number(reference, c), 2);
+    return std::sqrt(sum);
+  };
+  const json model = {{"plugin", "paper2d"}};
+  SUBCASE("regular: q = (0, 0), p = (0.5, 2) to t = 2") {
+    const json initial = {{"q", {0.0, 0.0}}, {"p", {0.5, 2.0}}};
+    const auto reference =
+        end_of("reference", run_of(model, {{"scheme", "gauss"}, {"stages", 3}}, initial, 2.0 / 4096, 2.0, 0));
+    // Triplet 2's error constant is large here: at 2048 steps its error is 0.28, beyond the horizon.
+    for (const auto& [integrator, steps] : {std::pair{json{{"scheme", "mpe"}, {"order", "4"}}, 256},
+                                            std::pair{json{{"scheme", "triplet"}, {"order", "2"}}, 8192}}) {
+      json job = run_of(model, integrator, initial, 2.0 / steps, 2.0, 0);
+      job["analysis"] = {{"error_estimate", true}};
+      const auto row = end_of("regular-" + integrator["scheme"].get<std::string>(), job);
+      const double actual = actual_against(row, reference);
+      CAPTURE(integrator.dump());
+      CAPTURE(actual);
+      CHECK(row.at("error_estimate") == "within_horizon");
+      CHECK(number(row, "estimated_phase_error") <= 3 * actual);
+      CHECK(number(row, "estimated_phase_error") >= actual / 3);
+    }
+  }
+  SUBCASE("chaotic: q = (0.5, 0), p = (0, 2.5) to t = 40") {
+    json job =
+        run_of(model, {{"scheme", "gauss"}, {"stages", 3}}, {{"q", {0.5, 0.0}}, {"p", {0.0, 2.5}}}, 0.01, 40.0, 0);
+    job["analysis"] = {{"error_estimate", true}};
+    const auto ran = run_job(folder, "chaotic", job);
+    REQUIRE(ran.status == 0);
+    const auto row = table(ran.folder / "trajectories.csv").at(0);
+    CHECK(row.at("error_estimate") == "separated");
+    const double horizon = number(row, "error_estimate_horizon");
+    CHECK(horizon > 0.0);
+    CHECK(horizon < 40.0);
+    const json summary = read_json(ran.folder / "summary.json");
+    CHECK(summary["analysis"]["error_estimate"]["separated"] == 1);
+    CHECK(summary["analysis"]["error_estimate"]["earliest_horizon"].get<double>() == horizon);
+    // Before the horizon no comparison is flagged, from it on every one is.
+    for (const auto& estimate : table(ran.folder / "error_estimate.csv"))
+      CHECK((estimate.at("separated") == "true") == (number(estimate, "t") >= horizon));
+  }
+}
+
+TEST_CASE("scheme auto meets its tolerance against the exact solution and records its choice") {
+  const TemporaryFolder folder;
+  SUBCASE("paper1d, phase, 1e-8") {
+    const json job = run_of({{"plugin", "paper1d"}}, {{"scheme", "auto"}, {"tolerance", 1e-8}},
+                            {{"q", {2.0}}, {"p", {0.0}}}, quarter_period, quarter_period, 1);
+    const auto ran = run_job(folder, "paper1d", job, {});
+    REQUIRE(ran.status == 0);
+    CHECK(ran.out.find("auto: ") != std::string::npos);
+    const auto row = table(ran.folder / "trajectories.csv").at(0);
+    CHECK(distance(number(row, "q0"), number(row, "p0"), 0.0, p_at_quarter) <= 1e-8);
+    const json summary = read_json(ran.folder / "summary.json");
+    const json& choice = summary["scheme_choice"];
+    CHECK(choice["tolerance"] == 1e-8);
+    CHECK(choice["candidates"].size() == 5);
+    CHECK(choice["estimated_error"].get<double>() <= 1e-8);
+    CHECK(choice["tolerance_met"] == true);
+    CHECK(choice["pilot_cost"]["state_steps"].get<std::uint64_t>() > 0);
+    CHECK(summary["integrator"]["scheme"] ==
+          choice["chosen"].get<std::string>().substr(0, choice["chosen"].get<std::string>().find(' ')));
+    // The output grid of time.dt is kept: the samples are at step 0 and t_end.
+    CHECK(table(ran.folder / "trajectory.csv").size() == 2);
+  }
+  SUBCASE("mathews_lakshmanan, energy, 1e-7, H at every step") {
+    const double period = oscillator.period(1.5);
+    json job =
+        run_of({{"plugin", "mathews_lakshmanan"}}, {{"scheme", "auto"}, {"tolerance", 1e-7}, {"measure", "energy"}},
+               {{"q", {1.5}}, {"p", {0.0}}}, period / 4, period / 4, 0);
+    job["output"]["energy_every"] = 1;
+    const auto ran = run_job(folder, "ml", job);
+    REQUIRE(ran.status == 0);
+    const auto row = table(ran.folder / "trajectories.csv").at(0);
+    CHECK(number(row, "max_abs_relative_energy_error") <= 1e-7);
+    CHECK(read_json(ran.folder / "summary.json")["scheme_choice"]["measured_error"].get<double>() ==
+          number(row, "max_abs_relative_energy_error"));
+  }
+  SUBCASE("tangent vectors leave only the schemes with a tangent map") {
+    json job = run_of({{"plugin", "paper2d"}}, {{"scheme", "auto"}, {"tolerance", 1e-4}},
+                      {{"q", {0.0, 0.0}}, {"p", {0.5, 2.0}}}, 0.5, 1.0, 0);
+    job["analysis"] = {{"megno", true}};
+    const auto ran = run_job(folder, "megno", job);
+    REQUIRE(ran.status == 0);
+    for (const auto& candidate : read_json(ran.folder / "summary.json")["scheme_choice"]["candidates"])
+      CHECK(candidate["scheme"] != "gauss");
+  }
+}
+
+TEST_CASE("scheme auto: validate says what would be tried; bad tolerances and measures are refused") {
+  const TemporaryFolder folder;
+  json job = run_of({{"plugin", "paper1d"}}, {{"scheme", "auto"}, {"tolerance", 1e-6}}, {{"q", {2.0}}, {"p", {0.0}}},
+                    0.1, 1.0, 1);
+  const auto file = write_job(folder / "auto.json", job);
+  const auto valid = run_nonsep({"validate", file.string()}, folder.path());
+  CHECK(valid.status == 0);
+  CHECK(valid.out.find("scheme auto: tolerance 1e-06") != std::string::npos);
+  CHECK(valid.out.find("would try gauss 6, gauss 4, mpe 4, triplet 8/3, triplet 2") != std::string::npos);
+  for (const json& bad : {json{{"scheme", "auto"}}, json{{"scheme", "auto"}, {"tolerance", 0.5}},
+                          json{{"scheme", "auto"}, {"tolerance", 1e-6}, {"measure", "both"}},
+                          json{{"scheme", "auto"}, {"tolerance", 1e-6}, {"order", "2"}}}) {
+    job["integrator"] = bad;
+    const auto result = run_nonsep({"validate", write_job(folder / "bad.json", job).string()}, folder.path());
+    CAPTURE(bad.dump());
+    CHECK(result.status == 2);
+    CHECK(result.err.find("/integrator/") != std::string::npos);
+  }
+  job["study"] = {{"integrators", {{{"scheme", "auto"}, {"tolerance", 1e-6}, {"steps", {4}}}}}};
+  job.erase("integrator");
+  job["time"] = {{"t_end", 1.0}};
+  job.erase("output");
+  const auto study = run_nonsep({"validate", write_job(folder / "study.json", job).string()}, folder.path());
+  CHECK(study.status == 2);
+  CHECK(study.err.find("/study/integrators/0/scheme") != std::string::npos);
+}
