@@ -13,7 +13,9 @@
 //                               is formed.
 //   hessian_vector_by_dual      out = H(x) v, one column pass of hessian_by_dual with the outer slot seeded with v
 //                               instead of e_j: the cost of a single Hessian column.
-// Each returns f(x) (the value computed alongside), which poison_if_not_finite uses.
+// Each returns f(x) (the value computed alongside). The adapter's gradients drop it, so that once inlined the work
+// only the value needs is dead code (dual.hpp's derivative rules carry the domains); the other passes give it to
+// poison_if_not_finite.
 //
 // For a model whose gradient g is written as a template over the number type (model_adapter.hpp), the
 // derivatives of g need no capacity K, and their storage is a per-thread buffer of n numbers that grows once:
