@@ -7,7 +7,9 @@
 # without instrumentation loads into an instrumented process. A different compiler: NONSEP_CXX at run time.
 # -O2, not the plugins' -O3: a user waits for the first compile, and -O3 added a sixth to it with no faster steps
 # (docs/formula-models.md, "Measured").
-set(NONSEP_FORMULA_FLAGS -std=c++20 -O2 -DNDEBUG -fPIC -shared -fvisibility=hidden -fvisibility-inlines-hidden)
+# -fno-math-errno as for every plugin (NonsepAddModel.cmake).
+set(NONSEP_FORMULA_FLAGS -std=c++20 -O2 -DNDEBUG -fno-math-errno -fPIC -shared -fvisibility=hidden
+                         -fvisibility-inlines-hidden)
 if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   list(APPEND NONSEP_FORMULA_FLAGS -fno-gnu-unique)
 endif()

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""The progress bar of `nonsep run`: drawn on stderr when stderr is a terminal (here a pseudo-terminal) and the run
+"""The progress of `nonsep run`: a bar drawn on stderr when stderr is a terminal (here a pseudo-terminal) and the run
 takes longer than a second, cleared when the run ends; never drawn with --quiet, nor when stderr is not a terminal.
+When stderr is a file, plain progress lines every --progress-every seconds instead (none with 0, nor with --quiet).
 
 Each run is a job of 10^9 steps stopped with SIGINT (exit 130) once the bar has appeared or, where no bar may
 appear, once the run has written its first checkpoint, which it does after 2 s of its own wall time (past the bar's
@@ -28,7 +29,7 @@ def read_available(master, wait):
     return b""
 
 
-def run(nonsep, job, quiet, terminal, wait_for_bar):
+def run(nonsep, job, quiet, terminal, wait_for_bar, extra=(), stderr_file=None):
     """Runs the job until the bar has appeared (wait_for_bar) or its first checkpoint exists, then sends SIGINT;
     returns the exit status and what was shown on stderr. Gives up waiting after 30 s (the checks then fail)."""
     checkpoint = os.path.splitext(job)[0] + ".out/checkpoint.json"
@@ -36,9 +37,10 @@ def run(nonsep, job, quiet, terminal, wait_for_bar):
         os.remove(checkpoint)
     master, slave = pty.openpty()
     # --force: each run starts over in the folder the previous, interrupted one left with a checkpoint.
-    args = [nonsep, "run", job, "--force"] + (["--quiet"] if quiet else [])
+    args = [nonsep, "run", job, "--force"] + (["--quiet"] if quiet else []) + list(extra)
+    log = open(stderr_file, "wb") if stderr_file else None
     process = subprocess.Popen(args, stdout=subprocess.DEVNULL,
-                               stderr=slave if terminal else subprocess.PIPE, close_fds=True)
+                               stderr=slave if terminal else log or subprocess.PIPE, close_fds=True)
     os.close(slave)
     seen = b""
     deadline = time.monotonic() + 30
@@ -62,6 +64,10 @@ def run(nonsep, job, quiet, terminal, wait_for_bar):
     else:
         _, seen = process.communicate(timeout=30)
         status = process.returncode
+    if log:
+        log.close()
+        with open(stderr_file, "rb") as file:
+            seen = file.read()
     os.close(master)
     return status, seen.decode(errors="replace")
 
@@ -106,6 +112,27 @@ def check(nonsep, job):
     drawn = "\r[" in shown
     if status != 130 or drawn:
         failures.append(f"stderr not a terminal: exit status {status}, bar drawn: {drawn}")
+
+    # stderr to a file: a progress line every 0.5 s; the run lasts past its first checkpoint (2 s), so several.
+    log = os.path.join(os.path.dirname(job), "stderr.log")
+    status, shown = run(nonsep, job, quiet=False, terminal=False, wait_for_bar=False,
+                        extra=["--progress-every", "0.5"], stderr_file=log)
+    lines = [line for line in shown.splitlines() if line.startswith("nonsep: progress: ")]
+    escapes = "\r" in shown or "\x1b" in shown
+    if status != 130 or len(lines) < 2 or escapes:
+        failures.append(f"stderr to a file: exit status {status}, {len(lines)} progress lines, escapes: {escapes}")
+    for line in lines[:1]:
+        for part in ("t = ", " of 1000", "%)", "step ", "/1000000000", "1 active", "max |dH/H0| ", "ETA ", " s"):
+            if part not in line:
+                failures.append(f"stderr to a file: the line {line!r} lacks {part!r}")
+    status, shown = run(nonsep, job, quiet=False, terminal=False, wait_for_bar=False,
+                        extra=["--progress-every", "0"], stderr_file=log)
+    if status != 130 or "progress" in shown:
+        failures.append(f"--progress-every 0: exit status {status}, progress shown: {'progress' in shown}")
+    status, shown = run(nonsep, job, quiet=True, terminal=False, wait_for_bar=False,
+                        extra=["--progress-every", "0.5"], stderr_file=log)
+    if status != 130 or "progress" in shown:
+        failures.append(f"--quiet, stderr to a file: exit status {status}, progress shown: {'progress' in shown}")
 
     for failure in failures:
         print(f"FAIL {failure}", file=sys.stderr)

@@ -58,7 +58,12 @@ int run_command_line(int argc, char** argv) {
     run->add_option("--output,-o", arguments.output,
                     "output folder, relative to the current directory (overrides the job's output.directory)")
         ->check(non_empty_path);
-    run->add_flag("--quiet,-q", arguments.quiet, "no progress bar and no completion line");
+    run->add_flag("--quiet,-q", arguments.quiet, "no progress (bar or lines) and no completion line");
+    run->add_option("--progress-every", arguments.progress_every,
+                    "when stderr is not a terminal (a batch log), a plain progress line every SECONDS (time, percent, "
+                    "max |dH/H0|, ETA); 0: none")
+        ->default_val(10.0)
+        ->check(CLI::NonNegativeNumber);
     run->add_flag("--resume", arguments.resume,
                   "continue an interrupted run from checkpoint.json in its output folder; the outputs end as those of "
                   "an uninterrupted run");
@@ -69,7 +74,7 @@ int run_command_line(int argc, char** argv) {
     run->add_option("--threads,-j", arguments.threads,
                     "worker threads for the ensemble (default: all cores); results are bit-identical for any number")
         ->check(CLI::Range(1u, 4096u));
-    run->footer(schemes_text() + "\n" + exit_status_text());
+    run->footer(scheme_names_text() + "\n" + exit_status_text());
 
     auto* validate = app.add_subcommand(
         "validate", "Check a job without running it: plugin found, parameters valid, dimensions agree");

@@ -14,6 +14,7 @@ struct RunArguments {
   std::string job_file, output;
   bool quiet = false, resume = false, force = false;
   unsigned threads = 0;
+  double progress_every = 10.0;  // seconds between progress lines when stderr is not a terminal; 0: none
 };
 
 struct ExampleArguments {
@@ -57,6 +58,7 @@ int command_schema();
 // Texts of --help, generated from the scheme catalogue and the exit statuses.
 std::string exit_status_text();
 std::string schemes_text();
+std::string scheme_names_text();  // one line: the names, and where each is described
 
 // "nonsep: <every issue>" on stderr; returns the invalid-input status.
 int report_invalid_job(const InvalidJob& error);

@@ -130,6 +130,13 @@ int command_inspect(const InspectArguments& arguments) {
     std::cout << plugin->metadata().dump(2) << "\n";
   else
     std::cout << describe_plugin(*plugin);
+  if (!arguments.as_json) {
+    try {
+      std::cout << describe_derivative_costs(*plugin, plugin->create(json::object()));
+    } catch (const std::exception& error) {
+      std::cout << "  cost per call: not measured (no instance at the default parameters: " << error.what() << ")\n";
+    }
+  }
   if (!arguments.check) return to_int(ExitStatus::success);
   try {
     return check(*plugin, arguments, arguments.as_json ? std::cerr : std::cout);

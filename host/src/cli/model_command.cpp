@@ -47,6 +47,24 @@ int command_model_compile(const ModelCompileArguments& arguments) {
   }
 }
 
+namespace {
+
+// The parameters a run would use: each declared one at the job's value, else at its default; those at their default
+// are named after the object ("{"c": 0.5, "d": 1} (d by default)").
+std::string parameters_with_defaults(const nlohmann::json& given, const std::vector<PluginParameter>& declared) {
+  nlohmann::json used = nlohmann::json::object();
+  std::string defaults;
+  for (const PluginParameter& parameter : declared) {
+    const bool set = given.contains(parameter.name);
+    used[parameter.name] = set ? given[parameter.name] : parameter.default_value;
+    if (!set) defaults += (defaults.empty() ? "" : ", ") + parameter.name;
+  }
+  if (defaults.empty()) return used.dump();
+  return used.dump() + " (" + defaults + (given.empty() ? ": the model's defaults)" : " by default)");
+}
+
+}  // namespace
+
 std::optional<Job> read_formula_job(const std::string& job_file) {
   std::vector<JobIssue> issues;
   auto job = read_job(job_file, issues);
@@ -65,9 +83,10 @@ int report_formula_job(const std::string& job_file, const Job& job) {
   std::cout << "valid: " << job_file << "\n"
             << "  model:       formula '" << model.name << "', dimension " << model.dimension
             << (model.file.empty() ? "" : " (" + model.file.string() + ")") << "\n"
-            << "    T = " << model.T << "\n"
-            << "    V = " << model.V << "\n"
-            << "  parameters:  " << job.parameters.dump() << (job.sweep.empty() ? "" : " and the sweep") << "\n"
+            << "    " << (model.t_gradient.empty() ? "T = " : "") << model.T << "\n"
+            << "    " << (model.v_gradient.empty() ? "V = " : "") << model.V << "\n"
+            << "  parameters:  " << parameters_with_defaults(job.parameters, formula::declared_parameters(model))
+            << (job.sweep.empty() ? "" : " and the sweep") << "\n"
             << sweep_text(job, false)
             << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "
                "(initial states on an energy shell, the gradient check) is checked then\n";

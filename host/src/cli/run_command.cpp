@@ -217,6 +217,10 @@ std::string counts_text(const StatusCounts& counts) {
   return text;
 }
 
+bool ran_off(const RunOutcome& outcome, std::size_t trajectory) {
+  return trajectory < outcome.runaways.size() && outcome.runaways[trajectory].has_value();
+}
+
 // One line per trajectory that stopped early, up to a screenful (an ensemble may have thousands; trajectories.csv
 // has them all), and a warning when the energy error grew large.
 void report_trajectories(const RunOutcome& outcome, const std::filesystem::path& directory) {
@@ -227,8 +231,9 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
     if (!stopped_early(trajectory.status) || ++stopped > shown_at_most) continue;
     if (trajectory.status == TrajectoryStatus::diverged)
       std::cerr << "nonsep: trajectory " << index << " diverged at step " << trajectory.stop_step
-                << ", t = " << format_number(trajectory.stop_t) << " (" << trajectory.stop_variable
-                << " is not finite)\n";
+                << ", t = " << format_number(trajectory.stop_t) << " (" << trajectory.stop_variable << " is not finite)"
+                << (ran_off(outcome, index) ? " after running off: " + runaway_text(*outcome.runaways[index]) : "")
+                << "\n";
     else
       std::cerr << "nonsep: trajectory " << index << " " << to_string(trajectory.status) << ": " << trajectory.message
                 << "\n";
@@ -236,12 +241,24 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
   if (stopped > shown_at_most)
     std::cerr << "nonsep: ... and " << stopped - shown_at_most << " more trajectories that stopped early; "
               << (directory / "trajectories.csv").string() << " lists them all\n";
+  std::size_t ran_off_unreported = 0;  // ran off without diverging: a warning each, up to a few
+  for (std::size_t index = 0; index < outcome.runaways.size(); ++index) {
+    if (!ran_off(outcome, index) || outcome.trajectories[index].status == TrajectoryStatus::diverged) continue;
+    if (++ran_off_unreported <= 3)
+      std::cerr << "nonsep: warning: trajectory " << index << ": " << runaway_text(*outcome.runaways[index]) << "\n";
+  }
+  if (ran_off_unreported > 3)
+    std::cerr << "nonsep: warning: ... and " << ran_off_unreported - 3 << " more trajectories ran off the same way\n";
   if (const auto& largest = outcome.largest_energy_error; largest && largest->value > warn_relative_energy_error)
     std::cerr << "nonsep: warning: the relative energy error |dH/H0| reached " << format_number(largest->value)
               << " (trajectory " << largest->trajectory << "), above " << format_number(warn_relative_energy_error)
-              << ": the results are not accurate; use a smaller dt or a higher order "
-                 "(analysis.max_relative_energy_error stops trajectories past a bound), or, if it does not shrink "
-                 "with dt, check the plugin's derivatives with `nonsep inspect PLUGIN --check`\n";
+              << ": the results are not accurate; "
+              << (ran_off(outcome, largest->trajectory)
+                      ? "that trajectory ran off with bounded energy first (above): the energy shell may be "
+                        "non-compact, which a smaller dt or a higher order only delays\n"
+                      : "use a smaller dt or a higher order (analysis.max_relative_energy_error stops trajectories "
+                        "past a bound), or, if it does not shrink with dt, check the plugin's derivatives with "
+                        "`nonsep inspect PLUGIN --check`\n");
 }
 
 // Runs `run` (run_job or run_study) with SIGINT and SIGTERM caught. Nothing, after saying why on stderr, when it
@@ -362,7 +379,11 @@ int command_run(const RunArguments& arguments) {
   RunOptions options;
   options.output_directory =
       arguments.output.empty() ? loaded->job.output_directory : std::filesystem::path(arguments.output);
-  options.show_progress = !arguments.quiet && stderr_is_terminal() && ranks->size() == 1;
+  if (!arguments.quiet && ranks->size() == 1)
+    options.progress = stderr_is_terminal()           ? ProgressStyle::bar
+                       : arguments.progress_every > 0 ? ProgressStyle::lines
+                                                      : ProgressStyle::none;
+  options.progress_interval = arguments.progress_every;
   options.stop_requested = &stop_requested;
   options.resume = arguments.resume;
   options.force = arguments.force;

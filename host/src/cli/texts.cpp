@@ -38,6 +38,13 @@ std::string schemes_text() {
   return text;
 }
 
+std::string scheme_names_text() {
+  std::string names;
+  for (const auto& scheme : scheme_catalogue()) names += (names.empty() ? "" : ", ") + scheme.name;
+  return "Integrator schemes: " + names +
+         " (`nonsep --help` describes each with its options; docs/user-guide.md, \"Integrator schemes\").\n";
+}
+
 int report_invalid_job(const InvalidJob& error) {
   std::cerr << "nonsep: " << error.what() << "\n";
   return to_int(ExitStatus::invalid_input);

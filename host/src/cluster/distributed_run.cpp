@@ -278,7 +278,7 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
         if (state == UnitState::done) continue;  // verified by rank 0 at the start and before the merge
         RunOptions unit_options = options;
         unit_options.output_directory = path;
-        unit_options.show_progress = false;
+        unit_options.progress = ProgressStyle::none;
         unit_options.work_unit = true;
         unit_options.resume = state == UnitState::checkpointed;
         unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over

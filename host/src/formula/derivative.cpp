@@ -15,9 +15,9 @@ namespace {
 using Kind = Node::Kind;
 using Terms = std::vector<std::pair<char, Node>>;  // sign ('+' '-' in sums, '*' '/' in products) and operand
 
-constexpr std::array<std::string_view, 6> derivative_rules = {"log_derivative", "log1p_derivative",
-                                                              "abs_derivative", "min_derivative",
-                                                              "max_derivative", "pow_exponent_derivative"};
+constexpr std::array<std::string_view, 8> derivative_rules = {
+    "log_derivative", "log1p_derivative", "acosh_derivative", "atanh_derivative",
+    "abs_derivative", "min_derivative",   "max_derivative",   "pow_exponent_derivative"};
 
 Node number(double value) { return Node{.kind = Kind::number, .value = value}; }
 
@@ -134,11 +134,11 @@ Node function_derivative(const std::string& f, const Node& u) {
   const auto sqrt_of = [&](Node x) { return reciprocal(call("sqrt", {std::move(x)})); };
   if (f == "abs") return call_u("abs_derivative");
   if (f == "acos") return negate(sqrt_of(sum({{'+', number(1.0)}, {'-', square(u)}})));
-  if (f == "acosh") return sqrt_of(sum({{'+', square(u)}, {'-', number(1.0)}}));
+  if (f == "acosh") return call_u("acosh_derivative");
   if (f == "asin") return sqrt_of(sum({{'+', number(1.0)}, {'-', square(u)}}));
   if (f == "asinh") return sqrt_of(sum({{'+', square(u)}, {'+', number(1.0)}}));
   if (f == "atan") return reciprocal(sum({{'+', number(1.0)}, {'+', square(u)}}));
-  if (f == "atanh") return reciprocal(sum({{'+', number(1.0)}, {'-', square(u)}}));
+  if (f == "atanh") return call_u("atanh_derivative");
   if (f == "cbrt") return reciprocal(times(number(3.0), square(call_u("cbrt"))));
   if (f == "cos") return negate(call_u("sin"));
   if (f == "cosh") return call_u("sinh");

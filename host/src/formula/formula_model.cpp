@@ -15,7 +15,7 @@ using job_reader::Checker;
 using nlohmann::json;
 
 constexpr std::size_t max_model_file_bytes = std::size_t{1} << 20;
-const std::vector<std::string> formula_keys = {"name", "T", "V", "K", "U", "parameters", "dimension"};
+const std::vector<std::string> formula_keys = {"name", "T", "V", "dT", "dV", "K", "U", "parameters", "dimension"};
 
 bool is_plugin_name(const std::string& name) {
   if (name.empty() || name.size() > 64 || !(name[0] == '_' || (name[0] >= 'a' && name[0] <= 'z'))) return false;
@@ -23,19 +23,20 @@ bool is_plugin_name(const std::string& name) {
                      [](char c) { return c == '_' || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); });
 }
 
-// One of T and V: parsed against its variable letter and the parameters; an issue quoting it on failure.
-std::optional<Node> read_term(Checker& check, const json& object, const std::string& pointer, const char* key,
-                              const Symbols& symbols, bool required = true) {
-  const std::string what = std::string("a formula of ") + (symbols.variable == 'q' ? "q0, q1, ..." : "p0, p1, ...") +
-                           " (the formula grammar: docs/formula-models.md)";
-  const json* value = check.member(object, pointer, key, required, what);
-  if (!value) return std::nullopt;
-  const std::string path = job_reader::child(pointer, key);
-  if (!value->is_string()) {
-    check.issue(path, job_reader::describe(*value), what);
+std::string formula_of(const Symbols& symbols) {
+  return std::string("a formula of ") + (symbols.variable == 'q' ? "q0, q1, ..." : "p0, p1, ...") +
+         " (the formula grammar: docs/formula-models.md)";
+}
+
+// The formula `value` at `path`, parsed against its variable letter and the parameters; an issue quoting it on
+// failure.
+std::optional<Node> parse_at(Checker& check, const json& value, const std::string& path, const Symbols& symbols) {
+  const std::string what = formula_of(symbols);
+  if (!value.is_string()) {
+    check.issue(path, job_reader::describe(value), what);
     return std::nullopt;
   }
-  const std::string& text = value->get_ref<const std::string&>();
+  const std::string& text = value.get_ref<const std::string&>();
   auto result = parse_formula(text, symbols);
   if (const auto* error = std::get_if<FormulaError>(&result)) {
     check.issue(path,
@@ -45,6 +46,66 @@ std::optional<Node> read_term(Checker& check, const json& object, const std::str
     return std::nullopt;
   }
   return std::get<Node>(std::move(result));
+}
+
+// One of T, V, K and U.
+std::optional<Node> read_term(Checker& check, const json& object, const std::string& pointer, const char* key,
+                              const Symbols& symbols, bool required = true) {
+  const json* value = check.member(object, pointer, key, required, formula_of(symbols));
+  if (!value) return std::nullopt;
+  return parse_at(check, *value, job_reader::child(pointer, key), symbols);
+}
+
+// "dT" or "dV": an array of formulas, one per component of the gradient; each parsed as read_term parses T or V.
+std::optional<std::vector<Node>> read_gradient(Checker& check, const json& object, const std::string& pointer,
+                                               const char* key, const Symbols& symbols) {
+  const json* value = check.member(object, pointer, key, false, "");
+  if (!value) return std::nullopt;
+  const std::string path = job_reader::child(pointer, key);
+  const std::string what = std::string("an array of 1 to ") + std::to_string(max_formula_dimension) + " formulas of " +
+                           (symbols.variable == 'q' ? "q0, q1, ..." : "p0, p1, ...") +
+                           ", component i the derivative by " + symbols.variable + "i";
+  if (!value->is_array() || value->empty() || value->size() > max_formula_dimension) {
+    check.issue(path, job_reader::describe(*value), what);
+    return std::nullopt;
+  }
+  std::vector<Node> components;
+  for (std::size_t i = 0; i < value->size(); ++i)
+    if (auto tree = parse_at(check, (*value)[i], job_reader::child(path, i), symbols))
+      components.push_back(std::move(*tree));
+  if (components.size() != value->size()) return std::nullopt;
+  return components;
+}
+
+// "grad T = [a, b]": the canonical text of a function given by its gradient.
+std::string gradient_text(const char* function, const std::vector<Node>& gradient) {
+  std::string text;
+  for (const Node& component : gradient) text += (text.empty() ? "" : ", ") + print(component);
+  return std::string("grad ") + function + " = [" + text + "]";
+}
+
+// T or V, or its gradient dT or dV (exactly one of the two), into `tree` or `gradient`; false after an issue.
+bool read_function(Checker& check, const json& object, const std::string& pointer, const char* key,
+                   const Symbols& symbols, Node& tree, std::vector<Node>& gradient, std::string& text) {
+  const std::string gradient_key = std::string("d") + key;
+  const bool has_function = object.contains(key), has_gradient = object.contains(gradient_key);
+  if (has_function && has_gradient) {
+    check.issue(job_reader::child(pointer, gradient_key), std::string("both ") + key + " and " + gradient_key,
+                std::string("one of them: ") + key + " or its gradient " + gradient_key);
+    return false;
+  }
+  if (has_gradient) {
+    auto components = read_gradient(check, object, pointer, gradient_key.c_str(), symbols);
+    if (!components) return false;
+    gradient = std::move(*components);
+    text = gradient_text(key, gradient);
+    return true;
+  }
+  auto function = read_term(check, object, pointer, key, symbols);
+  if (!function) return false;
+  tree = std::move(*function);
+  text = print(tree);
+  return true;
 }
 
 std::shared_ptr<const FormulaModel> read_object(const json& object, const std::string& pointer,
@@ -81,17 +142,17 @@ std::shared_ptr<const FormulaModel> read_object(const json& object, const std::s
     }
   }
   symbols.variable = 'p';
-  auto t_tree = read_term(check, object, pointer, "T", symbols);
+  const bool has_t = read_function(check, object, pointer, "T", symbols, model.t_tree, model.t_gradient, model.T);
   model.k_tree = read_term(check, object, pointer, "K", symbols, false);
   symbols.variable = 'q';
-  auto v_tree = read_term(check, object, pointer, "V", symbols);
+  const bool has_v = read_function(check, object, pointer, "V", symbols, model.v_tree, model.v_gradient, model.V);
   model.u_tree = read_term(check, object, pointer, "U", symbols, false);
-  if (!t_tree || !v_tree || check.issue_count() != before) return nullptr;
-  model.t_tree = std::move(*t_tree);
-  model.v_tree = std::move(*v_tree);
-  model.T = print(model.t_tree);
-  model.V = print(model.v_tree);
+  if (!has_t || !has_v || check.issue_count() != before) return nullptr;
   std::size_t used = std::max({dimension_used(model.t_tree), dimension_used(model.v_tree), std::size_t{1}});
+  for (const auto* gradient : {&model.t_gradient, &model.v_gradient}) {
+    used = std::max(used, gradient->size());
+    for (const Node& component : *gradient) used = std::max(used, dimension_used(component));
+  }
   if (model.k_tree) {
     model.K = print(*model.k_tree);
     used = std::max(used, dimension_used(*model.k_tree));
@@ -108,6 +169,11 @@ std::shared_ptr<const FormulaModel> read_object(const json& object, const std::s
                                          " (the largest variable index used, plus one) to " +
                                          std::to_string(max_formula_dimension)))
       model.dimension = static_cast<std::size_t>(*n);
+  for (const auto& [key, gradient] : {std::pair{"dT", &model.t_gradient}, std::pair{"dV", &model.v_gradient}})
+    if (!gradient->empty() && gradient->size() != model.dimension)
+      check.issue(job_reader::child(pointer, key), std::to_string(gradient->size()) + " components",
+                  "one component per variable: " + std::to_string(model.dimension) +
+                      " (the model's dimension: the largest variable index used plus one, or \"dimension\")");
   if (check.issue_count() != before) return nullptr;
   return std::make_shared<const FormulaModel>(std::move(model));
 }
@@ -186,7 +252,9 @@ nlohmann::ordered_json formula_schema() {
        "A model written as formulas, compiled on first use into a cached plugin "
        "(docs/formula-models.md)."},
       {"additionalProperties", false},
-      {"required", {"T", "V"}},
+      {"allOf",
+       {{{"oneOf", {{{"required", {"T"}}}, {{"required", {"dT"}}}}}},
+        {{"oneOf", {{{"required", {"V"}}}, {{"required", {"dV"}}}}}}}},
       {"properties",
        {{"name",
          {{"type", "string"},
@@ -206,6 +274,21 @@ nlohmann::ordered_json formula_schema() {
           {"minLength", 1},
           {"maxLength", max_formula_length},
           {"description", "V(q): as T, with q0, q1, ... instead of p0, p1, ...."}}},
+        {"dT",
+         {{"type", "array"},
+          {"minItems", 1},
+          {"maxItems", max_formula_dimension},
+          {"items", {{"type", "string"}, {"minLength", 1}, {"maxLength", max_formula_length}}},
+          {"description",
+           "Instead of T: its gradient, one formula of p0, p1, ... per component (dT/dp0, dT/dp1, ...). H_TTV and "
+           "H_VVT need only the gradient and Hessian of T; its value is then not available (value_T throws). "
+           "The run refuses a dT whose Jacobian is not symmetric at the initial states (not a gradient)."}}},
+        {"dV",
+         {{"type", "array"},
+          {"minItems", 1},
+          {"maxItems", max_formula_dimension},
+          {"items", {{"type", "string"}, {"minLength", 1}, {"maxLength", max_formula_length}}},
+          {"description", "Instead of V: its gradient, as dT with q0, q1, ...."}}},
         {"K",
          {{"type", "string"},
           {"minLength", 1},

@@ -1,12 +1,15 @@
 // The check of a plugin's gradients at a job's initial states (load_model, so `nonsep run` and `nonsep validate`):
-// grad T and grad V against 5-point finite differences of value_T and value_V (the SDK's derivative checker,
-// nonsep/derivative_checker.hpp), at up to gradient_check_states states spread evenly over the ensemble, on an
-// instance of the plugin of its own (the run's instance, and any call counts it keeps, are left alone).
+// for n > 1 the Hessians of T and V symmetric (the gradients are gradients of functions: a formula's dT and dV are
+// checked this way), and grad T and grad V against 5-point finite differences of value_T and value_V (the SDK's
+// derivative checker, nonsep/derivative_checker.hpp), at up to gradient_check_states states spread evenly over the
+// ensemble, on an instance of the plugin of its own (the run's instance, and any call counts it keeps, are left alone).
+#include <algorithm>
 #include <cmath>
 #include <exception>
 
 #include "checker.hpp"
 #include "nonsep/derivative_checker.hpp"
+#include "nonsep/host/formula/formula_model.hpp"
 
 namespace nonsep::host {
 
@@ -25,13 +28,60 @@ std::string vector_text(const std::vector<double>& x) {
   return "(" + text + ")";
 }
 
+// The Hessian of T (kinetic) or V at `x`, which must be symmetric: it is the Jacobian of the gradient, and a gradient
+// that is not one of any function (a formula's dT or dV, a gradient template) has an asymmetric Jacobian. An issue
+// at the first asymmetric pair beyond rounding; false then.
+bool check_symmetry(const LoadedJob& loaded, const PluginModel& model, bool kinetic, const std::vector<double>& x,
+                    std::size_t state, std::vector<JobIssue>& issues) {
+  const std::size_t n = x.size();
+  std::vector<double> hessian(n * n);
+  try {
+    kinetic ? model.hessian_T(x, hessian, 1) : model.hessian_V(x, hessian, 1);
+  } catch (const std::exception&) {
+    return true;  // the model cannot be evaluated there: the run reports it for that trajectory
+  }
+  const char letter = kinetic ? 'p' : 'q';
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const double a = hessian[i * n + j], b = hessian[j * n + i];
+      if (!std::isfinite(a) || !std::isfinite(b) || std::abs(a - b) <= 1e-8 * std::max({1.0, std::abs(a), std::abs(b)}))
+        continue;
+      const std::string at = " at initial state " + std::to_string(state) + " (" + letter + " = " + vector_text(x) +
+                             ") is not symmetric: ";
+      const auto& formula = loaded.job.formula;
+      const bool given = formula && !(kinetic ? formula->t_gradient : formula->v_gradient).empty();
+      const std::string key = kinetic ? "dT" : "dV";
+      const auto d = [&](std::size_t component, std::size_t by, double value) {
+        return "d " + key + "[" + std::to_string(component) + "] / d" + letter + std::to_string(by) + " = " +
+               DerivativeCheckReport::scientific(value, 6);
+      };
+      if (given)
+        issues.push_back({formula->file.empty() ? "/model/formula/" + key : formula->file.string() + "#/" + key,
+                          "the Jacobian of " + key + at + d(j, i, a) + " but " + d(i, j, b) + ", so " + key +
+                              " is not the gradient of any function",
+                          std::string("the gradient of a function ") + (kinetic ? "T(p)" : "V(q)") +
+                              " (whose Jacobian, the Hessian, is symmetric): check the components, or give " +
+                              (kinetic ? "T" : "V") + " itself"});
+      else
+        issues.push_back({"/model/plugin",
+                          "the plugin '" + loaded.plugin.name() + "', whose " + (kinetic ? "hessian_T" : "hessian_V") +
+                              at + "[" + std::to_string(i) + "][" + std::to_string(j) +
+                              "] = " + DerivativeCheckReport::scientific(a, 6) + " but [" + std::to_string(j) + "][" +
+                              std::to_string(i) + "] = " + DerivativeCheckReport::scientific(b, 6),
+                          "a plugin whose gradients are gradients of functions (their Jacobians, the Hessians, are "
+                          "symmetric); `nonsep inspect " +
+                              loaded.plugin.path().string() + " --check` compares them with finite differences"});
+      return false;
+    }
+  return true;
+}
+
 }  // namespace
 
 void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobIssue>& issues) {
   const InitialStates& initial = loaded.job.initial;
   const std::size_t n = loaded.model.dimension();
-  if (!loaded.plugin.has_values() || n == 0 || n > gradient_check_largest_dimension || initial.count == 0 ||
-      initial.q.size() != initial.count * n)
+  if (n == 0 || n > gradient_check_largest_dimension || initial.count == 0 || initial.q.size() != initial.count * n)
     return;
   std::optional<PluginModel> own;
   try {
@@ -47,6 +97,10 @@ void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobI
                                  x.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));
     };
     for (const bool kinetic : {true, false}) {
+      if (n > 1 && loaded.plugin.has_hessians() &&
+          !check_symmetry(loaded, *own, kinetic, at(kinetic ? initial.p : initial.q), state, issues))
+        return;
+      if (!loaded.plugin.has_values()) continue;
       DerivativeCheckOptions options;
       options.random_points = 0;
       options.points = {at(kinetic ? initial.p : initial.q)};

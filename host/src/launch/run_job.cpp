@@ -167,6 +167,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   outcome.status = run_status(end, outcome.counts);
   outcome.exit_status = exit_status_of(outcome.status);
   outcome.largest_energy_error = plan.energy.largest();
+  outcome.runaways = plan.runaway.runaways();
   if (!loaded.plugin.thread_safe() && options.threads != 1)
     outcome.notes.push_back("ran on one thread: the plugin '" + loaded.plugin.name() +
                             "' declares \"thread_safe\": false (plugin_abi.h)");

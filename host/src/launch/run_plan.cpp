@@ -69,7 +69,9 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
       resumed_(resumed_state(loaded, options)),
       driver(loaded.plugin, loaded.model, driver_setup(loaded, options)),
       energy(loaded.job.initial.count, driver.energy_available() ? loaded.job.run().energy_every : 0,
-             loaded.job.run().analysis.max_relative_energy_error) {
+             loaded.job.run().analysis.max_relative_energy_error),
+      runaway(loaded.job.initial.q, loaded.job.initial.p, loaded.job.initial.count, loaded.job.initial.dimension,
+              driver.time().t_end) {
   const Job& job = loaded.job;
   const SingleRun& run = job.run();
   const std::size_t count = job.initial.count;
@@ -105,6 +107,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   else
     remove_stale(directory / ErrorEstimateObserver::file_name);
   observers.push_back(&energy);
+  observers.push_back(&runaway);
   if (chaos) observers.push_back(&*chaos);
   if (closest) observers.push_back(&*closest);
   if (samples) observers.push_back(&*samples);
@@ -115,7 +118,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (estimate) observers.push_back(&*estimate);
   saver.emplace(directory / checkpoint_file_name, job_fingerprint(loaded), stepping_identity(loaded), run.checkpoint,
                 driver, observers);
-  progress.emplace(options.show_progress, driver, &energy);
+  progress.emplace(options.progress, options.progress_interval, driver, &energy);
   for (Observer* observer : observers) driver.add_observer(*observer);
   driver.add_observer(*saver);
   driver.add_observer(*progress);

@@ -20,6 +20,7 @@
 #include "nonsep/host/observers/lyapunov_megno.hpp"
 #include "nonsep/host/observers/poincare_section.hpp"
 #include "nonsep/host/observers/progress.hpp"
+#include "nonsep/host/observers/runaway.hpp"
 #include "nonsep/host/observers/sample_writer.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -46,6 +47,7 @@ class RunPlan {
  public:
   EnsembleDriver driver;
   EnergyErrorObserver energy;
+  RunawayObserver runaway;
   std::optional<ClosestReturnObserver> closest;
   std::optional<SampleWriter> samples;
 #ifdef NONSEP_HAVE_HDF5

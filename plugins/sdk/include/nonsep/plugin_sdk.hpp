@@ -157,6 +157,7 @@ class PluginTable {
                                  {"d3V", kind(Adapter::analytic_d3V)},
                                  {"hvp_T", kind(Adapter::analytic_hvp_T)},
                                  {"hvp_V", kind(Adapter::analytic_hvp_V)}}},
+                               {"automatic_differentiation", automatic_differentiation_text<Adapter>()},
                                {"kernels", {{"instruction_sets", kernel_sets}}}};
     for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
     for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
@@ -400,6 +401,10 @@ class PluginTable {
 
 // As NONSEP_EXPORT_MODEL, choosing the derivative policy (::nonsep::sdk::Derivatives::automatic ignores the
 // class's analytic derivatives; used to compare the two).
+#if NONSEP_SDK_KERNEL_UNIT != 0  // a unit of the wider kernels alone (kernels.hpp)
+#define NONSEP_EXPORT_MODEL_WITH_DERIVATIVES(Model, policy, name, version, description, hamiltonian) \
+  NONSEP_SDK_DEFINE_KERNEL_UNIT(::nonsep::sdk::ModelAdapter<Model, policy>)
+#else
 #define NONSEP_EXPORT_MODEL_WITH_DERIVATIVES(Model, policy, name, version, description, hamiltonian) \
   namespace {                                                                                        \
   struct nonsep_exported_model_identity {                                                            \
@@ -407,3 +412,4 @@ class PluginTable {
   };                                                                                                 \
   }                                                                                                  \
   NONSEP_DEFINE_PLUGIN((::nonsep::sdk::PluginTable<Model, policy, nonsep_exported_model_identity>::api))
+#endif

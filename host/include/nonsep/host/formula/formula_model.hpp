@@ -3,6 +3,10 @@
 //   {"name": "pdm_oscillator",                      optional: the plugin's name, [a-z_][a-z0-9_]*, default "formula"
 //    "T": "p0^2 / (2 * (1 + alpha * ...))",         required: T(p), a formula of p0, p1, ... (expression.hpp)
 //    "V": "q0^2 / 4",                               required: V(q), a formula of q0, q1, ...
+//    "dT": ["sqrt((1 + p0^2)/2)", ...],             instead of T: its gradient, n formulas of p (one per p_i)
+//    "dV": [...],                                   instead of V: its gradient, n formulas of q
+//                                                   (H_TTV and H_VVT need the gradients and Hessians of T and V,
+//                                                   never their values; the plugin's value_T, value_V then throw)
 //    "K": "...", "U": "alpha^2 * q0^2 / 2",         optional: a separable part K(p) + U(q) of H
 //                                                   (H = T_i V_ij T_j + K + U, nonsep/sdk/model_adapter.hpp)
 //    "parameters": {"alpha": 0.5},                  optional: names (is_parameter_name) and their default values
@@ -29,6 +33,9 @@ struct FormulaModel {
   std::string name = "formula";
   std::string T, V;  // canonical text (print) of the trees: what the metadata and summary.json show
   Node t_tree, v_tree;
+  // When given by their gradients ("dT", "dV"): n trees each, and T (V) is "grad T = [..., ...]", t_tree (v_tree)
+  // unused. Empty otherwise.
+  std::vector<Node> t_gradient, v_gradient;
   std::string K, U;  // the separable part's canonical text; empty when absent
   std::optional<Node> k_tree, u_tree;
   std::vector<std::pair<std::string, double>> parameters;  // in the order of the JSON object (by name)
@@ -48,8 +55,8 @@ std::shared_ptr<const FormulaModel> read_formula_file(const std::filesystem::pat
 // The JSON Schema of /model/formula (the job schema's $defs/formula).
 nlohmann::ordered_json formula_schema();
 
-// What summary.json records of a formula model: {"T", "V" (canonical), "parameters" (defaults), "dimension",
-// "file" (the model file, or null), "cache_key"}.
+// What summary.json records of a formula model: {"T", "V" (canonical; "grad T = [...]" when given by "dT"),
+// "parameters" (defaults), "dimension", "file" (the model file, or null), "cache_key"}.
 nlohmann::json formula_record(const FormulaModel& model, const std::string& cache_key);
 
 // The formula's parameters as the plugin metadata will declare them (for checking a job's /model/parameters

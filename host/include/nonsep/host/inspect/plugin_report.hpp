@@ -13,6 +13,12 @@ namespace nonsep::host {
 // parameters with type, default, range, unit and description. Several lines, each ending in '\n'.
 std::string describe_plugin(const Plugin& plugin);
 
+// `nonsep inspect`'s costs: how the derivatives are obtained (the metadata's "automatic_differentiation", when the
+// plugin says) and, for each derivative function the plugin has, its time per state of one call: the function
+// called on a batch of up to 32 states (seeded points in [-1, 1]^n) for about 10 ms. A function that throws there
+// shows "not measured: <message>"; Hessians are left out above n = 1024. Several lines, each ending in '\n'.
+std::string describe_derivative_costs(const Plugin& plugin, const PluginModel& model);
+
 // One line for `nonsep models`: "name  version  dimension  path  description", or "path  error" for a file that
 // failed to load. No trailing newline.
 std::string describe_discovered(const DiscoveredPlugin& discovered);

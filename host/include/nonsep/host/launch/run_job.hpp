@@ -25,6 +25,8 @@
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/observers/energy_error.hpp"
+#include "nonsep/host/observers/progress_bar.hpp"
+#include "nonsep/host/observers/runaway.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
@@ -33,8 +35,9 @@ namespace nonsep::host {
 enum class DriverEnd;  // ensemble_driver.hpp
 
 struct RunOptions {
-  std::filesystem::path output_directory;  // created if missing
-  bool show_progress = false;              // draw a ProgressBar on stderr (the caller checks for a terminal)
+  std::filesystem::path output_directory;        // created if missing
+  ProgressStyle progress = ProgressStyle::none;  // on stderr (progress_bar.hpp; the caller checks for a terminal)
+  double progress_interval = 10.0;               // seconds between progress lines (ProgressStyle::lines)
   // Checked between chunks (a fraction of a second apart); when true the run stops with status "interrupted"
   // (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;
@@ -66,6 +69,7 @@ struct RunOutcome {
   StatusCounts counts;
   std::vector<TrajectoryRecord> trajectories;              // one per trajectory, in job order
   std::optional<LargestEnergyError> largest_energy_error;  // over the steps where H was evaluated
+  std::vector<std::optional<Runaway>> runaways;            // per trajectory: ran off with bounded energy (runaway.hpp)
   nlohmann::ordered_json summary;                          // what summary.json holds
   std::vector<std::string> notes;                          // for the user, not errors (e.g. "ran on one thread: ...")
   // Spread over work units (cluster/distributed_run.hpp): `trajectories` is empty (trajectories.csv has them).

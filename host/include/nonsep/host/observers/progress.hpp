@@ -1,6 +1,6 @@
 #pragma once
-// The progress bar (progress_bar.hpp) as an observer: redrawn after chunks, with the step, the active trajectories
-// and the largest relative energy error so far.
+// The run's progress (progress_bar.hpp: a bar on a terminal, plain lines in a file) as an observer: updated after
+// chunks, with the step, the active trajectories and the largest relative energy error so far.
 #include "nonsep/host/observers/energy_error.hpp"
 #include "nonsep/host/observers/progress_bar.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -11,8 +11,12 @@ namespace nonsep::host {
 class ProgressObserver : public Observer, public ChunkObserver {
  public:
   // `energy` may be null.
-  ProgressObserver(bool enabled, const EnsembleDriver& driver, const EnergyErrorObserver* energy)
-      : enabled_(enabled), bar_(enabled, driver.time().steps), driver_(driver), energy_(energy) {}
+  ProgressObserver(ProgressStyle style, double interval_seconds, const EnsembleDriver& driver,
+                   const EnergyErrorObserver* energy)
+      : enabled_(style != ProgressStyle::none),
+        bar_(style, driver.time().steps, driver.time().t_end, interval_seconds),
+        driver_(driver),
+        energy_(energy) {}
 
   void after_chunk(std::uint64_t step) override {
     if (!enabled_) return;

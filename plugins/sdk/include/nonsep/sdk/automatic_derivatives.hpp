@@ -17,7 +17,9 @@
 //                               slots seeded with a and b
 //   mixed_fourth_by_dual        out_k = sum_ijl f_kijl(x) a_i b_j c_l, one pass of FourthDerivativeDual<K> with the
 //                               three outer slots seeded with a, b and c: 8 (K+1) doubles per number
-// Each returns f(x) (the value computed alongside), which poison_if_not_finite uses.
+// Each returns f(x) (the value computed alongside). The adapter's gradients drop it, so that once inlined the work
+// only the value needs is dead code (dual.hpp's derivative rules carry the domains); the other passes give it to
+// poison_if_not_finite.
 //
 // For a model whose gradient g is written as a template over the number type (model_adapter.hpp), the
 // derivatives of g need no capacity K, and their storage is a per-thread buffer of n numbers that grows once:

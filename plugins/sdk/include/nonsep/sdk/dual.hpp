@@ -20,7 +20,9 @@
 //   pow(x, double)  pow(x, y)  pow(double, y)  min max
 // where the two-argument functions (atan2, hypot, pow, min, max) take two duals or a dual and a double.
 // Functions with an infinite derivative at a point (sqrt(0), abs(0), acosh(1), ...) give inf or NaN derivatives
-// there; outside its domain (log(-1), acosh(0.5)) a function's value and derivatives are NaN. Non-finite results
+// there; outside its domain (log(-1), acosh(0.5), atanh(2)) a function's value and derivatives are NaN: each
+// function's derivative rule says so itself, so a derivative never needs the value of the whole function (a
+// gradient pass leaves the value unused, and the compiler drops the work only the value needs). Non-finite results
 // are numbers, not failures: the SDK's adapter (model_adapter.hpp) returns them as computed and the host reports
 // the trajectory as diverged. min and max at a tie take the first argument's derivatives; pow(x, y) has
 // derivative 0 in y at x <= 0 (see pow).
@@ -200,6 +202,8 @@ using std::tanh;
 // gradients nonsep writes for formula models (docs/formula-models.md), for double and duals alike:
 //   log_derivative(x)     1/x, NaN below 0 (where log is NaN: 1/x would pretend a derivative exists there)
 //   log1p_derivative(x)   1/(1 + x), NaN below -1 (as for log)
+//   acosh_derivative(x)   1/sqrt(x^2 - 1), NaN below 1 (acosh is NaN there, though the formula is finite below -1)
+//   atanh_derivative(x)   1/(1 - x^2), NaN outside [-1, 1] (atanh is NaN there, the formula finite)
 //   abs_derivative(x)     sign(x), NaN at 0 (|x| has no derivative there: a trajectory reaching it diverges)
 //   pow_exponent_derivative(x, r)   d/dy x^y = r log x with r = x^y, taken as 0 for x <= 0 (see pow below)
 //   min_derivative(a, b, da, db), max_derivative(a, b, da, db)   the derivative of the smaller (larger) argument;
@@ -211,6 +215,16 @@ S log_derivative(const S& x) {
 template <class S>
 S log1p_derivative(const S& x) {
   return value_of(x) < -1.0 ? S(std::nan("")) : S(S(1.0) / (1.0 + x));
+}
+template <class S>
+S acosh_derivative(const S& x) {
+  using std::sqrt;
+  return value_of(x) < 1.0 ? S(std::nan("")) : S(S(1.0) / sqrt(x * x - 1.0));
+}
+template <class S>
+S atanh_derivative(const S& x) {
+  const double v = value_of(x);
+  return v < -1.0 || v > 1.0 ? S(std::nan("")) : S(S(1.0) / (1.0 - x * x));
 }
 template <class S>
 S abs_derivative(const S& x) {
@@ -329,11 +343,11 @@ Dual<S, K> asinh(const Dual<S, K>& x) {
 }
 template <class S, std::size_t K>
 Dual<S, K> acosh(const Dual<S, K>& x) {
-  return detail::chain(x, S(acosh(x.value)), S(S(1.0) / sqrt(x.value * x.value - 1.0)));
+  return detail::chain(x, S(acosh(x.value)), acosh_derivative(x.value));
 }
 template <class S, std::size_t K>
 Dual<S, K> atanh(const Dual<S, K>& x) {
-  return detail::chain(x, S(atanh(x.value)), S(S(1.0) / (1.0 - x.value * x.value)));
+  return detail::chain(x, S(atanh(x.value)), atanh_derivative(x.value));
 }
 template <class S, std::size_t K>
 Dual<S, K> expm1(const Dual<S, K>& x) {

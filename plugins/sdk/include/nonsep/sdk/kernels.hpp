@@ -18,6 +18,15 @@
 // function of another arch, so a wider kernel there would call the model's gradients out of line.
 // NONSEP_SDK_WIDE_KERNEL_SETS (default 3) chooses the wider sets compiled, as bits: 1 for x86-64-v3, 2 for x86-64-v4, 0
 // for none (each costs compile time; formula models compile the one the host uses).
+//
+// Kernel units: the wider sets' kernels may be compiled in translation units of their own, in parallel with the rest
+// of the plugin (nonsep_add_model does so for a one-file plugin; the plugin is the same, built in about half the wall
+// time on two cores: docs/writing-models.md). NONSEP_SDK_KERNEL_UNIT says what a translation unit compiles:
+//   0 (default)  the plugin: its table, the baseline kernels, and the wider kernels not in units of their own
+//                (NONSEP_SDK_SEPARATE_KERNEL_UNITS, bits as above: those are declared here and called)
+//   1, 2         the x86-64-v3 (1) or x86-64-v4 (2) kernels alone: NONSEP_EXPORT_MODEL expands to the definition of
+//                nonsep::sdk::kernel_unit_1 (_2) and nothing else
+// The units see the same source, so the adapter they step is the plugin's (the function takes it as const void*).
 #include <cstddef>
 #include <span>
 #include <string_view>
@@ -30,13 +39,27 @@ namespace nonsep::sdk {
 #ifndef NONSEP_SDK_WIDE_KERNEL_SETS
 #define NONSEP_SDK_WIDE_KERNEL_SETS 3
 #endif
+#ifndef NONSEP_SDK_KERNEL_UNIT
+#define NONSEP_SDK_KERNEL_UNIT 0
+#endif
+#ifndef NONSEP_SDK_SEPARATE_KERNEL_UNITS
+#define NONSEP_SDK_SEPARATE_KERNEL_UNITS 0
+#endif
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX__)
-#define NONSEP_SDK_KERNEL_V3 (NONSEP_SDK_WIDE_KERNEL_SETS & 1)
-#define NONSEP_SDK_KERNEL_V4 (NONSEP_SDK_WIDE_KERNEL_SETS & 2)
+#define NONSEP_SDK_KERNEL_V3 \
+  (NONSEP_SDK_KERNEL_UNIT == 0 ? (NONSEP_SDK_WIDE_KERNEL_SETS & 1) : NONSEP_SDK_KERNEL_UNIT == 1)
+#define NONSEP_SDK_KERNEL_V4 \
+  (NONSEP_SDK_KERNEL_UNIT == 0 ? (NONSEP_SDK_WIDE_KERNEL_SETS & 2) : NONSEP_SDK_KERNEL_UNIT == 2)
 #else
 #define NONSEP_SDK_KERNEL_V3 0
 #define NONSEP_SDK_KERNEL_V4 0
 #endif
+// Whether this unit compiles the kernel bodies of v3 (v4), or calls another unit's.
+#define NONSEP_SDK_KERNEL_V3_HERE (NONSEP_SDK_KERNEL_V3 && !(NONSEP_SDK_SEPARATE_KERNEL_UNITS & 1))
+#define NONSEP_SDK_KERNEL_V4_HERE (NONSEP_SDK_KERNEL_V4 && !(NONSEP_SDK_SEPARATE_KERNEL_UNITS & 2))
+// The kernels of units 1 and 2, defined by NONSEP_SDK_DEFINE_KERNEL_UNIT there.
+void kernel_unit_1(const void* adapter, const ChinStepsCall& call);
+void kernel_unit_2(const void* adapter, const ChinStepsCall& call);
 inline constexpr std::string_view kernel_instruction_sets[] = {
     "x86-64",
 #if NONSEP_SDK_KERNEL_V3
@@ -61,13 +84,13 @@ struct ChinKernels {
   [[gnu::flatten]] static void baseline(const Adapter& adapter, const ChinStepsCall& call) {
     chin_kernel_blocks<fixed_dimension, Expansion>(adapter, call);
   }
-#if NONSEP_SDK_KERNEL_V3
+#if NONSEP_SDK_KERNEL_V3_HERE
   template <bool Expansion>
   [[gnu::target("arch=x86-64-v3"), gnu::flatten]] static void v3(const Adapter& adapter, const ChinStepsCall& call) {
     chin_kernel_blocks<fixed_dimension, Expansion>(adapter, call);
   }
 #endif
-#if NONSEP_SDK_KERNEL_V4
+#if NONSEP_SDK_KERNEL_V4_HERE
   template <bool Expansion>
   [[gnu::target("arch=x86-64-v4"), gnu::flatten]] static void v4(const Adapter& adapter, const ChinStepsCall& call) {
     chin_kernel_blocks<fixed_dimension, Expansion>(adapter, call);
@@ -83,18 +106,49 @@ struct ChinKernels {
     }
 #if NONSEP_SDK_KERNEL_V3
     if (index == set++) {
+#if NONSEP_SDK_KERNEL_V3_HERE
       expansion ? v3<true>(adapter, call) : v3<false>(adapter, call);
+#else
+      kernel_unit_1(&adapter, call);
+#endif
       return true;
     }
 #endif
 #if NONSEP_SDK_KERNEL_V4
     if (index == set++) {
+#if NONSEP_SDK_KERNEL_V4_HERE
       expansion ? v4<true>(adapter, call) : v4<false>(adapter, call);
+#else
+      kernel_unit_2(&adapter, call);
+#endif
       return true;
     }
 #endif
     return false;
   }
+
+#if NONSEP_SDK_KERNEL_UNIT == 1 && NONSEP_SDK_KERNEL_V3
+  static void run_unit(const Adapter& adapter, const ChinStepsCall& call) {
+    !call.weights.empty() ? v3<true>(adapter, call) : v3<false>(adapter, call);
+  }
+#elif NONSEP_SDK_KERNEL_UNIT == 2 && NONSEP_SDK_KERNEL_V4
+  static void run_unit(const Adapter& adapter, const ChinStepsCall& call) {
+    !call.weights.empty() ? v4<true>(adapter, call) : v4<false>(adapter, call);
+  }
+#endif
 };
 
 }  // namespace nonsep::sdk
+
+// A kernel unit's one definition (NONSEP_EXPORT_MODEL in a unit 1 or 2), or nothing where that set is not compiled.
+#if NONSEP_SDK_KERNEL_UNIT != 0 && (NONSEP_SDK_KERNEL_V3 || NONSEP_SDK_KERNEL_V4)
+#define NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(unit) ::nonsep::sdk::kernel_unit_##unit
+#define NONSEP_SDK_KERNEL_UNIT_FUNCTION(unit) NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(unit)
+#define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)                                                              \
+  void NONSEP_SDK_KERNEL_UNIT_FUNCTION(NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                     \
+                                                               const ::nonsep::ChinStepsCall& call) {   \
+    ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_unit(*static_cast<const __VA_ARGS__*>(adapter), call); \
+  }
+#else
+#define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)
+#endif

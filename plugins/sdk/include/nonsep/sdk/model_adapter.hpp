@@ -54,10 +54,14 @@
 //
 // Non-finite results are numbers, not failures: a gradient, Hessian or value that overflows or is NaN is returned
 // as computed, and the host sees the state become non-finite and reports the trajectory as diverged (where, when
-// and which variable). Only where automatic differentiation has no meaning (the function itself is not finite at
-// x, as in log(-1), whose dual "derivative" -1 is finite) are the derivatives set to NaN, so that such a point
-// diverges too instead of silently continuing with a wrong number. Failures are what model code throws
-// (EvaluationError and other exceptions).
+// and which variable). Where automatic differentiation has no meaning (a function outside its domain, as log(-1),
+// whose formula 1/x would give -1) the function's own derivative rule gives NaN (dual.hpp), so that such a point
+// diverges too instead of silently continuing with a wrong number. A gradient pass by automatic differentiation
+// leaves the value of T or V unused, so the compiler drops the work that only the value needs (T = asinh(p) + ...
+// computes no asinh for grad T): written with templated T and V alone, gradients cost about what written-out
+// ones do (docs/writing-models.md measures it). Hessian, Hessian-vector and third-derivative passes compute the
+// value anyway and also set their results to NaN where it is not finite (a T or V that returns NaN by its own
+// code). Failures are what model code throws (EvaluationError and other exceptions).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -645,7 +649,7 @@ class ModelAdapter {
       if constexpr (analytic)
         analytic_gradient(Vector<double>(at, n), std::span<double>(g, n));
       else
-        detail::poison_if_not_finite(detail::gradient_by_dual<capacity>(f, at, n, g), g, n);
+        detail::gradient_by_dual<capacity>(f, at, n, g);  // the value unused: see the header comment
     }
   }
   // The Hessian of f at each state, row-major n x n: analytic or automatic as gradients().
@@ -736,5 +740,21 @@ class ModelAdapter {
   M model_;
   std::size_t dimension_;
 };
+
+// How an adapter's automatic derivatives are computed, in words: the plugin metadata's "automatic_differentiation",
+// which `nonsep inspect` shows beside each function's "analytic" or "automatic".
+template <class Adapter>
+std::string automatic_differentiation_text() {
+  if constexpr (Adapter::differentiates_gradients)
+    return "forward mode over the model's gradient templates: a Hessian-vector product or a directional third "
+           "derivative in one pass of 1 tangent, a Hessian in n passes";
+  else
+    return "forward mode over T and V with " + std::to_string(Adapter::capacity) +
+           (HasFixedDimension<typename Adapter::Model> ? " tangents per number (the dimension, known at compile time)"
+                                                       : " tangents per number (max_dimension)") +
+           ": a gradient in one pass (the value of T or V "
+           "unused, so not computed), a Hessian in n passes, a Hessian-vector product or a directional third "
+           "derivative in one pass";
+}
 
 }  // namespace nonsep::sdk
