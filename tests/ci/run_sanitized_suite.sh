@@ -29,6 +29,8 @@ long_runs=(
   '^max_initial_values applies to every kind of initial state'
   '^paper2d, chaotic orbit: the long-time exponent'
   '^MEGNO: <Y> -> 2 within 5%'
+  '^chaotic orbit: SALI below 1e-8 by t = 50'
+  '^regular orbits: SALI stays above 1e-5 to t = 200'
 )
 exclude=$(IFS='|'; echo "${long_runs[*]}")
 start=$SECONDS
