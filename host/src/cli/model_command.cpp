@@ -62,14 +62,12 @@ std::optional<Job> read_formula_job(const std::string& job_file) {
 
 int report_formula_job(const std::string& job_file, const Job& job) {
   const formula::FormulaModel& model = *job.formula;
-  nlohmann::json parameters = job.parameters;  // a swept one as its list of values
-  for (const SweptParameter& swept : job.sweep) parameters[swept.name] = swept.values;
   std::cout << "valid: " << job_file << "\n"
             << "  model:       formula '" << model.name << "', dimension " << model.dimension
             << (model.file.empty() ? "" : " (" + model.file.string() + ")") << "\n"
             << "    T = " << model.T << "\n"
             << "    V = " << model.V << "\n"
-            << "  parameters:  " << parameters.dump() << "\n"
+            << "  parameters:  " << parameters_text(job.parameters, job) << "\n"
             << sweep_text(job, false)
             << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "
                "(initial states on an energy shell, the gradient check) is checked then\n";
