@@ -53,6 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   }
   check_model_parameters(job.parameters, fake_parameters(), issues);
+  check_swept_parameters(job, fake_parameters(), issues);
   for (std::size_t dimension : {std::size_t{1}, std::size_t{2}}) check_dimension(job.initial, dimension, issues);
   for (const auto& issue : issues) (void)to_string(issue);
   if (!issues.empty()) (void)InvalidJob("fuzz/job.json", issues).what();

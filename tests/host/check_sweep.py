@@ -2,7 +2,7 @@
 """Parameter sweeps (/model/parameters given as several values), run as a user runs them:
 
   1. A sweep of 31 couplings x 31 states of paper2d on the energy shell H = 7 (placed per coupling), with samples,
-     Poincare crossings, Lyapunov and MEGNO series and an energy bound, writes every file byte for byte with one and
+     Poincare crossings, Lyapunov and MEGNO series, closest returns and an energy bound, writes every file byte for byte with one and
      two threads; each coupling's rows of trajectories.csv, trajectory.csv, poincare.csv and lyapunov.csv equal
      byte for byte those of the separate run with that coupling (the trajectory number shifted, the coupling column
      dropped); killed (SIGKILL) after a checkpoint and resumed, it writes the same files as uninterrupted.
@@ -86,7 +86,7 @@ big = {
     "output": {"every": 100, "energy_every": 50},
     "analysis": {"poincare": {"component": "q1", "value": 0.0, "direction": "+", "max_crossings": 4},
                  "lyapunov": {"vectors": 2, "renormalize_every": 10, "every": 100}, "megno": True,
-                 "max_relative_energy_error": 1e-4},
+                 "max_relative_energy_error": 1e-4, "closest_return_after": 1.0},
 }
 sweep_file = write_job("sweep", big)
 r = run(["validate", str(sweep_file)])
@@ -212,6 +212,13 @@ env["NONSEP_CACHE_DIR"] = str(work / "formula_cache")
 product_sweep("formula", {"formula": {"T": "p0^2/2", "V": "q0^2/2 + lambda*q0^4/12", "parameters": {"lambda": 1}},
                           "parameters": {"lambda": {"from": 0.0, "to": 1.0, "count": 3}}},
               [{"lambda": lam} for lam in (0.0, 0.5, 1.0)], 3)
+
+# results.h5 (a build with HDF5): the swept column in /trajectories, read with h5ls where it is installed.
+hdf5 = dict(big, output={"every": 100, "format": "hdf5"}, time={"dt": 0.01, "steps": 100})
+r = run(["run", "-q", "--output", str(work / "hdf5"), str(write_job("hdf5", hdf5))], expected=None)
+if "no HDF5" not in r.stderr and shutil.which("h5ls"):
+    listing = subprocess.run(["h5ls", "-r", str(work / "hdf5" / "results.h5")], capture_output=True, text=True).stdout
+    check("/trajectories/coupling" in listing and "Dataset {961}" in listing, f"results.h5 has the coupling: {listing}")
 
 # 4. Bad input and studies.
 outside = dict(big, model={"plugin": "paper2d", "parameters": {"coupling": [0.1, 0.35]}})

@@ -53,6 +53,9 @@ int report_formula_job(const std::string& job_file, const Job& job);
 // The "  sweep: ..." line of `nonsep validate` (empty without a sweep): the swept parameters, the parameter sets
 // and the trajectories they make; `loaded`: the job's states are those of load_model (every set's, on its shell).
 std::string sweep_text(const Job& job, bool loaded);
+// The "  parameters: ..." of `nonsep validate`: `parameters` with job's swept ones as their values (a list of up to
+// 8, else "N values: a, b, ..., z").
+std::string parameters_text(nlohmann::json parameters, const Job& job);
 int command_schema();
 
 // Texts of --help, generated from the scheme catalogue and the exit statuses.

@@ -50,8 +50,9 @@ int command_model_compile(const ModelCompileArguments& arguments) {
 namespace {
 
 // The parameters a run would use: each declared one at the job's value, else at its default; those at their default
-// are named after the object ("{"c": 0.5, "d": 1} (d by default)").
-std::string parameters_with_defaults(const nlohmann::json& given, const std::vector<PluginParameter>& declared) {
+// are named after the object ("{"c": 0.5, "d": 1} (d by default)"); swept ones as parameters_text shows them.
+std::string parameters_with_defaults(const Job& job, const std::vector<PluginParameter>& declared) {
+  const nlohmann::json& given = job.parameters;
   nlohmann::json used = nlohmann::json::object();
   std::string defaults;
   for (const PluginParameter& parameter : declared) {
@@ -59,8 +60,8 @@ std::string parameters_with_defaults(const nlohmann::json& given, const std::vec
     used[parameter.name] = set ? given[parameter.name] : parameter.default_value;
     if (!set) defaults += (defaults.empty() ? "" : ", ") + parameter.name;
   }
-  if (defaults.empty()) return used.dump();
-  return used.dump() + " (" + defaults + (given.empty() ? ": the model's defaults)" : " by default)");
+  if (defaults.empty()) return parameters_text(used, job);
+  return parameters_text(used, job) + " (" + defaults + (given.empty() ? ": the model's defaults)" : " by default)");
 }
 
 }  // namespace
@@ -85,8 +86,7 @@ int report_formula_job(const std::string& job_file, const Job& job) {
             << (model.file.empty() ? "" : " (" + model.file.string() + ")") << "\n"
             << "    " << (model.t_gradient.empty() ? "T = " : "") << model.T << "\n"
             << "    " << (model.v_gradient.empty() ? "V = " : "") << model.V << "\n"
-            << "  parameters:  " << parameters_with_defaults(job.parameters, formula::declared_parameters(model))
-            << (job.sweep.empty() ? "" : " and the sweep") << "\n"
+            << "  parameters:  " << parameters_with_defaults(job, formula::declared_parameters(model)) << "\n"
             << sweep_text(job, false)
             << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "
                "(initial states on an energy shell, the gradient check) is checked then\n";

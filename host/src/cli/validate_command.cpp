@@ -19,14 +19,20 @@ std::string initial_shell_text(const InitialStates& initial, bool sweep) {
          (sweep ? " (parameter set, state) pairs" : " states") + " cannot reach it and are left out";
 }
 
-// The parameters in effect, a swept one as its list of values.
-std::string parameters_text(const LoadedJob& loaded) {
-  nlohmann::json parameters = loaded.model.parameters();
-  for (const SweptParameter& swept : loaded.job.sweep) parameters[swept.name] = swept.values;
+}  // namespace
+
+std::string parameters_text(nlohmann::json parameters, const Job& job) {
+  for (const SweptParameter& swept : job.sweep) {
+    const auto& values = swept.values;
+    if (values.size() <= 8) {
+      parameters[swept.name] = values;
+    } else {
+      parameters[swept.name] = std::to_string(values.size()) + " values: " + values[0].dump() + ", " +
+                               values[1].dump() + ", ..., " + values.back().dump();
+    }
+  }
   return parameters.dump();
 }
-
-}  // namespace
 
 std::string sweep_text(const Job& job, bool loaded) {
   if (job.sweep.empty()) return "";
@@ -70,7 +76,7 @@ int command_validate(const std::string& job_file) {
     std::cout << "valid: " << job_file << "\n"
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
-              << "  parameters:  " << parameters_text(loaded) << "\n"
+              << "  parameters:  " << parameters_text(loaded.model.parameters(), job) << "\n"
               << "  integrator:  "
               << (run.auto_scheme
                       ? describe_auto(loaded)

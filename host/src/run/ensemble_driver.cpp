@@ -29,7 +29,8 @@ struct EnsembleDriver::Impl {
   std::vector<std::size_t> block_first;     // each block's first trajectory
   std::vector<std::size_t> block_set;       // each block's parameter set
   std::vector<nlohmann::json> set_parameters;
-  // workers[thread][set]: created on first use by that thread (make_worker), thread 0's of set 0 from `model`.
+  // workers[thread][set]: created by that thread on first use (worker()); without parameter sets, thread 0's is
+  // `model` itself.
   std::vector<std::vector<std::unique_ptr<Worker>>> workers;
   std::mutex creating;  // Plugin::create from several threads
   std::vector<Observer*> observers;
