@@ -1,5 +1,6 @@
 // `nonsep model compile FILE [-o NAME.so]` (a formula model file into a plugin) and the formula side of
 // `nonsep validate` (formulas, parameters and dimensions checked without compiling).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -56,7 +57,9 @@ std::string parameters_with_defaults(const Job& job, const std::vector<PluginPar
   nlohmann::json used = nlohmann::json::object();
   std::string defaults;
   for (const PluginParameter& parameter : declared) {
-    const bool set = given.contains(parameter.name);
+    const bool set = given.contains(parameter.name) ||
+                     std::any_of(job.sweep.begin(), job.sweep.end(),
+                                 [&](const SweptParameter& swept) { return swept.name == parameter.name; });
     used[parameter.name] = set ? given[parameter.name] : parameter.default_value;
     if (!set) defaults += (defaults.empty() ? "" : ", ") + parameter.name;
   }
