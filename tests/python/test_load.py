@@ -175,6 +175,24 @@ class DynamicsTest(FolderTestCase):
             result.dynamics["lyapunov"]
 
 
+class ErrorEstimateTest(FolderTestCase):
+    def test_the_estimates_of_each_trajectory_and_its_columns(self):
+        job = paper1d_job([state(1.0, 0.0), state(2.0, 0.0)], steps=40, every=10,
+                          analysis={"error_estimate": True})
+        result = nonsep.run(job, output="out")
+        rows = read_csv(self.folder / "out" / "error_estimate.csv")[1]
+        self.assertEqual(len(result.error_estimate), len(rows))
+        for index in (0, 1):
+            estimates = result.error_estimates(index)
+            self.assertEqual(list(estimates.step), [10, 20, 30, 40])
+            self.assertTrue(np.all(estimates.phase_error > 0))
+            self.assertEqual(list(estimates.separated), [False] * 4)
+            # trajectories.csv holds the last estimate, at t_end.
+            self.assertEqual(result.trajectories["estimated_phase_error"][index], estimates.phase_error[-1])
+            self.assertEqual(result.trajectories["error_estimate"][index], "within_horizon")
+        self.assertIsNone(nonsep.run(paper1d_job(state(1.0, 0.0), steps=4), output="plain").error_estimate)
+
+
 class TablesTest(FolderTestCase):
     def test_a_row_of_the_wrong_length_is_an_error(self):
         (self.folder / "bad.csv").write_text('a,message\n1,"x, y"\n2\n')
