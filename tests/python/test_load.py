@@ -143,11 +143,13 @@ class StudyTest(FolderTestCase):
         for name in ("dt", "relative_energy_error", "phase_error"):
             k = header.index(name)
             self.assertEqual([x.hex() for x in table[name]], [number(row[k]).hex() for row in rows], name)
-        # The exponents, from summary.json, are the least-squares slopes of log |error| on log dt of the table.
+        # The exponents, from summary.json, are the least-squares slopes of log max |dH/H0| (the largest over each
+        # run, at least the value at t_end) on log dt of the table.
         self.assertEqual(list(result.exponents), ["basic", "triplet 4/3"])
+        self.assertTrue(np.all(table["max_abs_relative_energy_error"] >= np.abs(table["relative_energy_error"])))
         for name, exponent in result.exponents.items():
             rows_of = table[table["integrator"] == name]
-            slope = np.polyfit(np.log(rows_of["dt"]), np.log(np.abs(rows_of["relative_energy_error"])), 1)[0]
+            slope = np.polyfit(np.log(rows_of["dt"]), np.log(rows_of["max_abs_relative_energy_error"]), 1)[0]
             self.assertAlmostEqual(exponent, slope, places=9)
         self.assertAlmostEqual(result.exponents["basic"], 2 / 3, delta=0.03)     # eq. expalg: order 2/3
         self.assertAlmostEqual(result.exponents["triplet 4/3"], 4 / 3, delta=0.03)  # eq. sym43
@@ -171,6 +173,24 @@ class DynamicsTest(FolderTestCase):
         np.testing.assert_array_equal(result.dynamics["results.h5/lyapunov/exponents"], [[0.5, -0.5]])
         with self.assertRaises(KeyError):
             result.dynamics["lyapunov"]
+
+
+class ErrorEstimateTest(FolderTestCase):
+    def test_the_estimates_of_each_trajectory_and_its_columns(self):
+        job = paper1d_job([state(1.0, 0.0), state(2.0, 0.0)], steps=40, every=10,
+                          analysis={"error_estimate": True})
+        result = nonsep.run(job, output="out")
+        rows = read_csv(self.folder / "out" / "error_estimate.csv")[1]
+        self.assertEqual(len(result.error_estimate), len(rows))
+        for index in (0, 1):
+            estimates = result.error_estimates(index)
+            self.assertEqual(list(estimates.step), [10, 20, 30, 40])
+            self.assertTrue(np.all(estimates.phase_error > 0))
+            self.assertEqual(list(estimates.separated), [False] * 4)
+            # trajectories.csv holds the last estimate, at t_end.
+            self.assertEqual(result.trajectories["estimated_phase_error"][index], estimates.phase_error[-1])
+            self.assertEqual(result.trajectories["error_estimate"][index], "within_horizon")
+        self.assertIsNone(nonsep.run(paper1d_job(state(1.0, 0.0), steps=4), output="plain").error_estimate)
 
 
 class TablesTest(FolderTestCase):

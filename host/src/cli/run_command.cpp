@@ -322,13 +322,6 @@ int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& ar
 // Scheme "auto": runs the pilots, puts the choice into the job and `options` and says what was chosen. False, after
 // saying why on stderr, when no scheme could be chosen (or the pilots were interrupted).
 bool choose(LoadedJob& loaded, RunOptions& options, const RunArguments& arguments) {
-  if (options.resume) {
-    std::cerr << "nonsep: cannot resume " << arguments.job_file
-              << ": scheme \"auto\" chooses from timed pilot runs, which a resumed run would repeat and might answer "
-                 "differently; write the chosen integrator (summary.json scheme_choice.chosen, integrator) into the "
-                 "job to resume it\n";
-    return false;
-  }
   try {
     const SchemeChoice choice = choose_scheme(loaded, options);
     apply_choice(loaded.job, choice);
@@ -423,6 +416,13 @@ int command_run(const RunArguments& arguments) {
       status = outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
                        : to_int(ExitStatus::invalid_input);
     } else {
+      if (loaded->job.run().auto_scheme && options.resume) {
+        std::cerr << "nonsep: cannot resume " << arguments.job_file
+                  << ": scheme \"auto\" chooses from timed pilot runs, which a resumed run would repeat and might "
+                     "answer differently; write the chosen integrator (summary.json integrator) into the job to "
+                     "resume it\n";
+        return to_int(ExitStatus::invalid_input);
+      }
       if (loaded->job.run().auto_scheme && !choose(*loaded, options, arguments)) return to_int(ExitStatus::run_failed);
       auto outcome = run_guarded([&] { return run_job(*loaded, options); });
       status = outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())

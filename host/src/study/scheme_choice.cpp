@@ -128,19 +128,29 @@ class Pilots {
     const bool energy = choice_.measure == AutoScheme::Measure::energy;
     const std::size_t width = 2 * loaded_.job.initial.dimension;
     std::map<std::uint64_t, PilotRun> runs;
+    const PilotRun over;  // a pilot not run: it would have taken the candidate's pilots over the bound
+    // Over the bound: what the pilots took, and what the next one would take at the last one's seconds per step.
+    double per_step = 0.0;
+    const auto over_bound = [&](std::uint64_t next_steps) {
+      return bound && choice_.pilot_seconds - spent_before + per_step * static_cast<double>(next_steps) > *bound;
+    };
     const auto run = [&](std::uint64_t steps) -> const PilotRun& {
       auto found = runs.find(steps);
-      if (found == runs.end()) found = runs.emplace(steps, pilot(candidate.spec, steps, energy)).first;
-      return found->second;
+      if (found == runs.end() && !over_bound(steps)) {
+        found = runs.emplace(steps, pilot(candidate.spec, steps, energy)).first;
+        per_step = found->second.seconds / static_cast<double>(steps);
+      }
+      return found == runs.end() ? over : found->second;
     };
     std::string last;
     for (std::uint64_t n = 4; 4 * n <= auto_pilot_max_steps; n *= 2) {
-      if (bound && choice_.pilot_seconds - spent_before > *bound) {
+      const PilotRun &r1 = run(n), &r2 = run(2 * n), &r4 = run(4 * n);
+      if (&r1 == &over || &r2 == &over || &r4 == &over) {
         result.excluded = "its pilots took " + format_number(choice_.pilot_seconds - spent_before) +
-                          " s, more than the predicted run of a candidate before it (" + format_number(*bound) + " s)";
+                          " s, and the next would take them past the predicted run of a candidate before it (" +
+                          format_number(*bound) + " s)";
         return result;
       }
-      const PilotRun &r1 = run(n), &r2 = run(2 * n), &r4 = run(4 * n);
       if (!r1.problem.empty() || !r2.problem.empty() || !r4.problem.empty()) {
         last = "its pilot with " +
                std::to_string(!r1.problem.empty()   ? n
