@@ -107,7 +107,7 @@ TEST_CASE("formula cache: the temporary fallback is used only when it is this us
   }
 }
 
-TEST_CASE("formula cache: a lock that is a link is not followed; entry files that are FIFOs or links are rebuilt") {
+TEST_CASE("formula cache: a lock that is a link is not followed, and entry files that are FIFOs or links are rebuilt") {
   Setup setup;
   const TemporaryFolder& folder = setup.folder;
   REQUIRE(setup.run("first").status == 0);

@@ -206,6 +206,31 @@ TEST_CASE("formula C++: written from the tree alone, with products for integer p
   CHECK(source.find("q0^2/4   +") == std::string::npos);
 }
 
+TEST_CASE("formula C++: bounded by the formula, whatever its products (repeated factors, an outgrown gradient)") {
+  const auto source_of = [](const std::string& V) {
+    std::vector<nonsep::host::JobIssue> issues;
+    const auto model =
+        read_formula_model(nlohmann::json{{"name", "product"}, {"T", "p0^2/2"}, {"V", V}}, "/f", ".", issues);
+    REQUIRE(model);
+    return cpp_source(*model);
+  };
+  // 1365 factors q0 (4094 characters): once as a power, in the value and in the gradient (13 MB of C++ before).
+  std::string repeated = "q0";
+  while (repeated.size() + 3 <= max_formula_length) repeated += "*q0";
+  const std::string power = source_of(repeated);
+  CHECK(power.size() < 20000);
+  CHECK(power.find("::nonsep::sdk::pow(S(q[0]), 1365.0)") != std::string::npos);
+  // 467 distinct factors: the written gradient would have 467 * 466 of them; the SDK differentiates V instead.
+  std::string distinct = "(q0 + 1)";
+  for (int k = 2; distinct.size() + 11 <= max_formula_length; ++k) distinct += "*(q0 + " + std::to_string(k) + ")";
+  const std::string automatic = source_of(distinct);
+  CHECK(automatic.find("grad_V") == std::string::npos);
+  CHECK(automatic.find("grad_T") != std::string::npos);
+  CHECK(automatic.size() < 4 * distinct.size() + 5000);
+  // A small formula keeps its written gradient.
+  CHECK(source_of("q0^2/2 + q0^4/12").find("grad_V") != std::string::npos);
+}
+
 TEST_CASE("formula models: bad keys, parameter names, names and dimensions are issues at their pointers") {
   std::vector<nonsep::host::JobIssue> issues;
   CHECK(!read_formula_model(nlohmann::json{{"T", "p0"},

@@ -446,6 +446,10 @@ TEST_CASE("resume checks content: an edited checkpoint or trajectory.csv is refu
     write_text(checkpoint_path, signed_text(edited));
     resume("trajectory 0 is active but its record says \"completed\"");
   }
+  SUBCASE("bytes after a NUL, which a JSON parser would take for the end") {
+    write_text(checkpoint_path, original + std::string("\0garbage{{", 10));
+    resume("a NUL byte at byte offset " + std::to_string(original.size()));
+  }
   SUBCASE("trajectory.csv of the recorded length with other rows (another run's)") {
     write_text(checkpoint_path, original);
     std::string csv = read_text(folder / "out/trajectory.csv");

@@ -1,6 +1,7 @@
 // The C++ of a formula model (cpp_source.hpp), written from its trees.
 #include "nonsep/host/formula/cpp_source.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <optional>
@@ -33,6 +34,8 @@ std::optional<int> small_integer(const Node& exponent) {
   return sign * static_cast<int>(number->value);
 }
 
+std::string emit_product(const Node& node, char letter);
+
 std::string emit(const Node& node, char letter) {
   switch (node.kind) {
     case Node::Kind::number:
@@ -60,15 +63,44 @@ std::string emit(const Node& node, char letter) {
       }
       return "::nonsep::sdk::pow(" + base + ", " + emit(node.operands[1], letter) + ")";
     }
-    case Node::Kind::sum:
-    case Node::Kind::product: {
+    case Node::Kind::sum: {
       std::string text = "(";
       for (std::size_t i = 0; i < node.operands.size(); ++i)
         text += (i == 0 ? "" : std::string(" ") + node.signs[i] + " ") + emit(node.operands[i], letter);
       return text + ")";
     }
+    case Node::Kind::product:
+      return emit_product(node, letter);
   }
   return {};
+}
+
+// A product with each repeated factor written once, as a power: x*x*...*x (k times) is integer_power<k>(x) for
+// k <= 64, pow(x, k) beyond, so the C++ (and the automatic derivatives the SDK makes of it) grows with the distinct
+// factors, not with the formula's length. Factors keep the order of their first appearance.
+std::string emit_product(const Node& node, char letter) {
+  std::vector<std::pair<std::size_t, std::size_t>> groups;  // (first operand, count)
+  for (std::size_t i = 0; i < node.operands.size(); ++i) {
+    const auto same = std::find_if(groups.begin(), groups.end(), [&](const auto& group) {
+      return node.signs[group.first] == node.signs[i] && node.operands[group.first] == node.operands[i];
+    });
+    if (same != groups.end())
+      ++same->second;
+    else
+      groups.emplace_back(i, 1);
+  }
+  std::string text = "(";
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const auto [first, count] = groups[g];
+    const std::string factor = emit(node.operands[first], letter);
+    const std::string power = count == 1    ? factor
+                              : count <= 64 ? "integer_power<" + std::to_string(count) + ">(S(" + factor + "))"
+                                            : "::nonsep::sdk::pow(S(" + factor + "), " + literal(count) + ")";
+    text +=
+        (g == 0 ? std::string(node.signs[first] == '/' ? "1.0 / " : "") : std::string(" ") + node.signs[first] + " ") +
+        power;
+  }
+  return text + ")";
 }
 
 std::size_t node_count(const Node& tree) {

@@ -1,6 +1,6 @@
-// /initial: one state, a list of states or a grid, into InitialStates (state-major: component i of state b at
-// b * dimension + i). Every shape is held to max_initial_states and max_initial_values, checked on the sizes of
-// the JSON arrays before their numbers are copied.
+// /initial: one state, a list of states, a grid or a file (initial_file.cpp), into InitialStates (state-major:
+// component i of state b at b * dimension + i). Every shape is held to max_initial_states and max_initial_values,
+// checked on the sizes of the JSON arrays before their numbers are copied.
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -178,10 +178,11 @@ void read_state(Checker& check, const json& value, const std::string& path, Init
   ++states.count;
 }
 
-InitialStates read_initial(Checker& check, const json& document) {
+InitialStates read_initial(Checker& check, const json& document, const std::filesystem::path& directory) {
   InitialStates states;
   const std::string what =
-      "one state {\"q\": [...], \"p\": [...]}, an array of such states, or {\"grid\": {\"q\": [axes], \"p\": [axes]}}";
+      "one state {\"q\": [...], \"p\": [...]}, an array of such states, {\"grid\": {\"q\": [axes], \"p\": [axes]}} "
+      "or {\"file\": \"states.npy\"}";
   const json* initial = check.member(document, "", "initial", document_keys()["initial"].required, what);
   if (!initial) return states;
   if (initial->is_array()) {
@@ -209,6 +210,9 @@ InitialStates read_initial(Checker& check, const json& document) {
     check.known_keys(*initial, "/initial", initial_grid_keys().names());
     read_grid(check, (*initial)["grid"], states);
     read_energy_shell(check, *initial, states);
+  } else if (initial->is_object() && initial->contains("file")) {
+    states.shape = "file";
+    read_initial_file(check, *initial, directory, states);
   } else if (initial->is_object()) {
     states.shape = "single";
     read_state(check, *initial, "/initial", states, "/initial");
@@ -226,6 +230,7 @@ void check_dimension(const InitialStates& initial, std::size_t model_dimension, 
   if (initial.count == 0 || initial.dimension == model_dimension) return;
   const std::string path = initial.shape == "list"   ? "/initial/0/q"
                            : initial.shape == "grid" ? "/initial/grid/q"
+                           : initial.shape == "file" ? "/initial/file"
                                                      : "/initial/q";
   issues.push_back({path,
                     std::to_string(initial.dimension) + (initial.shape == "grid" ? " axes" : " components") +

@@ -53,8 +53,8 @@ const KeyTable& document_keys() {
       {.name = "initial",
        .type = ValueType::defined,
        .required = true,
-       .description = "One state, a non-empty array of states (an ensemble), or a grid of states; a study has one "
-                      "state.",
+       .description = "One state, a non-empty array of states (an ensemble), a grid of states, or states from a "
+                      ".npy or .csv file; a study has one state.",
        .definition = "initial"},
       {.name = "time",
        .type = ValueType::object,
@@ -273,6 +273,20 @@ const KeyTable& initial_grid_keys() {
            .pattern = "^-?p(0|[1-9][0-9]*)$"},
       },
       {{"dependentRequired", {{"energy", {"solve_for"}}, {"solve_for", {"energy"}}}}}};
+  return table;
+}
+
+const KeyTable& initial_file_keys() {
+  static const KeyTable table{{
+      {.name = "file",
+       .type = ValueType::path,
+       .required = true,
+       .description = "The states in a file, relative to the job file's folder, one state per row, q0..q(n-1) then "
+                      "p0..p(n-1): a NumPy .npy file of a little-endian float64 array of shape (states, 2n) or (2n,) "
+                      "(numpy.save), or a .csv file with the header q0,...,q(n-1),p0,...,p(n-1). At most " +
+                      std::to_string(max_initial_states) + " states and " + std::to_string(max_initial_values) +
+                      " numbers in q, every number finite."},
+  }};
   return table;
 }
 

@@ -88,6 +88,7 @@ const KeyTable& study_integrator_keys();
 // /initial and the states of /study/reference.
 const KeyTable& state_keys();
 const KeyTable& initial_grid_keys();  // {"grid": ...}
+const KeyTable& initial_file_keys();  // {"file": ...}
 const KeyTable& grid_keys();          // {"q": axes, "p": axes}
 const KeyTable& range_axis_keys();    // {"from", "to", "count"}
 const KeyTable& values_axis_keys();   // {"values"}

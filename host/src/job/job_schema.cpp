@@ -228,7 +228,8 @@ schema_json definitions() {
   defs["initial"] = {{"oneOf",
                       {ref("state"),
                        {{"type", "array"}, {"minItems", 1}, {"maxItems", max_initial_states}, {"items", ref("state")}},
-                       object_schema(initial_grid_keys())}}};
+                       object_schema(initial_grid_keys()),
+                       object_schema(initial_file_keys())}}};
   defs["axes"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("axis")}};
   schema_json fixed = ref("finite");
   fixed["description"] = "A fixed value.";

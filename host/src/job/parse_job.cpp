@@ -25,7 +25,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
 
   read_model(check, document, job);
   const HamiltonianForm form = read_hamiltonian(check, document);
-  job.initial = read_initial(check, document);
+  job.initial = read_initial(check, document, job.directory);
   if (const json* study_value = check.member(document, "", "study", false, "")) {
     for (const KeyRule& rule : document_keys().rules)
       if (rule.run_only && document.contains(rule.name))

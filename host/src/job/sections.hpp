@@ -4,6 +4,7 @@
 // (or the section's value) and a Checker, returns what it read, and adds one issue per problem; what it returns is
 // meaningful only if it added none.
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,7 +52,10 @@ std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt,
 std::optional<std::vector<double>> read_axis(Checker& check, const json& value, const std::string& path);
 // /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
 // `first_path` names the state whose dimension the others must have.
-InitialStates read_initial(Checker& check, const json& document);
+InitialStates read_initial(Checker& check, const json& document, const std::filesystem::path& directory);
+// /initial/file (initial_file.cpp): the states of a .npy or .csv file, relative to `directory` (the job's folder).
+void read_initial_file(Checker& check, const json& initial, const std::filesystem::path& directory,
+                       InitialStates& states);
 // /initial/energy and /initial/solve_for of a grid (energy_shell.cpp), into states.shell.
 void read_energy_shell(Checker& check, const json& initial, InitialStates& states);
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,

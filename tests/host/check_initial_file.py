@@ -1,0 +1,106 @@
+"""Initial states from a file (/initial/file): the same states given as a .npy file (C and Fortran order), as a
+.csv file and written in the job give byte-identical trajectories.csv; a file of the wrong shape, with a number
+that is not finite, cut short, with trailing bytes, over the states limit, a FIFO, or of another type is refused
+with exit status 2 naming /initial/file (and never waited on). The .npy files are written here byte by byte (the
+format of numpy.save, version 1.0), so numpy is not needed.
+
+    check_initial_file.py --nonsep NONSEP
+"""
+import argparse
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+
+def npy_bytes(rows, fortran=False, dtype="<f8", shape=None, trailing=b""):
+    count, columns = len(rows), len(rows[0])
+    shape = shape if shape is not None else (count, columns)
+    header = ("{'descr': '%s', 'fortran_order': %s, 'shape': (%s), }"
+              % (dtype, "True" if fortran else "False", ", ".join(map(str, shape)) + ("," if len(shape) == 1 else "")))
+    header += " " * ((64 - (10 + len(header) + 1) % 64) % 64) + "\n"
+    order = [rows[b][c] for c in range(columns) for b in range(count)] if fortran else [x for row in rows for x in row]
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header.encode() + struct.pack(
+        f"<{len(order)}d", *order) + trailing
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--nonsep", required=True)
+    arguments = parser.parse_args()
+    problems = []
+    # paper2d (dimension 2): q0, q1, p0, p1 per state.
+    states = [[0.1 * i - 0.3, 0.05 * i, 0.2 - 0.03 * i, 0.1] for i in range(7)]
+    with tempfile.TemporaryDirectory(prefix="nonsep-initial-file-") as folder:
+        folder = Path(folder)
+
+        def job(initial, name):
+            path = folder / f"{name}.json"
+            path.write_text(json.dumps({
+                "model": {"plugin": "paper2d"}, "integrator": {"scheme": "triplet", "order": "4/3"},
+                "initial": initial, "time": {"dt": 0.01, "steps": 50}, "output": {"every": 10}}))
+            return path
+
+        def run(path, output):
+            return subprocess.run([arguments.nonsep, "run", "--quiet", "--output", str(folder / output), str(path)],
+                                  capture_output=True, text=True, timeout=60)
+
+        written = run(job([{"q": s[:2], "p": s[2:]} for s in states], "written"), "written")
+        if written.returncode != 0:
+            problems.append(f"the job with the states written in it: exit {written.returncode}: {written.stderr}")
+        (folder / "states.npy").write_bytes(npy_bytes(states))
+        (folder / "fortran.npy").write_bytes(npy_bytes(states, fortran=True))
+        (folder / "states.csv").write_text("q0,q1,p0,p1\n" + "".join(",".join(repr(x) for x in s) + "\n"
+                                                                      for s in states))
+        for name in ["states.npy", "fortran.npy", "states.csv"]:
+            result = run(job({"file": name}, "from-" + name), "out-" + name)
+            if result.returncode != 0:
+                problems.append(f"{name}: exit {result.returncode}: {result.stderr}")
+                continue
+            for output in ["trajectories.csv", "trajectory.csv"]:
+                if (folder / ("out-" + name) / output).read_bytes() != (folder / "written" / output).read_bytes():
+                    problems.append(f"{name}: {output} differs from the run with the states written in the job")
+
+        os.mkfifo(folder / "fifo.npy")
+        bad = {
+            "odd_columns.npy": (npy_bytes([s[:3] for s in states]), "3 columns"),
+            "wrong_dimension.npy": (npy_bytes([s + [0.0, 0.0] for s in states]), "the dimension of the model"),
+            "not_finite.npy": (npy_bytes(states[:2] + [[math.nan, 0, 0, 0]]), "not finite at byte offset"),
+            "cut_short.npy": (npy_bytes(states)[:-8], "bytes where its header says"),
+            "trailing.npy": (npy_bytes(states, trailing=b"\0garbage"), "bytes where its header says"),
+            "float32.npy": (npy_bytes(states, dtype="<f4"), "an array of dtype '<f4'"),
+            "too_many.npy": (npy_bytes([states[0]], shape=(1000001, 4)), "of shape (1000001, 4)"),
+            "three_d.npy": (npy_bytes(states, shape=(7, 2, 2)), "more than two dimensions"),
+            "header.csv": ("p0,q1,q0,p1\n1,2,3,4\n", "column 1 of the header is \"p0\""),
+            "cell.csv": ("q0,q1,p0,p1\n1,2,3,4\n1,2,inf,4\n", "\"inf\" in column 3"),
+            "short_row.csv": ("q0,q1,p0,p1\n1,2,3\n", "3 cells"),
+            "states.txt": ("", "neither .npy nor .csv"),
+            "fifo.npy": (None, "not a regular file"),
+            "missing.csv": (None, "cannot be opened"),
+        }
+        for name, (content, expected) in bad.items():
+            if isinstance(content, bytes):
+                (folder / name).write_bytes(content)
+            elif isinstance(content, str):
+                (folder / name).write_text(content)
+            for command in ("validate", "run"):
+                path = job({"file": name}, "bad-" + name)
+                result = subprocess.run([arguments.nonsep, command, *(["--quiet"] if command == "run" else []),
+                                         str(path)], capture_output=True, text=True, timeout=60)
+                if result.returncode != 2 or "/initial/file: found" not in result.stderr or \
+                        expected not in result.stderr:
+                    problems.append(f"{name}, nonsep {command}: exit {result.returncode}, expected 2 naming "
+                                    f"/initial/file and {expected!r}:\n{result.stderr}")
+
+    for problem in problems:
+        print("FAILED:", problem)
+    print(f"{len(problems)} problems")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
