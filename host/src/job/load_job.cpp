@@ -140,10 +140,16 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
       check_comparator(reference->spec, "/study/reference_run/scheme");
   } else {
     check_comparator(checked.run().integrator, "/integrator/scheme");
-    if (checked.run().analysis.tangent_vectors() > 0 && Integrator(checked.run().integrator).is_comparator())
+    if (checked.run().analysis.tangent_vectors() > 0 && Integrator(checked.run().integrator).is_comparator() &&
+        has_gradient_of_h && !loaded.plugin.has_hamiltonian_hessian_products())
       issues.push_back({checked.run().analysis.lyapunov ? "/analysis/lyapunov" : "/analysis/megno",
-                        "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme + "\"",
-                        "a Chin scheme (basic, triplet, mpe): the comparators have no tangent map"});
+                        "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme +
+                            "\" and the plugin '" + loaded.plugin.name() +
+                            "', which has no directional derivative of grad H (hvp_H, plugin ABI version 5; it is of "
+                            "version " +
+                            std::to_string(loaded.plugin.abi_version()) + ")",
+                        "a plugin with hvp_H (rebuild it against the installed SDK, which provides it by automatic "
+                        "differentiation), or a Chin scheme (basic, triplet, mpe)"});
   }
   if (issues.size() != before) return std::nullopt;
   return loaded;

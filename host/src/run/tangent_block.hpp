@@ -41,7 +41,7 @@ struct BlockTangents {
 
   BlockTangents(const IntegratorSpec& spec, std::size_t vectors_per_state, std::uint64_t renormalize_every,
                 std::size_t n, std::size_t slots)
-      : integrator(spec),
+      : integrator(spec, vectors_per_state),
         exponents(vectors_per_state, renormalize_every),
         k(vectors_per_state),
         vectors(n, slots * vectors_per_state),
@@ -61,16 +61,17 @@ struct BlockTangents {
     std::fill(megno.begin(), megno.end(), MegnoRecord{});
   }
 
-  // Steps the states of `x`, which are slots first .. first + x.count() - 1 of the block, with their vectors as
-  // they were in `before` (the block's vectors before this step); writes the mapped vectors into `vectors`.
+  // Steps the states of `x`, which are slots first .. first + x.count() - 1 of the block, with their vectors and the
+  // scheme's private state as they were in `before` (this block's tangents before the step); writes the mapped vectors
+  // into `vectors`.
   template <class M>
-  void step_part(const M& model, PhaseSpaceBatch& x, const PhaseSpaceBatch& before, std::size_t first, double dt) {
+  void step_part(const M& model, PhaseSpaceBatch& x, const BlockTangents& before, std::size_t first, double dt) {
     const std::size_t n = vectors.dimension(), size = x.count() * k * n;
     const auto offset = static_cast<std::ptrdiff_t>(first * k * n);
     PhaseSpaceBatch part(n, x.count() * k);
-    std::copy_n(before.q().begin() + offset, size, part.q().begin());
-    std::copy_n(before.p().begin() + offset, size, part.p().begin());
-    integrator.step(model, x, part, dt);
+    std::copy_n(before.vectors.q().begin() + offset, size, part.q().begin());
+    std::copy_n(before.vectors.p().begin() + offset, size, part.p().begin());
+    integrator.step_part(model, x, part, before.integrator, first, before.vectors.count() / k, dt);
     std::copy(part.q().begin(), part.q().end(), vectors.q().begin() + offset);
     std::copy(part.p().begin(), part.p().end(), vectors.p().begin() + offset);
   }
@@ -112,6 +113,7 @@ struct BlockTangents {
 
   // Removes the slots marked in `retire`, keeping the others in order.
   void compact(const std::vector<bool>& retire) {
+    integrator.compact(retire);
     const std::size_t n = vectors.dimension();
     std::size_t kept = 0;
     for (std::size_t s = 0; s < retire.size(); ++s) {
