@@ -1,6 +1,6 @@
-// The shipped models, loaded as plugins: they pass the derivative checker (third derivatives included), their
-// automatic and analytic derivatives agree to 1e-12, the energy the core computes from them is the Hamiltonian each
-// documents, its gradient is what plugin_abi.h says the third derivatives give, and a plugin steps exactly like
+// The shipped models, loaded as plugins: they pass the derivative checker (third derivatives included, and hvp_H),
+// their automatic and analytic derivatives agree to 1e-12, the energy the core computes from them is the Hamiltonian
+// each documents, its gradient is what plugin_abi.h says the third derivatives give, and a plugin steps exactly like
 // the same model compiled in.
 #include <doctest/doctest.h>
 
@@ -13,8 +13,10 @@
 
 #include "nonsep/core/chin_basic_step.hpp"
 #include "nonsep/core/energy.hpp"
+#include "nonsep/core/hamiltonian_gradient.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/plugin_abi.h"
 #include "paper1d/paper1d.hpp"
 #include "paper2d/paper2d.hpp"
 #include "quadratic_kinetic/quadratic_kinetic.hpp"
@@ -336,4 +338,53 @@ TEST_CASE("a shipped model returns overflowing and NaN results as numbers, not a
   const double negative[] = {-1.0};
   log_model.grad_V(negative, out, 1);
   CHECK(std::isnan(out[0]));
+}
+
+TEST_CASE("every shipped plugin has hvp_H, the derivative of grad H along a tangent, in both forms (K + U included)") {
+  const std::pair<const char*, nlohmann::json> plugins[] = {{"paper1d", nlohmann::json::object()},
+                                                            {"radial", {{"dimension", 3}}},
+                                                            {"quadratic_kinetic", {{"lambda", 0.8}}},
+                                                            {"tao_product", nlohmann::json::object()},
+                                                            {"paper2d", {{"coupling", 0.2}}},
+                                                            {"mathews_lakshmanan", nlohmann::json::object()},
+                                                            {"variable_mass2d", nlohmann::json::object()},
+                                                            {"lattice_chain", {{"sites", 5}}}};
+  for (const auto& [name, parameters] : plugins) {
+    const std::string plugin_name(name);
+    CAPTURE(plugin_name);
+    const PluginModel model = shipped(name, parameters);
+    REQUIRE(model.plugin().has_hamiltonian_hessian_products());
+    CHECK(model.plugin().abi_version() == NONSEP_PLUGIN_ABI_VERSION);
+    const std::size_t n = model.dimension();
+    std::vector<double> q(n), p(n), dq(n), dp(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      q[i] = 0.3 + 0.1 * static_cast<double>(i);
+      p[i] = 0.5 - 0.2 * static_cast<double>(i);
+      dq[i] = 1.0 - 0.3 * static_cast<double>(i);
+      dp[i] = 0.4 + 0.25 * static_cast<double>(i);
+    }
+    for (const auto form : {nonsep::HamiltonianForm::TTV, nonsep::HamiltonianForm::VVT}) {
+      CAPTURE(form == nonsep::HamiltonianForm::TTV);
+      std::vector<double> out_q(n), out_p(n);
+      model.hvp_H(form, q, p, dq, dp, out_q, out_p, 1);
+      // Central differences of the core's grad H (hamiltonian_gradient.hpp) along (dq, dp).
+      const double h = 1e-5;
+      std::vector<double> gradients[2][2];
+      for (int side = 0; side < 2; ++side) {
+        std::vector<double> at_q = q, at_p = p;
+        for (std::size_t i = 0; i < n; ++i) {
+          at_q[i] += (side == 0 ? h : -h) * dq[i];
+          at_p[i] += (side == 0 ? h : -h) * dp[i];
+        }
+        gradients[side][0].resize(n);
+        gradients[side][1].resize(n);
+        nonsep::HamiltonianGradient(form).evaluate(model, at_q, at_p, gradients[side][0], gradients[side][1], 1);
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        CAPTURE(i);
+        CHECK(out_q[i] == doctest::Approx((gradients[0][0][i] - gradients[1][0][i]) / (2 * h)).epsilon(1e-7));
+        CHECK(out_p[i] == doctest::Approx((gradients[0][1][i] - gradients[1][1][i]) / (2 * h)).epsilon(1e-7));
+      }
+    }
+  }
 }

@@ -12,6 +12,7 @@
 
 #include "nonsep/core/alignment_indices.hpp"
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/core/tangent_integrator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/run_folder.hpp"
@@ -238,7 +239,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   state.tangent_q = read.numbers(read.member(active, "tangent_q"), tangent_size, "active.tangent_q");
   state.tangent_p = read.numbers(read.member(active, "tangent_p"), tangent_size, "active.tangent_p");
   // The scheme's private state, as the scheme names and sizes it (nothing for most schemes).
-  state.scheme = Integrator(job.run().integrator).save_state(PhaseSpaceBatch(n, 0));
+  state.scheme = scheme_state_layout(job.run().integrator, k, n);
   for (SchemeState::Column& column : state.scheme.columns) {
     const std::string what = "active." + column.name;
     column.values = read.numbers(read.member(active, column.name), state.active.size() * column.per_state, what);

@@ -168,10 +168,16 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
                         "\"energy\" with the plugin '" + loaded.plugin.name() + "', which has no Hessians",
                         "\"phase\": the energy H = T_i V_ij T_j needs the Hessians (hessian_T, hessian_V)"});
     if (checked.run().analysis.tangent_vectors() > 0 && !checked.run().auto_scheme &&
-        !has_tangent_map(checked.run().integrator))
+        Integrator(checked.run().integrator).is_comparator() && has_gradient_of_h &&
+        !loaded.plugin.has_hamiltonian_hessian_products())
       issues.push_back({checked.run().analysis.tangent_key(),
-                        "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme + "\"",
-                        "a Chin scheme (basic, triplet, mpe): the comparators have no tangent map"});
+                        "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme +
+                            "\" and the plugin '" + loaded.plugin.name() +
+                            "', which has no directional derivative of grad H (hvp_H, plugin ABI version 5; it is of "
+                            "version " +
+                            std::to_string(loaded.plugin.abi_version()) + ")",
+                        "a plugin with hvp_H (rebuild it against the installed SDK, which provides it by automatic "
+                        "differentiation), or a Chin scheme (basic, triplet, mpe)"});
   }
   if (issues.size() != before) return std::nullopt;
   return loaded;

@@ -143,6 +143,20 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
   EvaluationCounts evaluations() const {
     return tangents ? tangents->integrator.evaluations() : integrator.evaluations();
   }
+  // The private state of the scheme that steps the block (its tangent map's when it follows tangent vectors), and
+  // what it reports.
+  SchemeState save_scheme_state() const {
+    return tangents ? tangents->integrator.save_state(batch) : integrator.save_state(batch);
+  }
+  void restore_scheme_state(const SchemeState& state) {
+    if (tangents)
+      tangents->integrator.restore_state(state);
+    else
+      integrator.restore_state(state);
+  }
+  std::vector<SchemeFigure> scheme_report() const {
+    return tangents ? tangents->integrator.report() : integrator.report();
+  }
 
   // The final Lyapunov, MEGNO, SALI and GALI estimates of `slot` into `departure` (each when computed).
   template <class Record>

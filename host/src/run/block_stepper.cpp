@@ -61,8 +61,7 @@ void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker
 // One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge.
 void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step) {
   const PhaseSpaceBatch before = block.batch;
-  const std::optional<PhaseSpaceBatch> tangents_before =
-      block.tangents ? std::optional<PhaseSpaceBatch>(block.tangents->vectors) : std::nullopt;
+  const std::optional<BlockTangents> tangents_before = block.tangents;  // vectors and the scheme's private state
   const Integrator integrator_before = block.integrator;  // the scheme's private state, for a redo state by state
   const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
     if (block.tangents)

@@ -333,7 +333,7 @@ void EnsembleDriver::restore(DriverState state) {
       d.blocks[b].tangents.emplace(d.setup, trajectories.size()).restore(members[b], state);
     d.blocks[b].energies = std::move(energies);
     d.blocks[b].energy_step = state.step;
-    if (!members[b].empty()) d.blocks[b].integrator.restore_state(state.scheme.select(members[b]));
+    if (!members[b].empty()) d.blocks[b].restore_scheme_state(state.scheme.select(members[b]));
   }
   d.records = std::move(state.records);
   d.completed = state.step;
@@ -345,7 +345,7 @@ DriverState EnsembleDriver::state() const {
   const Impl& d = *impl_;
   DriverState state;
   state.step = d.completed;
-  state.scheme = Integrator(d.setup.integrator).save_state(PhaseSpaceBatch(d.setup.dimension, 0));
+  state.scheme = scheme_state_layout(d.setup.integrator, d.setup.tangent_vectors, d.setup.dimension);
   for (const Block& block : d.blocks) {
     state.active.insert(state.active.end(), block.trajectories.begin(), block.trajectories.end());
     state.q.insert(state.q.end(), block.batch.q().begin(), block.batch.q().end());
@@ -353,7 +353,7 @@ DriverState EnsembleDriver::state() const {
     for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
       state.energies.push_back(block.energy_step == d.completed ? block.energies[slot] : std::nan(""));
     if (block.tangents) block.tangents->save(state);
-    state.scheme.append(block.integrator.save_state(block.batch));
+    state.scheme.append(block.save_scheme_state());
   }
   state.records = d.records;
   state.evaluations = evaluations();
@@ -369,7 +369,7 @@ EvaluationCounts EnsembleDriver::evaluations() const {
 std::vector<SchemeFigure> EnsembleDriver::scheme_report() const {
   std::vector<SchemeFigure> report = Integrator(impl_->setup.integrator).report();
   for (const Block& block : impl_->blocks) {
-    const std::vector<SchemeFigure> part = block.integrator.report();
+    const std::vector<SchemeFigure> part = block.scheme_report();
     for (std::size_t i = 0; i < report.size() && i < part.size(); ++i)
       report[i].value = std::max(report[i].value, part[i].value);
   }

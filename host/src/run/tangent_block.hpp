@@ -46,7 +46,7 @@ struct BlockTangents {
 
   // setup.tangent_vectors per state, `slots` states.
   BlockTangents(const EnsembleSetup& setup, std::size_t slots)
-      : integrator(setup.integrator),
+      : integrator(setup.integrator, setup.tangent_vectors),
         exponents(setup.tangent_vectors, setup.renormalize_every),
         k(setup.tangent_vectors),
         with_megno(setup.megno),
@@ -70,16 +70,17 @@ struct BlockTangents {
     if (factor_size > 0) AlignmentIndices(k).start(alignment);
   }
 
-  // Steps the states of `x`, which are slots first .. first + x.count() - 1 of the block, with their vectors as
-  // they were in `before` (the block's vectors before this step); writes the mapped vectors into `vectors`.
+  // Steps the states of `x`, which are slots first .. first + x.count() - 1 of the block, with their vectors and the
+  // scheme's private state as they were in `before` (this block's tangents before the step); writes the mapped vectors
+  // into `vectors`.
   template <class M>
-  void step_part(const M& model, PhaseSpaceBatch& x, const PhaseSpaceBatch& before, std::size_t first, double dt) {
+  void step_part(const M& model, PhaseSpaceBatch& x, const BlockTangents& before, std::size_t first, double dt) {
     const std::size_t n = vectors.dimension(), size = x.count() * k * n;
     const auto offset = static_cast<std::ptrdiff_t>(first * k * n);
     PhaseSpaceBatch part(n, x.count() * k);
-    std::copy_n(before.q().begin() + offset, size, part.q().begin());
-    std::copy_n(before.p().begin() + offset, size, part.p().begin());
-    integrator.step(model, x, part, dt);
+    std::copy_n(before.vectors.q().begin() + offset, size, part.q().begin());
+    std::copy_n(before.vectors.p().begin() + offset, size, part.p().begin());
+    integrator.step_part(model, x, part, before.integrator, first, before.vectors.count() / k, dt);
     std::copy(part.q().begin(), part.q().end(), vectors.q().begin() + offset);
     std::copy(part.p().begin(), part.p().end(), vectors.p().begin() + offset);
   }
@@ -129,6 +130,7 @@ struct BlockTangents {
 
   // Removes the slots marked in `retire`, keeping the others in order.
   void compact(const std::vector<bool>& retire) {
+    integrator.compact(retire);
     const std::size_t n = vectors.dimension();
     std::size_t kept = 0;
     for (std::size_t s = 0; s < retire.size(); ++s) {

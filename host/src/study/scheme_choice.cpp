@@ -281,7 +281,11 @@ std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
   std::vector<AutoCandidate> usable;
   for (auto& candidate : all) {
     if (Integrator(candidate.spec).is_comparator() && !gradient_of_h) continue;
-    if (run.analysis.tangent_vectors() > 0 && !has_tangent_map(candidate.spec)) continue;
+    // A comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
+    if (run.analysis.tangent_vectors() > 0 &&
+        (!has_tangent_map(candidate.spec) ||
+         (Integrator(candidate.spec).is_comparator() && !loaded.plugin.has_hamiltonian_hessian_products())))
+      continue;
     usable.push_back(std::move(candidate));
   }
   return usable;

@@ -42,9 +42,11 @@ inline TangentTaoExtendedPhaseSpace tangent_map_of(const TaoExtendedPhaseSpace& 
 }
 
 // Whether the scheme `spec` names has a tangent map (TangentIntegrator builds one): the one place that says so, for
-// the job reader and scheme "auto". Throws InvalidArgument as Integrator(spec) does.
+// the job reader and scheme "auto". Every scheme of the catalogue has one; a comparator's needs the model's
+// directional derivative of grad H besides (the job reader checks the plugin for it). Throws InvalidArgument as
+// Integrator(spec) does.
 inline bool has_tangent_map(const IntegratorSpec& spec) {
-  return std::visit([](const auto& stepper) { return !is_comparator_stepper<std::decay_t<decltype(stepper)>>; },
+  return std::visit([](const auto& stepper) { return requires { tangent_map_of(stepper, std::size_t{1}); }; },
                     Integrator(spec).stepper());
 }
 
