@@ -16,6 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
 json run_job_with(json model, json initial, json time) {
   return {{"model", std::move(model)},
           {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}}},

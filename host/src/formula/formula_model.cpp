@@ -244,6 +244,21 @@ nlohmann::json formula_record(const FormulaModel& model, const std::string& cach
           {"cache_key", cache_key}};
 }
 
+namespace {
+
+// Exactly one of T and dT (or of V and dV), as the job-file reference can put it in words.
+nlohmann::ordered_json gradient_or_function(const std::string& function) {
+  const std::string gradient = "d" + function;
+  return {
+      {"if", {{"required", {gradient}}}},
+      {"then",
+       {{"description", function + " given by its gradient " + gradient + ": " + function + " itself is absent."},
+        {"not", {{"required", {function}}}}}},
+      {"else", {{"description", "Without " + gradient + ", " + function + " is required."}, {"required", {function}}}}};
+}
+
+}  // namespace
+
 nlohmann::ordered_json formula_schema() {
   nlohmann::ordered_json parameter_names = {{"pattern", "^[A-Za-z_][A-Za-z0-9_]{0,63}$"}};
   nlohmann::ordered_json object = {
@@ -252,9 +267,7 @@ nlohmann::ordered_json formula_schema() {
        "A model written as formulas, compiled on first use into a cached plugin "
        "(docs/formula-models.md)."},
       {"additionalProperties", false},
-      {"allOf",
-       {{{"oneOf", {{{"required", {"T"}}}, {{"required", {"dT"}}}}}},
-        {{"oneOf", {{{"required", {"V"}}}, {{"required", {"dV"}}}}}}}},
+      {"allOf", {gradient_or_function("T"), gradient_or_function("V")}},
       {"properties",
        {{"name",
          {{"type", "string"},

@@ -43,7 +43,7 @@ bool check_symmetry(const LoadedJob& loaded, const PluginModel& model, bool kine
   const char letter = kinetic ? 'p' : 'q';
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = i + 1; j < n; ++j) {
-      const double a = hessian[i * n + j], b = hessian[j * n + i];
+      const double a = hessian[i * n + j], b = hessian[j * n + i];  // d g_i / dx_j, d g_j / dx_i
       if (!std::isfinite(a) || !std::isfinite(b) || std::abs(a - b) <= 1e-8 * std::max({1.0, std::abs(a), std::abs(b)}))
         continue;
       const std::string at = " at initial state " + std::to_string(state) + " (" + letter + " = " + vector_text(x) +
@@ -57,7 +57,7 @@ bool check_symmetry(const LoadedJob& loaded, const PluginModel& model, bool kine
       };
       if (given)
         issues.push_back({formula->file.empty() ? "/model/formula/" + key : formula->file.string() + "#/" + key,
-                          "the Jacobian of " + key + at + d(j, i, a) + " but " + d(i, j, b) + ", so " + key +
+                          "the Jacobian of " + key + at + d(i, j, a) + " but " + d(j, i, b) + ", so " + key +
                               " is not the gradient of any function",
                           std::string("the gradient of a function ") + (kinetic ? "T(p)" : "V(q)") +
                               " (whose Jacobian, the Hessian, is symmetric): check the components, or give " +

@@ -750,8 +750,9 @@ std::string automatic_differentiation_text() {
            "derivative in one pass of 1 tangent, a Hessian in n passes";
   else
     return "forward mode over T and V with " + std::to_string(Adapter::capacity) +
-           (HasFixedDimension<typename Adapter::Model> ? " tangents per number (the dimension, known at compile time)"
-                                                       : " tangents per number (max_dimension)") +
+           (Adapter::capacity == 1 ? " tangent" : " tangents") +
+           (HasFixedDimension<typename Adapter::Model> ? " per number (the dimension, known at compile time)"
+                                                       : " per number (max_dimension)") +
            ": a gradient in one pass (the value of T or V "
            "unused, so not computed), a Hessian in n passes, a Hessian-vector product or a directional third "
            "derivative in one pass";
