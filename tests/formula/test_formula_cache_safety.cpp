@@ -219,6 +219,7 @@ TEST_CASE("formula cache: a build folder left by a nonsep that died is removed b
   const fs::path cache = folder / "cache" / "formula";
   fs::create_directories(cache / ".building-0123456789abcdef-1-2-3" / ".nonsep-compile-1-2-3");
   write_text(cache / ".building-0123456789abcdef-1-2-3" / "paper1d.so", "half");
+  fs::create_directories(cache / ".stale-1-2" / "0123456789abcdef");
   const auto result = setup.run("out");
   INFO(result.err);
   CHECK(result.status == 0);

@@ -48,13 +48,18 @@ bool entry_is_complete(const CacheFolder& cache, const std::string& key, const s
          record.value("content_hash", json()) == content_hash_hex(plugin->second);
 }
 
-// Removes the build folders of nonsep processes that died compiling: .building-<key>-* whose key's lock is free.
+// Removes the build folders of nonsep processes that died compiling (.building-<key>-* whose key's lock is free)
+// and what one that died removing an entry left (.stale-*, never used again).
 void remove_abandoned_builds(const CacheFolder& cache) {
   const std::string prefix = ".building-";
   std::error_code error;
   std::vector<std::string> names;
-  for (fs::directory_iterator it(cache.path(), error), end; !error && it != end; it.increment(error))
-    if (const std::string name = it->path().filename().string(); name.rfind(prefix, 0) == 0) names.push_back(name);
+  for (fs::directory_iterator it(cache.path(), error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) == 0) names.push_back(name);
+    std::error_code ignored;
+    if (name.rfind(".stale-", 0) == 0) fs::remove_all(it->path(), ignored);
+  }
   for (const auto& name : names) {
     const std::size_t dash = name.find('-', prefix.size());
     if (dash == std::string::npos) continue;

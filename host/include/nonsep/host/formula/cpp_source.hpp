@@ -7,8 +7,9 @@
 // formulas. A gradient is written out only while it stays small beside its function: at most max_gradient_growth
 // times the function's nodes plus max_gradient_slack (a product of n factors has a derivative of n(n-1) factors,
 // which grows the C++ and the compile quadratically); beyond that the plugin leaves the gradient to the SDK's
-// automatic differentiation of the function, whose C++ and compile grow linearly with the formula, so that every
-// formula within the grammar's limits compiles in bounded time and memory (docs/formula-models.md). Integer powers x^n
+// automatic differentiation of the function, whose C++ grows linearly with the formula (docs/formula-models.md,
+// "Long products": a product of hundreds of distinct factors is still slow to compile, and ends at the compile
+// time limit). A factor repeated in a product is written once, as a power. Integer powers x^n
 // (|n| <= 64) are products (the SDK's square and cube are the same products); other powers are pow. The text depends on
 // the model only, so it is the cache key's first part (plugin_cache.hpp).
 #include <cstddef>
