@@ -55,6 +55,8 @@ S function_value(const std::string& f, const std::vector<S>& a) {
   if (f == "tanh") return tanh(a[0]);
   if (f == "log_derivative") return log_derivative(a[0]);
   if (f == "log1p_derivative") return log1p_derivative(a[0]);
+  if (f == "acosh_derivative") return acosh_derivative(a[0]);
+  if (f == "atanh_derivative") return atanh_derivative(a[0]);
   if (f == "abs_derivative") return abs_derivative(a[0]);
   if (f == "pow_exponent_derivative") return pow_exponent_derivative(a[0], a[1]);
   if (f == "min_derivative") return min_derivative(a[0], a[1], a[2], a[3]);
@@ -194,8 +196,8 @@ TEST_CASE("formula derivatives: zero where a tree does not depend on the variabl
 }
 
 TEST_CASE("formula derivatives: the SDK's derivative rules are names a formula cannot use") {
-  for (const char* rule : {"log_derivative", "log1p_derivative", "abs_derivative", "min_derivative", "max_derivative",
-                           "pow_exponent_derivative"}) {
+  for (const char* rule : {"log_derivative", "log1p_derivative", "acosh_derivative", "atanh_derivative",
+                           "abs_derivative", "min_derivative", "max_derivative", "pow_exponent_derivative"}) {
     CHECK(is_derivative_rule(rule));
     const auto result = parse_formula(std::string(rule) + "(q0)", Symbols{'q', {}});
     CHECK_MESSAGE(std::holds_alternative<FormulaError>(result), rule);

@@ -33,7 +33,7 @@ Result run_compiling(const std::vector<std::string>& args, const fs::path& folde
 
 }  // namespace
 
-TEST_CASE("formula gradients: dT of Tao's H gives the states of the tao_product plugin; the summary says grad T") {
+TEST_CASE("formula gradients: a T given by its gradient dT gives the states of the tao_product plugin") {
   TemporaryFolder folder;
   ::setenv("NONSEP_CACHE_DIR", (folder / "cache").string().c_str(), 1);
   const json initial = {{{"q", {0.5}}, {"p", {0.25}}}, {{"q", {-1.0}}, {"p", {0.75}}}};

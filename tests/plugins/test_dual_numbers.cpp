@@ -76,6 +76,35 @@ TEST_CASE("abs at 0 has no derivative and says so with NaN") {
   CHECK(std::isnan(result.derivative[0]));
 }
 
+namespace {
+// T = acosh(p0) + atanh(p1): outside their domains (acosh below 1, atanh outside [-1, 1]) both are NaN, though
+// the formulas of their derivatives are finite there.
+struct OutsideDomains {
+  static constexpr std::size_t dimension = 2;
+  template <class S>
+  S T(nonsep::sdk::Vector<S> p) const {
+    return acosh(p[0]) + atanh(p[1]);
+  }
+  template <class S>
+  S V(nonsep::sdk::Vector<S> q) const {
+    return q[0] * q[0] + q[1] * q[1];
+  }
+};
+}  // namespace
+
+TEST_CASE("a gradient by automatic differentiation is NaN where T is outside its domain, though it skips T's value") {
+  const nonsep::sdk::ModelAdapter<OutsideDomains> model;
+  double gradient[2];
+  const double outside[] = {-2.0, 2.0};  // acosh(-2) and atanh(2) are NaN; 1/sqrt(x^2 - 1) and 1/(1 - x^2) are not
+  model.grad_T(outside, gradient, 1);
+  CHECK(std::isnan(gradient[0]));
+  CHECK(std::isnan(gradient[1]));
+  const double inside[] = {2.0, 0.5};
+  model.grad_T(inside, gradient, 1);
+  CHECK(gradient[0] == doctest::Approx(1.0 / std::sqrt(3.0)).epsilon(1e-15));
+  CHECK(gradient[1] == doctest::Approx(1.0 / 0.75).epsilon(1e-15));
+}
+
 TEST_CASE("gradients and Hessians of a function of three variables are exact") {
   // f = x^2 y + sin(z) x / y; derivatives written out by hand.
   auto f = [](auto v) { return v[0] * v[0] * v[1] + sin(v[2]) * v[0] / v[1]; };
