@@ -9,7 +9,8 @@
 # glibc refuse to ever unload the library; -fno-gnu-unique keeps a plugin unloadable (tests/plugins/
 # test_plugin_lifetime.cpp). A plugin's symbols are private to it, so uniqueness buys nothing.
 #
-# A one-file plugin built with GCC on x86-64 is compiled as three translation units that make can run in parallel:
+# A one-file plugin that exports its model with NONSEP_EXPORT_MODEL, built with GCC on x86-64, is compiled as three
+# translation units that make can run in parallel:
 # the plugin with its baseline kernels, and the x86-64-v3 and x86-64-v4 kernels each in a unit of its own
 # (${target}_kernel_unit_1.cpp and _2.cpp in the binary folder, which include the source; nonsep/sdk/kernels.hpp,
 # "Kernel units"). The plugin is the same; on two cores it builds in about two thirds of the wall time
@@ -35,10 +36,21 @@ function(nonsep_add_model target)
   endif()
   add_library(${target} MODULE ${arg_UNPARSED_ARGUMENTS})
   list(LENGTH arg_UNPARSED_ARGUMENTS source_count)
+  # Only a source that exports its model with NONSEP_EXPORT_MODEL is split: there the macro expands to the kernel
+  # unit's function in a unit. A source that defines its own table (NONSEP_DEFINE_PLUGIN) is compiled whole.
+  set(splittable FALSE)
   if(source_count EQUAL 1 AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
+    get_filename_component(source "${arg_UNPARSED_ARGUMENTS}" ABSOLUTE)
+    file(READ "${source}" source_text)
+    string(FIND "${source_text}" "NONSEP_EXPORT_MODEL" exports_model)
+    string(FIND "${source_text}" "NONSEP_DEFINE_PLUGIN" defines_table)
+    if(NOT exports_model EQUAL -1 AND defines_table EQUAL -1)
+      set(splittable TRUE)
+    endif()
+  endif()
+  if(splittable)
     # The wider kernel sets in translation units of their own, compiled in parallel with the rest
     # (nonsep/sdk/kernels.hpp, "Kernel units"): each unit includes the one source with NONSEP_SDK_KERNEL_UNIT set.
-    get_filename_component(source "${arg_UNPARSED_ARGUMENTS}" ABSOLUTE)
     set(units "")
     foreach(unit 1 2)
       set(unit_file "${CMAKE_CURRENT_BINARY_DIR}/${target}_kernel_unit_${unit}.cpp")
