@@ -42,6 +42,9 @@
 // pass (a few gradients' cost, whatever n), the directional third derivatives in one second-order pass along u,
 // Hessians in n passes; no capacity-sized dual is used, so max_dimension may be large (a lattice of 10^6 sites),
 // and T and V need only compile for double. Their scratch is a per-thread buffer of 2n numbers that grows once.
+// The directional derivative of grad H (hvp_H, plugin_abi.h), which the comparators' tangent maps need, reaches fourth
+// derivatives: one pass of the gradient templates on Dual<Dual<Dual<double, 1>, 1>, 1> (O(n)), else of T and V on
+// FourthDerivativeDual<K> (automatic_derivatives.hpp); a model whose T and V compile for neither has no hvp_H.
 // Model code signals a point where it cannot be evaluated by throwing EvaluationError; the plugin returns
 // NONSEP_EVALUATION_FAILED with that message. Any other exception becomes NONSEP_INTERNAL_ERROR.
 //
