@@ -37,11 +37,12 @@
 
 namespace nonsep {
 
-// The version of what a kernel computes (the ChinStepsCall it takes, chin_stages' flows): a plugin records the
-// version it was compiled from, and a host whose core has another one steps that plugin through its evaluations.
+// The version of what a kernel computes (the ChinStepsCall it takes, chin_stages' flows). A plugin of ABI version 5
+// has the kernels of this version (plugin_abi.h: the ABI version says it); a plugin of ABI version 4 named its
+// kernel version in its metadata, and the host steps those whose version is not this one through their evaluations.
 // Version 2: a call carries a schedule of sub-steps (ChinStepsCall::substeps). Version 3: a call may carry a
-// multi-product expansion's weights (ChinStepsCall::weights). Version 4: a call of no steps evaluates the outer
-// gradient at the call's point (ChinStepsCall::steps).
+// multi-product expansion's weights (ChinStepsCall::weights). Version 4 (ABI version 5): a call of no steps evaluates
+// the outer gradient at the call's point (ChinStepsCall::steps).
 inline constexpr std::uint64_t chin_kernel_version = 4;
 
 // States per block of local arrays for a fixed dimension: 32 states, at most 128 numbers of each array (the four
