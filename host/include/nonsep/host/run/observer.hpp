@@ -63,7 +63,7 @@ struct StateView {
   const LyapunovRecord* lyapunov = nullptr;
   const MegnoRecord* megno = nullptr;
   // With SALI or GALI: the state's factor of nonsep/core/alignment_indices.hpp; else empty.
-  std::span<const double> alignment;
+  std::span<const double> alignment = {};
 };
 
 // A retirement an observer asks for at an event: the trajectory stops there with `status` and `message`.
