@@ -152,7 +152,7 @@ TEST_CASE("the comparators' tangent maps are the derivative of their maps (centr
     }
 }
 
-TEST_CASE("the tangent map of Gauss-Legendre is symplectic to round-off; a step of dt then -dt is the identity") {
+TEST_CASE("the tangent map of Gauss-Legendre is symplectic to round-off, and a step of dt then -dt is the identity") {
   const Paper2DModel paper2d;
   const VariableMassModel variable_mass;
   for (const auto form : forms)

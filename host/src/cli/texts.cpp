@@ -42,7 +42,8 @@ std::string scheme_names_text() {
   std::string names;
   for (const auto& scheme : scheme_catalogue()) names += (names.empty() ? "" : ", ") + scheme.name;
   return "Integrator schemes: " + names +
-         " (`nonsep --help` describes each with its options; docs/user-guide.md, \"Integrator schemes\").\n";
+         " (`nonsep --help` describes each with its options; docs/user-guide.md, \"Integrator schemes\"), or auto "
+         "with a tolerance (docs/user-guide.md, \"Scheme auto\").\n";
 }
 
 int report_invalid_job(const InvalidJob& error) {

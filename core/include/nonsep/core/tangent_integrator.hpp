@@ -46,8 +46,11 @@ inline TangentTaoExtendedPhaseSpace tangent_map_of(const TaoExtendedPhaseSpace& 
 // directional derivative of grad H besides (the job reader checks the plugin for it). Throws InvalidArgument as
 // Integrator(spec) does.
 inline bool has_tangent_map(const IntegratorSpec& spec) {
-  return std::visit([](const auto& stepper) { return requires { tangent_map_of(stepper, std::size_t{1}); }; },
-                    Integrator(spec).stepper());
+  return std::visit(
+      [](const auto& stepper) {
+        return requires { tangent_map_of(stepper, std::size_t{1}); };
+      },
+      Integrator(spec).stepper());
 }
 
 class TangentIntegrator {

@@ -184,8 +184,9 @@ typedef struct nonsep_plugin_api {
    * triplet composition's steps whole, its sub-steps' eps in turn), the stages those of the
    * core's own template with this model's gradients inlined, so that with the baseline instruction set the
    * numbers are bit for bit those of the host stepping through grad_T and grad_V. Announced with the metadata
-   * object "kernels": {"instruction_sets": [...]} (version 4: {"version": K, ...}, not used by this host). A failed evaluation returns its status (message by last_error) with q, p
-   * and outer_gradient undefined: the host then redoes the steps through grad_T and grad_V. */
+   * object "kernels": {"instruction_sets": [...]} (version 4: {"version": K, ...}, not used by this host). A failed
+   * evaluation returns its status (message by last_error) with q, p and outer_gradient undefined: the host then redoes
+   * the steps through grad_T and grad_V. */
   nonsep_status (*chin_steps)(nonsep_instance* instance, const nonsep_chin_steps_args* args);
 
   /* The product term of the solved H in one pass, for a model that writes it out (a sparse model: its H then
