@@ -114,9 +114,11 @@ TEST_CASE("kernel path: steps started again from their states give the numbers o
   // The kernel rounds differently from the evaluation path (a wider instruction set's fused multiply-adds): a run
   // restarted from its states with a fresh integrator (a resume from a checkpoint) must start from the kernel's
   // gradient, not the evaluation path's, to continue bit for bit.
-  for (const auto& [scheme, order] :
+  for (const auto& scheme_and_order :
        {std::pair{"basic", Fraction(2, 3)}, std::pair{"triplet", Fraction(4, 3)}, std::pair{"mpe", Fraction(4, 3)}})
     for (const auto form : forms) {
+      const std::string scheme = scheme_and_order.first;  // not a structured binding: CAPTURE's lambda takes it
+      const Fraction order = scheme_and_order.second;
       CAPTURE(scheme);
       CAPTURE(static_cast<int>(form));
       WithKernel<Paper1D, 1, FusedPaper1D> kernel{};
