@@ -132,8 +132,10 @@ TEST_CASE("formula parser: nesting beyond the limit and over-long text are refus
     for (std::size_t i = 0; i < n; ++i) text += close;
     return text;
   };
-  for (const auto& [open, close] : std::vector<std::pair<std::string, std::string>>{
+  for (const auto& open_and_close : std::vector<std::pair<std::string, std::string>>{
            {"(", ")"}, {"sin(", ")"}, {"-", ""}, {"q0^", ""}, {"(-", ")"}}) {
+    const std::string& open = open_and_close.first;  // not a structured binding: CAPTURE's lambda takes it
+    const std::string& close = open_and_close.second;
     CAPTURE(open);
     const std::size_t per = open == "(-" ? 2 : 1;
     CHECK(std::holds_alternative<Node>(parse_formula(levels(open, "q0", close, max_formula_depth / per), q_symbols)));

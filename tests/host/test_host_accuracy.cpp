@@ -205,8 +205,10 @@ TEST_CASE("the error estimate on paper2d: a regular orbit against Gauss 6 at a t
     const auto reference =
         end_of("reference", run_of(model, {{"scheme", "gauss"}, {"stages", 3}}, initial, 2.0 / 4096, 2.0, 0));
     // Triplet 2's error constant is large here: at 2048 steps its error is 0.28, beyond the horizon.
-    for (const auto& [integrator, steps] : {std::pair{json{{"scheme", "mpe"}, {"order", "4"}}, 256},
-                                            std::pair{json{{"scheme", "triplet"}, {"order", "2"}}, 8192}}) {
+    for (const auto& integrator_and_steps : {std::pair{json{{"scheme", "mpe"}, {"order", "4"}}, 256},
+                                             std::pair{json{{"scheme", "triplet"}, {"order", "2"}}, 8192}}) {
+      const json& integrator = integrator_and_steps.first;  // not a structured binding: CAPTURE's lambda takes it
+      const int steps = integrator_and_steps.second;
       json job = run_of(model, integrator, initial, 2.0 / steps, 2.0, 0);
       job["analysis"] = {{"error_estimate", true}};
       const auto row = end_of("regular-" + integrator["scheme"].get<std::string>(), job);

@@ -204,7 +204,9 @@ TEST_CASE("resume under another instruction set or path than its checkpoint's: e
   // From the baseline kernel to the evaluation path, and to the widest set when this processor runs a wider one.
   std::vector<std::pair<std::string, std::string>> changes = {{"baseline", "evaluation"}};
   if (widest != "x86-64") changes.push_back({"baseline", ""});
-  for (const auto& [written, resumed] : changes) {
+  for (const auto& change : changes) {
+    const std::string& written = change.first;  // not a structured binding: CAPTURE's lambda takes it
+    const std::string& resumed = change.second;
     CAPTURE(written);
     CAPTURE(resumed);
     const auto out = folder / ("out_" + written + "_" + resumed);
