@@ -340,16 +340,9 @@ bool choose(LoadedJob& loaded, RunOptions& options, const RunArguments& argument
   }
 }
 
-}  // namespace
-
-int command_run(const RunArguments& arguments) {
-  std::unique_ptr<Ranks> ranks;
-  try {
-    ranks = Ranks::join();
-  } catch (const std::exception& error) {
-    std::cerr << "nonsep: " << error.what() << "\n";
-    return to_int(ExitStatus::invalid_input);
-  }
+// The run on this rank: every rank of a distributed run returns the same status; on the paths that rank 0 runs alone
+// (a study, the resume of a one-process run) the others return 0.
+int run_on_ranks(const RunArguments& arguments, const Ranks* ranks) {
   const OnlyRankZeroSpeaks quiet(*ranks);
   std::optional<LoadedJob> loaded;
   std::string invalid;
@@ -421,15 +414,31 @@ int command_run(const RunArguments& arguments) {
                   << ": scheme \"auto\" chooses from timed pilot runs, which a resumed run would repeat and might "
                      "answer differently; write the chosen integrator (summary.json integrator) into the job to "
                      "resume it\n";
-        return to_int(ExitStatus::invalid_input);
+        status = to_int(ExitStatus::invalid_input);
+      } else if (loaded->job.run().auto_scheme && !choose(*loaded, options, arguments)) {
+        status = to_int(ExitStatus::run_failed);
+      } else {
+        auto outcome = run_guarded([&] { return run_job(*loaded, options); });
+        status = outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
+                         : to_int(ExitStatus::invalid_input);
       }
-      if (loaded->job.run().auto_scheme && !choose(*loaded, options, arguments)) return to_int(ExitStatus::run_failed);
-      auto outcome = run_guarded([&] { return run_job(*loaded, options); });
-      status = outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())
-                       : to_int(ExitStatus::invalid_input);
     }
   }
-  return ranks->max(status);
+  return status;
+}
+
+}  // namespace
+
+int command_run(const RunArguments& arguments) {
+  std::unique_ptr<Ranks> ranks;
+  try {
+    ranks = Ranks::join();
+  } catch (const std::exception& error) {
+    std::cerr << "nonsep: " << error.what() << "\n";
+    return to_int(ExitStatus::invalid_input);
+  }
+  // Every rank ends with the largest status of all (rank 0 alone runs a study or a one-process resume).
+  return ranks->max(run_on_ranks(arguments, ranks.get()));
 }
 
 }  // namespace nonsep::host::cli
