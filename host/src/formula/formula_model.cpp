@@ -5,7 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "job/checker.hpp"
+#include "nonsep/host/json/checker.hpp"
+#include "nonsep/host/json/strict_json.hpp"
 
 namespace nonsep::host::formula {
 

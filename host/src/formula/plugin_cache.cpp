@@ -185,18 +185,4 @@ CachedPlugin cached_plugin(const FormulaModel& model, const std::function<void(c
   return result;
 }
 
-bool attach_formula_plugin(Job& job, std::vector<JobIssue>& issues) {
-  try {
-    const CachedPlugin plugin =
-        cached_plugin(*job.formula, [](const std::string& line) { std::cerr << "nonsep: " << line << std::endl; });
-    job.plugin = plugin.path.string();
-    job.formula_cache_key = plugin.key;
-    return true;
-  } catch (const std::exception& error) {
-    issues.push_back({"/model/formula", "a formula model that cannot be compiled: " + std::string(error.what()),
-                      "a formula model and a working C++ compiler (docs/formula-models.md)"});
-    return false;
-  }
-}
-
 }  // namespace nonsep::host::formula

@@ -7,9 +7,10 @@
 #include <cmath>
 #include <exception>
 
-#include "checker.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/json/checker.hpp"
 
 namespace nonsep::host {
 

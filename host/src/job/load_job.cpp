@@ -2,20 +2,33 @@
 // load_job, which runs all passes and throws InvalidJob with the issues of every pass together.
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 
-#include "checker.hpp"
 #include "nonsep/core/integrator.hpp"
 #include "nonsep/core/tangent_integrator.hpp"
 #include "nonsep/host/formula/plugin_cache.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/json/checker.hpp"
 
 namespace nonsep::host {
 
-std::string to_string(const JobIssue& issue) {
-  return (issue.path.empty() ? std::string("(document)") : issue.path) + ": found " + issue.found +
-         "; allowed: " + issue.allowed;
-}
-
 namespace {
+
+// The plugin of job.formula from the cache (compiling it first, saying so on standard error), into job.plugin and
+// job.formula_cache_key; false with an issue at /model/formula when it cannot be had.
+bool attach_formula_plugin(Job& job, std::vector<JobIssue>& issues) {
+  try {
+    const formula::CachedPlugin plugin = formula::cached_plugin(
+        *job.formula, [](const std::string& line) { std::cerr << "nonsep: " << line << std::endl; });
+    job.plugin = plugin.path.string();
+    job.formula_cache_key = plugin.key;
+    return true;
+  } catch (const std::exception& error) {
+    issues.push_back({"/model/formula", "a formula model that cannot be compiled: " + std::string(error.what()),
+                      "a formula model and a working C++ compiler (docs/formula-models.md)"});
+    return false;
+  }
+}
 
 std::string gibibytes(std::size_t bytes) {
   char text[32];
@@ -86,7 +99,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
     // What `nonsep validate` checks without the compiler comes first: a job with any problem compiles nothing.
     check_model_parameters(job.parameters, formula::declared_parameters(*job.formula), issues);
     check_dimension(job.initial, job.formula->dimension, issues);
-    if (!issues.empty() || !formula::attach_formula_plugin(job, issues)) return std::nullopt;
+    if (!issues.empty() || !attach_formula_plugin(job, issues)) return std::nullopt;
   }
   if (job.plugin.empty()) return std::nullopt;
   LoadedJob loaded{std::move(job), {}, {}};

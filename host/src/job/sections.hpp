@@ -9,8 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "checker.hpp"
 #include "job_keys.hpp"
+#include "nonsep/host/job.hpp"
+#include "nonsep/host/json/checker.hpp"
 
 namespace nonsep::host::job_reader {
 

@@ -26,6 +26,8 @@
 #include <vector>
 
 #include "nonsep/core/integrator.hpp"
+#include "nonsep/host/json/issues.hpp"
+#include "nonsep/host/json/strict_json.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/time_grid.hpp"
 
@@ -34,22 +36,6 @@ namespace nonsep::host {
 namespace formula {
 struct FormulaModel;  // nonsep/host/formula/formula_model.hpp
 }
-
-// One problem in a job file. `path` is a JSON Pointer ("/integrator/order"; "" for the whole document),
-// `found` describes what is there ("\"5/3\"", "nothing", "a string"), `allowed` what would be accepted.
-struct JobIssue {
-  std::string path;
-  std::string found;
-  std::string allowed;
-};
-// "/integrator/order: found \"5/3\"; allowed: ..."
-std::string to_string(const JobIssue& issue);
-
-// Whether the key `written` is likely a misspelling of `meant`: equal but for letter case, or (both at least 3
-// characters long) one edit away, two for names of 6 characters or more. The reader's messages name the likely
-// intended key with it; no two keys of one object of a job file are that close (a test checks it), so a
-// suggestion never names another valid key.
-bool looks_like_misspelling(std::string_view written, std::string_view meant);
 
 // Thrown by load_job with every issue of the file (never empty). what() is the full report, one issue a line.
 class InvalidJob : public std::runtime_error {
@@ -238,9 +224,6 @@ inline constexpr std::size_t max_initial_states = 1'000'000;
 // million states of dimension 16 fit), so that a grid written in a few lines cannot ask for more memory and time
 // than a machine has.
 inline constexpr std::size_t max_initial_values = 16'777'216;
-// Largest accepted nesting of objects and arrays (the document is level 1). A job needs 6; the limit bounds the
-// reader's memory and the recursion of formatting a value for a message.
-inline constexpr std::size_t max_nesting_depth = 64;
 // H is evaluated from one n x n Hessian per state (nonsep::EnergyEvaluator, a block's states a few at a time) for a
 // plugin without Hessian-vector products or its own energy_TTV/energy_VVT: such a model whose single Hessian would
 // take more than this many numbers (1 GiB) is refused before the run (dimension at most 11585).
@@ -248,9 +231,7 @@ inline constexpr std::size_t max_hessian_values = std::size_t{1} << 27;
 // Largest job file read (64 MiB); a longer file, or a device that never ends such as /dev/zero, is an issue at "".
 inline constexpr std::size_t max_job_file_bytes = std::size_t{64} << 20;
 
-// Pass 1. Parses `text` as JSON, refusing duplicate keys (nlohmann would keep the last one silently) and nesting
-// deeper than max_nesting_depth (naming the first value too deep). Returns nothing and adds issues on failure.
-std::optional<nlohmann::json> parse_job_text(const std::string& text, std::vector<JobIssue>& issues);
+// Pass 1: parse_job_text (json/strict_json.hpp).
 
 // Pass 2. Reads `document` into a Job, adding an issue for everything wrong. `job_file` locates relative paths
 // and names the default output folder. The returned Job is meaningful only if no issue was added.

@@ -25,7 +25,8 @@
 #include <vector>
 
 #include "nonsep/host/formula/expression.hpp"
-#include "nonsep/host/job.hpp"
+#include "nonsep/host/json/issues.hpp"
+#include "nonsep/host/plugin_loader.hpp"
 
 namespace nonsep::host::formula {
 

@@ -67,8 +67,4 @@ struct CachedPlugin {
 // "compiled in 9.4 s", a fallback note). Throws FormulaCompileError.
 CachedPlugin cached_plugin(const FormulaModel& model, const std::function<void(const std::string&)>& say);
 
-// For load_model (job.hpp): the plugin of job.formula from the cache (compiling it first, saying so on standard
-// error), into job.plugin and job.formula_cache_key; false with an issue at /model/formula when it cannot be had.
-bool attach_formula_plugin(Job& job, std::vector<JobIssue>& issues);
-
 }  // namespace nonsep::host::formula

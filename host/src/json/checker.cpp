@@ -1,4 +1,4 @@
-#include "checker.hpp"
+#include "nonsep/host/json/checker.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -31,6 +31,11 @@ std::string lower(std::string_view text) {
   return result;
 }
 }  // namespace
+
+std::string to_string(const JobIssue& issue) {
+  return (issue.path.empty() ? std::string("(document)") : issue.path) + ": found " + issue.found +
+         "; allowed: " + issue.allowed;
+}
 
 bool looks_like_misspelling(std::string_view written, std::string_view meant) {
   if (written == meant) return false;

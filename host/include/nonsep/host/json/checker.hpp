@@ -1,6 +1,7 @@
 #pragma once
-// Internal to the job reader (host/src/job/): JSON Pointers, the shortened description of a found value, and
-// Checker, the typed reads every section uses. Each read of Checker either returns the value or adds one JobIssue
+// The typed reads of the JSON readers (the job reader, host/src/job/, and the formula model reader,
+// host/src/formula/): JSON Pointers, the shortened description of a found value, and Checker, the typed reads every
+// section uses. Each read of Checker either returns the value or adds one JobIssue
 // (path, what was found, what is allowed) and returns nothing, so a section goes on and reports all its problems.
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -9,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "nonsep/host/job.hpp"
+#include "nonsep/host/json/issues.hpp"
 
 namespace nonsep::host::job_reader {
 

@@ -3,9 +3,11 @@
 // deeper than max_nesting_depth. The depth limit keeps every later step bounded: the builder holds a JSON Pointer
 // per open level (memory grows with the square of the depth), and serialising a value for a message recurses once
 // per level (a 200 KB file nested 10^5 levels deep took 10 GB and then overflowed the stack).
+#include "nonsep/host/json/strict_json.hpp"
+
 #include <utility>
 
-#include "checker.hpp"
+#include "nonsep/host/json/checker.hpp"
 #include "nonsep/host/platform/installation.hpp"
 
 namespace nonsep::host {
