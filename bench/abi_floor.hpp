@@ -18,7 +18,7 @@
 #include <string>
 
 #include "hand_written.hpp"
-#include "nonsep/core/aligned_allocator.hpp"
+#include "nonsep/core/base/aligned_allocator.hpp"
 #include "nonsep/plugin_abi.h"
 
 namespace bench {

@@ -1,4 +1,4 @@
-// The cost of the generic comparator steppers (core/include/nonsep/core/tao_extended_phase_space.hpp and
+// The cost of the generic comparator steppers (core/include/nonsep/core/schemes/tao_extended_phase_space.hpp and
 // gauss_legendre.hpp) against the same methods hand-written for the paper's 1D model, on one trajectory and on an
 // ensemble of 1024, in TTV form, dt = 1e-3, omega = 20:
 //
@@ -30,8 +30,8 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/gauss_legendre.hpp"
-#include "nonsep/core/tao_extended_phase_space.hpp"
+#include "nonsep/core/schemes/gauss_legendre.hpp"
+#include "nonsep/core/schemes/tao_extended_phase_space.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 
 namespace {

@@ -73,8 +73,8 @@
 #include "coupled3d.hpp"
 #include "hand_written.hpp"
 #include "hand_written_native.hpp"
-#include "nonsep/core/chin_basic_step.hpp"
-#include "nonsep/core/multi_product_expansion.hpp"
+#include "nonsep/core/schemes/chin_basic_step.hpp"
+#include "nonsep/core/schemes/multi_product_expansion.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/launch/run_job.hpp"
 #include "nonsep/host/plugin_loader.hpp"
@@ -89,8 +89,8 @@ using CompiledPaper1D = nonsep::sdk::ModelAdapter<Paper1D>;
 
 constexpr double dt = 1e-4;
 
-// The references' arrays start on a cache line, as the host's do (nonsep/core/aligned_allocator.hpp): with the wide
-// vectors of a native build, arrays that straddle lines would make the limit slower than it is.
+// The references' arrays start on a cache line, as the host's do (nonsep/core/base/aligned_allocator.hpp): with the
+// wide vectors of a native build, arrays that straddle lines would make the limit slower than it is.
 using Doubles = nonsep::AlignedDoubles;
 Doubles copy_of(const std::vector<double>& values) { return Doubles(values.begin(), values.end()); }
 

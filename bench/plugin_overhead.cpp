@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/schemes/chin_basic_step.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "paper1d/paper1d.hpp"
 

@@ -29,15 +29,15 @@
 #include <utility>
 #include <vector>
 
-#include "nonsep/core/chin_basic_step.hpp"
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/gauss_legendre.hpp"
-#include "nonsep/core/multi_product_expansion.hpp"
-#include "nonsep/core/tangent_basic_step.hpp"
-#include "nonsep/core/tangent_multi_product_expansion.hpp"
-#include "nonsep/core/tangent_triplet_composition.hpp"
-#include "nonsep/core/tao_extended_phase_space.hpp"
-#include "nonsep/core/triplet_composition.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/schemes/chin_basic_step.hpp"
+#include "nonsep/core/schemes/gauss_legendre.hpp"
+#include "nonsep/core/schemes/multi_product_expansion.hpp"
+#include "nonsep/core/schemes/tao_extended_phase_space.hpp"
+#include "nonsep/core/schemes/triplet_composition.hpp"
+#include "nonsep/core/tangent/tangent_basic_step.hpp"
+#include "nonsep/core/tangent/tangent_multi_product_expansion.hpp"
+#include "nonsep/core/tangent/tangent_triplet_composition.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 
 namespace {

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/chin_basic_step.hpp"
-#include "nonsep/core/tangent_basic_step.hpp"
+#include "nonsep/core/schemes/chin_basic_step.hpp"
+#include "nonsep/core/tangent/tangent_basic_step.hpp"
 #include "paper1d/paper1d.hpp"
 #include "paper2d/paper2d.hpp"
 

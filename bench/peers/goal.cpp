@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "benchmark_problems.hpp"
-#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #ifdef NONSEP_BENCH_HAVE_GSL
 #include "gsl_gauss_methods.hpp"

@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "benchmark_problems.hpp"
-#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "odeint_methods.hpp"

@@ -1,12 +1,12 @@
 #pragma once
 // The Mathews-Lakshmanan oscillator, a position-dependent inverse mass with a potential:
 //   H = (1/2)(1 + lambda q^2) p^2 + (1/2) alpha^2 q^2 / (1 + lambda q^2).
-// Product form plus a separable part (nonsep/core/separable_composition.hpp): T = p^2/2 and V = q^2/4 + lambda q^4/24
-// give T'(p)^2 V''(q) = (1/2)(1 + lambda q^2) p^2, and U(q) = (1/2) alpha^2 q^2 / (1 + lambda q^2); no K.
-// Exact solution (nonsep/reference/mathews_lakshmanan_exact.hpp): q(t) = A sin(omega t + phi) with
-// omega = alpha / sqrt(1 + lambda A^2), p = q' / (1 + lambda q^2), for 1 + lambda A^2 > 0.
-// Parameters "lambda" (default 0.5, range [0, 10]: the inverse mass stays >= 1) and "alpha" (default 1, > 0).
-// Defined everywhere for lambda >= 0. Analytic gradients; Hessians by automatic differentiation.
+// Product form plus a separable part (nonsep/core/schemes/separable_composition.hpp): T = p^2/2 and V = q^2/4 + lambda
+// q^4/24 give T'(p)^2 V''(q) = (1/2)(1 + lambda q^2) p^2, and U(q) = (1/2) alpha^2 q^2 / (1 + lambda q^2); no K. Exact
+// solution (nonsep/reference/mathews_lakshmanan_exact.hpp): q(t) = A sin(omega t + phi) with omega = alpha / sqrt(1 +
+// lambda A^2), p = q' / (1 + lambda q^2), for 1 + lambda A^2 > 0. Parameters "lambda" (default 0.5, range [0, 10]: the
+// inverse mass stays >= 1) and "alpha" (default 1, > 0). Defined everywhere for lambda >= 0. Analytic gradients;
+// Hessians by automatic differentiation.
 #include <nonsep/plugin_sdk.hpp>
 
 class MathewsLakshmanan {

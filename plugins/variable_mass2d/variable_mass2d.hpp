@@ -2,7 +2,7 @@
 // A particle in the plane with a position-dependent inverse mass that is a Hessian, in an anisotropic potential:
 //   H = (1/2) p . M^-1(q) p + U(q),   M^-1(q) = kappa I + 2 Hess V(q),
 // the product form T_i V_ij T_j with T = |p|^2/2 and V = |q|^2/4 + lambda |q|^4/24 plus the separable part
-// (nonsep/core/separable_composition.hpp) K = kappa |p|^2/2 and U = (q1^2 + omega^2 q2^2)/2 + mu q1^2 q2^2:
+// (nonsep/core/schemes/separable_composition.hpp) K = kappa |p|^2/2 and U = (q1^2 + omega^2 q2^2)/2 + mu q1^2 q2^2:
 //   2 Hess V = (1 + lambda |q|^2/3) I + (2 lambda/3) q q^T,
 //   H = (1/2)(kappa + 1 + lambda |q|^2/3) |p|^2 + (lambda/3)(q . p)^2 + (q1^2 + omega^2 q2^2)/2 + mu q1^2 q2^2.
 // Compact energy shells: for lambda, kappa, mu >= 0, M^-1 >= I and H >= |p|^2/2 + min(1, omega^2) |q|^2/2.

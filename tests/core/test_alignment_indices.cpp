@@ -9,9 +9,9 @@
 #include <cmath>
 #include <vector>
 
-#include "nonsep/core/alignment_indices.hpp"
-#include "nonsep/core/lyapunov_exponents.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/analysis/alignment_indices.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "nonsep/core.hpp"
-#include "nonsep/core/lyapunov_exponents.hpp"
-#include "nonsep/core/megno.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
+#include "nonsep/core/analysis/megno.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;

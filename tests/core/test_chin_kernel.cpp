@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "nonsep/core.hpp"
-#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/core/kernel/chin_kernel.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;

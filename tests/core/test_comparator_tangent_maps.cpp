@@ -15,7 +15,7 @@
 
 #include "lattice_chain/lattice_chain.hpp"
 #include "nonsep/core.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "paper2d/paper2d.hpp"
 #include "support/finite_difference.hpp"
 #include "support/phase_space_jacobian.hpp"

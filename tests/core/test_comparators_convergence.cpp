@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/gauss_legendre.hpp"
-#include "nonsep/core/hamiltonian_gradient.hpp"
-#include "nonsep/core/tao_extended_phase_space.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/base/hamiltonian_gradient.hpp"
+#include "nonsep/core/schemes/gauss_legendre.hpp"
+#include "nonsep/core/schemes/tao_extended_phase_space.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "support/convergence.hpp"

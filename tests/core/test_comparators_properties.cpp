@@ -14,9 +14,9 @@
 #include <variant>
 #include <vector>
 
-#include "nonsep/core/gauss_legendre.hpp"
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/tao_extended_phase_space.hpp"
+#include "nonsep/core/schemes/gauss_legendre.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/schemes/tao_extended_phase_space.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
 #include "support/models.hpp"
 #include "support/nan_aware.hpp"

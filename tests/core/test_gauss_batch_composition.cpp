@@ -10,7 +10,7 @@
 #include <numeric>
 #include <vector>
 
-#include "nonsep/core/gauss_legendre.hpp"
+#include "nonsep/core/schemes/gauss_legendre.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "nonsep/core.hpp"
-#include "nonsep/core/poincare_crossing.hpp"
+#include "nonsep/core/analysis/poincare_crossing.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;

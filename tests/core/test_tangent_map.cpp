@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "nonsep/core.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "support/models.hpp"
 #include "support/phase_space_jacobian.hpp"
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "host_run_support.hpp"
-#include "nonsep/core/lyapunov_exponents.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "paper2d/paper2d.hpp"
 
 using namespace nonsep::host_testing;

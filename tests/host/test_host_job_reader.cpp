@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "host_test_support.hpp"
-#include "nonsep/core/scheme_catalogue.hpp"
+#include "nonsep/core/schemes/scheme_catalogue.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/platform/build_features.hpp"
 

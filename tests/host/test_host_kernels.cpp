@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "host_run_support.hpp"
-#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/core/kernel/chin_kernel.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host_testing;

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <string>
 
-#include "nonsep/core/chin_basic_step.hpp"
-#include "nonsep/core/energy.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/schemes/chin_basic_step.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 

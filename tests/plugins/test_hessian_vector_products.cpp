@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "lattice_chain/lattice_chain.hpp"
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/hamiltonian_gradient.hpp"
-#include "nonsep/core/multi_product_expansion.hpp"
-#include "nonsep/core/tangent_basic_step.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/base/hamiltonian_gradient.hpp"
+#include "nonsep/core/schemes/multi_product_expansion.hpp"
+#include "nonsep/core/tangent/tangent_basic_step.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "mathews_lakshmanan/mathews_lakshmanan.hpp"
-#include "nonsep/core/model.hpp"
+#include "nonsep/core/base/model.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "paper1d/paper1d.hpp"
 #include "support/models.hpp"

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/chin_basic_step.hpp"
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/hamiltonian_gradient.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/base/hamiltonian_gradient.hpp"
+#include "nonsep/core/schemes/chin_basic_step.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/plugin_abi.h"

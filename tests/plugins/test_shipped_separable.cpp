@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "mathews_lakshmanan/mathews_lakshmanan.hpp"
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/hamiltonian_gradient.hpp"
-#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/base/hamiltonian_gradient.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/plugin_abi.h"

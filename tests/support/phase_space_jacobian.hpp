@@ -9,8 +9,8 @@
 #include <limits>
 #include <vector>
 
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/phase_space_batch.hpp"
+#include "nonsep/core/base/phase_space_batch.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "support/finite_difference.hpp"
 
 namespace nonsep::testing {

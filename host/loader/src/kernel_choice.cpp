@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/core/kernel/chin_kernel.hpp"
 #include "plugin_internals.hpp"
 
 namespace nonsep::host {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/base/error.hpp"
 #include "plugin_internals.hpp"
 
 namespace nonsep::host {

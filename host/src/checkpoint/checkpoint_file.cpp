@@ -10,9 +10,9 @@
 #include <variant>
 #include <vector>
 
-#include "nonsep/core/alignment_indices.hpp"
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/analysis/alignment_indices.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/run_folder.hpp"

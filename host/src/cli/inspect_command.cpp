@@ -10,7 +10,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/base/error.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/inspect/plugin_report.hpp"
 #include "nonsep/host/number_format.hpp"

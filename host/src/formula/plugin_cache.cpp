@@ -9,7 +9,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/core/kernel/chin_kernel.hpp"
 #include "nonsep/host/formula/cpp_source.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/plugin_abi.h"

@@ -9,7 +9,7 @@
 #include <regex>
 #include <sstream>
 
-#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/core/kernel/chin_kernel.hpp"
 #include "nonsep/host/formula/plugin_cache.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/platform/installation.hpp"

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/energy.hpp"
+#include "nonsep/core/analysis/energy.hpp"
 #include "nonsep/host/inspect/plugin_report.hpp"
 
 namespace nonsep::host {

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <string>
 
-#include "nonsep/core/chin_kernel.hpp"
-#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/kernel/chin_kernel.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/host/inspect/plugin_report.hpp"
 
 namespace nonsep::host {

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "job_keys.hpp"
-#include "nonsep/core/lyapunov_exponents.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {

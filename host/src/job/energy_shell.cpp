@@ -5,8 +5,8 @@
 #include <boost/math/tools/toms748_solve.hpp>
 #include <cmath>
 
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/base/error.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "sections.hpp"
 

@@ -1,13 +1,13 @@
 // /hamiltonian and /integrator: the scheme and its options, read against the core's catalogue
 // (nonsep::scheme_catalogue()); whether an option's value is valid is decided by the core, by building the scheme.
-#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 
 #include <algorithm>
 #include <stdexcept>
 #include <variant>
 
 #include "job_keys.hpp"
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/base/error.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "sections.hpp"
 

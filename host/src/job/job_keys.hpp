@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/schemes/chin_basic_step.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/time_grid.hpp"
 

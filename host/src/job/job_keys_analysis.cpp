@@ -3,7 +3,7 @@
 #include <limits>
 
 #include "job_keys.hpp"
-#include "nonsep/core/lyapunov_exponents.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
 
 namespace nonsep::host::job_reader {
 

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <iostream>
 
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "nonsep/host/formula/plugin_cache.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/json/checker.hpp"

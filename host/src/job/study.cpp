@@ -2,8 +2,8 @@
 // turned into counts by step_count), and the optional exact reference state at t_end.
 #include <algorithm>
 
-#include "nonsep/core/error.hpp"
-#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/base/error.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {

@@ -1,6 +1,6 @@
 #include "nonsep/host/observers/lyapunov_megno.hpp"
 
-#include "nonsep/core/alignment_indices.hpp"
+#include "nonsep/core/analysis/alignment_indices.hpp"
 #include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {

@@ -4,7 +4,7 @@
 #include <numeric>
 #include <tuple>
 
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/base/error.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/saved_state.hpp"
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/error.hpp"
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/phase_space_batch.hpp"
+#include "nonsep/core/base/error.hpp"
+#include "nonsep/core/base/phase_space_batch.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/host/run/observer.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 #include "run/tangent_block.hpp"

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/base/error.hpp"
 
 namespace nonsep::host {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/energy.hpp"
+#include "nonsep/core/analysis/energy.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/observer.hpp"
 #include "nonsep/host/time_grid.hpp"

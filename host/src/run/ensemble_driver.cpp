@@ -11,8 +11,8 @@
 #include <optional>
 #include <tuple>
 
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/base/error.hpp"
 #include "run/block.hpp"
 #include "run/block_stepper.hpp"
 #include "run/worker_pool.hpp"

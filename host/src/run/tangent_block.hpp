@@ -17,9 +17,9 @@
 #include <span>
 #include <vector>
 
-#include "nonsep/core/lyapunov_exponents.hpp"
-#include "nonsep/core/megno.hpp"
-#include "nonsep/core/tangent_integrator.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
+#include "nonsep/core/analysis/megno.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
 namespace nonsep::host {

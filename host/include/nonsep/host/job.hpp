@@ -25,7 +25,7 @@
 #include <variant>
 #include <vector>
 
-#include "nonsep/core/integrator.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/host/json/issues.hpp"
 #include "nonsep/host/json/strict_json.hpp"
 #include "nonsep/host/plugin_loader.hpp"
@@ -135,7 +135,7 @@ struct Analysis {
   std::size_t tangent_vectors() const {
     return std::max({lyapunov ? lyapunov->vectors : 0, megno ? std::size_t{1} : 0, sali ? std::size_t{2} : 0, gali});
   }
-  // Whether the run keeps the factors of SALI and GALI (nonsep/core/alignment_indices.hpp).
+  // Whether the run keeps the factors of SALI and GALI (nonsep/core/analysis/alignment_indices.hpp).
   bool alignment_indices() const { return sali || gali > 0; }
   // The job file's key of the first analysis that needs tangent vectors, for messages ("" for none).
   std::string tangent_key() const {

@@ -3,7 +3,7 @@
 // and directional third derivatives with finite differences at sample points, the way Ceres' GradientChecker does
 // for cost functions.
 //
-// Input: any batched model in the layout of nonsep/core/model.hpp (a plugin's PluginModel, a
+// Input: any batched model in the layout of nonsep/core/base/model.hpp (a plugin's PluginModel, a
 // nonsep::sdk::ModelAdapter, a hand-written model) with
 //   dimension(), grad_T, grad_V                     always,
 //   value_T(x, out, count), value_V(x, out, count)  (one value per state) when options.check_gradients,
@@ -371,7 +371,7 @@ struct SeparablePartView {
 };
 }  // namespace detail
 
-// The separable part K(p) + U(q) of a model (nonsep/core/model.hpp, ModelWithSeparablePart: value_K, value_U,
+// The separable part K(p) + U(q) of a model (nonsep/core/base/model.hpp, ModelWithSeparablePart: value_K, value_U,
 // grad_K, grad_U, hessian_K, hessian_U) checked as check_derivatives checks T and V: grad K and grad U against
 // differences of K and U, their Hessians against differences of the gradients, only the parts the model has
 // (has_K(), has_U()). Mismatches name grad_K, grad_U, hessian_K, hessian_U.

@@ -31,7 +31,7 @@
  *                                                   last_error)
  *   4. metadata_json() returns valid JSON of the shape below, whose capabilities match the table.
  *
- * Batch layout (same as nonsep/core/model.hpp): `count` states of dimension n, state-major and contiguous.
+ * Batch layout (same as nonsep/core/base/model.hpp): `count` states of dimension n, state-major and contiguous.
  * Component i of state b is at x[b*n + i]; gradient outputs have the same layout; Hessian outputs hold count
  * row-major n x n matrices, entry (i, j) of state b at out[b*n*n + i*n + j]. Value outputs hold one double
  * per state. Directions (u of the third derivatives, v of the Hessian-vector products; one per state) and their
@@ -92,7 +92,7 @@ typedef enum nonsep_status {
 
 typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin */
 
-/* The forms of the solved Hamiltonian (nonsep/core/integrator_description.hpp's HamiltonianForm). */
+/* The forms of the solved Hamiltonian (nonsep/core/schemes/integrator_description.hpp's HamiltonianForm). */
 #define NONSEP_FORM_TTV 0u /* H = T_i V_ij T_j (+ K + U) */
 #define NONSEP_FORM_VVT 1u /* H = V_i T_ij V_j (+ K + U) */
 

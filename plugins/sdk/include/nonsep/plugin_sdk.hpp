@@ -31,7 +31,7 @@
 // global or static state (a model that does is not for this SDK's export macro; see plugin_abi.h).
 //
 // The SDK is header-only: a plugin needs no nonsep library linked in (it includes a few header-only core
-// headers, nonsep/core/error.hpp).
+// headers, nonsep/core/base/error.hpp).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>

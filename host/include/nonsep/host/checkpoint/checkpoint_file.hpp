@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/model.hpp"
+#include "nonsep/core/base/model.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"

@@ -5,8 +5,8 @@
 //                     re-orthonormalisation), megno, mean_megno (Y and <Y> of the first tangent vector:
 //                     <Y> -> 2 on a quasi-periodic orbit, ~ lambda t / 2 on a chaotic one, 0 on a stable periodic
 //                     one), sali and gali2 .. gali<k> (at the last re-orthonormalisation,
-//                     nonsep/core/alignment_indices.hpp), each when asked for; empty for a trajectory that diverged
-//                     or failed.
+//                     nonsep/core/analysis/alignment_indices.hpp), each when asked for; empty for a trajectory that
+//                     diverged or failed.
 //   lyapunov.csv      with /analysis/lyapunov/every = s > 0, the running estimates every s-th step:
 //                     trajectory,step,t,lyapunov0,...[,megno,mean_megno][,sali][,gali2,...], in (step, trajectory)
 //                     order.

@@ -26,9 +26,9 @@
 #include <optional>
 #include <vector>
 
-#include "nonsep/core/energy.hpp"
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/poincare_crossing.hpp"
+#include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/analysis/poincare_crossing.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/run/observer.hpp"

@@ -37,9 +37,9 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/integrator.hpp"
-#include "nonsep/core/lyapunov_exponents.hpp"
-#include "nonsep/core/megno.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
+#include "nonsep/core/analysis/megno.hpp"
+#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/observer.hpp"
 #include "nonsep/host/run/trajectory.hpp"
@@ -86,7 +86,7 @@ struct EnsembleSetup {
   // blocks: one instance per set and thread (`model` is then not stepped).
   std::vector<ParameterSet> parameter_sets = {};
   // With tangent vectors: whether the run computes MEGNO (the first vector's log-growth at every step), and whether
-  // it keeps the factors of SALI and GALI (nonsep/core/alignment_indices.hpp; tangent_vectors >= 2).
+  // it keeps the factors of SALI and GALI (nonsep/core/analysis/alignment_indices.hpp; tangent_vectors >= 2).
   bool megno = false;
   bool alignment_indices = false;
 };

@@ -43,8 +43,8 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/lyapunov_exponents.hpp"
-#include "nonsep/core/megno.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
+#include "nonsep/core/analysis/megno.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 namespace nonsep::host {
@@ -62,7 +62,7 @@ struct StateView {
   // The running Lyapunov and MEGNO sums, when the run follows tangent vectors (EnsembleSetup::tangent_vectors).
   const LyapunovRecord* lyapunov = nullptr;
   const MegnoRecord* megno = nullptr;
-  // With SALI or GALI: the state's factor of nonsep/core/alignment_indices.hpp; else empty.
+  // With SALI or GALI: the state's factor of nonsep/core/analysis/alignment_indices.hpp; else empty.
   std::span<const double> alignment = {};
 };
 

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/integrator_description.hpp"
-#include "nonsep/core/model.hpp"
+#include "nonsep/core/base/model.hpp"
+#include "nonsep/core/schemes/integrator_description.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/launch/run_job.hpp"
 

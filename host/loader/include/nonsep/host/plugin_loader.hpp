@@ -1,6 +1,6 @@
 #pragma once
 // Host side of the plugin boundary: finding, loading and checking plugins (plugin_abi.h), and PluginModel, which
-// puts a plugin instance behind the core's model interface (nonsep/core/model.hpp).
+// puts a plugin instance behind the core's model interface (nonsep/core/base/model.hpp).
 //
 // Naming and search. A plugin file is `<name>.so`. `load_plugin(spec, base)` treats `spec` as a path when it
 // contains a '/' or ends in ".so" (relative paths resolve against `base`, the job file's folder); otherwise as a
@@ -25,8 +25,8 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/chin_stages.hpp"
-#include "nonsep/core/error.hpp"
+#include "nonsep/core/base/error.hpp"
+#include "nonsep/core/kernel/chin_stages.hpp"
 
 struct nonsep_plugin_api;
 struct nonsep_instance;

@@ -1,7 +1,7 @@
 #pragma once
 // The stepping kernels an SDK plugin carries (plugin_abi.h, chin_steps): nonsep::chin_kernel_blocks, the core's own
-// template (nonsep/core/chin_kernel.hpp), instantiated with the plugin's model adapter inlined. No stepping code is
-// written here: this header only compiles that template once per instruction set and picks one by index.
+// template (nonsep/core/kernel/chin_kernel.hpp), instantiated with the plugin's model adapter inlined. No stepping code
+// is written here: this header only compiles that template once per instruction set and picks one by index.
 //
 // Instruction sets, in the order of the metadata's "kernels": {"instruction_sets": [...]} (index 0 first):
 //   "x86-64"     the baseline every x86-64 runs, compiled with the plugin's own flags: bit for bit the evaluation
@@ -31,7 +31,7 @@
 #include <span>
 #include <string_view>
 
-#include "nonsep/core/chin_kernel.hpp"
+#include "nonsep/core/kernel/chin_kernel.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 
 namespace nonsep::sdk {

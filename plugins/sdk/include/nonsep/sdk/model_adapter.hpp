@@ -1,6 +1,6 @@
 #pragma once
 // What a plugin model class looks like, and ModelAdapter, which turns one into a batched nonsep model
-// (nonsep/core/model.hpp) with derivatives by automatic differentiation or by the author's own code.
+// (nonsep/core/base/model.hpp) with derivatives by automatic differentiation or by the author's own code.
 //
 // A model class M (see plugins/paper1d/paper1d.hpp for a complete one) has
 //   template <class S> S T(nonsep::sdk::Vector<S> p) const;      the kinetic term T(p)
@@ -78,8 +78,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "nonsep/core/error.hpp"
-#include "nonsep/core/model.hpp"
+#include "nonsep/core/base/error.hpp"
+#include "nonsep/core/base/model.hpp"
 #include "nonsep/sdk/automatic_derivatives.hpp"
 #include "nonsep/sdk/dual.hpp"
 #include "nonsep/sdk/parameters.hpp"
@@ -290,7 +290,7 @@ consteval bool dimension_parameter_is_bounded() {
   }
 }
 
-// A model class behind the batched interface of nonsep/core/model.hpp (it models
+// A model class behind the batched interface of nonsep/core/base/model.hpp (it models
 // nonsep::ModelWithThirdDerivatives), plus value_T / value_V and hvp_T / hvp_V. Batch layout as in model.hpp. Spans
 // must hold at least count*n (count*n*n for Hessians, count for values) entries; shorter spans are a caller bug and
 // throw nonsep::InvalidArgument. Evaluation failures throw EvaluationError. ModelAdapter keeps no mutable state:

@@ -1,0 +1,36 @@
+#pragma once
+// The tangent map of the triplet composition, eqs. (sym43) and (sym63): the chain rule through the 3^levels basic
+// steps of a step, which is the product of their tangent maps (tangent_separable_composition.hpp) taken in the order
+// the composition runs them. The schedule of step sizes is TripletComposition::for_each_basic_step, the one the plain
+// composition runs, so the states get bit for bit the numbers of TripletComposition::step, and the tangent map is
+// symplectic (a product of symplectic maps). Tangent layout as in tangent_basic_step.hpp.
+#include "nonsep/core/schemes/triplet_composition.hpp"
+#include "nonsep/core/tangent/tangent_separable_composition.hpp"
+
+namespace nonsep {
+
+class TangentTripletComposition {
+ public:
+  // The tangent map of `stepper`: its base's form and t2, its number of levels.
+  explicit TangentTripletComposition(const TripletComposition<SeparableBasicStep>& stepper)
+      : base_(stepper.base()), levels_(stepper.levels()) {}
+
+  int levels() const { return levels_; }
+  HamiltonianForm form() const { return base_.form(); }
+  const EvaluationCounts& evaluations() const { return base_.evaluations(); }
+  const HessianCounts& hessian_evaluations() const { return base_.hessian_evaluations(); }
+
+  // As TripletComposition::step, with the tangent vectors mapped along; errors as TangentBasicStep::step.
+  template <ModelWithHessians M>
+  void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, double dt) {
+    check_step_size(dt);
+    TripletComposition<SeparableBasicStep>::for_each_basic_step(
+        levels_, dt, [&](double basic_dt) { base_.step(model, x, tangents, basic_dt); });
+  }
+
+ private:
+  TangentSeparableComposition base_;
+  int levels_;
+};
+
+}  // namespace nonsep
