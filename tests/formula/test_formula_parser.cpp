@@ -4,6 +4,7 @@
 // what the tree says.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -228,9 +229,54 @@ TEST_CASE("formula C++: bounded by the formula, whatever its products (repeated 
   const std::string automatic = source_of(distinct);
   CHECK(automatic.find("grad_V") == std::string::npos);
   CHECK(automatic.find("grad_T") != std::string::npos);
-  CHECK(automatic.size() < 4 * distinct.size() + 5000);
+  CHECK(automatic.size() < 6 * distinct.size() + 5000);  // its parts' headers included
   // A small formula keeps its written gradient.
   CHECK(source_of("q0^2/2 + q0^4/12").find("grad_V") != std::string::npos);
+}
+
+TEST_CASE("formula C++: long sums and products are cut into parts of bounded size that are not inlined") {
+  const auto source_of = [](const std::string& V) {
+    std::vector<nonsep::host::JobIssue> issues;
+    const auto model =
+        read_formula_model(nlohmann::json{{"name", "long"}, {"T", "p0^2/2"}, {"V", V}}, "/f", ".", issues);
+    REQUIRE(model);
+    return cpp_source(*model);
+  };
+  // The longest statement of the functions (a return or a gradient component), in characters: what the compiler
+  // optimises as one function grows with it.
+  const auto longest_statement = [](const std::string& source) {
+    std::size_t longest = 0, start = 0;
+    for (std::size_t end; (end = source.find('\n', start)) != std::string::npos; start = end + 1)
+      if (source.compare(start, 11, "    return ") == 0 || source.compare(start, 8, "    out[") == 0)
+        longest = std::max(longest, end - start);
+    return longest;
+  };
+  std::string product = "(q0 + 1)";  // 467 distinct factors (4094 characters)
+  for (int k = 2; product.size() + 11 <= max_formula_length; ++k) product += "*(q0 + " + std::to_string(k) + ")";
+  std::string sines = "sin(q0 + 1)";  // 280 distinct terms
+  for (int k = 2;; ++k) {
+    const std::string term = " + sin(q0 + " + std::to_string(k) + ")";
+    if (sines.size() + term.size() > max_formula_length) break;
+    sines += term;
+  }
+  std::string nested = "q0";  // sums inside sums: (1 + q0*(2 + q0*(3 + ...)))
+  for (int k = 1; nested.size() + 16 <= max_formula_length - 64 && k < 60; ++k)
+    nested = "(" + std::to_string(k) + " + q0*q1*" + nested + ")";
+  for (const std::string& formula : {product, sines, nested, std::string("q0^2/2 + q0^4/12")}) {
+    const std::string source = source_of(formula);
+    const std::size_t longest = longest_statement(source);
+    CAPTURE(formula.size());
+    CAPTURE(longest);
+    CHECK(longest < 2500);
+    const bool long_formula = formula.size() > 200;
+    CHECK((source.find("[[gnu::noinline]] S part_0(") != std::string::npos) == long_formula);
+  }
+  // Runs of terms with their signs become parts, joined in the formula's order.
+  std::string alternating = "q0";
+  for (int k = 1; alternating.size() + 24 <= 1000; ++k)
+    alternating += (k % 2 ? " - " : " + ") + std::string("q0*(q0 + ") + std::to_string(k) + ")/" + std::to_string(k);
+  const std::string source = source_of(alternating);
+  CHECK(source.find("part_0<S>(q) + part_1<S>(q)") != std::string::npos);
 }
 
 TEST_CASE("formula models: bad keys, parameter names, names and dimensions are issues at their pointers") {

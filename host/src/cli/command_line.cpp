@@ -61,7 +61,7 @@ int run_command_line(int argc, char** argv) {
     run->add_flag("--quiet,-q", arguments.quiet, "no progress (bar or lines) and no completion line");
     run->add_option("--progress-every", arguments.progress_every,
                     "when stderr is not a terminal (a batch log), a plain progress line every SECONDS (time, percent, "
-                    "max |dH/H0|, ETA); 0: none")
+                    "max |dH/H0|, ETA; under mpirun each rank's, labelled with the rank and its work unit); 0: none")
         ->default_val(10.0)
         ->check(CLI::NonNegativeNumber);
     run->add_flag("--resume", arguments.resume,

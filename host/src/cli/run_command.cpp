@@ -365,10 +365,11 @@ int run_on_ranks(const RunArguments& arguments, const Ranks* ranks) {
   RunOptions options;
   options.output_directory =
       arguments.output.empty() ? loaded->job.output_directory : std::filesystem::path(arguments.output);
-  if (!arguments.quiet && ranks->size() == 1)
-    options.progress = stderr_is_terminal()           ? ProgressStyle::bar
-                       : arguments.progress_every > 0 ? ProgressStyle::lines
-                                                      : ProgressStyle::none;
+  // Ranks share one stderr: they write lines, never a bar (distributed_run.cpp labels each rank's).
+  if (!arguments.quiet)
+    options.progress = stderr_is_terminal() && ranks->size() == 1 ? ProgressStyle::bar
+                       : arguments.progress_every > 0             ? ProgressStyle::lines
+                                                                  : ProgressStyle::none;
   options.progress_interval = arguments.progress_every;
   options.stop_requested = &stop_requested;
   options.resume = arguments.resume;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <optional>
 
 #include "cluster/unit_seal.hpp"
@@ -261,6 +262,12 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
   fail_if_any(local_failure);
 
   bool interrupted = false;
+  // Each rank writes its own progress lines, labelled with the rank and the unit, at the run's interval across its
+  // units (progress_bar.hpp): no rank waits for another to report. Lines, not a bar: the ranks share one stderr.
+  const bool progress = options.progress != ProgressStyle::none && options.progress_interval > 0;
+  const auto schedule = std::make_shared<ProgressSchedule>(ProgressSchedule{
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                             std::chrono::duration<double>(options.progress_interval))});
   {
     Ranks::UnitCounter counter(ranks);
     while (local_failure.empty()) {
@@ -278,7 +285,10 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
         if (state == UnitState::done) continue;  // verified by rank 0 at the start and before the merge
         RunOptions unit_options = options;
         unit_options.output_directory = path;
-        unit_options.progress = ProgressStyle::none;
+        unit_options.progress = progress ? ProgressStyle::lines : ProgressStyle::none;
+        unit_options.progress_label = "rank " + std::to_string(ranks.rank()) + " of " + std::to_string(ranks.size()) +
+                                      ", unit " + path.filename().string() + " of " + std::to_string(plan.units);
+        unit_options.progress_schedule = schedule;
         unit_options.work_unit = true;
         unit_options.resume = state == UnitState::checkpointed;
         unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over

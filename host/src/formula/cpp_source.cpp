@@ -34,87 +34,149 @@ std::optional<int> small_integer(const Node& exponent) {
   return sign * static_cast<int>(number->value);
 }
 
-std::string emit_product(const Node& node, char letter);
-
-std::string emit(const Node& node, char letter) {
-  switch (node.kind) {
-    case Node::Kind::number:
-      return literal(node.value);
-    case Node::Kind::variable:
-      return std::string(1, letter) + "[" + std::to_string(node.index) + "]";
-    case Node::Kind::parameter:
-      return "parameter_" + node.name;
-    case Node::Kind::pi:
-      return literal(3.141592653589793);
-    case Node::Kind::call: {
-      // The derivative rules take their arguments as S: some may be plain numbers, others S.
-      std::string text = "::nonsep::sdk::" + node.name + (is_derivative_rule(node.name) ? "<S>(" : "(");
-      for (std::size_t i = 0; i < node.operands.size(); ++i)
-        text += (i == 0 ? "" : ", ") + emit(node.operands[i], letter);
-      return text + ")";
-    }
-    case Node::Kind::negate:
-      return "(-" + emit(node.operands[0], letter) + ")";
-    case Node::Kind::power: {
-      const std::string base = emit(node.operands[0], letter);
-      if (const auto n = small_integer(node.operands[1])) {
-        const std::string product = "integer_power<" + std::to_string(*n < 0 ? -*n : *n) + ">(" + base + ")";
-        return *n < 0 ? "(1.0 / " + product + ")" : product;
-      }
-      return "::nonsep::sdk::pow(" + base + ", " + emit(node.operands[1], letter) + ")";
-    }
-    case Node::Kind::sum: {
-      std::string text = "(";
-      for (std::size_t i = 0; i < node.operands.size(); ++i)
-        text += (i == 0 ? "" : std::string(" ") + node.signs[i] + " ") + emit(node.operands[i], letter);
-      return text + ")";
-    }
-    case Node::Kind::product:
-      return emit_product(node, letter);
-  }
-  return {};
-}
-
-// A product with each repeated factor written once, as a power: x*x*...*x (k times) is integer_power<k>(x) for
-// k <= 64, pow(x, k) beyond, so the C++ (and the automatic derivatives the SDK makes of it) grows with the distinct
-// factors, not with the formula's length. Factors keep the order of their first appearance.
-std::string emit_product(const Node& node, char letter) {
-  std::vector<std::pair<std::size_t, std::size_t>> groups;  // (first operand, count)
-  for (std::size_t i = 0; i < node.operands.size(); ++i) {
-    const auto same = std::find_if(groups.begin(), groups.end(), [&](const auto& group) {
-      return node.signs[group.first] == node.signs[i] && node.operands[group.first] == node.operands[i];
-    });
-    if (same != groups.end())
-      ++same->second;
-    else
-      groups.emplace_back(i, 1);
-  }
-  std::string text = "(";
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const auto [first, count] = groups[g];
-    const std::string factor = emit(node.operands[first], letter);
-    const std::string power = count == 1    ? factor
-                              : count <= 64 ? "integer_power<" + std::to_string(count) + ">(S(" + factor + "))"
-                                            : "::nonsep::sdk::pow(S(" + factor + "), " + literal(count) + ")";
-    text +=
-        (g == 0 ? std::string(node.signs[first] == '/' ? "1.0 / " : "") : std::string(" ") + node.signs[first] + " ") +
-        power;
-  }
-  return text + ")";
-}
-
 std::size_t node_count(const Node& tree) {
   std::size_t count = 1;
   for (const auto& operand : tree.operands) count += node_count(operand);
   return count;
 }
 
+// The C++ of trees over the variables `letter`. A sum or product of more than max_part_nodes nodes is cut into parts
+// of consecutive operands of at most that many nodes together, each part a member function of its own that the
+// compiler does not inline ([[gnu::noinline]]): the optimiser's work grows faster than the function it works on
+// (with the nested dual numbers of the third derivatives, a product of 50 distinct factors took twice the CPU time of
+// one of 25), so a formula is compiled as functions of bounded size, and its compile time grows with its length.
+// The parts' definitions collect in `parts`, numbered across the whole class by `count`.
+class ExpressionWriter {
+ public:
+  ExpressionWriter(char letter, std::string& parts, std::size_t& count)
+      : letter_(letter), parts_(parts), count_(count) {}
+
+  char letter() const { return letter_; }
+
+  std::string emit(const Node& node) {
+    switch (node.kind) {
+      case Node::Kind::number:
+        return literal(node.value);
+      case Node::Kind::variable:
+        return std::string(1, letter_) + "[" + std::to_string(node.index) + "]";
+      case Node::Kind::parameter:
+        return "parameter_" + node.name;
+      case Node::Kind::pi:
+        return literal(3.141592653589793);
+      case Node::Kind::call: {
+        // The derivative rules take their arguments as S: some may be plain numbers, others S.
+        std::string text = "::nonsep::sdk::" + node.name + (is_derivative_rule(node.name) ? "<S>(" : "(");
+        for (std::size_t i = 0; i < node.operands.size(); ++i) text += (i == 0 ? "" : ", ") + emit(node.operands[i]);
+        return text + ")";
+      }
+      case Node::Kind::negate:
+        return "(-" + emit(node.operands[0]) + ")";
+      case Node::Kind::power: {
+        const std::string base = emit(node.operands[0]);
+        if (const auto n = small_integer(node.operands[1])) {
+          const std::string product = "integer_power<" + std::to_string(*n < 0 ? -*n : *n) + ">(" + base + ")";
+          return *n < 0 ? "(1.0 / " + product + ")" : product;
+        }
+        return "::nonsep::sdk::pow(" + base + ", " + emit(node.operands[1]) + ")";
+      }
+      case Node::Kind::sum: {
+        std::vector<Term> terms;
+        for (std::size_t i = 0; i < node.operands.size(); ++i)
+          terms.push_back({node.signs[i], emit(node.operands[i]), node_count(node.operands[i])});
+        return combine(terms, '+');
+      }
+      case Node::Kind::product:
+        return emit_product(node);
+    }
+    return {};
+  }
+
+ private:
+  struct Term {
+    char sign;  // + - * /
+    std::string text;
+    std::size_t nodes;
+  };
+
+  // A product with each repeated factor written once, as a power: x*x*...*x (k times) is integer_power<k>(x) for
+  // k <= 64, pow(x, k) beyond, so the C++ (and the automatic derivatives the SDK makes of it) grows with the distinct
+  // factors, not with the formula's length. Factors keep the order of their first appearance.
+  std::string emit_product(const Node& node) {
+    std::vector<std::pair<std::size_t, std::size_t>> groups;  // (first operand, count)
+    for (std::size_t i = 0; i < node.operands.size(); ++i) {
+      const auto same = std::find_if(groups.begin(), groups.end(), [&](const auto& group) {
+        return node.signs[group.first] == node.signs[i] && node.operands[group.first] == node.operands[i];
+      });
+      if (same != groups.end())
+        ++same->second;
+      else
+        groups.emplace_back(i, 1);
+    }
+    std::vector<Term> factors;
+    for (const auto& [first, count] : groups) {
+      const std::string factor = emit(node.operands[first]);
+      factors.push_back({node.signs[first],
+                         count == 1    ? factor
+                         : count <= 64 ? "integer_power<" + std::to_string(count) + ">(S(" + factor + "))"
+                                       : "::nonsep::sdk::pow(S(" + factor + "), " + literal(count) + ")",
+                         node_count(node.operands[first]) + 1});
+    }
+    return combine(factors, '*');
+  }
+
+  // `terms` joined by their signs ('+' or '*' for the first is left out, '-' and '/' kept); beyond max_part_nodes in
+  // all, runs of consecutive terms of at most max_part_nodes nodes, each a part, joined by `join`.
+  std::string combine(const std::vector<Term>& terms, char join) {
+    std::size_t nodes = 0;
+    for (const Term& term : terms) nodes += term.nodes;
+    if (nodes <= max_part_nodes) return joined(terms.begin(), terms.end());
+    std::string text = "(";
+    for (auto first = terms.begin(); first != terms.end();) {
+      auto last = first;
+      std::size_t run = 0;
+      for (; last != terms.end() && (last == first || run + last->nodes <= max_part_nodes); ++last) run += last->nodes;
+      // A term larger than a part on its own is written in place: its own sums and products are cut the same way.
+      const std::string run_text = run <= max_part_nodes ? part(joined(first, last)) : joined(first, last);
+      text += (first == terms.begin() ? "" : std::string(" ") + join + " ") + run_text;
+      first = last;
+    }
+    return text + ")";
+  }
+
+  static std::string joined(std::vector<Term>::const_iterator first, std::vector<Term>::const_iterator last) {
+    std::string text = "(";
+    for (auto term = first; term != last; ++term) {
+      if (term != first)
+        text += std::string(" ") + term->sign + " ";
+      else if (term->sign == '-')
+        text += "-";
+      else if (term->sign == '/')
+        text += "1.0 / ";
+      text += term->text;
+    }
+    return text + ")";
+  }
+
+  // A new part returning `text`, and its call.
+  std::string part(const std::string& text) {
+    const std::string name = "part_" + std::to_string(count_++);
+    parts_ += "  template <class S>\n  [[gnu::noinline]] S " + name + "([[maybe_unused]] nonsep::sdk::Vector<S> " +
+              letter_ + ") const {\n    return S(" + text + ");\n  }\n";
+    return name + "<S>(" + letter_ + ")";
+  }
+
+  char letter_;
+  std::string& parts_;
+  std::size_t& count_;
+};
+
 // The gradient of `tree` as a template over the number type (the SDK differentiates it for the Hessians and the
 // third derivatives), one line per component: d tree / d x_i written from derivative(), 0 where it is zero; or the
 // components as given (`given`, "dT" or "dV", when not empty). Nothing when a written-out gradient would outgrow the
 // tree (gradient_is_written): the SDK then differentiates the function itself.
-std::string gradient(const char* function, const Node& tree, const std::vector<Node>& given, char letter,
+std::string gradient(const char* function, const Node& tree, const std::vector<Node>& given, ExpressionWriter writer,
                      std::size_t dimension) {
+  const char letter = writer.letter();
   std::vector<std::optional<Node>> components;
   for (std::size_t i = 0; i < dimension; ++i)
     components.push_back(given.empty() ? derivative(tree, i) : std::optional<Node>(given[i]));
@@ -122,19 +184,20 @@ std::string gradient(const char* function, const Node& tree, const std::vector<N
   std::string text = std::string("  template <class S>\n  void ") + function +
                      "([[maybe_unused]] nonsep::sdk::Vector<S> " + letter + ", std::span<S> out) const {\n";
   for (std::size_t i = 0; i < dimension; ++i)
-    text += "    out[" + std::to_string(i) + "] = S(" + (components[i] ? emit(*components[i], letter) : "0.0") + ");\n";
+    text += "    out[" + std::to_string(i) + "] = S(" + (components[i] ? writer.emit(*components[i]) : "0.0") + ");\n";
   return text + "  }\n";
 }
 
 // T or V as a template: the formula, or, for one given by its gradient, an evaluation error (H_TTV and H_VVT never
 // need the value; the gradient check and `inspect --check` skip what throws).
-std::string function(const char* name, const Node& tree, const std::vector<Node>& given, char letter) {
+std::string function(const char* name, const Node& tree, const std::vector<Node>& given, ExpressionWriter writer) {
+  const char letter = writer.letter();
   const std::string head = std::string("  template <class S>\n  S ") + name +
                            "([[maybe_unused]] nonsep::sdk::Vector<S> " + letter + ") const {\n";
   if (!given.empty())
     return head + "    throw nonsep::sdk::EvaluationError(\"" + name + " is given by its gradient d" + name +
            " only: its value is not known (H needs only the gradient and the Hessian)\");\n  }\n";
-  return head + "    return S(" + emit(tree, letter) + ");\n  }\n";
+  return head + "    return S(" + writer.emit(tree) + ");\n  }\n";
 }
 
 }  // namespace
@@ -174,18 +237,18 @@ std::string cpp_source(const FormulaModel& model) {
     source += " {}\n";
     for (const auto& parameter : model.parameters) source += "  double parameter_" + parameter.first + ";\n";
   }
-  source += function("T", model.t_tree, model.t_gradient, 'p');
-  source += function("V", model.v_tree, model.v_gradient, 'q');
-  if (model.k_tree)
-    source += "  template <class S>\n  S K([[maybe_unused]] nonsep::sdk::Vector<S> p) const {\n    return S(" +
-              emit(*model.k_tree, 'p') + ");\n  }\n";
-  if (model.u_tree)
-    source += "  template <class S>\n  S U([[maybe_unused]] nonsep::sdk::Vector<S> q) const {\n    return S(" +
-              emit(*model.u_tree, 'q') + ");\n  }\n";
-  source += gradient("grad_T", model.t_tree, model.t_gradient, 'p', model.dimension);
-  source += gradient("grad_V", model.v_tree, model.v_gradient, 'q', model.dimension);
-  if (model.k_tree) source += gradient("grad_K", *model.k_tree, {}, 'p', model.dimension);
-  if (model.u_tree) source += gradient("grad_U", *model.u_tree, {}, 'q', model.dimension);
+  std::string parts;
+  std::size_t part_count = 0;
+  const ExpressionWriter p('p', parts, part_count), q('q', parts, part_count);
+  source += function("T", model.t_tree, model.t_gradient, p);
+  source += function("V", model.v_tree, model.v_gradient, q);
+  if (model.k_tree) source += function("K", *model.k_tree, {}, p);
+  if (model.u_tree) source += function("U", *model.u_tree, {}, q);
+  source += gradient("grad_T", model.t_tree, model.t_gradient, p, model.dimension);
+  source += gradient("grad_V", model.v_tree, model.v_gradient, q, model.dimension);
+  if (model.k_tree) source += gradient("grad_K", *model.k_tree, {}, p, model.dimension);
+  if (model.u_tree) source += gradient("grad_U", *model.u_tree, {}, q, model.dimension);
+  source += parts;
   source += "};\n\n}  // namespace\n\n";
   source += "NONSEP_EXPORT_MODEL(Formula, \"" + model.name + "\", \"1.0.0\", \"A formula model: " + formulas +
             "\", \"" + formulas + "\");\n";

@@ -118,7 +118,8 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (estimate) observers.push_back(&*estimate);
   saver.emplace(directory / checkpoint_file_name, job_fingerprint(loaded), stepping_identity(loaded), run.checkpoint,
                 driver, observers);
-  progress.emplace(options.progress, options.progress_interval, driver, &energy);
+  progress.emplace(options.progress, options.progress_interval, driver, &energy, options.progress_label,
+                   options.progress_schedule);
   for (Observer* observer : observers) driver.add_observer(*observer);
   driver.add_observer(*saver);
   driver.add_observer(*progress);

@@ -3,35 +3,41 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <utility>
 
 namespace nonsep::host {
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 
-ProgressBar::ProgressBar(ProgressStyle style, std::uint64_t total_steps, double t_end, double interval_seconds)
+ProgressBar::ProgressBar(ProgressStyle style, std::uint64_t total_steps, double t_end, double interval_seconds,
+                         std::string label, std::shared_ptr<ProgressSchedule> schedule)
     : style_(style),
       total_(total_steps),
       t_end_(t_end),
       interval_(std::chrono::duration_cast<Clock::duration>(
           std::chrono::duration<double>(style == ProgressStyle::lines ? interval_seconds : 0.1))),
       start_(Clock::now()),
-      next_draw_(start_ + (style == ProgressStyle::lines ? interval_ : std::chrono::seconds(1))) {}
+      label_(std::move(label)),
+      schedule_(schedule ? std::move(schedule)
+                         : std::make_shared<ProgressSchedule>(ProgressSchedule{
+                               start_ + (style == ProgressStyle::lines ? interval_ : std::chrono::seconds(1))})) {}
 
 void ProgressBar::update(std::uint64_t step, double t, std::size_t active_trajectories,
                          std::optional<double> largest_energy_error) {
   if (style_ == ProgressStyle::none) return;
   const auto now = Clock::now();
-  if (now < next_draw_) return;
-  next_draw_ = now + interval_;
+  if (now < schedule_->next_line) return;
+  schedule_->next_line = now + interval_;
   const double fraction = total_ ? static_cast<double>(step) / static_cast<double>(total_) : 1.0;
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   const double remaining = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
   char energy[48] = "";
   if (style_ == ProgressStyle::lines) {
     if (largest_energy_error) std::snprintf(energy, sizeof energy, ", max |dH/H0| %.2e", *largest_energy_error);
-    std::fprintf(stderr, "nonsep: progress: t = %.6g of %.6g (%.1f%%), step %llu/%llu, %zu active%s, ETA %.0f s\n", t,
-                 t_end_, 100.0 * fraction, static_cast<unsigned long long>(step),
-                 static_cast<unsigned long long>(total_), active_trajectories, energy, remaining);
+    std::fprintf(stderr, "nonsep: progress: %s%st = %.6g of %.6g (%.1f%%), step %llu/%llu, %zu active%s, ETA %.0f s\n",
+                 label_.c_str(), label_.empty() ? "" : ": ", t, t_end_, 100.0 * fraction,
+                 static_cast<unsigned long long>(step), static_cast<unsigned long long>(total_), active_trajectories,
+                 energy, remaining);
     std::fflush(stderr);
     return;
   }

@@ -7,9 +7,11 @@
 // formulas. A gradient is written out only while it stays small beside its function: at most max_gradient_growth
 // times the function's nodes plus max_gradient_slack (a product of n factors has a derivative of n(n-1) factors,
 // which grows the C++ and the compile quadratically); beyond that the plugin leaves the gradient to the SDK's
-// automatic differentiation of the function, whose C++ grows linearly with the formula (docs/formula-models.md,
-// "Long products": a product of hundreds of distinct factors is still slow to compile, and ends at the compile
-// time limit). A factor repeated in a product is written once, as a power. Integer powers x^n
+// automatic differentiation of the function, whose C++ grows linearly with the formula. A sum or product of more
+// than max_part_nodes tree nodes is cut into parts of at most that many, each a function the compiler does not
+// inline, so that no function it optimises outgrows that bound and the compile time grows linearly with the formula
+// (docs/formula-models.md, "Long formulas"). A factor repeated in a product is written once, as a power. Integer
+// powers x^n
 // (|n| <= 64) are products (the SDK's square and cube are the same products); other powers are pow. The text depends on
 // the model only, so it is the cache key's first part (plugin_cache.hpp).
 #include <cstddef>
@@ -23,6 +25,7 @@ namespace nonsep::host::formula {
 
 inline constexpr std::size_t max_gradient_growth = 8;
 inline constexpr std::size_t max_gradient_slack = 256;
+inline constexpr std::size_t max_part_nodes = 64;
 
 // Whether the gradient `components` (derivative() of `tree` per variable; nothing where zero) is written out.
 bool gradient_is_written(const Node& tree, const std::vector<std::optional<Node>>& components);

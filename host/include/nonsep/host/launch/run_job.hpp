@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -38,6 +39,10 @@ struct RunOptions {
   std::filesystem::path output_directory;        // created if missing
   ProgressStyle progress = ProgressStyle::none;  // on stderr (progress_bar.hpp; the caller checks for a terminal)
   double progress_interval = 10.0;               // seconds between progress lines (ProgressStyle::lines)
+  // A distributed run's work unit: what its progress lines begin with (the rank and the unit) and when the rank's
+  // next line is due, shared by its units (progress_bar.hpp). Empty and null for a whole run.
+  std::string progress_label;
+  std::shared_ptr<ProgressSchedule> progress_schedule;
   // Checked between chunks (a fraction of a second apart); when true the run stops with status "interrupted"
   // (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;

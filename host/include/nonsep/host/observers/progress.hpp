@@ -1,6 +1,10 @@
 #pragma once
 // The run's progress (progress_bar.hpp: a bar on a terminal, plain lines in a file) as an observer: updated after
 // chunks, with the step, the active trajectories and the largest relative energy error so far.
+#include <memory>
+#include <string>
+#include <utility>
+
 #include "nonsep/host/observers/energy_error.hpp"
 #include "nonsep/host/observers/progress_bar.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -10,11 +14,12 @@ namespace nonsep::host {
 
 class ProgressObserver : public Observer, public ChunkObserver {
  public:
-  // `energy` may be null.
+  // `energy` may be null; label and schedule as for ProgressBar.
   ProgressObserver(ProgressStyle style, double interval_seconds, const EnsembleDriver& driver,
-                   const EnergyErrorObserver* energy)
+                   const EnergyErrorObserver* energy, std::string label = {},
+                   std::shared_ptr<ProgressSchedule> schedule = nullptr)
       : enabled_(style != ProgressStyle::none),
-        bar_(style, driver.time().steps, driver.time().t_end, interval_seconds),
+        bar_(style, driver.time().steps, driver.time().t_end, interval_seconds, std::move(label), std::move(schedule)),
         driver_(driver),
         energy_(energy) {}
 

@@ -7,20 +7,36 @@
 //            nonsep: progress: t = 12.5 of 50 (25.0%), step 2500/10000, 32 active, max |dH/H0| 1.2e-09, ETA 31 s
 // Both show the time reached, the fraction of the steps, the active trajectories, the largest relative energy
 // error so far (when known) and the time left, estimated from the rate so far.
+//
+// A rank of a distributed run runs work units one after another, each with a bar of its own: its lines begin with a
+// label naming the rank and the unit, and the moment the next line is due (a ProgressSchedule) carries over from one
+// unit to the next, so the rank writes one line every interval however short or long its units are:
+//   nonsep: progress: rank 1 of 4, unit 000012 of 64: t = 12.5 of 50 (25.0%), step 2500/10000, 8 active, ...
+// (everything after the label is the unit's).
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <string>
 
 namespace nonsep::host {
 
 enum class ProgressStyle { none, bar, lines };
 
+// When the next progress line is due: a bar's own, or shared by the bars of successive runs (a rank's work units).
+struct ProgressSchedule {
+  std::chrono::steady_clock::time_point next_line;
+};
+
 class ProgressBar {
  public:
   // style: the caller's decision (bar when stderr is a terminal, lines otherwise, none with --quiet). total: steps of
-  // the run, ending at t_end. interval: seconds between lines (style lines; > 0).
-  ProgressBar(ProgressStyle style, std::uint64_t total_steps, double t_end, double interval_seconds = 10.0);
+  // the run, ending at t_end. interval: seconds between lines (style lines; > 0). label: the start of each line
+  // (style lines), none when empty. schedule: when the next line is due, kept across bars; null: the first line
+  // after one interval from now.
+  ProgressBar(ProgressStyle style, std::uint64_t total_steps, double t_end, double interval_seconds = 10.0,
+              std::string label = {}, std::shared_ptr<ProgressSchedule> schedule = nullptr);
   ProgressBar(const ProgressBar&) = delete;
   ProgressBar& operator=(const ProgressBar&) = delete;
   ~ProgressBar() { finish(); }
@@ -39,7 +55,9 @@ class ProgressBar {
   std::uint64_t total_;
   double t_end_;
   Clock::duration interval_;
-  Clock::time_point start_, next_draw_;
+  Clock::time_point start_;
+  std::string label_;
+  std::shared_ptr<ProgressSchedule> schedule_;
 };
 
 // True when file descriptor 2 is a terminal.
