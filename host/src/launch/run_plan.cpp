@@ -3,7 +3,7 @@
 #include <string>
 
 #include "nonsep/host/output/atomic_files.hpp"
-#include "output/run_summary.hpp"
+#include "nonsep/host/output/run_files.hpp"
 
 namespace nonsep::host {
 
