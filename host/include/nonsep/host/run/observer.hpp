@@ -66,19 +66,13 @@ struct StateView {
   std::span<const double> alignment = {};
 };
 
-// A retirement an observer asks for at an event: the trajectory stops there with `status` and `message`.
-struct RetirementRequest {
-  std::size_t trajectory = 0;
-  TrajectoryStatus status = TrajectoryStatus::inaccurate;
-  std::string message;
-};
-
 struct Event {
   std::uint64_t step = 0;
   double t = 0.0;
   std::span<const StateView> states;  // trajectory order
   bool energy_evaluated = false;      // H was evaluated at this step (StateView::energy may still be empty)
-  std::vector<RetirementRequest>* retire = nullptr;
+  // Stops the observer asks for: each trajectory stops here with its record's status and message (trajectory.hpp).
+  std::vector<StoppedTrajectory>* retire = nullptr;
 };
 
 // The states of one block inside a chunk (on_step): trajectories[s] is the index of slot s, its q at
@@ -89,7 +83,7 @@ struct BlockView {
   std::span<const std::size_t> trajectories;
   std::span<const double> q, p;
   const PluginModel* model = nullptr;                // the worker thread's plugin instance; use it on this thread only
-  std::vector<RetirementRequest>* retire = nullptr;  // on_step only: stop these trajectories at this step
+  std::vector<StoppedTrajectory>* retire = nullptr;  // on_step only: stop these trajectories at this step
 };
 
 // The observer every observer is: the events of the run, seen on the driver's thread.
