@@ -19,9 +19,10 @@
 //   before_finish(step, interrupted)  the stepping is over, before the active states are retired.
 //   on_end()               after the last retirement: flush, close.
 // The interface is small, as Odeint's observer is one callable: Observer has the events every observer may want;
-// what few observers need are facets, separate small interfaces an observer also derives from and the driver finds
-// by dynamic_cast: ChunkObserver (prepare_blocks, after_chunk, before_finish), StepObserver (every step),
-// CheckpointedObserver (save, restore) and TrajectoryColumns (trajectories.csv).
+// what few observers need are facets, separate small interfaces an observer also derives from: ChunkObserver
+// (prepare_blocks, after_chunk, before_finish) and StepObserver (every step), which the driver finds by dynamic_cast
+// when the observer is added, and CheckpointedObserver (save, restore) and TrajectoryColumns (trajectories.csv),
+// which the run's plan lists by the observers' types (launch/).
 // Observers that watch every step (StepObserver) are called inside chunks, on the worker thread of
 // each block, with that block's states only (on_step); they must touch nothing but their state for those
 // trajectories. Before a chunk the driver calls save_block; when a chunk is redone step by step (a state stopped
