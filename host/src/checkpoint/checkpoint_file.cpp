@@ -156,8 +156,11 @@ std::string stepping_identity(const LoadedJob& job) {
   return set.empty() ? "evaluation" : set;
 }
 
-void check_stepping(const std::string& recorded, const LoadedJob& job, const std::filesystem::path& written) {
-  const std::string current = stepping_identity(job);
+namespace {
+
+// Refuses a `recorded` stepping that differs from this process's, `current` (check_stepping).
+void refuse_other_stepping(const std::string& recorded, const std::string& current, const LoadedJob& job,
+                           const std::filesystem::path& written) {
   if (recorded == current) return;
   const auto path_of = [](const std::string& stepping) {
     return stepping == "evaluation" ? std::string("the evaluation path (no kernel)")
@@ -171,7 +174,20 @@ void check_stepping(const std::string& recorded, const LoadedJob& job, const std
                         recorded + " (the variable that chooses the stepping), or run with --force to start over");
 }
 
-Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded) {
+}  // namespace
+
+void check_stepping(const std::string& recorded, const LoadedJob& job, const std::filesystem::path& written) {
+  refuse_other_stepping(recorded, stepping_identity(job), job, written);
+}
+
+CheckpointIdentity checkpoint_identity(const LoadedJob& job) { return {job_fingerprint(job), stepping_identity(job)}; }
+
+Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& job) {
+  return load_checkpoint(path, job, checkpoint_identity(job));
+}
+
+Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded,
+                           const CheckpointIdentity& identity) {
   const Job& job = loaded.job;
   std::optional<std::string> text;
   try {
@@ -201,13 +217,14 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   if (checksum != checkpoint_checksum(document))
     read.damaged("its content does not match its checksum: it was edited or damaged");
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
-  if (const std::string expected = job_fingerprint(loaded); fingerprint != expected)
+  if (fingerprint != identity.fingerprint)
     throw CheckpointError(
-        path.string() + " belongs to a different job: its " + fingerprint_difference(fingerprint, expected) +
+        path.string() + " belongs to a different job: its " +
+        fingerprint_difference(fingerprint, identity.fingerprint) +
         " differ (the plugin part covers the plugin file's bytes, integrator.NAME is the integrator's option NAME, "
         "output covers output.every, energy_every and format); run with --force to start over, or resume with the "
         "job that wrote it");
-  check_stepping(read.string(read.member(document, "stepping"), "stepping"), loaded, path);
+  refuse_other_stepping(read.string(read.member(document, "stepping"), "stepping"), identity.stepping, loaded, path);
   Checkpoint checkpoint;
   DriverState& state = checkpoint.driver;
   const std::size_t n = job.initial.dimension;

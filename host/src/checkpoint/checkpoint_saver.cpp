@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 
@@ -38,7 +37,7 @@ json encode(const MegnoRecord& record) {
 
 // Writes checkpoint.json (checkpoint_file.hpp describes it) atomically. Throws OutputError.
 void save_checkpoint(const std::filesystem::path& path, const DriverState& state, const json& observers,
-                     const std::string& fingerprint, const std::string& stepping) {
+                     const CheckpointIdentity& identity) {
   json records = json::array();
   for (const TrajectoryRecord& record : state.records)
     records.push_back({{"status", to_string(record.status)},
@@ -72,8 +71,8 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
     evaluations["grad_U"] = state.evaluations.grad_U;
   }
   json document = {{"format", checkpoint_format},
-                   {"job_fingerprint", fingerprint},
-                   {"stepping", stepping},
+                   {"job_fingerprint", identity.fingerprint},
+                   {"stepping", identity.stepping},
                    {"step", state.step},
                    {"evaluations", evaluations},
                    {"active",
@@ -100,12 +99,11 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
 
 }  // namespace
 
-CheckpointSaver::CheckpointSaver(std::filesystem::path path, std::string fingerprint, std::string stepping,
+CheckpointSaver::CheckpointSaver(std::filesystem::path path, CheckpointIdentity identity,
                                  const CheckpointPolicy& policy, const EnsembleDriver& driver,
-                                 std::vector<Observer*> observers)
+                                 std::vector<CheckpointedObserver*> observers)
     : path_(std::move(path)),
-      fingerprint_(std::move(fingerprint)),
-      stepping_(std::move(stepping)),
+      identity_(std::move(identity)),
       policy_(policy),
       driver_(driver),
       observers_(std::move(observers)),
@@ -132,10 +130,9 @@ void CheckpointSaver::before_finish(std::uint64_t, bool interrupted) {
 
 void CheckpointSaver::save_now() {
   json observers = json::object();
-  for (Observer* each : observers_)
-    if (auto* observer = dynamic_cast<CheckpointedObserver*>(each); observer && !observer->name().empty())
-      observers[observer->name()] = observer->save();
-  save_checkpoint(path_, driver_.state(), observers, fingerprint_, stepping_);
+  for (CheckpointedObserver* observer : observers_)
+    if (!observer->name().empty()) observers[observer->name()] = observer->save();
+  save_checkpoint(path_, driver_.state(), observers, identity_);
   next_save_ =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(policy_.every_seconds));
 }

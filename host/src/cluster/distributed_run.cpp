@@ -12,7 +12,6 @@
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "output/run_summary.hpp"
 #ifdef NONSEP_HAVE_HDF5
 #include "output/results_h5.hpp"
 #endif
@@ -221,7 +220,7 @@ void finish_results_h5(const LoadedJob& loaded, const RunOptions& options, const
       units.push_back({unit_folder(options.output_directory, u), plan.first(u), plan.size(u)});
     merge_samples_h5(path, loaded, units, ranks);
   }
-  if (ranks.rank() == 0) write_results_file(path, run.every > 0, loaded, options.output_directory, summary);
+  if (ranks.rank() == 0) write_results_file(path, run.every > 0, options.output_directory, summary);
 #else
   (void)options, (void)plan, (void)summary, (void)ranks;
 #endif

@@ -154,7 +154,7 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
     add_counts(merged["evaluations"], unit["evaluations"]);
     auto& completed = merged["time"]["steps_completed"];
     completed = std::max(completed.get<std::uint64_t>(), unit["time"]["steps_completed"].get<std::uint64_t>());
-    // The scheme's figures (under its family's name, output/run_summary.cpp) combine by the largest, as a process's
+    // The scheme's figures (under its family's name, launch/run_summary.cpp) combine by the largest, as a process's
     // blocks do.
     if (const std::string family = merged.contains("integrator") ? merged["integrator"].value("family", "") : "";
         !family.empty() && merged.contains(family))

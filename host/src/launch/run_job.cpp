@@ -5,10 +5,10 @@
 #include <optional>
 
 #include "launch/run_plan.hpp"
+#include "launch/run_summary.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
-#include "output/run_summary.hpp"
 #ifdef NONSEP_HAVE_HDF5
 #include "output/results_h5.hpp"
 #endif
@@ -212,7 +212,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
 #ifdef NONSEP_HAVE_HDF5
   // After trajectories.csv, which it copies, and before summary.json, so that a failure here is in summary.json.
   if (hdf5) try {
-      write_results_file(directory / results_file_name, run.every > 0, loaded, directory, outcome.summary);
+      write_results_file(directory / results_file_name, run.every > 0, directory, outcome.summary);
     } catch (const OutputError& error) {
       fail(error);
     }

@@ -3,7 +3,7 @@
 #include <string>
 
 #include "nonsep/host/output/atomic_files.hpp"
-#include "output/run_summary.hpp"
+#include "nonsep/host/output/run_files.hpp"
 
 namespace nonsep::host {
 
@@ -56,9 +56,10 @@ FineRun run_finer(const LoadedJob& loaded, const RunOptions& options) {
   return fine;
 }
 
-std::optional<Checkpoint> resumed_state(const LoadedJob& loaded, const RunOptions& options) {
+std::optional<Checkpoint> resumed_state(const LoadedJob& loaded, const RunOptions& options,
+                                        const CheckpointIdentity& identity) {
   if (!options.resume) return std::nullopt;
-  return load_checkpoint(options.output_directory / checkpoint_file_name, loaded);
+  return load_checkpoint(options.output_directory / checkpoint_file_name, loaded, identity);
 }
 
 }  // namespace
@@ -66,7 +67,8 @@ std::optional<Checkpoint> resumed_state(const LoadedJob& loaded, const RunOption
 RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
     : directory(options.output_directory),
       folder_(directory, options.work_unit ? "unit" : "run", loaded.job.file, folder_use(options)),
-      resumed_(resumed_state(loaded, options)),
+      identity_(checkpoint_identity(loaded)),
+      resumed_(resumed_state(loaded, options, identity_)),
       driver(loaded.plugin, loaded.model, driver_setup(loaded, options)),
       energy(loaded.job.initial.count, driver.energy_available() ? loaded.job.run().energy_every : 0,
              loaded.job.run().analysis.max_relative_energy_error),
@@ -106,18 +108,17 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
                      Integrator(run.integrator).describe().order.value(), job.initial.dimension, options.resume);
   else
     remove_stale(directory / ErrorEstimateObserver::file_name);
-  observers.push_back(&energy);
-  observers.push_back(&runaway);
-  if (chaos) observers.push_back(&*chaos);
-  if (closest) observers.push_back(&*closest);
-  if (samples) observers.push_back(&*samples);
+  watch(energy);
+  watch(runaway);
+  if (chaos) watch(*chaos);
+  if (closest) watch(*closest);
+  if (samples) watch(*samples);
 #ifdef NONSEP_HAVE_HDF5
-  if (hdf5_samples) observers.push_back(&*hdf5_samples);
+  if (hdf5_samples) watch(*hdf5_samples);
 #endif
-  if (poincare) observers.push_back(&*poincare);
-  if (estimate) observers.push_back(&*estimate);
-  saver.emplace(directory / checkpoint_file_name, job_fingerprint(loaded), stepping_identity(loaded), run.checkpoint,
-                driver, observers);
+  if (poincare) watch(*poincare);
+  if (estimate) watch(*estimate);
+  saver.emplace(directory / checkpoint_file_name, identity_, run.checkpoint, driver, checkpointed);
   progress.emplace(options.progress, options.progress_interval, driver, &energy, options.progress_label,
                    options.progress_schedule);
   for (Observer* observer : observers) driver.add_observer(*observer);
@@ -130,8 +131,8 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
 // The checkpoint's state to the driver, and to each observer its own (by its name()).
 void RunPlan::resume(Checkpoint checkpoint) {
   driver.restore(std::move(checkpoint.driver));
-  for (Observer* each : observers)
-    if (auto* observer = dynamic_cast<CheckpointedObserver*>(each); observer && !observer->name().empty()) {
+  for (CheckpointedObserver* observer : checkpointed)
+    if (!observer->name().empty()) {
       const std::string name = observer->name();
       if (!checkpoint.observers.contains(name))
         throw CheckpointError((directory / checkpoint_file_name).string() + " is damaged (no state for " + name + ")");

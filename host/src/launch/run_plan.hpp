@@ -1,13 +1,15 @@
 #pragma once
 // A loaded job made ready to run, built once and in the order its data flows: the output folder (taken,
-// run_folder.hpp), the state a resumed run continues from (checkpoint.json, read here and nowhere else:
-// checkpoint_file.hpp), the driver, the finer run of /analysis/error_estimate (run here, before the run), the
-// observers the job asks for (their files opened; earlier runs' files this run
-// does not write removed), the resumed state handed to the driver and to each observer, then the checkpoint saver (the
-// one writer of checkpoint.json: checkpoint_saver.hpp) and the progress bar. run_job (run_job.hpp) runs the driver and
-// writes the run's files from what the plan's observers hold. Internal to src/launch/.
+// run_folder.hpp), the job's identity (checkpoint_identity, computed once), the state a resumed run continues from
+// (checkpoint.json, read and checked against that identity here and nowhere else: checkpoint_file.hpp), the driver, the
+// finer run of /analysis/error_estimate (run here, before the run), the observers the job asks for (their files opened;
+// earlier runs' files this run does not write removed), the resumed state handed to the driver and to each observer,
+// then the checkpoint saver (the one writer of checkpoint.json: checkpoint_saver.hpp) and the progress bar. run_job
+// (run_job.hpp) runs the driver and writes the run's files from what the plan's observers hold. Internal to
+// src/launch/.
 #include <filesystem>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
@@ -42,6 +44,7 @@ class RunPlan {
 
  private:
   RunFolder folder_;
+  const CheckpointIdentity identity_;  // the saver writes it into every checkpoint
   std::optional<Checkpoint> resumed_;  // until the constructor hands it to the driver and the observers
 
  public:
@@ -58,10 +61,17 @@ class RunPlan {
   std::optional<ErrorEstimateObserver> estimate;  // /analysis/error_estimate: its finer run is done by the plan
   // The observers above that the driver tells, in the order it tells them; the saver and the progress bar follow.
   std::vector<Observer*> observers;
+  std::vector<CheckpointedObserver*> checkpointed;  // those of them with state for checkpoints, in the same order
   std::optional<CheckpointSaver> saver;
   std::optional<ProgressObserver> progress;
 
  private:
+  // Adds `observer` to `observers`, and to `checkpointed` when its type has that facet.
+  template <class O>
+  void watch(O& observer) {
+    observers.push_back(&observer);
+    if constexpr (std::is_base_of_v<CheckpointedObserver, O>) checkpointed.push_back(&observer);
+  }
   void resume(Checkpoint checkpoint);
 };
 

@@ -32,10 +32,10 @@ void EnergyErrorObserver::on_event(const Event& event) {
     const auto error = include(state.trajectory, state.energy, state.record->energy_initial);
     if (!error) continue;
     if (bound_ && !(std::abs(*error) <= *bound_))
-      event.retire->push_back({state.trajectory, TrajectoryStatus::inaccurate,
-                               "the relative energy error " + format_number(*error) + " at step " +
-                                   std::to_string(event.step) +
-                                   " exceeds analysis.max_relative_energy_error = " + format_number(*bound_)});
+      event.retire->push_back(
+          stop_request(state.trajectory, TrajectoryStatus::inaccurate,
+                       "the relative energy error " + format_number(*error) + " at step " + std::to_string(event.step) +
+                           " exceeds analysis.max_relative_energy_error = " + format_number(*bound_)));
   }
 }
 

@@ -73,9 +73,9 @@ void PoincareSectionObserver::on_step(std::uint64_t step, double, const BlockVie
       }
     } catch (const ModelError& error) {
       if (block.retire)
-        block.retire->push_back({trajectory, TrajectoryStatus::failed,
-                                 "the model failed while locating a Poincare crossing in step " + std::to_string(step) +
-                                     ": " + error.what()});
+        block.retire->push_back(stop_request(trajectory, TrajectoryStatus::failed,
+                                             "the model failed while locating a Poincare crossing in step " +
+                                                 std::to_string(step) + ": " + error.what()));
       continue;
     }
     ++counts_[trajectory];
@@ -85,8 +85,8 @@ void PoincareSectionObserver::on_step(std::uint64_t step, double, const BlockVie
     state.found.push_back(std::move(found));
     if (max_crossings_ && counts_[trajectory] == *max_crossings_ && block.retire)
       block.retire->push_back(
-          {trajectory, TrajectoryStatus::completed,
-           "stopped at its " + std::to_string(*max_crossings_) + "-th Poincare crossing (max_crossings)"});
+          stop_request(trajectory, TrajectoryStatus::completed,
+                       "stopped at its " + std::to_string(*max_crossings_) + "-th Poincare crossing (max_crossings)"));
   }
   remember(block);
 }

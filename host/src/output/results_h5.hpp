@@ -4,22 +4,22 @@
 // written by write_csv_table (output/hdf5_tables.hpp) from the CSV file of the same run:
 //   /trajectories  trajectories.csv     /poincare  poincare.csv (when written)     /lyapunov  lyapunov.csv (when
 //   written)
-// Attributes of the root group: nonsep_version, hdf5_version, format_version (1), model, plugin_version, parameters
-// (JSON), integrator (JSON: summary.json's "integrator"), hamiltonian, dt, steps, t_end, every, dimension,
-// trajectories, summary (summary.json's text). A resumed run replaces the groups and attributes its interrupted
-// run wrote. Only in builds with HDF5.
+// Attributes of the root group, all from the run's summary (summary.json's content, launch/run_summary.hpp):
+// nonsep_version, hdf5_version, format_version (1), model, plugin_version, parameters (JSON), integrator (JSON:
+// summary.json's "integrator"), hamiltonian, dt, steps, t_end, every, dimension, trajectories, summary (summary.json's
+// text). A resumed run replaces the groups and attributes its interrupted run wrote. Only in builds with HDF5.
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "output/run_summary.hpp"
+#include "nonsep/host/output/run_files.hpp"
 
 namespace nonsep::host {
 
 inline constexpr std::uint64_t results_format_version = 1;
 
 // Throws OutputError.
-// The tables come from the CSV files in `directory`.
-void write_results_file(const std::filesystem::path& path, bool has_samples, const LoadedJob& loaded,
-                        const std::filesystem::path& directory, const nlohmann::ordered_json& summary);
+// The tables come from the CSV files in `directory`, the attributes from `summary`.
+void write_results_file(const std::filesystem::path& path, bool has_samples, const std::filesystem::path& directory,
+                        const nlohmann::ordered_json& summary);
 
 }  // namespace nonsep::host

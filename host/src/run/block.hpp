@@ -20,23 +20,23 @@
 
 namespace nonsep::host {
 
-// A trajectory that stops before the end of the run, as found by its block's worker. The driver retires them in
-// (step, phase, trajectory) order, the order a step-by-step run finds them.
+// A trajectory that stops before the end of the run, as found by its block's worker, with its record filled in but
+// H0 (trajectory.hpp). The driver retires them in (stop step, phase, trajectory) order, the order a step-by-step run
+// finds them.
 struct Departure {
-  std::size_t trajectory = 0;
-  std::uint64_t step = 0;        // the step at which it was found
-  int phase = 0;                 // 0: while stepping, 1: while evaluating H at `step`, 2: asked by an observer
-  std::uint64_t final_step = 0;  // the step of its final state
-  TrajectoryStatus status = TrajectoryStatus::failed;
-  std::string variable;  // diverged: the first non-finite variable
-  std::string message;
-  std::vector<double> q, p;      // the final state
-  std::optional<double> energy;  // H of the final state, when known
-  std::vector<double> lyapunov;  // the final estimates, when the block follows tangent vectors
-  std::optional<double> megno, mean_megno;
-  std::optional<double> sali;
-  std::vector<double> gali;
+  int phase = 0;  // 0: while stepping, 1: while evaluating H at the stop step, 2: asked by an observer
+  StoppedTrajectory stopped;
 };
+
+// A stopped trajectory's final state (the state of `slot` in `x` at `step`, time `t`, with H `energy`) in `record`.
+inline void record_final_state(TrajectoryRecord& record, const PhaseSpaceBatch& x, std::size_t slot, std::uint64_t step,
+                               double t, std::optional<double> energy) {
+  record.final_step = step;
+  record.final_t = t;
+  record.final_q.assign(x.q(slot).begin(), x.q(slot).end());
+  record.final_p.assign(x.p(slot).begin(), x.p(slot).end());
+  record.energy_final = energy;
+}
 
 // The first non-finite variable of state `slot` ("q[0]", "p[2]"), or "".
 inline std::string first_non_finite(const PhaseSpaceBatch& x, std::size_t slot) {
@@ -89,10 +89,10 @@ std::vector<std::string> isolate_failures(PhaseSpaceBatch& x, const PhaseSpaceBa
   return errors;
 }
 
-// Retirement requests in trajectory order, the order a step-by-step run applies them (Block::retire_requested).
-inline void sort_requests(std::vector<RetirementRequest>& requests) {
+// Observers' stops in trajectory order, the order a step-by-step run applies them (Block::retire_requested).
+inline void sort_requests(std::vector<StoppedTrajectory>& requests) {
   std::sort(requests.begin(), requests.end(),
-            [](const RetirementRequest& a, const RetirementRequest& b) { return a.trajectory < b.trajectory; });
+            [](const StoppedTrajectory& a, const StoppedTrajectory& b) { return a.trajectory < b.trajectory; });
 }
 
 // Consecutive trajectories stepped together; the unit of work of a thread.
@@ -158,21 +158,20 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
     return tangents ? tangents->integrator.report() : integrator.report();
   }
 
-  // The final Lyapunov, MEGNO, SALI and GALI estimates of `slot` into `departure` (each when computed).
-  template <class Record>
-  void final_estimates(std::size_t slot, Record& departure) const {
+  // The final Lyapunov, MEGNO, SALI and GALI estimates of `slot` into `record` (each when computed).
+  void final_estimates(std::size_t slot, TrajectoryRecord& record) const {
     if (!tangents) return;
-    departure.lyapunov.clear();
-    for (std::size_t j = 0; j < tangents->k; ++j) departure.lyapunov.push_back(tangents->lyapunov[slot].exponent(j));
+    record.lyapunov.clear();
+    for (std::size_t j = 0; j < tangents->k; ++j) record.lyapunov.push_back(tangents->lyapunov[slot].exponent(j));
     if (tangents->with_megno) {
-      departure.megno = tangents->megno[slot].y();
-      departure.mean_megno = tangents->megno[slot].mean_y();
+      record.megno = tangents->megno[slot].y();
+      record.mean_megno = tangents->megno[slot].mean_y();
     }
     if (tangents->factor_size == 0) return;
     const auto factor = tangents->factor(slot);
-    departure.sali = AlignmentIndices::sali(factor);
-    departure.gali.clear();
-    for (std::size_t j = 2; j <= tangents->k; ++j) departure.gali.push_back(AlignmentIndices::gali(factor, j));
+    record.sali = AlignmentIndices::sali(factor);
+    record.gali.clear();
+    for (std::size_t j = 2; j <= tangents->k; ++j) record.gali.push_back(AlignmentIndices::gali(factor, j));
   }
   void clear() { trajectories.clear(); }
 
@@ -214,26 +213,22 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
   }
 
   // Retires the trajectories of `requests` (sorted by trajectory; those not in this block are ignored) at `step`,
-  // phase 2, with their state there and H from `energy(slot)`.
+  // time `t`, phase 2, each with its request's status and message, its state there and H from `energy(slot)`.
   template <class Energy>
-  void retire_requested(std::span<const RetirementRequest> requests, std::uint64_t step, Energy&& energy) {
+  void retire_requested(std::span<const StoppedTrajectory> requests, std::uint64_t step, double t, Energy&& energy) {
     std::vector<bool> retire(trajectories.size(), false);
     for (std::size_t slot = 0; slot < trajectories.size(); ++slot) {
       const auto found = std::lower_bound(
           requests.begin(), requests.end(), trajectories[slot],
-          [](const RetirementRequest& r, std::size_t trajectory) { return r.trajectory < trajectory; });
+          [](const StoppedTrajectory& r, std::size_t trajectory) { return r.trajectory < trajectory; });
       if (found == requests.end() || found->trajectory != trajectories[slot]) continue;
       retire[slot] = true;
-      Departure departure;
-      departure.trajectory = found->trajectory;
-      departure.step = departure.final_step = step;
-      departure.phase = 2;
-      departure.status = found->status;
-      departure.message = found->message;
-      departure.q.assign(batch.q(slot).begin(), batch.q(slot).end());
-      departure.p.assign(batch.p(slot).begin(), batch.p(slot).end());
-      departure.energy = energy(slot);
-      final_estimates(slot, departure);
+      Departure departure{2, *found};
+      TrajectoryRecord& record = departure.stopped.record;
+      record.stop_step = step;
+      record.stop_t = t;
+      record_final_state(record, batch, slot, step, t, energy(slot));
+      final_estimates(slot, record);
       departures.push_back(std::move(departure));
     }
     compact(retire);

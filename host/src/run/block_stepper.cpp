@@ -13,13 +13,14 @@ BlockView BlockStepper::view(const Block& block, std::size_t index, const Worker
 // The every-step observers see the block at `step`; the trajectories they ask to stop leave it there.
 void BlockStepper::watch_step(Block& block, std::size_t index, Worker& worker, std::uint64_t step) {
   if (step_watchers.empty()) return;
-  std::vector<RetirementRequest> requests;
+  std::vector<StoppedTrajectory> requests;
   auto v = view(block, index, worker);
   v.retire = &requests;
   for (StepObserver* watcher : step_watchers) watcher->on_step(step, time.time_at(step), v);
   if (requests.empty()) return;
   sort_requests(requests);
-  block.retire_requested(requests, step, [&](std::size_t slot) { return energy_of(worker, block.batch, slot); });
+  block.retire_requested(requests, step, time.time_at(step),
+                         [&](std::size_t slot) { return energy_of(worker, block.batch, slot); });
 }
 
 void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker, std::uint64_t from,
@@ -74,23 +75,21 @@ void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step
   if (block.tangents) block.tangents->after_step(time.dt);
   std::vector<bool> retire(block.trajectories.size(), false);
   for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
-    Departure departure;
+    Departure departure{0, {block.trajectories[slot], {}}};
+    TrajectoryRecord& record = departure.stopped.record;
     if (!errors[slot].empty()) {
-      departure.status = TrajectoryStatus::failed;
-      departure.message = "the model failed at step " + std::to_string(step) + ": " + errors[slot];
+      record.status = TrajectoryStatus::failed;
+      record.message = "the model failed at step " + std::to_string(step) + ": " + errors[slot];
     } else if (auto variable = first_non_finite(block.batch, slot); !variable.empty()) {
-      departure.status = TrajectoryStatus::diverged;
-      departure.variable = variable;
+      record.status = TrajectoryStatus::diverged;
+      record.stop_variable = variable;
     } else {
       continue;
     }
     retire[slot] = true;
-    departure.trajectory = block.trajectories[slot];
-    departure.step = step;
-    departure.final_step = step - 1;
-    departure.q.assign(before.q(slot).begin(), before.q(slot).end());
-    departure.p.assign(before.p(slot).begin(), before.p(slot).end());
-    departure.energy = energy_of(worker, before, slot);
+    record.stop_step = step;
+    record.stop_t = time.time_at(step);
+    record_final_state(record, before, slot, step - 1, time.time_at(step - 1), energy_of(worker, before, slot));
     block.departures.push_back(std::move(departure));
   }
   block.compact(retire);
@@ -114,14 +113,13 @@ void BlockStepper::evaluate_energies(Block& block, Worker& worker, std::uint64_t
   for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
     if (errors[slot].empty()) continue;
     retire[slot] = true;
-    Departure departure;
-    departure.trajectory = block.trajectories[slot];
-    departure.step = departure.final_step = step;
-    departure.phase = 1;
-    departure.status = TrajectoryStatus::failed;
-    departure.message = "the energy could not be evaluated at step " + std::to_string(step) + ": " + errors[slot];
-    departure.q.assign(block.batch.q(slot).begin(), block.batch.q(slot).end());
-    departure.p.assign(block.batch.p(slot).begin(), block.batch.p(slot).end());
+    Departure departure{1, {block.trajectories[slot], {}}};
+    TrajectoryRecord& record = departure.stopped.record;
+    record.status = TrajectoryStatus::failed;
+    record.message = "the energy could not be evaluated at step " + std::to_string(step) + ": " + errors[slot];
+    record.stop_step = step;
+    record.stop_t = time.time_at(step);
+    record_final_state(record, block.batch, slot, step, record.stop_t, std::nullopt);
     block.departures.push_back(std::move(departure));
   }
   block.compact(retire);

@@ -2,8 +2,8 @@
 // Internal to the ensemble driver (ensemble_driver.cpp): what a worker thread does to one block of trajectories
 // inside a chunk. It steps the block without checks and, when the chunk ends with a non-finite number or the
 // plugin failed in it, puts the block back and redoes the chunk step by step, retiring the states that fail or
-// diverge (Departure, block.hpp); it shows every step to the observers that watch every step, and evaluates H.
-// The driver decides which blocks run where and when; this class knows one block at a time.
+// diverge (Departure, block.hpp: their records, trajectory.hpp); it shows every step to the observers that watch every
+// step, and evaluates H. The driver decides which blocks run where and when; this class knows one block at a time.
 #include <cstdint>
 #include <optional>
 #include <string>

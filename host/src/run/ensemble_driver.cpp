@@ -135,19 +135,12 @@ struct EnsembleDriver::Impl {
     return std::min(to, from + longest);
   }
 
-  // Records the final state of a trajectory and tells the observers.
-  void retire(std::size_t trajectory, std::uint64_t step, std::span<const double> q, std::span<const double> p,
-              std::optional<double> energy) {
-    TrajectoryRecord& record = records[trajectory];
-    record.final_step = step;
-    record.final_t = setup.time.time_at(step);
-    record.final_q.assign(q.begin(), q.end());
-    record.final_p.assign(p.begin(), p.end());
-    record.energy_final = energy;
-    for (Observer* observer : observers) observer->on_retire(trajectory, record);
+  // Tells the observers that `trajectory` stopped; its record is final.
+  void announce(std::size_t trajectory) {
+    for (Observer* observer : observers) observer->on_retire(trajectory, records[trajectory]);
   }
 
-  // Moves the blocks' departures into the records, in the order a step-by-step run finds them.
+  // Moves the blocks' departures into the records (each keeps its H0), in the order a step-by-step run finds them.
   void apply_departures() {
     std::vector<Departure> departures;
     for (Block& block : blocks) {
@@ -155,21 +148,14 @@ struct EnsembleDriver::Impl {
       block.departures.clear();
     }
     std::sort(departures.begin(), departures.end(), [](const Departure& a, const Departure& b) {
-      return std::tie(a.step, a.phase, a.trajectory) < std::tie(b.step, b.phase, b.trajectory);
+      return std::tie(a.stopped.record.stop_step, a.phase, a.stopped.trajectory) <
+             std::tie(b.stopped.record.stop_step, b.phase, b.stopped.trajectory);
     });
-    for (const Departure& departure : departures) {
-      TrajectoryRecord& record = records[departure.trajectory];
-      record.status = departure.status;
-      record.message = departure.message;
-      record.stop_step = departure.step;
-      record.stop_t = setup.time.time_at(departure.step);
-      record.stop_variable = departure.variable;
-      record.lyapunov = departure.lyapunov;
-      record.megno = departure.megno;
-      record.mean_megno = departure.mean_megno;
-      record.sali = departure.sali;
-      record.gali = departure.gali;
-      retire(departure.trajectory, departure.final_step, departure.q, departure.p, departure.energy);
+    for (Departure& departure : departures) {
+      TrajectoryRecord& record = records[departure.stopped.trajectory];
+      departure.stopped.record.energy_initial = record.energy_initial;
+      record = std::move(departure.stopped.record);
+      announce(departure.stopped.trajectory);
     }
   }
 
@@ -185,13 +171,13 @@ struct EnsembleDriver::Impl {
                           block.tangents ? &block.tangents->lyapunov[slot] : nullptr,
                           block.tangents ? &block.tangents->megno[slot] : nullptr,
                           block.tangents ? block.tangents->factor(slot) : std::span<const double>()});
-    std::vector<RetirementRequest> requests;
+    std::vector<StoppedTrajectory> requests;
     const Event event{step, setup.time.time_at(step), states, energy_evaluated, &requests};
     for (Observer* observer : observers) observer->on_event(event);
     if (requests.empty()) return;
     sort_requests(requests);
     for (Block& block : blocks)
-      block.retire_requested(requests, step, [&](std::size_t slot) {
+      block.retire_requested(requests, step, event.t, [&](std::size_t slot) {
         return block.energy_step == step ? block.energy(slot) : std::nullopt;
       });
     apply_departures();
@@ -249,8 +235,9 @@ struct EnsembleDriver::Impl {
         if (!error.empty()) record.message = error;
         block.final_estimates(slot, record);
         try {
-          retire(block.trajectories[slot], completed, block.batch.q(slot), block.batch.p(slot),
-                 block.energy_step == completed ? block.energy(slot) : std::nullopt);
+          record_final_state(record, block.batch, slot, completed, setup.time.time_at(completed),
+                             block.energy_step == completed ? block.energy(slot) : std::nullopt);
+          announce(block.trajectories[slot]);
         } catch (const std::exception& thrown) {
           if (error.empty()) error = thrown.what();
         }

@@ -1,7 +1,8 @@
 #pragma once
 // checkpoint.json: everything a run needs to continue, bit for bit, after an interruption or a crash
-// (`nonsep run JOB --resume`). This file reads it (load_checkpoint, once, before a resumed run's driver starts:
-// launch/run_plan.hpp) and identifies the job it belongs to; CheckpointSaver (checkpoint_saver.hpp) writes it.
+// (`nonsep run JOB --resume`). This file identifies the job (checkpoint_identity: computed once per run, before its
+// driver is built, launch/run_plan.hpp) and reads the file (load_checkpoint, once, before a resumed run's driver
+// starts); CheckpointSaver (checkpoint_saver.hpp) owns the file's format and writes it.
 //
 // A checkpoint is taken between two steps and holds: the number of steps completed, the active states in
 // trajectory order with their energies, every trajectory's record (retired ones included: status, final state,
@@ -29,8 +30,8 @@
 #include <vector>
 
 #include "nonsep/core/base/model.hpp"
+#include "nonsep/host/checkpoint/checkpoint_saver.hpp"  // the format, checkpoint_file_name, CheckpointIdentity
 #include "nonsep/host/job.hpp"
-#include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/saved_state.hpp"  // CheckpointError
 
@@ -61,20 +62,14 @@ std::string stepping_identity(const LoadedJob& job);
 // chooses the stepping.
 void check_stepping(const std::string& recorded, const LoadedJob& job, const std::filesystem::path& written);
 
-// The file name inside a run's output folder.
-inline constexpr const char* checkpoint_file_name = "checkpoint.json";
+// The job's identity as a checkpoint records it: job_fingerprint and stepping_identity.
+CheckpointIdentity checkpoint_identity(const LoadedJob& job);
 
-// The value of the file's "format" key; a checkpoint with another is refused.
-// 4: the scheme's private state, grad H; 5: "stepping" (stepping_identity).
-inline constexpr const char* checkpoint_format = "nonsep checkpoint 5";
-// The value of the file's "checksum" key: the content hash of everything else, as dumped (keys sorted, numbers as
-// strings), so that an edited or damaged checkpoint is refused instead of changing the results.
-inline std::string checkpoint_checksum(const nlohmann::json& document) {
-  return content_hash_hex(content_hash(document.dump()));
-}
-
-// Reads the checkpoint at `path` and checks it against the job (fingerprint, stepping, number of trajectories,
-// dimension, steps). The observers' states are checked by the observers' restore(). Throws CheckpointError.
+// Reads the checkpoint at `path` and checks it against the job, whose identity is `identity` (fingerprint,
+// stepping), and against its number of trajectories, dimension and steps. The observers' states are checked by the
+// observers' restore(). Throws CheckpointError.
+Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& job, const CheckpointIdentity& identity);
+// The same with checkpoint_identity(job).
 Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& job);
 
 }  // namespace nonsep::host

@@ -2,24 +2,46 @@
 // checkpoint.json (checkpoint_file.hpp): saved after every `every_steps` steps and/or once `every_seconds` of wall time
 // have passed since the last one (job /checkpoint), and when the run is interrupted, from the driver's state and
 // every observer's save(). A run that ends otherwise removes it. Add it after the observers whose state it saves.
-// The one writer of the file: its layout is written here and read back by load_checkpoint (checkpoint_file.hpp).
+// The one writer of the file: it owns the file's format (its name, layout, format key and checksum, below), which
+// load_checkpoint (checkpoint_file.hpp) reads back; it writes with nothing but what it is handed.
 #include <chrono>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/observer.hpp"
 
 namespace nonsep::host {
 
+// The file name inside a run's output folder.
+inline constexpr const char* checkpoint_file_name = "checkpoint.json";
+
+// The value of the file's "format" key; a checkpoint with another is refused.
+// 4: the scheme's private state, grad H; 5: "stepping" (stepping_identity).
+inline constexpr const char* checkpoint_format = "nonsep checkpoint 5";
+// The value of the file's "checksum" key: the content hash of everything else, as dumped (keys sorted, numbers as
+// strings), so that an edited or damaged checkpoint is refused instead of changing the results.
+inline std::string checkpoint_checksum(const nlohmann::json& document) {
+  return content_hash_hex(content_hash(document.dump()));
+}
+
+// What a checkpoint says of the job it belongs to (checkpoint_identity, checkpoint_file.hpp): its "job_fingerprint"
+// and "stepping" keys.
+struct CheckpointIdentity {
+  std::string fingerprint;  // job_fingerprint
+  std::string stepping;     // stepping_identity
+};
+
 class CheckpointSaver : public Observer, public ChunkObserver {
  public:
-  // `fingerprint` and `stepping`: the job's (job_fingerprint, stepping_identity: checkpoint_file.hpp). `observers`:
-  // those whose state goes into the checkpoint (not owned).
-  CheckpointSaver(std::filesystem::path path, std::string fingerprint, std::string stepping,
-                  const CheckpointPolicy& policy, const EnsembleDriver& driver, std::vector<Observer*> observers);
+  // `identity`: the job's (checkpoint_identity). `observers`: those whose state goes into the checkpoint, under
+  // their name() (not owned; one with an empty name has none).
+  CheckpointSaver(std::filesystem::path path, CheckpointIdentity identity, const CheckpointPolicy& policy,
+                  const EnsembleDriver& driver, std::vector<CheckpointedObserver*> observers);
 
   std::uint64_t next_event(std::uint64_t step) const override;
   void after_chunk(std::uint64_t step) override;
@@ -31,10 +53,10 @@ class CheckpointSaver : public Observer, public ChunkObserver {
  private:
   using Clock = std::chrono::steady_clock;
   std::filesystem::path path_;
-  std::string fingerprint_, stepping_;
+  CheckpointIdentity identity_;
   CheckpointPolicy policy_;
   const EnsembleDriver& driver_;
-  std::vector<Observer*> observers_;
+  std::vector<CheckpointedObserver*> observers_;
   Clock::time_point next_save_;
 };
 

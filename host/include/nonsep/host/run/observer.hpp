@@ -19,9 +19,10 @@
 //   before_finish(step, interrupted)  the stepping is over, before the active states are retired.
 //   on_end()               after the last retirement: flush, close.
 // The interface is small, as Odeint's observer is one callable: Observer has the events every observer may want;
-// what few observers need are facets, separate small interfaces an observer also derives from and the driver finds
-// by dynamic_cast: ChunkObserver (prepare_blocks, after_chunk, before_finish), StepObserver (every step),
-// CheckpointedObserver (save, restore) and TrajectoryColumns (trajectories.csv).
+// what few observers need are facets, separate small interfaces an observer also derives from: ChunkObserver
+// (prepare_blocks, after_chunk, before_finish) and StepObserver (every step), which the driver finds by dynamic_cast
+// when the observer is added, and CheckpointedObserver (save, restore) and TrajectoryColumns (trajectories.csv),
+// which the run's plan lists by the observers' types (launch/).
 // Observers that watch every step (StepObserver) are called inside chunks, on the worker thread of
 // each block, with that block's states only (on_step); they must touch nothing but their state for those
 // trajectories. Before a chunk the driver calls save_block; when a chunk is redone step by step (a state stopped
@@ -66,19 +67,13 @@ struct StateView {
   std::span<const double> alignment = {};
 };
 
-// A retirement an observer asks for at an event: the trajectory stops there with `status` and `message`.
-struct RetirementRequest {
-  std::size_t trajectory = 0;
-  TrajectoryStatus status = TrajectoryStatus::inaccurate;
-  std::string message;
-};
-
 struct Event {
   std::uint64_t step = 0;
   double t = 0.0;
   std::span<const StateView> states;  // trajectory order
   bool energy_evaluated = false;      // H was evaluated at this step (StateView::energy may still be empty)
-  std::vector<RetirementRequest>* retire = nullptr;
+  // Stops the observer asks for: each trajectory stops here with its record's status and message (trajectory.hpp).
+  std::vector<StoppedTrajectory>* retire = nullptr;
 };
 
 // The states of one block inside a chunk (on_step): trajectories[s] is the index of slot s, its q at
@@ -89,7 +84,7 @@ struct BlockView {
   std::span<const std::size_t> trajectories;
   std::span<const double> q, p;
   const PluginModel* model = nullptr;                // the worker thread's plugin instance; use it on this thread only
-  std::vector<RetirementRequest>* retire = nullptr;  // on_step only: stop these trajectories at this step
+  std::vector<StoppedTrajectory>* retire = nullptr;  // on_step only: stop these trajectories at this step
 };
 
 // The observer every observer is: the events of the run, seen on the driver's thread.

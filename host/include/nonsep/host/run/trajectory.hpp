@@ -1,10 +1,12 @@
 #pragma once
 // One trajectory of an ensemble, as the driver knows it: how it ended and where. O(dimension) memory, whatever the
 // number of steps. Observers keep anything else they track (energy errors, closest returns, ...) themselves.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace nonsep::host {
@@ -50,6 +52,24 @@ struct TrajectoryRecord {
   std::optional<double> sali;
   std::vector<double> gali;
 };
+
+// A trajectory that stops before the end of the run, and its record: the one record of a stopped trajectory, from
+// the block that stops it to the files. An observer asks for a stop with the record's status and message
+// (Event::retire, BlockView::retire); the block that holds the trajectory fills in the rest (the final state, where
+// it stopped, the final estimates); the driver keeps the record, with the H0 it knows (EnsembleDriver::records), and
+// shows it to every observer (Observer::on_retire); the run's files are written from the records.
+struct StoppedTrajectory {
+  std::size_t trajectory = 0;
+  TrajectoryRecord record;
+};
+
+// An observer's request that `trajectory` stop with `status` and `message`.
+inline StoppedTrajectory stop_request(std::size_t trajectory, TrajectoryStatus status, std::string message) {
+  StoppedTrajectory stop{trajectory, {}};
+  stop.record.status = status;
+  stop.record.message = std::move(message);
+  return stop;
+}
 
 // (H - H0) / H0, unknown when either is unknown or H0 = 0: trajectory.csv's and trajectories.csv's
 // relative_energy_error.

@@ -1,6 +1,7 @@
 #pragma once
-// What a run writes at its end: summary.json (the run's facts, written with nlohmann-json) and trajectories.csv
-// (one row per trajectory; columns in launch/run_job.hpp). Both are replaced atomically.
+// What a run writes at its end, assembled from the job and the driver: summary.json (the run's facts, written with
+// nlohmann-json) and trajectories.csv (one row per trajectory; columns in launch/run_job.hpp). Both are replaced
+// atomically; their names are in output/run_files.hpp. Internal to src/launch/.
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <span>
@@ -8,14 +9,11 @@
 
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/launch/run_job.hpp"
+#include "nonsep/host/output/run_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/observer.hpp"
 
 namespace nonsep::host {
-
-inline constexpr const char* summary_file_name = "summary.json";
-inline constexpr const char* trajectories_file_name = "trajectories.csv";
-inline constexpr const char* results_file_name = "results.h5";  // output.format "hdf5" (output/results_h5.hpp)
 
 struct RunFacts {
   const LoadedJob& loaded;

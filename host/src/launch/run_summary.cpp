@@ -1,4 +1,4 @@
-#include "output/run_summary.hpp"
+#include "launch/run_summary.hpp"
 
 #include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
