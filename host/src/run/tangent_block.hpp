@@ -92,9 +92,10 @@ struct BlockTangents {
     after_step(dt);
   }
 
-  // `n` steps of every slot, bit for bit n calls of step(). A Chin scheme with a plugin's tangent kernel takes them in
-  // runs that end at the orthonormalisations (one step a run with MEGNO, whose growth is taken at every step), each
-  // run one kernel call; otherwise step by step through the evaluation path.
+  // `n` steps of every slot, n calls of step(). A Chin scheme with a plugin's tangent kernel takes them in runs that
+  // end at the orthonormalisations (one step a run with MEGNO, whose growth is taken at every step), each run one
+  // kernel call (bit for bit step()'s numbers with the baseline instruction set; the wider sets round as their kernels
+  // do); otherwise step by step through the evaluation path.
   template <class M>
   void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
     while (n > 0) {
