@@ -1,8 +1,9 @@
 // The plugins' stepping kernels in the `nonsep` executable: runs through the kernel (NONSEP_INSTRUCTION_SET=
 // baseline) write byte for byte the files of runs through the evaluation path (NONSEP_INSTRUCTION_SET=evaluation),
 // for every Chin scheme (mpe of 2 and 3 terms) and form, 1, 5 and 300 states, 1 and 2 threads, states that fail or
-// diverge partway, and a run killed and resumed; summary.json says which path ran; inspect shows and checks the
-// kernels; a plugin of another kernel version, and one without kernels, run through the evaluation path.
+// diverge partway, and a run killed and resumed; the tangent kernel likewise for Lyapunov exponents, MEGNO, SALI and
+// GALI (basic and triplet, 1 and 4 vectors); summary.json says which path ran; inspect shows and checks the kernels;
+// a plugin of another kernel version, and one without kernels, run through the evaluation path.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -94,6 +95,34 @@ TEST_CASE(
       }
 }
 
+TEST_CASE("tangent kernel: Lyapunov exponents, MEGNO, SALI and GALI, the evaluation path's files") {
+  TemporaryFolder folder;
+  const json analyses[] = {
+      {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 7}, {"every", 10}}}},
+      {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 3}, {"every", 10}}}, {"megno", true}},
+      {{"lyapunov", {{"vectors", 2}, {"renormalize_every", 5}, {"every", 20}}}, {"sali", true}, {"gali", 2}}};
+  for (const json& integrator : {json{{"scheme", "basic"}}, json{{"scheme", "triplet"}, {"order", "4/3"}}})
+    for (std::size_t a = 0; a < std::size(analyses); ++a)
+      for (const char* form : {"TTV", "VVT"}) {
+        json job = paper1d_job(states(70), {{"dt", 0.01}, {"steps", 45}}, integrator);
+        job["hamiltonian"] = form;
+        job["output"] = {{"every", 15}};
+        job["analysis"] = analyses[a];
+        const std::string name =
+            "tangent-" + integrator["scheme"].get<std::string>() + "-" + std::to_string(a) + "-" + form;
+        CAPTURE(name);
+        const auto file = write_job(folder / (name + ".json"), job);
+        for (const char* threads : {"1", "2"}) {
+          CAPTURE(threads);
+          const auto kernel = run_with("baseline", folder, name + "-kernel-" + threads, file, threads);
+          const auto evaluation = run_with("evaluation", folder, name + "-evaluation-" + threads, file, threads);
+          CHECK(read_text(folder / (name + "-kernel-" + threads) / "lyapunov.csv") ==
+                read_text(folder / (name + "-evaluation-" + threads) / "lyapunov.csv"));
+          check_same_files(kernel, evaluation);
+        }
+      }
+}
+
 TEST_CASE("kernel path: states that fail or diverge partway are reported as the evaluation path reports them") {
   TemporaryFolder folder;
   use_test_plugins();
@@ -171,6 +200,8 @@ TEST_CASE("inspect shows a plugin's kernels and --check compares them with the e
   INFO(checked.out);
   CHECK(checked.status == 0);
   CHECK(checked.out.find("kernel x86-64: identical to the evaluation path bit for bit [used by runs]") !=
+        std::string::npos);
+  CHECK(checked.out.find("tangent kernel x86-64 (basic, 2 vectors): identical to the evaluation path bit for bit") !=
         std::string::npos);
   const auto none = run_nonsep({"inspect", "blowup", "--check"}, folder.path());
   CHECK(none.out.find("kernels: none (the evaluation path steps this plugin)") != std::string::npos);

@@ -91,7 +91,8 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, unsigned abi_ve
                                                   {"chin_steps", api.chin_steps != nullptr},
                                                   {"energy_TTV", api.energy_TTV != nullptr},
                                                   {"energy_VVT", api.energy_VVT != nullptr},
-                                                  {"hvp_H", api.hvp_H != nullptr}};
+                                                  {"hvp_H", api.hvp_H != nullptr},
+                                                  {"chin_tangent_steps", api.chin_tangent_steps != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");
@@ -120,6 +121,8 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, unsigned abi_ve
 
   // "kernels": {"instruction_sets": ["x86-64", ...]}, exactly when the table has chin_steps; in version 4 with the
   // kernel version "version": K, which version 5 says by abi_version.
+  if (api.chin_tangent_steps != nullptr && api.chin_steps == nullptr)
+    fail("has chin_tangent_steps without chin_steps (the tangent kernel uses chin_steps' instruction sets)");
   if (m.contains("kernels") != (api.chin_steps != nullptr))
     fail(api.chin_steps != nullptr ? "lacks the object \"kernels\" that its chin_steps needs"
                                    : "has \"kernels\" but the table's chin_steps pointer is null");

@@ -174,35 +174,62 @@ PluginModel PluginModel::with_kernel(std::size_t instruction_set) const {
 
 std::uint64_t PluginModel::kernel_calls() const { return instance_->kernel_calls; }
 
-bool PluginModel::chin_steps(const ChinStepsCall& call) const {
-  if (!kernel_) return false;
-  const std::size_t size = call.count * instance_->dimension;
+namespace {
+
+// A call's arguments across the boundary, its sizes checked for states of dimension n.
+nonsep_chin_steps_args steps_args(const ChinStepsCall& call, std::uint32_t instruction_set, std::size_t n,
+                                  const char* function) {
+  const std::size_t size = call.count * n;
   if (call.q.size() != size || call.p.size() != size || call.outer_gradient.size() != size ||
       call.inner_gradient.size() != size ||
       !chin_eps_fit(call.eps.size(), call.substeps, call.count, call.weights.size())) [[unlikely]]
-    throw_bad_spans("chin_steps", call.count, instance_->dimension, instance_->dimension, call.q.size(), call.p.size());
+    throw_bad_spans(function, call.count, n, n, call.q.size(), call.p.size());
+  return nonsep_chin_steps_args{call.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT,
+                                instruction_set,
+                                call.coefficients.t1,
+                                call.coefficients.t2,
+                                call.coefficients.v0,
+                                call.coefficients.v1,
+                                call.coefficients.v2,
+                                call.eps.data(),
+                                call.eps.size(),
+                                call.substeps,
+                                call.steps,
+                                call.count,
+                                call.q.data(),
+                                call.p.data(),
+                                call.outer_gradient.data(),
+                                call.inner_gradient.data(),
+                                call.weights.empty() ? nullptr : call.weights.data(),
+                                call.weights.size()};
+}
+
+}  // namespace
+
+bool PluginModel::chin_steps(const ChinStepsCall& call) const {
+  if (!kernel_) return false;
   const nonsep_plugin_api& api = *instance_->api;
-  const nonsep_chin_steps_args args{call.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT,
-                                    *kernel_,
-                                    call.coefficients.t1,
-                                    call.coefficients.t2,
-                                    call.coefficients.v0,
-                                    call.coefficients.v1,
-                                    call.coefficients.v2,
-                                    call.eps.data(),
-                                    call.eps.size(),
-                                    call.substeps,
-                                    call.steps,
-                                    call.count,
-                                    call.q.data(),
-                                    call.p.data(),
-                                    call.outer_gradient.data(),
-                                    call.inner_gradient.data(),
-                                    call.weights.empty() ? nullptr : call.weights.data(),
-                                    call.weights.size()};
+  const nonsep_chin_steps_args args = steps_args(call, *kernel_, instance_->dimension, "chin_steps");
   const nonsep_status status = api.chin_steps(instance_->handle, &args);
   if (status != NONSEP_OK) [[unlikely]]
     throw_failed(*this, instance_->handle, api, "chin_steps", status);
+  ++instance_->kernel_calls;
+  return true;
+}
+
+bool PluginModel::chin_tangent_steps(const ChinTangentStepsCall& call) const {
+  const nonsep_plugin_api& api = *instance_->api;
+  if (!kernel_ || api.chin_tangent_steps == nullptr) return false;
+  const std::size_t n = instance_->dimension, size = call.steps.count * call.vectors * n;
+  if (!call.steps.weights.empty() || call.vectors == 0 || call.tangent_q.size() != size ||
+      call.tangent_p.size() != size) [[unlikely]]
+    throw_bad_spans("chin_tangent_steps", call.steps.count * call.vectors, n, n, call.tangent_q.size(),
+                    call.tangent_p.size());
+  const nonsep_chin_tangent_steps_args args{steps_args(call.steps, *kernel_, n, "chin_tangent_steps"), call.vectors,
+                                            call.tangent_q.data(), call.tangent_p.data()};
+  const nonsep_status status = api.chin_tangent_steps(instance_->handle, &args);
+  if (status != NONSEP_OK) [[unlikely]]
+    throw_failed(*this, instance_->handle, api, "chin_tangent_steps", status);
   ++instance_->kernel_calls;
   return true;
 }

@@ -1,12 +1,14 @@
 // The kernel part of `nonsep inspect --check` (plugin_report.hpp, check_kernels): each kernel this processor runs
 // against the evaluation path, on a few steps of the basic step (one dt for all states) and of MPE 4/3 (a step
 // size per state), both forms: the catalogue's Chin schemes with one order and those that are not symplectic (the
-// sums of substeps), each at its default options.
+// sums of substeps), each at its default options. The tangent kernel (chin_tangent_steps) likewise: the same steps of
+// the basic step with two tangent vectors per state, states and vectors against TangentIntegrator's evaluation path.
 #include <algorithm>
 #include <string>
 
 #include "nonsep/core/kernel/chin_kernel.hpp"
 #include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/tangent/tangent_integrator.hpp"
 #include "nonsep/host/inspect/plugin_report.hpp"
 
 namespace nonsep::host {
@@ -22,6 +24,35 @@ PhaseSpaceBatch run(const PluginModel& model, const IntegratorSpec& spec, std::s
   Integrator integrator(spec);
   integrator.step_n(model, x, dt, steps);
   return x;
+}
+
+// The numbers of `count` states and two tangent vectors each (the unit vectors of dq_0 and dp_0) after `steps` basic
+// steps of `form`, through the tangent kernel (`kernel` true; nothing when the plugin has none) or the evaluation path:
+// q, p, then the vectors' dq and dp.
+std::vector<double> tangent_run(const PluginModel& model, HamiltonianForm form, std::span<const double> q,
+                                std::span<const double> p, std::size_t count, double dt, std::uint64_t steps,
+                                bool kernel) {
+  const std::size_t n = model.dimension();
+  PhaseSpaceBatch x(n, count), vectors(n, 2 * count);
+  std::copy_n(q.begin(), x.size(), x.q().begin());
+  std::copy_n(p.begin(), x.size(), x.p().begin());
+  for (std::size_t b = 0; b < count; ++b) {
+    vectors.q()[2 * b * n] = 1.0;
+    vectors.p()[(2 * b + 1) * n] = 1.0;
+  }
+  IntegratorSpec spec;
+  spec.form = form;
+  TangentIntegrator integrator(spec, 2);
+  if (kernel) {
+    if (!integrator.step_kernel_n(model, x, vectors, dt, steps)) return {};
+  } else {
+    for (std::uint64_t step = 0; step < steps; ++step) integrator.step(model, x, vectors, dt);
+  }
+  std::vector<double> numbers(x.q().begin(), x.q().end());
+  numbers.insert(numbers.end(), x.p().begin(), x.p().end());
+  numbers.insert(numbers.end(), vectors.q().begin(), vectors.q().end());
+  numbers.insert(numbers.end(), vectors.p().begin(), vectors.p().end());
+  return numbers;
 }
 
 // The schemes the check steps, in catalogue order: the basic step and the multi-product expansion.
@@ -93,6 +124,28 @@ PathCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::spa
                            "relative to max(1, |x|); fused multiply-add or other compiler flags round differently");
     }
     result.text += line + (index == kernels.chosen ? " [used by runs]" : "") + "\n";
+    if (!model.has_hessian_vector_products()) continue;
+    PathDifference tangent_difference;
+    bool tangent_kernel = true;
+    failure.clear();
+    for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT}) try {
+        const std::vector<double> expected = tangent_run(model, form, q, p, count, dt, steps, false);
+        const std::vector<double> found = tangent_run(kernel, form, q, p, count, dt, steps, true);
+        tangent_kernel = !found.empty();
+        for (std::size_t i = 0; i < found.size(); ++i) tangent_difference.add(expected[i], found[i]);
+      } catch (const ModelError& error) {
+        failure = error.what();
+      }
+    if (!tangent_kernel) continue;  // a plugin of ABI version 4, or one without chin_tangent_steps
+    line = "tangent kernel " + name + " (basic, 2 vectors): ";
+    if (!failure.empty())
+      line += "not compared: the model failed at the sample points (" + failure + ")";
+    else if (tangent_difference.identical)
+      line += "identical to the evaluation path bit for bit";
+    else
+      line += result.judge(tangent_difference, tolerance, "the evaluation path",
+                           "relative to max(1, |x|); fused multiply-add or other compiler flags round differently");
+    result.text += line + "\n";
   }
   result.text = "kernels (" + std::to_string(steps) + " steps of " + checked_schemes_text(checked_schemes()) + ", dt " +
                 std::to_string(dt).substr(0, 5) + ", TTV and VVT, " + std::to_string(count) + " states):\n" +

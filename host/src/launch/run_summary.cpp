@@ -52,7 +52,8 @@ json stepping_facts(const RunFacts& facts) {
           {"kernel_calls", facts.driver.kernel_calls()},
           {"plugin_kernels", kernels.instruction_sets},
           {"note", kernels.chosen && !kernel ? "every step needed the evaluation path (an every-step observer, tangent "
-                                               "vectors, or a scheme without basic steps)"
+                                               "vectors of a scheme without a tangent kernel, or a scheme without "
+                                               "basic steps)"
                                              : kernels.note}};
 }
 

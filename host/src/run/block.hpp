@@ -136,7 +136,7 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
   template <class M>
   void step_n(const M& model, double dt, std::uint64_t n) {
     if (tangents)
-      for (std::uint64_t k = 0; k < n; ++k) tangents->step(model, batch, dt);
+      tangents->step_n(model, batch, dt, n);
     else
       integrator.step_n(model, batch, dt, n);
   }

@@ -92,6 +92,22 @@ struct BlockTangents {
     after_step(dt);
   }
 
+  // `n` steps of every slot, n calls of step(). A Chin scheme with a plugin's tangent kernel takes them in runs that
+  // end at the orthonormalisations (one step a run with MEGNO, whose growth is taken at every step), each run one
+  // kernel call (bit for bit step()'s numbers with the baseline instruction set; the wider sets round as their kernels
+  // do); otherwise step by step through the evaluation path.
+  template <class M>
+  void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
+    while (n > 0) {
+      const std::uint64_t run = with_megno ? 1 : std::min(n, exponents.steps_to_renormalization(lyapunov));
+      if (!integrator.step_kernel_n(model, x, vectors, dt, run)) break;
+      exponents.after_steps(vectors, lyapunov, dt, run, growth, alignment);
+      if (with_megno) add_megno_step(megno, growth, dt);
+      n -= run;
+    }
+    for (; n > 0; --n) step(model, x, dt);
+  }
+
   // The Lyapunov and MEGNO sums and the SALI/GALI factors after a step of dt of every slot.
   void after_step(double dt) {
     exponents.after_step(vectors, lyapunov, dt, growth, alignment);

@@ -22,6 +22,7 @@ const char* metadata() {
     auto metadata = nlohmann::json::parse(Table::api.metadata_json());
     metadata["kernels"]["version"] = 999;
     metadata["capabilities"]["hvp_H"] = false;  // past version 4's table
+    metadata["capabilities"]["chin_tangent_steps"] = false;
     return metadata.dump();
   }();
   return text.c_str();

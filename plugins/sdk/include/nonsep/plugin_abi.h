@@ -9,8 +9,9 @@
  *        their gradients, since version 5's kernels also evaluate the gradient their steps start from), the product
  *        term of H in one pass (energy_TTV, energy_VVT)                           NONSEP_PLUGIN_V4_STRUCT_SIZE
  *        (a version-4 table as first published ends before energy_TTV: NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE)
- *   5  + the directional derivative of grad H, hvp_H (the tangent maps of the comparators); chin_steps takes the
- *        arguments below and the metadata's "kernels" has no "version"          NONSEP_PLUGIN_V5_STRUCT_SIZE
+ *   5  + the directional derivative of grad H, hvp_H (the tangent maps of the comparators), the tangent kernel
+ *        chin_tangent_steps; chin_steps takes the arguments below and the metadata's "kernels" has no "version"
+ *                                                                                  NONSEP_PLUGIN_V5_STRUCT_SIZE
  * docs/plugin-abi.md lists the versions and their entries. Version 2 had a fused stepping function integrate() with
  * a stepper of its own; version 1 exported a function, nonsep_plugin_entry, returning the table instead of the
  * pointer below. Plugins of either are refused: rebuild them against the installed SDK.
@@ -61,8 +62,9 @@
  *     "capabilities": { "value_T": true, "value_V": true, "hessian_T": true, "hessian_V": true,
  *                       "d3T": true, "d3V": true, "grad_K": false, "grad_U": true, "value_U": true, ...,
  *                       "hvp_T": true, "hvp_V": true, "chin_steps": true,
- *                       "energy_TTV": false, "energy_VVT": false, "hvp_H": true },
+ *                       "energy_TTV": false, "energy_VVT": false, "hvp_H": true, "chin_tangent_steps": true },
  *     "kernels": { "instruction_sets": ["x86-64", ...] }          exactly when chin_steps is non-null
+ *                                                                  (chin_tangent_steps only with chin_steps)
  *   }
  * "minimum", "maximum" and "unit" may be absent; "thread_safe" is required. Each capability is true exactly
  * when the table's pointer of that name is non-null (an absent capability counts as false).
@@ -124,6 +126,18 @@ typedef struct nonsep_chin_steps_args {
   size_t terms;              /* 0: basic steps; m >= 2: expansion steps (then substeps 1 and eps_count m), whose
                                 outer_gradient out is not at the final point (the host evaluates it anew) */
 } nonsep_chin_steps_args;
+
+/* The arguments of chin_tangent_steps (below): the basic steps of `steps` (terms 0; with `steps.steps` 0 only the
+ * outer gradient, as chin_steps), each flow followed by its linear map applied to `vectors` tangent vectors per state
+ * (core chin_tangent_stages.hpp): a kick p <- p - c eps V'(q) maps dp <- dp - c eps V''(q) dq, a drift
+ * q <- q + c eps T'(p) maps dq <- dq + c eps T''(p) dp, each at the point the flow started from. Vector j of state b
+ * is at (b*vectors + j)*n of tangent_q (its dq) and tangent_p (its dp). */
+typedef struct nonsep_chin_tangent_steps_args {
+  nonsep_chin_steps_args steps; /* as for chin_steps, terms 0 */
+  size_t vectors;               /* k, 1 <= k <= 2n */
+  double* tangent_q;            /* count*k*n, mapped in place */
+  double* tangent_p;            /* count*k*n, mapped in place */
+} nonsep_chin_tangent_steps_args;
 
 typedef struct nonsep_plugin_api {
   uint32_t abi_version; /* NONSEP_PLUGIN_ABI_VERSION */
@@ -212,6 +226,14 @@ typedef struct nonsep_plugin_api {
    * the host refuses them a plugin without it. Another form returns NONSEP_UNSUPPORTED. */
   nonsep_status (*hvp_H)(nonsep_instance* instance, uint32_t form, const double* q, const double* p, const double* dq,
                          const double* dp, double* out_q, double* out_p, size_t count);
+
+  /* The tangent kernel: chin_steps' basic steps with the tangent maps of their flows (args above), for the Lyapunov
+   * exponents, MEGNO, SALI and GALI; the instruction sets those of chin_steps (present only with it), the stages and
+   * the Hessian-vector products those of the core's template with this model inlined, so that with the baseline
+   * instruction set the numbers are bit for bit those of the host stepping through grad_T, grad_V, hvp_T and hvp_V.
+   * A failed evaluation returns its status with the arrays undefined: the host then redoes the steps through the
+   * evaluations. */
+  nonsep_status (*chin_tangent_steps)(nonsep_instance* instance, const nonsep_chin_tangent_steps_args* args);
 } nonsep_plugin_api;
 
 /* The size of a version-3 table: the entries before grad_K. */

@@ -13,8 +13,9 @@
 //
 // The plugin's file must be named <name>.so (nonsep_add_model() in CMake does that): the host refuses a file whose
 // metadata name differs from its file name. Every SDK plugin provides all optional functions of plugin_abi.h
-// for T and V (values, Hessians, directional third derivatives, Hessian-vector products) and the stepping kernel
-// chin_steps: the core's chin_kernel_steps with the model inlined, compiled for the instruction sets of
+// for T and V (values, Hessians, directional third derivatives, Hessian-vector products) and the stepping kernels
+// chin_steps and chin_tangent_steps: the core's chin_kernel_steps and chin_tangent_kernel_blocks with the model
+// inlined, compiled for the instruction sets of
 // kernels.hpp (metadata "kernels": {"instruction_sets"}); no stepping code is written here; and, where the model's
 // T and V (or gradient templates) compile for one more level of dual numbers, the directional derivative of grad H,
 // hvp_H, by automatic differentiation (model_adapter.hpp; capability "hvp_H"). Its
@@ -147,7 +148,8 @@ class PluginTable {
                                  {"chin_steps", true},
                                  {"energy_TTV", Adapter::analytic_energy_TTV},
                                  {"energy_VVT", Adapter::analytic_energy_VVT},
-                                 {"hvp_H", Adapter::has_hamiltonian_hessian}}},
+                                 {"hvp_H", Adapter::has_hamiltonian_hessian},
+                                 {"chin_tangent_steps", true}}},
                                {"derivatives",
                                 {{"grad_T", kind(Adapter::analytic_grad_T)},
                                  {"grad_V", kind(Adapter::analytic_grad_V)},
@@ -317,38 +319,67 @@ class PluginTable {
 
   // The stepping kernel (plugin_abi.h chin_steps): the core's chin_kernel_steps with this model inlined, for the
   // instruction set the host asks for (kernels.hpp).
+  // The arguments of chin_steps as the core's call, checked (std::invalid_argument names what is wrong).
+  static ChinStepsCall steps_call(const Adapter& adapter, const nonsep_chin_steps_args* args, const char* function) {
+    const std::string name(function);
+    if (args == nullptr) throw std::invalid_argument(name + ": no arguments");
+    const std::size_t size = args->count * adapter.dimension();
+    if (args->form != NONSEP_FORM_TTV && args->form != NONSEP_FORM_VVT)
+      throw std::invalid_argument(name + ": form " + std::to_string(args->form) + " is neither TTV (0) nor VVT (1)");
+    if (args->terms != 0 && (args->terms < 2 || args->weights == nullptr))
+      throw std::invalid_argument(name + ": an expansion of " + std::to_string(args->terms) + " terms" +
+                                  (args->weights == nullptr ? " without weights" : "") +
+                                  " (expected 0 for basic steps, or at least 2 terms with their weights)");
+    if (!chin_eps_fit(args->eps_count, args->substeps, args->count, args->terms))
+      throw std::invalid_argument(
+          name + ": " + std::to_string(args->eps_count) + " step sizes for " + std::to_string(args->substeps) +
+          " sub-steps of " + std::to_string(args->count) + " states and " + std::to_string(args->terms) +
+          " expansion terms (expected one per term with terms, else one per sub-step, or with one sub-step 1 or "
+          "one per state)");
+    return ChinStepsCall{args->form == NONSEP_FORM_VVT ? HamiltonianForm::VVT : HamiltonianForm::TTV,
+                         ChinCoefficients{args->t1, args->t2, args->v0, args->v1, args->v2},
+                         std::span<const double>(args->eps, args->eps_count),
+                         args->substeps,
+                         args->steps,
+                         args->count,
+                         std::span<double>(args->q, size),
+                         std::span<double>(args->p, size),
+                         std::span<double>(args->outer_gradient, size),
+                         std::span<double>(args->inner_gradient, size),
+                         std::span<const double>(args->weights, args->terms)};
+  }
+  [[noreturn]] static void throw_unknown_instruction_set(const char* function, std::uint32_t instruction_set) {
+    throw std::invalid_argument(std::string(function) + ": instruction set " + std::to_string(instruction_set) +
+                                " is not among this plugin's kernels (its metadata lists them)");
+  }
+
+  // The stepping kernel (plugin_abi.h chin_steps): the core's chin_kernel_steps with this model inlined, for the
+  // instruction set the host asks for (kernels.hpp).
   static nonsep_status chin_steps(nonsep_instance* instance, const nonsep_chin_steps_args* args) noexcept {
     return guarded(instance, "chin_steps", [&](const Instance& self) {
-      if (args == nullptr) throw std::invalid_argument("chin_steps: no arguments");
-      const Adapter& adapter = self.adapter;
-      const std::size_t size = args->count * adapter.dimension();
-      if (args->form != NONSEP_FORM_TTV && args->form != NONSEP_FORM_VVT)
-        throw std::invalid_argument("chin_steps: form " + std::to_string(args->form) +
-                                    " is neither TTV (0) nor VVT (1)");
-      if (args->terms != 0 && (args->terms < 2 || args->weights == nullptr))
-        throw std::invalid_argument("chin_steps: an expansion of " + std::to_string(args->terms) + " terms" +
-                                    (args->weights == nullptr ? " without weights" : "") +
-                                    " (expected 0 for basic steps, or at least 2 terms with their weights)");
-      if (!chin_eps_fit(args->eps_count, args->substeps, args->count, args->terms))
-        throw std::invalid_argument(
-            "chin_steps: " + std::to_string(args->eps_count) + " step sizes for " + std::to_string(args->substeps) +
-            " sub-steps of " + std::to_string(args->count) + " states and " + std::to_string(args->terms) +
-            " expansion terms (expected one per term with terms, else one per sub-step, or with one sub-step 1 or "
-            "one per state)");
-      const ChinStepsCall call{args->form == NONSEP_FORM_VVT ? HamiltonianForm::VVT : HamiltonianForm::TTV,
-                               ChinCoefficients{args->t1, args->t2, args->v0, args->v1, args->v2},
-                               std::span<const double>(args->eps, args->eps_count),
-                               args->substeps,
-                               args->steps,
-                               args->count,
-                               std::span<double>(args->q, size),
-                               std::span<double>(args->p, size),
-                               std::span<double>(args->outer_gradient, size),
-                               std::span<double>(args->inner_gradient, size),
-                               std::span<const double>(args->weights, args->terms)};
-      if (!ChinKernels<Adapter>::run(args->instruction_set, adapter, call))
-        throw std::invalid_argument("chin_steps: instruction set " + std::to_string(args->instruction_set) +
-                                    " is not among this plugin's kernels (its metadata lists them)");
+      const ChinStepsCall call = steps_call(self.adapter, args, "chin_steps");
+      if (!ChinKernels<Adapter>::run(args->instruction_set, self.adapter, call))
+        throw_unknown_instruction_set("chin_steps", args->instruction_set);
+    });
+  }
+
+  // The tangent kernel (plugin_abi.h chin_tangent_steps): the core's chin_tangent_kernel_blocks with this model
+  // inlined, for the instruction set the host asks for.
+  static nonsep_status chin_tangent_steps(nonsep_instance* instance,
+                                          const nonsep_chin_tangent_steps_args* args) noexcept {
+    return guarded(instance, "chin_tangent_steps", [&](const Instance& self) {
+      if (args == nullptr) throw std::invalid_argument("chin_tangent_steps: no arguments");
+      const ChinStepsCall steps = steps_call(self.adapter, &args->steps, "chin_tangent_steps");
+      const std::size_t n = self.adapter.dimension(), k = args->vectors;
+      if (args->steps.terms != 0) throw std::invalid_argument("chin_tangent_steps: an expansion (terms must be 0)");
+      if (k < 1 || k > 2 * n)
+        throw std::invalid_argument("chin_tangent_steps: " + std::to_string(k) + " vectors per state (expected 1 to " +
+                                    std::to_string(2 * n) + ")");
+      const std::size_t size = args->steps.count * k * n;
+      const ChinTangentStepsCall call{steps, k, std::span<double>(args->tangent_q, size),
+                                      std::span<double>(args->tangent_p, size)};
+      if (!ChinKernels<Adapter>::run_tangent(args->steps.instruction_set, self.adapter, call))
+        throw_unknown_instruction_set("chin_tangent_steps", args->steps.instruction_set);
     });
   }
 
@@ -383,6 +414,7 @@ class PluginTable {
       Adapter::analytic_energy_TTV ? &product_energy<HamiltonianForm::TTV> : nullptr,
       Adapter::analytic_energy_VVT ? &product_energy<HamiltonianForm::VVT> : nullptr,
       Adapter::has_hamiltonian_hessian ? &hvp_H : nullptr,
+      &chin_tangent_steps,
   };
 };
 

@@ -21,6 +21,7 @@
 // Errors: InvalidArgument for k outside 1 .. min(2n, max_exponents), renormalize_every == 0, or spans whose
 // sizes disagree with the batch. A tangent vector that has become zero, infinite or NaN (an overflow of the
 // state, or k > rank) gives non-finite sums, not an exception: the caller sees NaN exponents.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -120,7 +121,33 @@ class LyapunovExponents {
   // The exponents are the same bit for bit whichever outputs are asked for.
   void after_step(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt,
                   std::span<double> first_growth, std::span<double> alignment = {}) {
+    after_steps(tangents, records, dt, 1, first_growth, alignment);
+  }
+  // Without first_growth and alignment.
+  void after_step(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt) {
+    after_steps(tangents, records, dt, 1, {}, {});
+  }
+
+  // The steps every state can take before one reaches its next orthonormalisation (at least 1; renormalize_every
+  // for no state).
+  std::uint64_t steps_to_renormalization(std::span<const LyapunovRecord> records) const {
+    std::uint64_t steps = renormalize_every_;
+    for (const LyapunovRecord& record : records)
+      steps = std::min<std::uint64_t>(steps, renormalize_every_ - record.steps_since_renormalization);
+    return steps;
+  }
+
+  // after_step for `steps` steps of dt taken together (a tangent kernel's run): the same records and vectors bit for
+  // bit as `steps` calls of after_step, when no state reaches its orthonormalisation before the last of them
+  // (steps <= steps_to_renormalization(records); InvalidArgument otherwise). first_growth, when not empty, requires
+  // steps == 1.
+  void after_steps(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt, std::uint64_t steps,
+                   std::span<double> first_growth, std::span<double> alignment = {}) {
     check(tangents, records);
+    if (steps == 0 || steps > steps_to_renormalization(records) || (steps > 1 && !first_growth.empty()))
+      throw InvalidArgument("after_steps: " + std::to_string(steps) +
+                            " steps at once, which must be at least 1, pass no orthonormalisation and be 1 with "
+                            "first_growth");
     if (!first_growth.empty() && first_growth.size() != records.size())
       throw InvalidArgument("first_growth has " + std::to_string(first_growth.size()) + " entries for " +
                             std::to_string(records.size()) + " states");
@@ -148,9 +175,10 @@ class LyapunovExponents {
         first_growth[b] = log_norm - record.log_norm_first;
         record.log_norm_first = log_norm;
       }
-      ++record.steps;
-      record.time_since_renormalization += dt;
-      if (++record.steps_since_renormalization < renormalize_every_) continue;
+      record.steps += steps;
+      for (std::uint64_t step = 0; step < steps; ++step) record.time_since_renormalization += dt;
+      record.steps_since_renormalization += steps;
+      if (record.steps_since_renormalization < renormalize_every_) continue;
       orthonormalize_state(tangents, k_, b, log_norms, triangle);
       for (std::size_t j = 0; j < k_; ++j) record.log_stretch[j] += log_norms[j];
       if (indices) indices->update(alignment.subspan(b * indices->factor_size(), indices->factor_size()), triangle);
@@ -159,10 +187,6 @@ class LyapunovExponents {
       record.steps_since_renormalization = 0;
       record.log_norm_first = 0.0;
     }
-  }
-  // Without first_growth and alignment.
-  void after_step(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt) {
-    after_step(tangents, records, dt, {}, {});
   }
 
  private:

@@ -20,8 +20,11 @@
 // and 64 run at the machine's throughput, as the hand-written loop over all states does.
 // A call with weights takes whole steps of a multi-product expansion (chin_expansion_stages.hpp) over the same blocks,
 // its terms one after the other, so that one trajectory's expansion stays in registers.
-// Each number sees the same operations in the same order as in the evaluation path, so a kernel compiled with the
-// evaluation path's flags gives its numbers bit for bit (tests/core/test_chin_kernel.cpp).
+// A tangent call (chin_tangent_kernel_blocks) takes the steps with k tangent vectors per state
+// (chin_tangent_stages.hpp) over the same blocks, the vectors in local arrays beside the states while a block's
+// tangents take at most 1024 numbers of each array, else in the caller's arrays. Each number sees the same operations
+// in the same order as in the evaluation path, so a kernel compiled with the evaluation path's flags gives its numbers
+// bit for bit (tests/core/test_chin_kernel.cpp, tests/core/test_chin_tangent_kernel.cpp).
 //
 // Throws what the model throws; the call's arrays then hold a mixture of steps (the caller redoes the call through
 // the evaluation path).
@@ -34,6 +37,7 @@
 
 #include "nonsep/core/kernel/chin_expansion_stages.hpp"
 #include "nonsep/core/kernel/chin_stages.hpp"
+#include "nonsep/core/kernel/chin_tangent_stages.hpp"
 
 namespace nonsep {
 
@@ -42,7 +46,8 @@ namespace nonsep {
 // kernel version in its metadata, and the host steps those whose version is not this one through their evaluations.
 // Version 2: a call carries a schedule of sub-steps (ChinStepsCall::substeps). Version 3: a call may carry a
 // multi-product expansion's weights (ChinStepsCall::weights). Version 4 (ABI version 5): a call of no steps evaluates
-// the outer gradient at the call's point (ChinStepsCall::steps).
+// the outer gradient at the call's point (ChinStepsCall::steps), and the tangent kernel (chin_tangent_kernel_blocks)
+// is part of the same version.
 inline constexpr std::uint64_t chin_kernel_version = 4;
 
 // States per block of local arrays for a fixed dimension: 32 states, at most 128 numbers of each array (the four
@@ -115,7 +120,92 @@ inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::
   }
 }
 
+// A tangent call's steps for states [first, first + B) of dimension N in local arrays (the tangent vectors too).
+template <std::size_t N, std::size_t B, Model M>
+inline void chin_tangent_steps_in_local_arrays(const M& model, const ChinTangentStepsCall& call, std::size_t first) {
+  constexpr std::size_t size = B * N, capacity = size * 2 * N;  // k <= 2n vectors per state
+  const std::size_t k = call.vectors, tangent_size = size * k;
+  std::array<double, size> q, p, outer_gradient, inner_gradient;
+  std::array<double, capacity> tangent_q, tangent_p, products, points;
+  std::array<double, B> eps;
+  const ChinStepsCall& c = call.steps;
+  const auto offset = static_cast<std::ptrdiff_t>(first * N);
+  const auto tangent_offset = static_cast<std::ptrdiff_t>(first * k * N);
+  std::copy_n(c.q.begin() + offset, size, q.begin());
+  std::copy_n(c.p.begin() + offset, size, p.begin());
+  std::copy_n(c.outer_gradient.begin() + offset, size, outer_gradient.begin());
+  std::copy_n(call.tangent_q.begin() + tangent_offset, tangent_size, tangent_q.begin());
+  std::copy_n(call.tangent_p.begin() + tangent_offset, tangent_size, tangent_p.begin());
+  std::span<const double> block_eps = c.eps;
+  if (eps_per_state(c)) {
+    std::copy_n(c.eps.begin() + static_cast<std::ptrdiff_t>(first), B, eps.begin());
+    block_eps = eps;
+  }
+  const ChinTangentStepsCall block{
+      {c.form, c.coefficients, block_eps, c.substeps, c.steps, B, q, p, outer_gradient, inner_gradient, {}},
+      k,
+      std::span<double>(tangent_q).first(tangent_size),
+      std::span<double>(tangent_p).first(tangent_size)};
+  chin_tangent_stages<size>(model, block, {products, points});
+  std::copy_n(q.begin(), size, c.q.begin() + offset);
+  std::copy_n(p.begin(), size, c.p.begin() + offset);
+  std::copy_n(outer_gradient.begin(), size, c.outer_gradient.begin() + offset);
+  std::copy_n(tangent_q.begin(), tangent_size, call.tangent_q.begin() + tangent_offset);
+  std::copy_n(tangent_p.begin(), tangent_size, call.tangent_p.begin() + tangent_offset);
+}
+
+// A tangent call's steps for states [first, first + states) of dimension n in the caller's arrays; scratch holds
+// 2 states*k*n numbers.
+template <Model M>
+inline void chin_tangent_steps_in_place(const M& model, const ChinTangentStepsCall& call, std::size_t n,
+                                        std::size_t first, std::size_t states, std::span<double> scratch) {
+  const ChinStepsCall& c = call.steps;
+  const std::size_t k = call.vectors, offset = first * n, size = states * n, tangent_size = size * k;
+  const ChinTangentStepsCall part{{c.form,
+                                   c.coefficients,
+                                   eps_per_state(c) ? c.eps.subspan(first, states) : c.eps,
+                                   c.substeps,
+                                   c.steps,
+                                   states,
+                                   c.q.subspan(offset, size),
+                                   c.p.subspan(offset, size),
+                                   c.outer_gradient.subspan(offset, size),
+                                   c.inner_gradient.subspan(offset, size),
+                                   {}},
+                                  k,
+                                  call.tangent_q.subspan(offset * k, tangent_size),
+                                  call.tangent_p.subspan(offset * k, tangent_size)};
+  chin_tangent_stages(model, part, {scratch.first(tangent_size), scratch.subspan(tangent_size, tangent_size)});
+}
+
 }  // namespace detail
+
+// The steps of a tangent call (chin_tangent_stages.hpp) for `model` (its dimension is FixedDimension when that is not
+// 0), over blocks of states as chin_kernel_blocks takes them; whole blocks in local arrays when a fixed dimension's
+// block of tangents fits 1024 numbers, the states left over one at a time in local arrays. Requires the sizes of
+// ChinTangentStepsCall and chin_eps_fit(eps.size(), substeps, count) (no weights). Allocates scratch for blocks in the
+// caller's arrays (std::bad_alloc).
+template <std::size_t FixedDimension, ModelWithHessianProducts M>
+void chin_tangent_kernel_blocks(const M& model, const ChinTangentStepsCall& call) {
+  const std::size_t count = call.steps.count, k = call.vectors;
+  std::size_t first = 0;
+  if constexpr (FixedDimension > 0) {
+    constexpr std::size_t B = block_states(FixedDimension);
+    if constexpr (B * FixedDimension * 2 * FixedDimension <= 1024) {
+      for (; first + B <= count; first += B)
+        detail::chin_tangent_steps_in_local_arrays<FixedDimension, B>(model, call, first);
+      if constexpr (B > 1)
+        for (; first < count; ++first)
+          detail::chin_tangent_steps_in_local_arrays<FixedDimension, 1>(model, call, first);
+      return;
+    }
+  }
+  const std::size_t n = count == 0 ? 0 : call.steps.q.size() / count;
+  const std::size_t block = FixedDimension > 0 ? block_states(FixedDimension) : block_states_at_run_time(n);
+  std::vector<double> scratch(2 * std::min(block, count) * k * n);
+  for (; first < count; first += block)
+    detail::chin_tangent_steps_in_place(model, call, n, first, std::min(block, count - first), scratch);
+}
 
 // chin_kernel_steps (below) for calls without weights (Expansion false) or with them (true), which the SDK
 // instantiates as separate functions (nonsep/sdk/kernels.hpp).

@@ -193,6 +193,36 @@ class ChinBasicStep {
     }
   }
 
+  // Advances every state of `x` by `n` times the schedule `dts` of basic steps (each finite and non-zero) through
+  // `kernel`, a callable kernel(const ChinStepsCall&) -> bool that takes the call's steps (with whatever it carries
+  // along: a tangent kernel's vectors) or returns false, having done nothing, when none is at hand. The gradient the
+  // steps start from comes from the same kernel (a call of no steps) unless cached, as prime() says. Returns whether
+  // the kernel took the steps; then x holds bit for bit what step_schedule_n gives through a kernel of the same code,
+  // evaluations counted alike. Throws as step_schedule_n does.
+  template <Model M, class Kernel>
+  bool step_schedule_by(const M& model, PhaseSpaceBatch& x, std::span<const double> dts, std::uint64_t n,
+                        Kernel&& kernel) {
+    if (n == 0 || dts.empty()) return true;
+    check_batch_fits(model, x);
+    for (double dt : dts) check_step_size(dt);
+    eps_.resize(dts.size());
+    for (std::size_t s = 0; s < dts.size(); ++s) eps_[s] = cube_root(dts[s]);
+    substeps_ = dts.size();
+    const std::size_t size = x.size(), count = x.count();
+    if (inner_gradient_.size() != size) inner_gradient_.resize(size);
+    prime_by(model, x, kernel);
+    const ChinStepsCall call{form_, c_, eps_, substeps_, n, count, x.q(), x.p(), outer_gradient_, inner_gradient_, {}};
+    cache_valid_ = false;
+    if (!kernel(call)) {
+      cache_valid_ = true;  // untouched: still the gradient at x's point
+      return false;
+    }
+    evaluations_.grad_T += 4 * n * substeps_ * count;
+    evaluations_.grad_V += 4 * n * substeps_ * count;
+    end_steps(x);
+    return true;
+  }
+
   // Makes sure the outer gradient at x's current point is at hand (evaluates it unless cached). A model with a kernel
   // (ModelWithChinSteps) evaluates it there, in a call of no steps (chin_stages.hpp): the gradient the kernel's steps
   // start from is then the one its own steps would have left, bit for bit, so steps started again from a state
@@ -241,14 +271,20 @@ class ChinBasicStep {
   // watches them), which then evaluates their first gradient too.
   template <Model M>
   void prime_for(const M& model, const PhaseSpaceBatch& x, bool through_kernel) {
+    if constexpr (ModelWithChinSteps<M>)
+      if (through_kernel) return prime_by(model, x, [&](const ChinStepsCall& call) { return model.chin_steps(call); });
+    prime_by(model, x, [](const ChinStepsCall&) { return false; });
+  }
+  // The same with the gradient from `kernel` (kernel(call) -> bool, false: none at hand), else the evaluation path.
+  template <Model M, class Kernel>
+  void prime_by(const M& model, const PhaseSpaceBatch& x, Kernel&& kernel) {
     const bool ttv = form_ == HamiltonianForm::TTV;
     std::span<const double> inner = ttv ? x.q() : x.p();
     if (cache_valid_ && cached_at_.size() == inner.size() && same_bits(cached_at_, inner)) return;
     cache_valid_ = false;
     outer_gradient_.resize(inner.size());
     cached_at_.assign(inner.begin(), inner.end());
-    if (!through_kernel || !kernel_gradient(model, x.count()))
-      evaluate(model, ttv, cached_at_, outer_gradient_, x.count());
+    if (!kernel_gradient(kernel, x.count())) evaluate(model, ttv, cached_at_, outer_gradient_, x.count());
     cache_valid_ = true;
   }
 
@@ -340,25 +376,22 @@ class ChinBasicStep {
     return root;
   }
 
-  // The outer gradient at cached_at_ (count states) into outer_gradient_ by the model's kernel, when it has one: a call
-  // of no steps, whose other variable (p in TTV, q in VVT) is scratch it leaves alone. Returns false without one.
-  template <Model M>
-  bool kernel_gradient(const M& model, std::size_t count) {
-    if constexpr (!ModelWithChinSteps<M>) {
-      return false;
-    } else {
-      const std::size_t size = cached_at_.size();
-      if (inner_gradient_.size() != size) inner_gradient_.resize(size);
-      if (other_variable_.size() != size) other_variable_.resize(size);
-      static constexpr double unused_eps[1] = {1.0};  // a call of no steps takes none
-      const bool ttv = form_ == HamiltonianForm::TTV;
-      const std::span<double> at(cached_at_), other(other_variable_);
-      const ChinStepsCall call{
-          form_, c_, unused_eps, 1, 0, count, ttv ? at : other, ttv ? other : at, outer_gradient_, inner_gradient_, {}};
-      if (!model.chin_steps(call)) return false;
-      (ttv ? evaluations_.grad_V : evaluations_.grad_T) += count;
-      return true;
-    }
+  // The outer gradient at cached_at_ (count states) into outer_gradient_ by a kernel (kernel(call) -> bool), when one
+  // is at hand: a call of no steps, whose other variable (p in TTV, q in VVT) is scratch it leaves alone. Returns false
+  // without one.
+  template <class Kernel>
+  bool kernel_gradient(Kernel& kernel, std::size_t count) {
+    const std::size_t size = cached_at_.size();
+    if (inner_gradient_.size() != size) inner_gradient_.resize(size);
+    if (other_variable_.size() != size) other_variable_.resize(size);
+    static constexpr double unused_eps[1] = {1.0};  // a call of no steps takes none
+    const bool ttv = form_ == HamiltonianForm::TTV;
+    const std::span<double> at(cached_at_), other(other_variable_);
+    const ChinStepsCall call{
+        form_, c_, unused_eps, 1, 0, count, ttv ? at : other, ttv ? other : at, outer_gradient_, inner_gradient_, {}};
+    if (!kernel(call)) return false;
+    (ttv ? evaluations_.grad_V : evaluations_.grad_T) += count;
+    return true;
   }
 
   template <Model M>

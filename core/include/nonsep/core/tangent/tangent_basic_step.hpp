@@ -24,6 +24,10 @@
 // reused: steady stepping does not allocate. A model with Hessian-vector products (hessian_products.hpp) is used
 // through them instead: one batched product per stage for all k vectors, O(k n) numbers per state, no matrix
 // formed and none counted in hessian_evaluations().
+//
+// A model with a tangent kernel (ModelWithChinTangentSteps: a plugin's chin_tangent_steps) and Hessian-vector products
+// takes whole runs of steps there (step_kernel_n): the same operations inlined in the plugin (chin_tangent_stages.hpp),
+// the first-same-as-last gradient kept here as the basic step keeps it.
 #include <cstdint>
 #include <cstring>
 #include <span>
@@ -31,6 +35,7 @@
 #include <vector>
 
 #include "nonsep/core/base/hessian_products.hpp"
+#include "nonsep/core/kernel/chin_tangent_stages.hpp"
 #include "nonsep/core/schemes/chin_basic_step.hpp"
 
 namespace nonsep {
@@ -67,6 +72,24 @@ class TangentBasicStep {
   HamiltonianForm form() const { return base_.form(); }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
   const HessianCounts& hessian_evaluations() const { return hessians_; }
+
+  // Advances x by `n` times the schedule `dts` of basic steps with the tangent vectors mapped along, in one call of the
+  // model's tangent kernel; bit for bit that many calls of step() for a kernel compiled as the evaluation path. Returns
+  // false, having changed nothing, when the model has no tangent kernel at hand or no Hessian-vector products (the
+  // caller then calls step()). Throws as step() does; after a model exception x and tangents are unspecified.
+  template <ModelWithHessians M>
+  bool step_kernel_n(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, std::span<const double> dts,
+                     std::uint64_t n) {
+    if constexpr (!ModelWithChinTangentSteps<M> || !ModelWithHessianProducts<M>) {
+      return false;
+    } else {
+      if (!has_hessian_products(model)) return false;
+      const std::size_t k = check_tangents_fit(x, tangents);
+      return base_.step_schedule_by(model, x, dts, n, [&](const ChinStepsCall& call) {
+        return model.chin_tangent_steps(ChinTangentStepsCall{call, k, tangents.q(), tangents.p()});
+      });
+    }
+  }
 
   // Advances the states of x by dt as ChinBasicStep::step does, and maps their tangent vectors (layout above)
   // by the step's derivative. Throws InvalidArgument on a bad dt, a batch whose dimension differs from the

@@ -81,6 +81,20 @@ class TangentIntegrator {
         stepper_);
   }
 
+  // n steps of dt through the model's tangent kernel (a Chin scheme of basic or triplet steps and a plugin with
+  // chin_tangent_steps), bit for bit n calls of step() for a kernel compiled as the evaluation path; false (nothing
+  // done) when the scheme or the model has none: the caller then calls step().
+  template <ModelWithHessians M>
+  bool step_kernel_n(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, double dt, std::uint64_t n) {
+    if (auto* basic = std::get_if<TangentSeparableComposition>(&stepper_)) {
+      check_step_size(dt);
+      return basic->step_kernel_n(model, x, tangents, std::span<const double>(&dt, 1), n);
+    }
+    if (auto* triplet = std::get_if<TangentTripletComposition>(&stepper_))
+      return triplet->step_kernel_n(model, x, tangents, dt, n);
+    return false;
+  }
+
   // Redoes one step for part of a batch, as Integrator::step_part: `part` and `part_tangents` hold states first ..
   // first + part.count() - 1 of a batch of `total` states (and their vectors) whose step `before` (this integrator
   // as it was before the step) was to take.

@@ -35,6 +35,13 @@ class TangentSeparableComposition {
     return hessians_;
   }
 
+  // TangentBasicStep::step_kernel_n for a model without a separable part; false (nothing done) for one with it.
+  template <ModelWithHessians M>
+  bool step_kernel_n(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, std::span<const double> dts,
+                     std::uint64_t n) {
+    return !has_separable_part(model) && base_.step_kernel_n(model, x, tangents, dts, n);
+  }
+
   // As SeparableComposition::step, with the tangent vectors mapped along; errors as TangentBasicStep::step.
   template <ModelWithHessians M>
   void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, double dt) {

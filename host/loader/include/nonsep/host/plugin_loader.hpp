@@ -27,6 +27,7 @@
 
 #include "nonsep/core/base/error.hpp"
 #include "nonsep/core/kernel/chin_stages.hpp"
+#include "nonsep/core/kernel/chin_tangent_stages.hpp"
 
 struct nonsep_plugin_api;
 struct nonsep_instance;
@@ -188,7 +189,10 @@ class PluginModel {
   // Advances `call` through the plugin's kernel and returns true, or returns false without a kernel at hand.
   // Throws nonsep::ModelError with the plugin's message when the kernel fails.
   bool chin_steps(const ChinStepsCall& call) const;
-  // Calls of chin_steps that ran the kernel, on this instance (every PluginModel sharing it).
+  // Advances `call` through the plugin's tangent kernel (plugin_abi.h chin_tangent_steps, ABI version 5) with the same
+  // instruction set and returns true, or returns false without one at hand. Throws as chin_steps does.
+  bool chin_tangent_steps(const ChinTangentStepsCall& call) const;
+  // Calls of chin_steps and chin_tangent_steps that ran a kernel, on this instance (every PluginModel sharing it).
   std::uint64_t kernel_calls() const;
 
   const Plugin& plugin() const;

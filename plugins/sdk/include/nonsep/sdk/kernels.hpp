@@ -1,7 +1,8 @@
 #pragma once
-// The stepping kernels an SDK plugin carries (plugin_abi.h, chin_steps): nonsep::chin_kernel_blocks, the core's own
-// template (nonsep/core/kernel/chin_kernel.hpp), instantiated with the plugin's model adapter inlined. No stepping code
-// is written here: this header only compiles that template once per instruction set and picks one by index.
+// The stepping kernels an SDK plugin carries (plugin_abi.h, chin_steps and chin_tangent_steps):
+// nonsep::chin_kernel_blocks and nonsep::chin_tangent_kernel_blocks, the core's own templates
+// (nonsep/core/kernel/chin_kernel.hpp), instantiated with the plugin's model adapter inlined. No stepping code is
+// written here: this header only compiles that template once per instruction set and picks one by index.
 //
 // Instruction sets, in the order of the metadata's "kernels": {"instruction_sets": [...]} (index 0 first):
 //   "x86-64"     the baseline every x86-64 runs, compiled with the plugin's own flags: bit for bit the evaluation
@@ -57,9 +58,11 @@ namespace nonsep::sdk {
 // Whether this unit compiles the kernel bodies of v3 (v4), or calls another unit's.
 #define NONSEP_SDK_KERNEL_V3_HERE (NONSEP_SDK_KERNEL_V3 && !(NONSEP_SDK_SEPARATE_KERNEL_UNITS & 1))
 #define NONSEP_SDK_KERNEL_V4_HERE (NONSEP_SDK_KERNEL_V4 && !(NONSEP_SDK_SEPARATE_KERNEL_UNITS & 2))
-// The kernels of units 1 and 2, defined by NONSEP_SDK_DEFINE_KERNEL_UNIT there.
+// The kernels of units 1 and 2, defined by NONSEP_SDK_DEFINE_KERNEL_UNIT there: the steps, and the tangent steps.
 void kernel_unit_1(const void* adapter, const ChinStepsCall& call);
 void kernel_unit_2(const void* adapter, const ChinStepsCall& call);
+void tangent_kernel_unit_1(const void* adapter, const ChinTangentStepsCall& call);
+void tangent_kernel_unit_2(const void* adapter, const ChinTangentStepsCall& call);
 inline constexpr std::string_view kernel_instruction_sets[] = {
     "x86-64",
 #if NONSEP_SDK_KERNEL_V3
@@ -97,6 +100,53 @@ struct ChinKernels {
   }
 #endif
 
+  // The tangent kernels (chin_tangent_kernel_blocks), one per instruction set as above.
+  [[gnu::flatten]] static void tangent_baseline(const Adapter& adapter, const ChinTangentStepsCall& call) {
+    chin_tangent_kernel_blocks<fixed_dimension>(adapter, call);
+  }
+#if NONSEP_SDK_KERNEL_V3_HERE
+  [[gnu::target("arch=x86-64-v3"), gnu::flatten]] static void tangent_v3(const Adapter& adapter,
+                                                                         const ChinTangentStepsCall& call) {
+    chin_tangent_kernel_blocks<fixed_dimension>(adapter, call);
+  }
+#endif
+#if NONSEP_SDK_KERNEL_V4_HERE
+  [[gnu::target("arch=x86-64-v4"), gnu::flatten]] static void tangent_v4(const Adapter& adapter,
+                                                                         const ChinTangentStepsCall& call) {
+    chin_tangent_kernel_blocks<fixed_dimension>(adapter, call);
+  }
+#endif
+
+  // As run, for a tangent call.
+  static bool run_tangent(std::size_t index, const Adapter& adapter, const ChinTangentStepsCall& call) {
+    std::size_t set = 0;
+    if (index == set++) {
+      tangent_baseline(adapter, call);
+      return true;
+    }
+#if NONSEP_SDK_KERNEL_V3
+    if (index == set++) {
+#if NONSEP_SDK_KERNEL_V3_HERE
+      tangent_v3(adapter, call);
+#else
+      tangent_kernel_unit_1(&adapter, call);
+#endif
+      return true;
+    }
+#endif
+#if NONSEP_SDK_KERNEL_V4
+    if (index == set++) {
+#if NONSEP_SDK_KERNEL_V4_HERE
+      tangent_v4(adapter, call);
+#else
+      tangent_kernel_unit_2(&adapter, call);
+#endif
+      return true;
+    }
+#endif
+    return false;
+  }
+
   static bool run(std::size_t index, const Adapter& adapter, const ChinStepsCall& call) {
     const bool expansion = !call.weights.empty();
     std::size_t set = 0;
@@ -131,23 +181,29 @@ struct ChinKernels {
   static void run_unit(const Adapter& adapter, const ChinStepsCall& call) {
     !call.weights.empty() ? v3<true>(adapter, call) : v3<false>(adapter, call);
   }
+  static void run_tangent_unit(const Adapter& adapter, const ChinTangentStepsCall& call) { tangent_v3(adapter, call); }
 #elif NONSEP_SDK_KERNEL_UNIT == 2 && NONSEP_SDK_KERNEL_V4
   static void run_unit(const Adapter& adapter, const ChinStepsCall& call) {
     !call.weights.empty() ? v4<true>(adapter, call) : v4<false>(adapter, call);
   }
+  static void run_tangent_unit(const Adapter& adapter, const ChinTangentStepsCall& call) { tangent_v4(adapter, call); }
 #endif
 };
 
 }  // namespace nonsep::sdk
 
-// A kernel unit's one definition (NONSEP_EXPORT_MODEL in a unit 1 or 2), or nothing where that set is not compiled.
+// A kernel unit's definitions (NONSEP_EXPORT_MODEL in a unit 1 or 2), or nothing where that set is not compiled.
 #if NONSEP_SDK_KERNEL_UNIT != 0 && (NONSEP_SDK_KERNEL_V3 || NONSEP_SDK_KERNEL_V4)
-#define NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(unit) ::nonsep::sdk::kernel_unit_##unit
-#define NONSEP_SDK_KERNEL_UNIT_FUNCTION(unit) NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(unit)
-#define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)                                                              \
-  void NONSEP_SDK_KERNEL_UNIT_FUNCTION(NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                     \
-                                                               const ::nonsep::ChinStepsCall& call) {   \
-    ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_unit(*static_cast<const __VA_ARGS__*>(adapter), call); \
+#define NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(prefix, unit) ::nonsep::sdk::prefix##kernel_unit_##unit
+#define NONSEP_SDK_KERNEL_UNIT_FUNCTION(prefix, unit) NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(prefix, unit)
+#define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)                                                                             \
+  void NONSEP_SDK_KERNEL_UNIT_FUNCTION(, NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                                  \
+                                                                 const ::nonsep::ChinStepsCall& call) {                \
+    ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_unit(*static_cast<const __VA_ARGS__*>(adapter), call);                \
+  }                                                                                                                    \
+  void NONSEP_SDK_KERNEL_UNIT_FUNCTION(tangent_, NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                          \
+                                                                         const ::nonsep::ChinTangentStepsCall& call) { \
+    ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_tangent_unit(*static_cast<const __VA_ARGS__*>(adapter), call);        \
   }
 #else
 #define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)
