@@ -125,11 +125,10 @@ std::vector<Contender> contenders() {
   add("basic", "chin", {"basic", Fraction(2, 3)});
   add("triplet 4/3", "chin", {"triplet", Fraction(4, 3)});
   add("triplet 2", "chin", {"triplet", Fraction(2)});
-  for (const int order : {2, 4, 6}) add("tao " + std::to_string(order), "tao", {"tao", Fraction(order)});
+  for (const int order : {2, 4, 6}) add("tao " + std::to_string(order), "tao", {"tao", TaoOptions{Fraction(order)}});
   add("implicit midpoint", "gauss", {"implicit_midpoint"});
   for (const int stages : {2, 3}) {
-    IntegratorSpec spec{"gauss"};
-    spec.stages = stages;
+    const IntegratorSpec spec{"gauss", GaussOptions{stages}};
     add("gauss " + std::to_string(2 * stages), "gauss", spec);
   }
   list.push_back({"odeint rk4", "peer", odeint_rk4_trajectory});

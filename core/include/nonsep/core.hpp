@@ -1,7 +1,10 @@
 #pragma once
 // Everything of nonsep::core in one include.
+#include "nonsep/core/basic_integrator.hpp"
 #include "nonsep/core/chin_basic_step.hpp"
+#include "nonsep/core/chin_schemes.hpp"
 #include "nonsep/core/comparator_description.hpp"
+#include "nonsep/core/comparator_schemes.hpp"
 #include "nonsep/core/energy.hpp"
 #include "nonsep/core/error.hpp"
 #include "nonsep/core/fraction.hpp"
@@ -16,7 +19,10 @@
 #include "nonsep/core/phase_space_batch.hpp"
 #include "nonsep/core/poincare_crossing.hpp"
 #include "nonsep/core/scheme_catalogue.hpp"
+#include "nonsep/core/scheme_options.hpp"
 #include "nonsep/core/separable_composition.hpp"
+#include "nonsep/core/shipped_schemes.hpp"
+#include "nonsep/core/stepper.hpp"
 #include "nonsep/core/tangent_basic_step.hpp"
 #include "nonsep/core/tangent_integrator.hpp"
 #include "nonsep/core/tangent_multi_product_expansion.hpp"

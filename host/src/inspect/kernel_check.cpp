@@ -39,7 +39,8 @@ std::string checked_schemes_text(const std::vector<IntegratorSpec>& specs) {
   for (std::size_t i = 0; i < specs.size(); ++i) {
     text += i == 0 ? "" : i + 1 == specs.size() ? " and " : ", ";
     text += specs[i].scheme;
-    if (find_scheme(specs[i].scheme)->highest_order_index > 1) text += " " + specs[i].order.to_string();
+    if (find_scheme(specs[i].scheme)->highest_order_index > 1)
+      text += " " + Integrator(specs[i]).describe().order.to_string();
   }
   return text;
 }

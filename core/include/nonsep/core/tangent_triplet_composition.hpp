@@ -33,4 +33,10 @@ class TangentTripletComposition {
   int levels_;
 };
 
+// The tangent map of the stepper (BasicTangentIntegrator, tangent_integrator.hpp): its states stepped bit for bit
+// as the stepper steps them.
+inline TangentTripletComposition tangent_map_of(const TripletComposition<SeparableBasicStep>& stepper, std::size_t) {
+  return TangentTripletComposition(stepper);
+}
+
 }  // namespace nonsep
