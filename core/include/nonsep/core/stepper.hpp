@@ -90,7 +90,7 @@ using DistinctVariantWithNone = typename detail::DistinctVariant<std::variant<st
 template <class... Schemes, class F>
 void with_scheme_at(std::size_t index, F&& f) {
   std::size_t i = 0;
-  ((i++ == index ? (f(std::type_identity<Schemes>{}), true) : false) || ...);
+  static_cast<void>(((i++ == index ? (f(std::type_identity<Schemes>{}), true) : false) || ...));
 }
 
 }  // namespace nonsep
