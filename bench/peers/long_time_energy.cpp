@@ -122,9 +122,9 @@ std::vector<Contender> contenders() {
   auto add = [&](const std::string& name, const std::string& family, IntegratorSpec spec) {
     list.push_back({name, family, [spec] { return nonsep_trajectory(spec); }});
   };
-  add("basic", "chin", {"basic", Fraction(2, 3)});
-  add("triplet 4/3", "chin", {"triplet", Fraction(4, 3)});
-  add("triplet 2", "chin", {"triplet", Fraction(2)});
+  add("basic", "chin", {"basic", ChinOptions{Fraction(2, 3)}});
+  add("triplet 4/3", "chin", {"triplet", ChinOptions{Fraction(4, 3)}});
+  add("triplet 2", "chin", {"triplet", ChinOptions{Fraction(2)}});
   for (const int order : {2, 4, 6}) add("tao " + std::to_string(order), "tao", {"tao", TaoOptions{Fraction(order)}});
   add("implicit midpoint", "gauss", {"implicit_midpoint"});
   for (const int stages : {2, 3}) {
