@@ -303,14 +303,11 @@ TEST_CASE("every option of every catalogue entry is in the checkpoint's fingerpr
       CAPTURE(option.name);
       nonsep::host::LoadedJob changed = loaded;
       auto& spec = std::get<nonsep::host::SingleRun>(changed.job.plan).integrator;
-      std::visit(
-          [](auto* field) {
-            if constexpr (std::is_same_v<decltype(field), nonsep::Fraction*>)
-              *field = nonsep::Fraction(99, 7);
-            else
-              *field = *field * 2 + 1;
-          },
-          nonsep::option_field(spec, option));
+      const nonsep::OptionValue value = nonsep::option_value(spec, option);
+      if (std::holds_alternative<nonsep::Fraction>(value))
+        nonsep::set_option(spec, option, nonsep::Fraction(99, 7));
+      else
+        nonsep::set_option(spec, option, std::get<double>(value) * 2 + 1);
       CHECK(nonsep::host::fingerprint_difference(fingerprint, nonsep::host::job_fingerprint(changed)) ==
             "integrator." + option.name);
     }
