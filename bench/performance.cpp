@@ -146,7 +146,8 @@ double time_host(const nonsep::host::LoadedJob& job, unsigned threads, std::vect
 // loaded job, not from constants, so that cbrt runs at run time as in the host (a compile-time cbrt may round
 // differently).
 double time_hand_written(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
-  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt,
+                                 std::get<nonsep::ChinOptions>(job.job.run().integrator.options).t2);
   Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p), g(q.size());
   const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
@@ -172,12 +173,13 @@ double time_hand_written_composition(const nonsep::host::LoadedJob& job, std::ve
   double q = job.job.initial.q.at(0), p = job.job.initial.p.at(0);
   const auto start = Clock::now();
   if (run.integrator.scheme == "triplet")
-    bench::hand_written_triplet_run(run.time.dt, run.integrator.t2, q, p, run.time.steps);
+    bench::hand_written_triplet_run(run.time.dt, std::get<nonsep::ChinOptions>(run.integrator.options).t2, q, p,
+                                    run.time.steps);
   else
-    bench::hand_written_mpe_run(
-        run.time.dt, run.integrator.t2,
-        nonsep::MultiProductExpansion<>::weights_for(static_cast<int>(std::lround(run.integrator.order.value() * 1.5))),
-        q, p, run.time.steps);
+    bench::hand_written_mpe_run(run.time.dt, std::get<nonsep::ChinOptions>(run.integrator.options).t2,
+                                nonsep::MultiProductExpansion<>::weights_for(static_cast<int>(std::lround(
+                                    std::get<nonsep::ChinOptions>(run.integrator.options).order.value() * 1.5))),
+                                q, p, run.time.steps);
   const std::chrono::duration<double> elapsed = Clock::now() - start;
   final_q.assign(1, q);
   return elapsed.count();
@@ -186,7 +188,8 @@ double time_hand_written_composition(const nonsep::host::LoadedJob& job, std::ve
 // Seconds for the hand-written loops over `job`'s states compiled -march=native (hand_written_native.cpp): the
 // faster of the two, which must agree.
 double time_hand_written_native(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
-  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt,
+                                 std::get<nonsep::ChinOptions>(job.job.run().integrator.options).t2);
   Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p), g(q.size());
   Doubles q2 = q, p2 = p;
   const std::uint64_t steps = job.job.run().time.steps;
@@ -204,7 +207,8 @@ double time_hand_written_native(const nonsep::host::LoadedJob& job, std::vector<
 // Seconds for the hand-written basic step on coupled3d (coupled3d.hpp) on `job`'s states: the local-array loop for
 // one state, the stage-by-stage loop compiled -march=native for more.
 double time_hand_written_coupled3d(const nonsep::host::LoadedJob& job, std::vector<double>& final_q) {
-  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt,
+                                 std::get<nonsep::ChinOptions>(job.job.run().integrator.options).t2);
   Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p), g(q.size());
   const std::uint64_t steps = job.job.run().time.steps;
   const double coupling = 0.2;
@@ -224,7 +228,8 @@ double time_hand_written_coupled3d(const nonsep::host::LoadedJob& job, std::vect
 // largest Lyapunov exponents.
 double time_hand_written_tangent(const nonsep::host::LoadedJob& job, std::uint64_t renormalize_every,
                                  std::vector<double>& final_q, std::vector<double>& exponents) {
-  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt,
+                                 std::get<nonsep::ChinOptions>(job.job.run().integrator.options).t2);
   Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p);
   const double norm = std::sqrt(1.25);
   Doubles dq(q.size(), 1.0 / norm), dp(q.size(), 0.5 / norm), log_stretch(q.size(), 0.0);
@@ -246,7 +251,8 @@ double time_core(const nonsep::host::LoadedJob& job, std::vector<double>& final_
   nonsep::PhaseSpaceBatch x(1, job.job.initial.count);
   std::copy(job.job.initial.q.begin(), job.job.initial.q.end(), x.q().begin());
   std::copy(job.job.initial.p.begin(), job.job.initial.p.end(), x.p().begin());
-  nonsep::ChinBasicStep stepper(job.job.run().integrator.form, job.job.run().integrator.t2);
+  nonsep::ChinBasicStep stepper(job.job.run().integrator.form,
+                                std::get<nonsep::ChinOptions>(job.job.run().integrator.options).t2);
   const double step_size = job.job.run().time.dt;
   const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
@@ -261,7 +267,8 @@ double time_core(const nonsep::host::LoadedJob& job, std::vector<double>& final_
 // that calls the scalar gradients by value.
 double time_abi_floor(const nonsep::host::LoadedJob& job, const bench::MinimalPlugin& plugin, bool by_value,
                       std::vector<double>& final_q) {
-  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt,
+                                 std::get<nonsep::ChinOptions>(job.job.run().integrator.options).t2);
   Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p);
   const std::uint64_t steps = job.job.run().time.steps;
   const auto start = Clock::now();
@@ -279,7 +286,8 @@ double time_abi_floor(const nonsep::host::LoadedJob& job, const bench::MinimalPl
 // Stage by stage, as the host steps: the fused loop over a block of 256 took 11.5 ns per state and step on one
 // thread here against 3.7 staged, and gave an implausible 2.9x "speed-up" on two cores.
 double time_hand_written_blocks(const nonsep::host::LoadedJob& job, unsigned threads, std::vector<double>& final_q) {
-  const bench::HandWrittenStep c(job.job.run().time.dt, job.job.run().integrator.t2);
+  const bench::HandWrittenStep c(job.job.run().time.dt,
+                                 std::get<nonsep::ChinOptions>(job.job.run().integrator.options).t2);
   Doubles q = copy_of(job.job.initial.q), p = copy_of(job.job.initial.p), g(q.size());
   const std::size_t count = q.size(), block = nonsep::host::run_block_size;
   const std::size_t blocks = (count + block - 1) / block;

@@ -26,6 +26,7 @@ LAYERS = {
         ["kernel"],  # the stepping kernels compiled into every plugin (its headers and base only)
         ["schemes"],  # Chin's schemes, the comparators, the catalogue and the runtime Integrator
         ["tangent"],  # the tangent map of every scheme
+        ["runtime"],  # the list of shipped schemes, the catalogue, the Integrator and TangentIntegrator over it
         ["analysis"],  # what watches a trajectory: energy, crossings, Lyapunov exponents, MEGNO, SALI/GALI
     ],
     "host": [

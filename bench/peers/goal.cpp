@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "benchmark_problems.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #ifdef NONSEP_BENCH_HAVE_GSL
 #include "gsl_gauss_methods.hpp"
@@ -88,20 +88,16 @@ Timing median_time(const std::function<double()>& run) {
 }
 
 std::string label(const IntegratorSpec& spec) {
-  if (spec.scheme == "gauss") return "gauss " + std::to_string(2 * static_cast<int>(spec.stages));
   if (spec.scheme == "basic" || spec.scheme == "implicit_midpoint") return spec.scheme;
-  return spec.scheme + " " + spec.order.to_string();
+  return spec.scheme + " " + Integrator(spec).describe().order.to_string();
 }
 
 std::vector<IntegratorSpec> symplectic_schemes() {
-  std::vector<IntegratorSpec> specs{{"basic", Fraction(2, 3)},   {"triplet", Fraction(4, 3)}, {"triplet", Fraction(2)},
-                                    {"triplet", Fraction(8, 3)}, {"tao", Fraction(2)},        {"tao", Fraction(4)},
-                                    {"tao", Fraction(6)},        {"implicit_midpoint"}};
-  for (const int stages : {2, 3}) {
-    IntegratorSpec gauss{"gauss"};
-    gauss.stages = stages;
-    specs.push_back(gauss);
-  }
+  std::vector<IntegratorSpec> specs{{"basic", ChinOptions{Fraction(2, 3)}}, {"triplet", ChinOptions{Fraction(4, 3)}},
+                                    {"triplet", ChinOptions{Fraction(2)}},  {"triplet", ChinOptions{Fraction(8, 3)}},
+                                    {"tao", TaoOptions{Fraction(2)}},       {"tao", TaoOptions{Fraction(4)}},
+                                    {"tao", TaoOptions{Fraction(6)}},       {"implicit_midpoint"}};
+  for (const int stages : {2, 3}) specs.push_back({"gauss", GaussOptions{stages}});
   return specs;
 }
 

@@ -38,7 +38,7 @@
 #include <vector>
 
 #include "benchmark_problems.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "odeint_methods.hpp"
 #ifdef NONSEP_BENCH_HAVE_GSL
@@ -122,14 +122,13 @@ std::vector<Contender> contenders() {
   auto add = [&](const std::string& name, const std::string& family, IntegratorSpec spec) {
     list.push_back({name, family, [spec] { return nonsep_trajectory(spec); }});
   };
-  add("basic", "chin", {"basic", Fraction(2, 3)});
-  add("triplet 4/3", "chin", {"triplet", Fraction(4, 3)});
-  add("triplet 2", "chin", {"triplet", Fraction(2)});
-  for (const int order : {2, 4, 6}) add("tao " + std::to_string(order), "tao", {"tao", Fraction(order)});
+  add("basic", "chin", {"basic", ChinOptions{Fraction(2, 3)}});
+  add("triplet 4/3", "chin", {"triplet", ChinOptions{Fraction(4, 3)}});
+  add("triplet 2", "chin", {"triplet", ChinOptions{Fraction(2)}});
+  for (const int order : {2, 4, 6}) add("tao " + std::to_string(order), "tao", {"tao", TaoOptions{Fraction(order)}});
   add("implicit midpoint", "gauss", {"implicit_midpoint"});
   for (const int stages : {2, 3}) {
-    IntegratorSpec spec{"gauss"};
-    spec.stages = stages;
+    const IntegratorSpec spec{"gauss", GaussOptions{stages}};
     add("gauss " + std::to_string(2 * stages), "gauss", spec);
   }
   list.push_back({"odeint rk4", "peer", odeint_rk4_trajectory});

@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "benchmark_problems.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "odeint_methods.hpp"
@@ -189,15 +189,16 @@ std::string format_double(double x) {
 template <class P>
 void run_problem(const Setup& setup, const Policy& policy, std::vector<Row>& rows) {
   std::cout << "[" << setup.name << "] nonsep schemes" << std::endl;
-  std::vector<IntegratorSpec> specs{{"basic", Fraction(2, 3)}};
+  std::vector<IntegratorSpec> specs{{"basic", ChinOptions{Fraction(2, 3)}}};
   for (const auto& scheme : {"triplet", "mpe"})
     for (const auto& order : policy.orders) {
-      specs.push_back({scheme, Fraction::parse(order)});
-      for (const double t2 : policy.extra_t2) specs.push_back({scheme, Fraction::parse(order), t2});
+      specs.push_back({scheme, ChinOptions{Fraction::parse(order)}});
+      for (const double t2 : policy.extra_t2) specs.push_back({scheme, ChinOptions{Fraction::parse(order), t2}});
     }
   for (const auto& spec : specs) {
-    const std::string method = spec.scheme == "basic" ? "basic" : spec.scheme + " " + spec.order.to_string();
-    const std::string t2 = spec.t2 == ChinCoefficients::default_t2() ? "default" : format_double(spec.t2);
+    const ChinOptions& options = std::get<ChinOptions>(spec.options);
+    const std::string method = spec.scheme == "basic" ? "basic" : spec.scheme + " " + options.order.to_string();
+    const std::string t2 = options.t2 == ChinCoefficients::default_t2() ? "default" : format_double(options.t2);
     step_ladder(
         policy, 2,
         [&](std::size_t steps, double* first) -> Row {
@@ -220,10 +221,10 @@ void run_problem(const Setup& setup, const Policy& policy, std::vector<Row>& row
 
   // The comparators, through the same Integrator; their `evaluations` count grad H (a peer's f is the same thing).
   std::vector<std::pair<std::string, IntegratorSpec>> comparators;
-  for (const int order : {2, 4, 6}) comparators.push_back({"tao " + std::to_string(order), {"tao", Fraction(order)}});
+  for (const int order : {2, 4, 6})
+    comparators.push_back({"tao " + std::to_string(order), {"tao", TaoOptions{Fraction(order)}}});
   for (const int stages : {1, 2, 3}) {
-    IntegratorSpec spec{"gauss"};
-    spec.stages = stages;
+    const IntegratorSpec spec{"gauss", GaussOptions{stages}};
     comparators.push_back({stages == 1 ? "implicit midpoint" : "gauss " + std::to_string(2 * stages), spec});
   }
   for (const auto& [method, spec] : comparators)
@@ -400,8 +401,9 @@ void energy_drift(const Policy& policy, const std::filesystem::path& path) {
   };
 
   const BatchedModel<Paper1D> model;
-  for (const auto& [method, spec] : {std::pair<std::string, IntegratorSpec>{"basic", {"basic", Fraction(2, 3)}},
-                                     {"triplet 4/3", {"triplet", Fraction(4, 3)}}}) {
+  for (const auto& [method, spec] :
+       {std::pair<std::string, IntegratorSpec>{"basic", {"basic", ChinOptions{Fraction(2, 3)}}},
+        {"triplet 4/3", {"triplet", ChinOptions{Fraction(4, 3)}}}}) {
     Integrator integrator(spec);
     PhaseSpaceBatch x(1, 1);
     record(method, [&](double& q, double& p) {

@@ -28,7 +28,7 @@ int main() {
   for (const char* scheme : {"basic", "triplet", "mpe"})
     for (int j = 1; j <= 4; ++j) {
       if (std::string(scheme) == "basic" && j > 1) break;
-      nonsep::Integrator integrator(nonsep::IntegratorSpec{scheme, nonsep::Fraction(2 * j, 3)});
+      nonsep::Integrator integrator(nonsep::IntegratorSpec{scheme, nonsep::ChinOptions{nonsep::Fraction(2 * j, 3)}});
       const double q0[] = {2.0}, p0[] = {0.0};
       auto x = nonsep::PhaseSpaceBatch::single(q0, p0);
       for (int s = 0; s < steps; ++s) integrator.step(Paper1D{}, x, quarter_period / steps);

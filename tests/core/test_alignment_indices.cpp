@@ -11,7 +11,7 @@
 
 #include "nonsep/core/analysis/alignment_indices.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;
@@ -130,7 +130,7 @@ TEST_CASE("under a linear map GALI_j decays at exactly the rate sum_{i<=j} (l_1 
 
 TEST_CASE("the factors and the skipped MEGNO logarithm leave the exponents bit for bit") {
   using nonsep::testing::Paper2D;
-  const IntegratorSpec mpe4{"mpe", Fraction(4)};
+  const IntegratorSpec mpe4{"mpe", ChinOptions{Fraction(4)}};
   std::array<TangentIntegrator, 3> integrators{TangentIntegrator(mpe4), TangentIntegrator(mpe4),
                                                TangentIntegrator(mpe4)};
   PhaseSpaceBatch x_first = PhaseSpaceBatch::single(std::vector<double>{-0.75, 0.3}, std::vector<double>{-1.5, 0.2});

@@ -12,7 +12,7 @@
 #include "nonsep/core.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/reference/variational_flow.hpp"
 #include "support/convergence.hpp"
 #include "support/models.hpp"
@@ -73,10 +73,10 @@ double growth_power(const Orbit& orbit) {
 const std::vector<double> delta1{1.0, 0.5}, delta2{1.0, 0.5, -0.3, 0.7};
 // Symplectic, for the integrable models. On paper2d's high-energy orbits its largest basic step (6.4 dt) overflows
 // at dt = 2e-3.
-const IntegratorSpec triplet2{"triplet", Fraction(2)};
+const IntegratorSpec triplet2{"triplet", ChinOptions{Fraction(2)}};
 // Order 4, 21 basic steps per step: on paper2d at dt = 2e-3 within 2e-4 of the flow at t = 15 (triplet of order 2
 // at dt = 2.5e-4 is 6e-3 away at t = 1), which a finite-time exponent of a chaotic orbit needs.
-const IntegratorSpec mpe4{"mpe", Fraction(4)};
+const IntegratorSpec mpe4{"mpe", ChinOptions{Fraction(4)}};
 
 }  // namespace
 

@@ -12,7 +12,7 @@
 #include "nonsep/core.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "support/models.hpp"
 
 using namespace nonsep;
@@ -57,7 +57,7 @@ struct IndicatorRun {
 };
 
 // Order 4, not symplectic: accurate and stable on paper2d's chaotic orbit at dt = 2e-3.
-const IntegratorSpec mpe4{"mpe", Fraction(4)};
+const IntegratorSpec mpe4{"mpe", ChinOptions{Fraction(4)}};
 
 // dt as a value the compiler cannot see (see test_tangent_map.cpp: a literal dt can make std::cbrt differ by an
 // ulp between two call sites that the compiler inlines differently).
@@ -135,7 +135,8 @@ TEST_CASE("the full spectrum of a symplectic map sums to zero (det M = 1), and M
   const std::vector<double> delta{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // k = 2n = 4
   // Triplet of order 2, stable on this chaotic orbit at dt = 1e-3; MPE of order 4 at dt = 4e-3 as the negative
   // control.
-  for (const IntegratorSpec& spec : {IntegratorSpec{"triplet", Fraction(2)}, IntegratorSpec{"mpe", Fraction(4)}}) {
+  for (const IntegratorSpec& spec :
+       {IntegratorSpec{"triplet", ChinOptions{Fraction(2)}}, IntegratorSpec{"mpe", ChinOptions{Fraction(4)}}}) {
     CAPTURE(spec.scheme);
     IndicatorRun run(Paper2D{}, spec, {-0.75, 0.3}, {-1.5, 0.2}, delta, 10);
     const double dt = spec.scheme == "mpe" ? 0.004 : 0.001;

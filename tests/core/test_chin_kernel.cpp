@@ -78,7 +78,7 @@ void check_scheme(const std::string& scheme, HamiltonianForm form, std::size_t c
   CAPTURE(FixedDimension);
   const M plain{};
   WithKernel<M, FixedDimension> kernel{};
-  IntegratorSpec spec{scheme, order};
+  IntegratorSpec spec{scheme, ChinOptions{order}};
   spec.form = form;
   Integrator with(spec), without(spec);
   auto x = spread_states(plain.dimension(), count);
@@ -122,7 +122,7 @@ TEST_CASE("kernel path: steps started again from their states give the numbers o
       CAPTURE(scheme);
       CAPTURE(static_cast<int>(form));
       WithKernel<Paper1D, 1, FusedPaper1D> kernel{};
-      IntegratorSpec spec{scheme, order};
+      IntegratorSpec spec{scheme, ChinOptions{order}};
       spec.form = form;
       const auto start = spread_states(1, 300);
       auto whole = start, restarted = start, evaluation_path = start;
@@ -166,7 +166,7 @@ TEST_CASE("kernel path: mpe of a model with a separable part steps its terms thr
   // and the numbers of the model without a kernel.
   WithKernel<VariableMass2D, 2> kernel{};
   const VariableMass2D plain{};
-  IntegratorSpec spec{"mpe", Fraction(2)};
+  IntegratorSpec spec{"mpe", ChinOptions{Fraction(2)}};
   Integrator with(spec), without(spec);
   auto x = spread_states(2, 3);
   auto y = x;

@@ -17,7 +17,7 @@
 #include "nonsep/core.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/kernel/chin_kernel.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "paper1d/paper1d.hpp"
 #include "paper2d/paper2d.hpp"
 

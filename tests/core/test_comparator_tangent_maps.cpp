@@ -15,7 +15,7 @@
 
 #include "lattice_chain/lattice_chain.hpp"
 #include "nonsep/core.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "paper2d/paper2d.hpp"
 #include "support/finite_difference.hpp"
 #include "support/phase_space_jacobian.hpp"
@@ -33,17 +33,16 @@ using VariableMassModel = sdk::ModelAdapter<VariableMass2D>;
 // Every comparator spec: gauss 1..3 stages (1 as implicit_midpoint), tao 2, 4, 6.
 std::vector<IntegratorSpec> comparator_specs(HamiltonianForm form) {
   std::vector<IntegratorSpec> specs;
-  IntegratorSpec midpoint{"implicit_midpoint", Fraction(2)};
+  IntegratorSpec midpoint{"implicit_midpoint"};
   midpoint.form = form;
   specs.push_back(midpoint);
   for (int stages = 1; stages <= 3; ++stages) {
-    IntegratorSpec gauss{"gauss", Fraction(2 * stages)};
-    gauss.stages = stages;
+    IntegratorSpec gauss{"gauss", GaussOptions{stages}};
     gauss.form = form;
     specs.push_back(gauss);
   }
   for (int order : {2, 4, 6}) {
-    IntegratorSpec tao{"tao", Fraction(order)};
+    IntegratorSpec tao{"tao", TaoOptions{Fraction(order)}};
     tao.form = form;
     specs.push_back(tao);
   }
@@ -52,8 +51,8 @@ std::vector<IntegratorSpec> comparator_specs(HamiltonianForm form) {
 
 std::string name_of(const IntegratorSpec& spec) {
   return spec.scheme +
-         (spec.scheme == "gauss" ? " " + std::to_string(static_cast<int>(spec.stages)) + " stages"
-                                 : " order " + spec.order.to_string()) +
+         (spec.scheme == "gauss" ? " " + std::to_string(std::get<GaussOptions>(spec.options).stages) + " stages"
+                                 : " order " + Integrator(spec).describe().order.to_string()) +
          (spec.form == HamiltonianForm::TTV ? " TTV" : " VVT");
 }
 
@@ -179,7 +178,7 @@ TEST_CASE("Tao's copies' part follows a renormalisation of the vectors: the resu
   const Paper2DModel paper2d;
   for (const auto form : forms)
     for (int order : {2, 4}) {
-      IntegratorSpec spec{"tao", Fraction(order)};
+      IntegratorSpec spec{"tao", TaoOptions{Fraction(order)}};
       spec.form = form;
       CAPTURE(name_of(spec));
       const auto x0 = PhaseSpaceBatch::single(std::vector{0.5, 0.1}, std::vector{0.2, 1.5});
@@ -291,8 +290,7 @@ LyapunovRecord spectrum(const Paper2DModel& model, const IntegratorSpec& spec, s
 TEST_CASE("the full Lyapunov spectrum of a symplectic scheme sums to zero within 1e-9 at t = 20") {
   const auto paper2d = Paper2DModel::from_json(R"({"coupling": 0.2})");
   for (int stages : {1, 3}) {
-    IntegratorSpec gauss{"gauss", Fraction(2 * stages)};
-    gauss.stages = stages;
+    const IntegratorSpec gauss{"gauss", GaussOptions{stages}};
     CAPTURE(name_of(gauss));
     const LyapunovRecord record = spectrum(paper2d, gauss, {0.5, 0.0}, {0.0, 2.5}, 0.005, 20.0);
     double sum = 0.0;
@@ -307,9 +305,8 @@ TEST_CASE("tao's tangent map gives Gauss's leading exponent on a chaotic orbit (
   // Tao's map on (q, p) is not symplectic: its spectrum does not sum to zero (the smallest exponent takes up the
   // copies' part), but the largest exponent is that of the flow.
   const auto paper2d = Paper2DModel::from_json(R"({"coupling": 0.2})");
-  IntegratorSpec gauss{"gauss", Fraction(6)};
-  gauss.stages = 3;
-  const IntegratorSpec tao{"tao", Fraction(4)};
+  const IntegratorSpec gauss{"gauss", GaussOptions{3}};
+  const IntegratorSpec tao{"tao", TaoOptions{Fraction(4)}};
   const double reference = spectrum(paper2d, gauss, {-0.75, 0.3}, {-1.5, 0.2}, 0.005, 10.0).exponent(0);
   const double tao_exponent = spectrum(paper2d, tao, {-0.75, 0.3}, {-1.5, 0.2}, 0.005, 10.0).exponent(0);
   CAPTURE(reference);

@@ -14,8 +14,8 @@
 #include <variant>
 #include <vector>
 
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/core/schemes/gauss_legendre.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
 #include "nonsep/core/schemes/tao_extended_phase_space.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
 #include "support/models.hpp"
@@ -108,9 +108,11 @@ std::vector<IntegratorSpec> catalogue_specs(HamiltonianForm form) {
       if (scheme.family == "chin" && order.value() > 2.0) break;
       // Order 2/3 of triplet and mpe is the basic step itself (no composition, one term).
       if (scheme.family == "chin" && scheme.highest_order_index > 1 && order == Fraction(2, 3)) continue;
-      IntegratorSpec spec{scheme.name, order};
-      spec.form = form;
-      spec.stages = static_cast<double>(order.numerator() / 2);  // gauss: s = order / 2
+      IntegratorSpec spec = default_spec(scheme, form);
+      for (const auto& parameter : scheme.parameters) {
+        if (parameter.name == "order") set_option(spec, parameter, order);
+        if (parameter.name == "stages") set_option(spec, parameter, static_cast<double>(order.numerator() / 2));
+      }
       specs.push_back(spec);
     }
   return specs;
@@ -124,7 +126,7 @@ TEST_CASE("every catalogue scheme: the one-step map is symplectic exactly as its
     for (const IntegratorSpec& spec : catalogue_specs(form)) {
       CAPTURE(static_cast<int>(form));
       CAPTURE(spec.scheme);
-      CAPTURE(spec.order.to_string());
+      CAPTURE(Integrator(spec).describe().order.to_string());
       const bool symplectic = find_scheme(spec.scheme)->symplectic;
       ++tested;
       if (spec.scheme == "tao") {

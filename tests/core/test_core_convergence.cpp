@@ -56,14 +56,10 @@ double measured_order(const Study& study) {
 }
 
 IntegratorSpec chin(const char* scheme, Fraction order, double t2 = ChinCoefficients::default_t2()) {
-  return {scheme, order, t2};
+  return {scheme, ChinOptions{order, t2}};
 }
-IntegratorSpec tao(int order) { return {"tao", Fraction(order)}; }
-IntegratorSpec gauss(int stages) {
-  IntegratorSpec spec{"gauss"};
-  spec.stages = stages;
-  return spec;
-}
+IntegratorSpec tao(int order) { return {"tao", TaoOptions{Fraction(order)}}; }
+IntegratorSpec gauss(int stages) { return {"gauss", GaussOptions{stages}}; }
 
 // Each dt range lies inside the asymptotic regime, found by printing the local slopes log2(e(dt)/e(dt/2)) from
 // dt = T/4 (or T/8) down to round-off; the slopes are quoted at each case.

@@ -68,7 +68,7 @@ TEST_CASE("a step of dt followed by one of -dt returns to the start (basic and t
         CAPTURE(scheme);
         CAPTURE(order.to_string());
         CAPTURE(static_cast<int>(form));
-        Integrator integrator(IntegratorSpec{scheme, order, t2_default, form});
+        Integrator integrator(IntegratorSpec{scheme, ChinOptions{order, t2_default}, form});
         const auto start1 = state({1.3}, {0.4});
         auto x1 = start1;
         integrator.step(Paper1D{}, x1, 0.01);
@@ -88,17 +88,17 @@ TEST_CASE("the one-step map is symplectic for basic and triplet, and MPE is not"
     CAPTURE(static_cast<int>(form));
     for (const Fraction order : {Fraction(2, 3), Fraction(4, 3), Fraction(2)}) {
       CAPTURE(order.to_string());
-      const IntegratorSpec triplet{"triplet", order, t2_default, form};
+      const IntegratorSpec triplet{"triplet", ChinOptions{order, t2_default}, form};
       // dt = 0.02: at 0.05 the order-2 triplet's largest basic step (6.4 dt) throws paper1d from
       // (1.2, 0.5) to infinity in one step (its drift is cubic in p).
       CHECK(symplecticity_defect(Paper1D{}, triplet, state({1.2}, {0.5}), 0.02) < 1e-8);
       CHECK(symplecticity_defect(Coupled2D{}, triplet, state({0.6, -0.4}, {0.3, 0.2}), 0.02) < 1e-8);
     }
-    const IntegratorSpec basic{"basic", Fraction(2, 3), -2.5, form};
+    const IntegratorSpec basic{"basic", ChinOptions{Fraction(2, 3), -2.5}, form};
     CHECK(symplecticity_defect(Paper1D{}, basic, state({1.2}, {0.5}), 0.1) < 1e-8);
     CHECK(symplecticity_defect(Coupled2D{}, basic, state({0.6, -0.4}, {0.3, 0.2}), 0.1) < 1e-8);
     // The same measurement on MPE finds a defect far above the finite-difference noise (~1e-10) and the 1e-8 tolerance.
-    const IntegratorSpec mpe{"mpe", Fraction(4, 3), t2_default, form};
+    const IntegratorSpec mpe{"mpe", ChinOptions{Fraction(4, 3), t2_default}, form};
     CHECK(symplecticity_defect(Paper1D{}, mpe, state({1.2}, {0.5}), 0.1) > 1e-6);
     CHECK(symplecticity_defect(Coupled2D{}, mpe, state({0.6, -0.4}, {0.3, 0.2}), 0.1) > 1e-6);
   }
@@ -108,7 +108,7 @@ TEST_CASE("stepping a batch equals stepping each state alone, bit for bit") {
   for (const char* scheme : {"basic", "triplet", "mpe"}) {
     const std::string scheme_name = scheme;
     CAPTURE(scheme_name);
-    const IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
+    const IntegratorSpec spec{scheme, ChinOptions{Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)}};
     PhaseSpaceBatch batch(2, 3);
     const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};
     std::copy(std::begin(qs), std::end(qs), batch.q().begin());
@@ -261,7 +261,7 @@ TEST_CASE("step_n: n steps in one call give n calls of step bit for bit, with th
   for (const char* scheme : {"basic", "triplet", "mpe"}) {
     const std::string scheme_name = scheme;
     CAPTURE(scheme_name);
-    const IntegratorSpec spec{scheme, Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)};
+    const IntegratorSpec spec{scheme, ChinOptions{Fraction(std::string(scheme) == "basic" ? 2 : 4, 3)}};
     auto x = state({0.5, -0.2}, {0.1, 0.3});
     auto y = x;
     Integrator together(spec), one_by_one(spec);
@@ -424,7 +424,7 @@ TEST_CASE("the VVT form converges to the exact flow of H_VVT = (q + q^3/3)^2 p")
     CAPTURE(order_name);
     std::vector<double> dts, errors;
     for (int steps = first; steps <= 8 * first; steps *= 2) {
-      Integrator integrator(IntegratorSpec{"triplet", order, t2_default, HamiltonianForm::VVT});
+      Integrator integrator(IntegratorSpec{"triplet", ChinOptions{order, t2_default}, HamiltonianForm::VVT});
       auto x = state({0.5}, {0.5});
       for (int s = 0; s < steps; ++s) integrator.step(Paper1D{}, x, t_end / steps);
       dts.push_back(t_end / steps);

@@ -73,12 +73,13 @@ int check_crossings(const M& model, const IntegratorSpec& spec, PhaseSpaceBatch 
 TEST_CASE("crossings of q1 = 0 on paper2d lie on the plane to round-off and on the numerical flow") {
   const auto start = PhaseSpaceBatch::single(std::vector{-0.75, 0.3}, std::vector{-1.5, 0.2});
   const SectionPlane q1_zero({1.0, 0.0, 0.0, 0.0}, 0.0);
-  CHECK(check_crossings(Paper2D{}, IntegratorSpec{"mpe", Fraction(4)}, start, 2e-3, q1_zero, 20) == 20);
+  CHECK(check_crossings(Paper2D{}, IntegratorSpec{"mpe", ChinOptions{Fraction(4)}}, start, 2e-3, q1_zero, 20) == 20);
   // Triplet of order 2 needs dt = 1e-3 on this orbit (at 2e-3 its largest basic step overflows).
-  CHECK(check_crossings(Paper2D{}, IntegratorSpec{"triplet", Fraction(2)}, start, 1e-3, q1_zero, 10) == 10);
+  CHECK(check_crossings(Paper2D{}, IntegratorSpec{"triplet", ChinOptions{Fraction(2)}}, start, 1e-3, q1_zero, 10) ==
+        10);
   // A plane that mixes q and p, with an offset, and steps backwards in time.
   const SectionPlane mixed({0.6, -0.3, 0.5, 0.2}, 0.1);
-  CHECK(check_crossings(Paper2D{}, IntegratorSpec{"mpe", Fraction(4)}, start, -2e-3, mixed, 20) == 20);
+  CHECK(check_crossings(Paper2D{}, IntegratorSpec{"mpe", ChinOptions{Fraction(4)}}, start, -2e-3, mixed, 20) == 20);
 }
 
 TEST_CASE("crossings of q = 0 by the basic step on paper1d, where H fixes p at the crossing") {

@@ -62,9 +62,10 @@ double measured_order(const Study& study, const M& model, const std::vector<doub
     MESSAGE("local slopes " << s1 << ", " << s2 << "; fitted exponent " << order);
     order = (s2 - r * s1) / (1.0 - r);
   }
-  MESSAGE(study.spec.scheme << " " << Integrator(study.spec).describe().order.to_string() << " (t2 " << study.spec.t2
-                            << "): measured " << order << " for dt from " << dts.front() << " to " << dts.back()
-                            << ", errors " << errors.front() << " to " << errors.back());
+  MESSAGE(study.spec.scheme << " " << Integrator(study.spec).describe().order.to_string() << " (t2 "
+                            << Integrator(study.spec).describe().t2 << "): measured " << order << " for dt from "
+                            << dts.front() << " to " << dts.back() << ", errors " << errors.front() << " to "
+                            << errors.back());
   return order;
 }
 
@@ -77,14 +78,10 @@ double measured_order(const Study& study) {
 }
 
 IntegratorSpec chin(const char* scheme, Fraction order, double t2 = ChinCoefficients::default_t2()) {
-  return {scheme, order, t2};
+  return {scheme, ChinOptions{order, t2}};
 }
-IntegratorSpec tao(int order) { return {"tao", Fraction(order)}; }
-IntegratorSpec gauss(int stages) {
-  IntegratorSpec spec{"gauss"};
-  spec.stages = stages;
-  return spec;
-}
+IntegratorSpec tao(int order) { return {"tao", TaoOptions{Fraction(order)}}; }
+IntegratorSpec gauss(int stages) { return {"gauss", GaussOptions{stages}}; }
 
 const std::vector<Study>& order_cases() {
   static const std::vector<Study> cases = {
@@ -167,7 +164,7 @@ const std::vector<double>& swapped_end() {
 }
 
 IntegratorSpec vvt(const char* scheme, Fraction order, double t2 = ChinCoefficients::default_t2()) {
-  return {scheme, order, t2, HamiltonianForm::VVT};
+  return {scheme, ChinOptions{order, t2}, HamiltonianForm::VVT};
 }
 
 const std::vector<Study>& vvt_cases() {

@@ -43,10 +43,10 @@ double symplecticity_defect(const M& model, const IntegratorSpec& spec, const Ph
 
 // The symplectic schemes and the orders checked on them.
 std::vector<IntegratorSpec> symplectic_specs(HamiltonianForm form) {
-  return {{"basic", Fraction(2, 3), -2.5, form},
-          {"triplet", Fraction(4, 3), t2_default, form},
-          {"triplet", Fraction(2), t2_default, form},
-          {"triplet", Fraction(8, 3), t2_default, form}};
+  return {{"basic", ChinOptions{Fraction(2, 3), -2.5}, form},
+          {"triplet", ChinOptions{Fraction(4, 3), t2_default}, form},
+          {"triplet", ChinOptions{Fraction(2), t2_default}, form},
+          {"triplet", ChinOptions{Fraction(8, 3), t2_default}, form}};
 }
 
 // VariableMass2D's product part alone, as a model type without the separable concept.
@@ -67,7 +67,7 @@ TEST_CASE("separable part: a step of dt followed by one of -dt returns to the st
   for (const auto form : forms)
     for (const auto& spec : symplectic_specs(form)) {
       CAPTURE(spec.scheme);
-      CAPTURE(spec.order.to_string());
+      CAPTURE(std::get<ChinOptions>(spec.options).order.to_string());
       CAPTURE(static_cast<int>(form));
       Integrator integrator(spec);
       const auto start1 = state({1.2}, {0.4});
@@ -89,14 +89,14 @@ TEST_CASE("separable part: the one-step map is symplectic for basic and triplet,
     CAPTURE(static_cast<int>(form));
     for (const auto& spec : symplectic_specs(form)) {
       CAPTURE(spec.scheme);
-      CAPTURE(spec.order.to_string());
+      CAPTURE(std::get<ChinOptions>(spec.options).order.to_string());
       CHECK(symplecticity_defect(MathewsLakshmanan{}, spec, state({1.2}, {0.5}), 0.05) < 1e-8);
       CHECK(symplecticity_defect(VariableMass2D{}, spec, state({0.6, -0.4}, {0.3, 0.2}), 0.05) < 1e-8);
       VariableMass2D only_K;
       only_K.with_U = false;
       CHECK(symplecticity_defect(only_K, spec, state({0.6, -0.4}, {0.3, 0.2}), 0.05) < 1e-8);
     }
-    const IntegratorSpec mpe{"mpe", Fraction(4, 3), t2_default, form};
+    const IntegratorSpec mpe{"mpe", ChinOptions{Fraction(4, 3), t2_default}, form};
     CHECK(symplecticity_defect(MathewsLakshmanan{}, mpe, state({1.2}, {0.5}), 0.1) > 1e-6);
     CHECK(symplecticity_defect(VariableMass2D{}, mpe, state({0.6, -0.4}, {0.3, 0.2}), 0.1) > 1e-6);
   }
@@ -104,9 +104,12 @@ TEST_CASE("separable part: the one-step map is symplectic for basic and triplet,
 
 TEST_CASE("separable part: stepping a batch equals stepping each state alone, bit for bit, every scheme") {
   IntegratorSpec gauss{"gauss"};
-  const std::vector<IntegratorSpec> specs = {{"basic", Fraction(2, 3)}, {"triplet", Fraction(4, 3)},
-                                             {"mpe", Fraction(2)},      {"tao", Fraction(2)},
-                                             {"implicit_midpoint"},     gauss};
+  const std::vector<IntegratorSpec> specs = {{"basic", ChinOptions{Fraction(2, 3)}},
+                                             {"triplet", ChinOptions{Fraction(4, 3)}},
+                                             {"mpe", ChinOptions{Fraction(2)}},
+                                             {"tao", TaoOptions{Fraction(2)}},
+                                             {"implicit_midpoint"},
+                                             gauss};
   for (const auto& spec : specs) {
     CAPTURE(spec.scheme);
     PhaseSpaceBatch batch(2, 3);
@@ -151,14 +154,14 @@ TEST_CASE("separable part: MPE's batched terms give the term-by-term numbers and
 TEST_CASE("separable part: evaluations per step, 2 grad U without K, 4 grad U and 2 grad K with both") {
   const double q[] = {0.4}, p[] = {0.1};
   auto x = PhaseSpaceBatch::single(q, p);
-  Integrator basic(IntegratorSpec{"basic", Fraction(2, 3)});
+  Integrator basic(IntegratorSpec{"basic", ChinOptions{Fraction(2, 3)}});
   basic.step_n(MathewsLakshmanan{}, x, 0.01, 5);
   CHECK(basic.evaluations().grad_U == 10);
   CHECK(basic.evaluations().grad_K == 0);
   CHECK(basic.evaluations().grad_T == 20);
   CHECK(basic.evaluations().grad_V == 21);  // no K: the half-kicks leave q, so first-same-as-last holds
   auto y = state({0.4, 0.2}, {0.1, -0.3});
-  Integrator triplet(IntegratorSpec{"triplet", Fraction(4, 3)});
+  Integrator triplet(IntegratorSpec{"triplet", ChinOptions{Fraction(4, 3)}});
   triplet.step(VariableMass2D{}, y, 0.01);
   CHECK(triplet.evaluations().grad_U == 12);
   CHECK(triplet.evaluations().grad_K == 6);
@@ -189,9 +192,9 @@ TEST_CASE("separable part: energy and grad H are those of the full H = T_i V_ij 
 
 TEST_CASE("separable part: the tangent map is the derivative of the step, symplectic for basic and triplet") {
   for (const auto form : forms)
-    for (const auto& spec : {IntegratorSpec{"basic", Fraction(2, 3), -2.5, form},
-                             IntegratorSpec{"triplet", Fraction(4, 3), t2_default, form},
-                             IntegratorSpec{"mpe", Fraction(2), t2_default, form}}) {
+    for (const auto& spec : {IntegratorSpec{"basic", ChinOptions{Fraction(2, 3), -2.5}, form},
+                             IntegratorSpec{"triplet", ChinOptions{Fraction(4, 3), t2_default}, form},
+                             IntegratorSpec{"mpe", ChinOptions{Fraction(2), t2_default}, form}}) {
       CAPTURE(spec.scheme);
       CAPTURE(static_cast<int>(form));
       const VariableMass2D model;
@@ -235,14 +238,14 @@ TEST_CASE("a model with K = U = 0 is stepped bit for bit as by the steppers over
       CHECK(b == c);
       CHECK(integrator.evaluations() == reference.evaluations());
     };
-    check_scheme(IntegratorSpec{"basic", Fraction(2, 3), t2_default, form}, ChinBasicStep(form));
-    check_scheme(IntegratorSpec{"triplet", Fraction(2), t2_default, form},
+    check_scheme(IntegratorSpec{"basic", ChinOptions{Fraction(2, 3), t2_default}, form}, ChinBasicStep(form));
+    check_scheme(IntegratorSpec{"triplet", ChinOptions{Fraction(2), t2_default}, form},
                  TripletComposition<ChinBasicStep>(ChinBasicStep(form), 2));
-    check_scheme(IntegratorSpec{"mpe", Fraction(2), t2_default, form},
+    check_scheme(IntegratorSpec{"mpe", ChinOptions{Fraction(2), t2_default}, form},
                  MultiProductExpansion<ChinBasicStep>(ChinBasicStep(form), 3));
     auto a = start, b = start;
     auto ta = testing::identity_tangents(2), tb = testing::identity_tangents(2);
-    TangentIntegrator tangent(IntegratorSpec{"basic", Fraction(2, 3), t2_default, form});
+    TangentIntegrator tangent(IntegratorSpec{"basic", ChinOptions{Fraction(2, 3), t2_default}, form});
     TangentBasicStep reference{ChinBasicStep(form)};
     tangent.step(none, a, ta, 0.02);
     reference.step(none, b, tb, 0.02);

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "nonsep/core.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "support/models.hpp"
 #include "support/phase_space_jacobian.hpp"
 
@@ -34,11 +34,11 @@ const std::array<HamiltonianForm, 2> forms{HamiltonianForm::TTV, HamiltonianForm
 // The specs every property is checked on: basic, triplet of orders 4/3 and 2, MPE of orders 4/3 and 2.
 std::vector<IntegratorSpec> all_specs(HamiltonianForm form) {
   const double t2 = ChinCoefficients::default_t2();
-  return {{"basic", Fraction(2, 3), -2.5, form},
-          {"triplet", Fraction(4, 3), t2, form},
-          {"triplet", Fraction(2), t2, form},
-          {"mpe", Fraction(4, 3), t2, form},
-          {"mpe", Fraction(2), t2, form}};
+  return {{"basic", ChinOptions{Fraction(2, 3), -2.5}, form},
+          {"triplet", ChinOptions{Fraction(4, 3), t2}, form},
+          {"triplet", ChinOptions{Fraction(2), t2}, form},
+          {"mpe", ChinOptions{Fraction(4, 3), t2}, form},
+          {"mpe", ChinOptions{Fraction(2), t2}, form}};
 }
 
 // `steps` steps of the tangent integrator from x: the Jacobian of the `steps`-step map.
@@ -65,7 +65,7 @@ void check_against_differences(const M& model, const PhaseSpaceBatch& x0, double
   for (const auto form : forms)
     for (const auto& spec : all_specs(form)) {
       CAPTURE(spec.scheme);
-      CAPTURE(spec.order.to_string());
+      CAPTURE(std::get<ChinOptions>(spec.options).order.to_string());
       CAPTURE(static_cast<int>(form));
       // Three steps, so that the cached Hessian is reused across steps.
       const Eigen::MatrixXd exact = tangent_jacobian(model, spec, x0, dt, 3);
@@ -88,7 +88,7 @@ TEST_CASE("the tangent map of basic and triplet is symplectic to 1e-12 per step,
   for (const auto form : forms)
     for (const auto& spec : all_specs(form)) {
       CAPTURE(spec.scheme);
-      CAPTURE(spec.order.to_string());
+      CAPTURE(std::get<ChinOptions>(spec.options).order.to_string());
       CAPTURE(static_cast<int>(form));
       const bool symplectic = spec.scheme != "mpe";
       // dt = 0.02: at 0.05 the order-2 triplet's largest basic step (6.4 dt) overflows these states.
@@ -126,7 +126,7 @@ TEST_CASE("stepping with tangent vectors leaves the states bit for bit as the pl
     for (const auto& spec : all_specs(form))
       for (const std::size_t k : {std::size_t{1}, std::size_t{4}}) {
         CAPTURE(spec.scheme);
-        CAPTURE(spec.order.to_string());
+        CAPTURE(std::get<ChinOptions>(spec.options).order.to_string());
         CAPTURE(k);
         PhaseSpaceBatch plain(2, 3);
         const double qs[] = {0.5, 0.1, -0.2, 0.3, 0.9, -0.7}, ps[] = {0.1, 0.2, 0.3, -0.4, 0.0, 0.25};
@@ -218,5 +218,5 @@ TEST_CASE("tangent vectors that do not fit the states are refused with the shape
     CHECK((message.find("1 <= k <= 4 (found 5") != std::string::npos ||
            message.find("tangent vectors have dimension 1 but the states have dimension 2") != std::string::npos));
   }
-  CHECK_THROWS_AS(TangentIntegrator(IntegratorSpec{"triplet", Fraction(1, 3)}), InvalidArgument);
+  CHECK_THROWS_AS(TangentIntegrator(IntegratorSpec{"triplet", ChinOptions{Fraction(1, 3)}}), InvalidArgument);
 }

@@ -46,7 +46,9 @@ CoreRun core_run(const nonsep::IntegratorSpec& spec, double q0, double p0, doubl
   return run;
 }
 
-inline nonsep::IntegratorSpec triplet_43(double t2 = -2.0) { return {"triplet", nonsep::Fraction(4, 3), t2}; }
+inline nonsep::IntegratorSpec triplet_43(double t2 = -2.0) {
+  return {"triplet", nonsep::ChinOptions{nonsep::Fraction(4, 3), t2}};
+}
 
 // Runs `job` (written to folder/name.json) with --output folder/name and returns the summary.
 inline json run_job(const TemporaryFolder& folder, const std::string& name, const json& job, int expected_status = 0) {

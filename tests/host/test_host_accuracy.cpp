@@ -87,7 +87,7 @@ TEST_CASE("a study reports the largest |dH/H0| over each run, which the core fin
   const double q0[] = {2.0}, p0[] = {0.0};
   for (const auto& row : rows) {
     const auto steps = std::stoull(row.at("steps"));
-    nonsep::Integrator integrator({"triplet", nonsep::Fraction(8, 3)});
+    nonsep::Integrator integrator({"triplet", nonsep::ChinOptions{nonsep::Fraction(8, 3)}});
     auto x = nonsep::PhaseSpaceBatch::single(q0, p0);
     const double h0 = energy.evaluate_one(model, x);
     double largest = 0.0, at_end = 0.0;

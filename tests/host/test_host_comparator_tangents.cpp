@@ -10,7 +10,7 @@
 
 #include "host_run_support.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "paper2d/paper2d.hpp"
 
 using namespace nonsep::host_testing;
@@ -121,9 +121,9 @@ TEST_CASE("the host's exponents with a comparator are the core tangent map's, bi
     const double host = column(folder / "out/trajectories.csv", "lyapunov0").at(0);
 
     const auto model = PluginPaper2D::from_json(R"({"coupling": 0.2})");
-    nonsep::IntegratorSpec spec{scheme, nonsep::Fraction(2)};
-    if (std::string(scheme) == "gauss") spec.stages = 3;
-    if (std::string(scheme) == "tao") spec.order = nonsep::Fraction(4);
+    nonsep::IntegratorSpec spec{scheme};
+    if (std::string(scheme) == "gauss") spec.options = nonsep::GaussOptions{3};
+    if (std::string(scheme) == "tao") spec.options = nonsep::TaoOptions{nonsep::Fraction(4)};
     const double q[] = {0.5, 0.0}, p[] = {0.0, 2.5};
     auto x = nonsep::PhaseSpaceBatch::single(q, p);
     nonsep::PhaseSpaceBatch v(2, 1);

@@ -54,8 +54,9 @@ TEST_CASE("tao and gauss runs: the core's numbers bit for bit, family and grad_H
     CHECK(summary["evaluations"]["grad_T"] == 0);
     CHECK(summary["evaluations"]["grad_V"] == 0);
     CHECK(summary["evaluations"]["grad_H"].get<std::uint64_t>() >= 3 * 40);
-    nonsep::IntegratorSpec spec{scheme, nonsep::Fraction(integrator.value("order", 2))};
-    spec.stages = integrator.value("stages", 2);
+    nonsep::IntegratorSpec spec{scheme};
+    if (spec.scheme == "tao") spec.options = nonsep::TaoOptions{nonsep::Fraction(integrator.value("order", 2))};
+    if (spec.scheme == "gauss") spec.options = nonsep::GaussOptions{integrator.value("stages", 2)};
     const double starts[3][2] = {{2.0, 0.0}, {1.0, 0.5}, {0.5, -0.3}};
     for (std::size_t k = 0; k < 3; ++k) {
       const CoreRun core = core_run(spec, starts[k][0], starts[k][1], 0.01, 40);
@@ -98,9 +99,7 @@ TEST_CASE("gauss: a trajectory whose fixed-point iteration fails retires as fail
   // The survivors have the numbers of a run without the failing trajectory.
   const CoreRun alone = core_run(
       [] {
-        nonsep::IntegratorSpec spec{"gauss"};
-        spec.max_iterations = 60;
-        return spec;
+        return nonsep::IntegratorSpec{"gauss", nonsep::GaussOptions{2, 60}};
       }(),
       1.5, 0.1, 0.05, 6);
   CHECK(number(summary["trajectories"][2]["final"]["q"][0]) == alone.state.q()[0]);
@@ -117,7 +116,7 @@ TEST_CASE("tao: a trajectory that diverges leaves the block with its copy, the o
   CHECK(summary["counts"]["diverged"] == 1);
   CHECK(summary["trajectories"][1]["status"] == "diverged");
   CHECK(summary["trajectories"][1]["final"]["step"] == 1);
-  const nonsep::IntegratorSpec spec{"tao", nonsep::Fraction(2)};
+  const nonsep::IntegratorSpec spec{"tao", nonsep::TaoOptions{nonsep::Fraction(2)}};
   for (const std::size_t k : {0u, 2u}) {
     CAPTURE(k);
     const double q0 = k == 0 ? 2.0 : 1.5, p0 = k == 0 ? 0.0 : 0.1;
@@ -228,11 +227,7 @@ TEST_CASE("a study's default labels name each integrator's order as summary.json
 
 TEST_CASE("a study's reference_run: its end state is the reference of the phase errors, as a given reference") {
   TemporaryFolder folder;
-  const nonsep::IntegratorSpec reference_spec = [] {
-    nonsep::IntegratorSpec spec{"gauss"};
-    spec.stages = 3;
-    return spec;
-  }();
+  const nonsep::IntegratorSpec reference_spec{"gauss", nonsep::GaussOptions{3}};
   const CoreRun reference = core_run(reference_spec, 2.0, 0.0, quarter_period / 256, 256);
   json job = {{"model", {{"plugin", "paper1d"}}},
               {"initial", state(2.0, 0.0)},
@@ -308,14 +303,11 @@ TEST_CASE("every option of every catalogue entry is in the checkpoint's fingerpr
       CAPTURE(option.name);
       nonsep::host::LoadedJob changed = loaded;
       auto& spec = std::get<nonsep::host::SingleRun>(changed.job.plan).integrator;
-      std::visit(
-          [](auto* field) {
-            if constexpr (std::is_same_v<decltype(field), nonsep::Fraction*>)
-              *field = nonsep::Fraction(99, 7);
-            else
-              *field = *field * 2 + 1;
-          },
-          nonsep::option_field(spec, option));
+      const nonsep::OptionValue value = nonsep::option_value(spec, option);
+      if (std::holds_alternative<nonsep::Fraction>(value))
+        nonsep::set_option(spec, option, nonsep::Fraction(99, 7));
+      else
+        nonsep::set_option(spec, option, std::get<double>(value) * 2 + 1);
       CHECK(nonsep::host::fingerprint_difference(fingerprint, nonsep::host::job_fingerprint(changed)) ==
             "integrator." + option.name);
     }

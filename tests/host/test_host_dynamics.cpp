@@ -171,7 +171,7 @@ TEST_CASE("the host's largest exponent and states are the core's, bit for bit, w
   volatile double opaque_dt = 0.005;
   const double dt = opaque_dt;
   const PluginPaper2D model;
-  nonsep::TangentIntegrator integrator({"mpe", nonsep::Fraction(4)});
+  nonsep::TangentIntegrator integrator({"mpe", nonsep::ChinOptions{nonsep::Fraction(4)}});
   nonsep::PhaseSpaceBatch x = nonsep::PhaseSpaceBatch::single(chaotic_q, chaotic_p);
   // The first vector (1, 1/2, 1/3, 1/4) over (dq0, dq1, dp0, dp1); the second the unit vector of dq1.
   nonsep::PhaseSpaceBatch tangents(2, 2);

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "host_test_support.hpp"
-#include "nonsep/core/schemes/scheme_catalogue.hpp"
+#include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/platform/build_features.hpp"
 
@@ -62,8 +62,8 @@ TEST_CASE("the quickstart job reads into the values it spells out") {
   CHECK(job.plugin == "paper1d");
   CHECK(job.parameters == json::object());
   CHECK(job.run().integrator.scheme == "triplet");
-  CHECK(job.run().integrator.order == Fraction(4, 3));
-  CHECK(job.run().integrator.t2 == -2.0);
+  CHECK(std::get<ChinOptions>(job.run().integrator.options).order == Fraction(4, 3));
+  CHECK(std::get<ChinOptions>(job.run().integrator.options).t2 == -2.0);
   CHECK(job.run().integrator.form == HamiltonianForm::TTV);
   CHECK(job.initial.shape == "single");
   CHECK(job.initial.count == 1);
@@ -82,22 +82,21 @@ TEST_CASE("integrator options left out take the catalogue's defaults") {
     REQUIRE(parsed.issues.empty());
     for (const auto& parameter : scheme.parameters) {
       REQUIRE_FALSE(parameter.default_text.empty());
-      if (parameter.name == "order")
-        CHECK(parsed.job.run().integrator.order == Fraction::parse(parameter.default_text));
-      if (parameter.name == "t2") CHECK(parsed.job.run().integrator.t2 == std::stod(parameter.default_text));
+      CHECK(option_value(parsed.job.run().integrator, parameter) == default_option_value(parameter));
     }
   }
-  CHECK(parse(host_testing::quickstart_job()).job.run().integrator.t2 != ChinCoefficients::default_t2());
+  CHECK(std::get<ChinOptions>(parse(host_testing::quickstart_job()).job.run().integrator.options).t2 !=
+        ChinCoefficients::default_t2());
 }
 
 TEST_CASE("orders are exact fractions or integers and must exist for the scheme") {
   json document = host_testing::quickstart_job();
   document["integrator"] = {{"scheme", "triplet"}, {"order", 2}};
-  CHECK(parse(document).job.run().integrator.order == Fraction(2));
+  CHECK(std::get<ChinOptions>(parse(document).job.run().integrator.options).order == Fraction(2));
   document["integrator"]["order"] = " 8 / 3 ";
-  CHECK(parse(document).job.run().integrator.order == Fraction(8, 3));
+  CHECK(std::get<ChinOptions>(parse(document).job.run().integrator.options).order == Fraction(8, 3));
   document["integrator"]["order"] = 2.0;
-  CHECK(parse(document).job.run().integrator.order == Fraction(2));
+  CHECK(std::get<ChinOptions>(parse(document).job.run().integrator.options).order == Fraction(2));
   for (const json& bad : {json("5/3"), json(1.5), json("4/3x"), json(0), json("-4/3"), json(true)}) {
     CAPTURE(bad.dump());
     document["integrator"]["order"] = bad;

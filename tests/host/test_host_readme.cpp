@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "host_test_support.hpp"
-#include "nonsep/core/schemes/scheme_catalogue.hpp"
+#include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 using nlohmann::json;

@@ -88,7 +88,7 @@ TEST_CASE("every scheme and both Hamiltonian forms agree with the core bit for b
     json job = paper1d_job(state(q0, 0.25), {{"dt", 0.01}, {"steps", 25}}, {{"scheme", c.scheme}, {"order", c.order}});
     job["hamiltonian"] = c.form;
     const json summary = run_job(folder, std::string(c.scheme) + "-" + c.form, job);
-    nonsep::IntegratorSpec spec{c.scheme, nonsep::Fraction::parse(c.order)};
+    nonsep::IntegratorSpec spec{c.scheme, nonsep::ChinOptions{nonsep::Fraction::parse(c.order)}};
     spec.form = std::string(c.form) == "VVT" ? nonsep::HamiltonianForm::VVT : nonsep::HamiltonianForm::TTV;
     const CoreRun core = core_run(spec, q0, 0.25, 0.01, 25);
     CHECK(number(summary["trajectories"][0]["final"]["q"][0]) == core.state.q()[0]);

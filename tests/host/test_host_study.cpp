@@ -138,7 +138,7 @@ TEST_CASE("a study's rows are the core's runs bit for bit, and its fit is the sl
     const double dt = quarter_period / static_cast<double>(steps);
     CHECK(std::stod(row[5]) == dt);
     nonsep::Integrator integrator(
-        {basic ? "basic" : "mpe", basic ? nonsep::Fraction(2, 3) : nonsep::Fraction(2), -2.0});
+        {basic ? "basic" : "mpe", nonsep::ChinOptions{basic ? nonsep::Fraction(2, 3) : nonsep::Fraction(2), -2.0}});
     auto x = nonsep::PhaseSpaceBatch::single(q0, p0);
     for (std::uint64_t k = 0; k < steps; ++k) integrator.step(model, x, dt);
     CHECK(std::stoull(row[7]) == steps * (basic ? 1 : 6));

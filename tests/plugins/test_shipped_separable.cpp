@@ -11,7 +11,7 @@
 #include "mathews_lakshmanan/mathews_lakshmanan.hpp"
 #include "nonsep/core/analysis/energy.hpp"
 #include "nonsep/core/base/hamiltonian_gradient.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/plugin_abi.h"
@@ -91,8 +91,9 @@ TEST_CASE("shipped separable models: the energy is the full H, and grad H its gr
 TEST_CASE("shipped separable models: a plugin steps bit for bit like the same model compiled in") {
   const PluginModel plugin = shipped("variable_mass2d");
   const nonsep::sdk::ModelAdapter<VariableMass2D> compiled_in;
-  const nonsep::IntegratorSpec specs[] = {
-      {"basic", nonsep::Fraction(2, 3)}, {"triplet", nonsep::Fraction(2)}, {"mpe", nonsep::Fraction(4, 3)}};
+  const nonsep::IntegratorSpec specs[] = {{"basic", nonsep::ChinOptions{nonsep::Fraction(2, 3)}},
+                                          {"triplet", nonsep::ChinOptions{nonsep::Fraction(2)}},
+                                          {"mpe", nonsep::ChinOptions{nonsep::Fraction(4, 3)}}};
   for (const auto& spec : specs) {
     CAPTURE(spec.scheme);
     auto through_plugin =

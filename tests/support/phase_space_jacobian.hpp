@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "nonsep/core/base/phase_space_batch.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "support/finite_difference.hpp"
 
 namespace nonsep::testing {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "nonsep/core/analysis/alignment_indices.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 #include "nonsep/host/output/run_folder.hpp"

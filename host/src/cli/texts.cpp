@@ -2,7 +2,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
-#include "nonsep/core/schemes/scheme_catalogue.hpp"
+#include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
 

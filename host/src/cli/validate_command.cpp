@@ -21,6 +21,19 @@ std::string initial_shell_text(const InitialStates& initial, bool sweep) {
 
 }  // namespace
 
+// "triplet, order 4/3, t2 = -1.8171205928321397": the scheme, the order it has and its other catalogue options.
+std::string integrator_text(const IntegratorSpec& spec) {
+  std::string text = spec.scheme + ", order " + Integrator(spec).describe().order.to_string();
+  for (const auto& parameter : find_scheme(spec.scheme)->parameters) {
+    if (parameter.name == "order") continue;
+    const auto value = option_value(spec, parameter);
+    text += ", " + parameter.name + " = " +
+            (std::holds_alternative<Fraction>(value) ? std::get<Fraction>(value).to_string()
+                                                     : format_number(std::get<double>(value)));
+  }
+  return text;
+}
+
 std::string parameters_text(nlohmann::json parameters, const Job& job) {
   for (const SweptParameter& swept : job.sweep) {
     const auto& values = swept.values;
@@ -64,8 +77,7 @@ int command_validate(const std::string& job_file) {
                 << " integrators to t_end = " << format_number(study.t_end)
                 << (study.reference_q.empty() ? "" : ", with a reference") << "\n";
       for (const auto& integrator : study.integrators)
-        std::cout << "    " << integrator.label << ": " << integrator.spec.scheme << ", order "
-                  << integrator.spec.order.to_string() << ", t2 = " << format_number(integrator.spec.t2) << ", "
+        std::cout << "    " << integrator.label << ": " << integrator_text(integrator.spec) << ", "
                   << integrator.steps.size() << " step counts " << integrator.steps.front() << ".."
                   << integrator.steps.back() << " (" << integrator.steps_from << ")\n";
       std::cout << "  output:      " << job.output_directory.string() << "\n";
@@ -77,11 +89,8 @@ int command_validate(const std::string& job_file) {
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
               << "  parameters:  " << parameters_text(loaded.model.parameters(), job) << "\n"
-              << "  integrator:  "
-              << (run.auto_scheme
-                      ? describe_auto(loaded)
-                      : spec.scheme + ", order " + spec.order.to_string() + ", t2 = " + format_number(spec.t2))
-              << ", H_" << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT") << "\n"
+              << "  integrator:  " << (run.auto_scheme ? describe_auto(loaded) : integrator_text(spec)) << ", H_"
+              << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT") << "\n"
               << "  initial:     " << job.initial.count
               << (job.sweep.empty() ? (job.initial.count == 1 ? " state" : " states")
                                     : (job.initial.count == 1 ? " trajectory" : " trajectories"))

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "nonsep/core/kernel/chin_kernel.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/inspect/plugin_report.hpp"
 
 namespace nonsep::host {
@@ -70,7 +70,8 @@ std::string checked_schemes_text(const std::vector<IntegratorSpec>& specs) {
   for (std::size_t i = 0; i < specs.size(); ++i) {
     text += i == 0 ? "" : i + 1 == specs.size() ? " and " : ", ";
     text += specs[i].scheme;
-    if (find_scheme(specs[i].scheme)->highest_order_index > 1) text += " " + specs[i].order.to_string();
+    if (find_scheme(specs[i].scheme)->highest_order_index > 1)
+      text += " " + Integrator(specs[i]).describe().order.to_string();
   }
   return text;
 }

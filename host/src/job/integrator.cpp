@@ -1,6 +1,6 @@
 // /hamiltonian and /integrator: the scheme and its options, read against the core's catalogue
 // (nonsep::scheme_catalogue()); whether an option's value is valid is decided by the core, by building the scheme.
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -23,7 +23,6 @@ std::string scheme_names() {
 
 // The value of one catalogue parameter, as the job wrote it or as its default: a Fraction for the order, a double
 // otherwise (nonsep::set_option).
-using OptionValue = std::variant<Fraction, double>;
 
 std::optional<OptionValue> read_option(Checker& check, const ParameterDescription& parameter, const json& value,
                                        const std::string& path) {
@@ -95,17 +94,18 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
     const json* given =
         check.member(integrator, path, parameter.name, parameter.default_text.empty(), parameter.description);
     if (!given) {
-      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
+      if (scheme && !parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
       continue;
     }
     const auto value = read_option(check, parameter, *given, option_path);
     if (!value || !scheme) continue;
-    // The core decides what is valid: build the scheme with this one option set and the others at their defaults.
-    IntegratorSpec probe{scheme->name, {}, {}, spec.form};
+    // The core decides what is valid: build the scheme with this one option set and the others at their defaults
+    // (setting an integer option refuses a number that is not whole).
+    IntegratorSpec probe{scheme->name, {}, spec.form};
     for (const auto& other : parameters)
       if (!other.default_text.empty()) set_option(probe, other, default_option_value(other));
-    set_option(probe, parameter, *value);
     try {
+      set_option(probe, parameter, *value);
       const Integrator probe_integrator(probe);
       set_option(spec, parameter, *value);
     } catch (const InvalidArgument& error) {
@@ -148,7 +148,7 @@ IntegratorSpec read_integrator(Checker& check, const json& document, Hamiltonian
   }
   auto_scheme = chosen;
   spec.scheme = "triplet";  // a valid spec until the choice replaces it
-  spec.order = Fraction(4, 3);
+  spec.options = ChinOptions{Fraction(4, 3)};
   return spec;
 }
 

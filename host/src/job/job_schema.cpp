@@ -8,7 +8,7 @@
 #include <string>
 
 #include "job_keys.hpp"
-#include "nonsep/core/schemes/scheme_catalogue.hpp"
+#include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/time_grid.hpp"

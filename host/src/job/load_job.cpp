@@ -4,8 +4,8 @@
 #include <fstream>
 #include <iostream>
 
-#include "nonsep/core/schemes/integrator.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/formula/plugin_cache.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/json/checker.hpp"

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "nonsep/core/base/error.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -83,18 +83,17 @@ std::optional<std::vector<std::uint64_t>> read_steps_or_dt(Checker& check, const
 }
 
 // The label of an integrator without "label": the scheme alone for a Chin scheme with one order (basic), else the
-// scheme and the order of what the catalogue's factory builds from the spec, as summary.json reports it ("gauss 6"
-// for 3 stages, "implicit_midpoint 2"); the spec's order when the factory refuses the spec (the reader reports why).
+// scheme and the order of what the scheme builds from the spec, as summary.json reports it ("gauss 6" for 3 stages,
+// "implicit_midpoint 2"); the scheme alone when it refuses the spec (the reader reports why).
 std::string default_label(const IntegratorSpec& spec) {
   if (const Scheme* scheme = find_scheme(spec.scheme);
       scheme && scheme->family == "chin" && scheme->highest_order_index == 1)
     return spec.scheme;
-  Fraction order = spec.order;
   try {
-    order = Integrator(spec).describe().order;
+    return spec.scheme + " " + Integrator(spec).describe().order.to_string();
   } catch (const InvalidArgument&) {
+    return spec.scheme;
   }
-  return spec.scheme + " " + order.to_string();
 }
 
 }  // namespace

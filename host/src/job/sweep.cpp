@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <utility>
 
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/sdk/parameters.hpp"
 #include "sections.hpp"

@@ -1,6 +1,6 @@
 #include "launch/run_summary.hpp"
 
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/atomic_files.hpp"

@@ -13,7 +13,7 @@
 
 #include "nonsep/core/base/error.hpp"
 #include "nonsep/core/base/phase_space_batch.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/run/observer.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 #include "run/tangent_block.hpp"

@@ -19,7 +19,7 @@
 
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
 namespace nonsep::host {

@@ -9,7 +9,7 @@
 
 #include "nonsep/core/analysis/energy.hpp"
 #include "nonsep/core/base/error.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/observers/energy_error.hpp"

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <map>
 
-#include "nonsep/core/schemes/scheme_catalogue.hpp"
-#include "nonsep/core/tangent/tangent_integrator.hpp"
+#include "nonsep/core/runtime/scheme_catalogue.hpp"
+#include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 

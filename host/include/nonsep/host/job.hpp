@@ -25,7 +25,7 @@
 #include <variant>
 #include <vector>
 
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/json/issues.hpp"
 #include "nonsep/host/json/strict_json.hpp"
 #include "nonsep/host/plugin_loader.hpp"

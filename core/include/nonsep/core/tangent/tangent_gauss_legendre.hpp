@@ -175,4 +175,10 @@ class TangentGaussLegendre {
   std::vector<std::size_t> active_, still_;
 };
 
+// The tangent map of the stepper (BasicTangentIntegrator, tangent_integrator.hpp): its states stepped bit for bit
+// as the stepper steps them.
+inline TangentGaussLegendre tangent_map_of(const GaussLegendre& stepper, std::size_t) {
+  return TangentGaussLegendre(stepper);
+}
+
 }  // namespace nonsep

@@ -71,4 +71,11 @@ class TangentMultiProductExpansion {
   PhaseSpaceBatch start_tangents_, term_tangents_, last_tangents_;  // their tangent vectors
 };
 
+// The tangent map of the stepper (BasicTangentIntegrator, tangent_integrator.hpp): its states stepped bit for bit
+// as the stepper steps them.
+inline TangentMultiProductExpansion tangent_map_of(const MultiProductExpansion<SeparableBasicStep>& stepper,
+                                                   std::size_t) {
+  return TangentMultiProductExpansion(stepper);
+}
+
 }  // namespace nonsep

@@ -102,4 +102,10 @@ class TangentSeparableComposition {
   std::vector<double> gradient_, hessian_;
 };
 
+// The tangent map of the stepper (BasicTangentIntegrator, tangent_integrator.hpp): its states stepped bit for bit
+// as the stepper steps them.
+inline TangentSeparableComposition tangent_map_of(const SeparableBasicStep& stepper, std::size_t) {
+  return TangentSeparableComposition(stepper);
+}
+
 }  // namespace nonsep

@@ -289,4 +289,10 @@ class TangentTaoExtendedPhaseSpace {
   std::vector<double> point_q_, point_p_, product_q_, product_p_;
 };
 
+// The tangent map of the stepper (BasicTangentIntegrator, tangent_integrator.hpp): its states stepped bit for bit
+// as the stepper steps them; k vectors per state size the copies' part before the first step.
+inline TangentTaoExtendedPhaseSpace tangent_map_of(const TaoExtendedPhaseSpace& stepper, std::size_t k) {
+  return TangentTaoExtendedPhaseSpace(stepper, k);
+}
+
 }  // namespace nonsep

@@ -48,4 +48,10 @@ class TangentTripletComposition {
   std::vector<double> schedule_;  // step_kernel_n's basic step sizes, kept for their storage
 };
 
+// The tangent map of the stepper (BasicTangentIntegrator, tangent_integrator.hpp): its states stepped bit for bit
+// as the stepper steps them.
+inline TangentTripletComposition tangent_map_of(const TripletComposition<SeparableBasicStep>& stepper, std::size_t) {
+  return TangentTripletComposition(stepper);
+}
+
 }  // namespace nonsep

@@ -28,7 +28,7 @@
 
 #include "nonsep/core/analysis/energy.hpp"
 #include "nonsep/core/analysis/poincare_crossing.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/run/observer.hpp"

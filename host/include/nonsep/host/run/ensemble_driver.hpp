@@ -39,7 +39,7 @@
 
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/observer.hpp"
 #include "nonsep/host/run/trajectory.hpp"

@@ -32,7 +32,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/schemes/integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/launch/run_job.hpp"
 

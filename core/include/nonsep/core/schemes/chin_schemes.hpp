@@ -1,0 +1,115 @@
+#pragma once
+// The paper's schemes as the runtime-chosen integrators offer them (stepper.hpp): the basic step (eq. (expalg)),
+// its triplet composition (eqs. (sym43), (sym63)) and its multi-product expansion (eqs. (mpe43), (mpe63)), each
+// built over the basic step with the separable flows of K(p) + U(q) around it (separable_composition.hpp), which is
+// the basic step itself for a model without them. They share their options: the order and t2.
+#include <cstdio>
+#include <string>
+#include <tuple>
+
+#include "nonsep/core/schemes/chin_basic_step.hpp"
+#include "nonsep/core/schemes/multi_product_expansion.hpp"
+#include "nonsep/core/schemes/scheme_options.hpp"
+#include "nonsep/core/schemes/separable_composition.hpp"
+#include "nonsep/core/schemes/triplet_composition.hpp"
+
+namespace nonsep {
+
+struct ChinOptions {
+  Fraction order = Fraction(2, 3);  // 2j/3; which j a scheme has, its catalogue entry says
+  double t2 = ChinCoefficients::default_t2();
+  static constexpr auto members() {
+    return std::tuple{option("order", &ChinOptions::order), option("t2", &ChinOptions::t2)};
+  }
+};
+
+namespace chin_scheme {
+inline ParameterDescription t2_parameter() {
+  char default_t2[32];
+  std::snprintf(default_t2, sizeof default_t2, "%.17g", ChinCoefficients::default_t2());
+  return number_parameter("t2", default_t2,
+                          "free coefficient of the basic step, any finite non-zero number; t1 = -t2, v1 = 1/t2^2, "
+                          "v2 = -v1/2, v0 = -2(v1+v2). The default -6^(1/3) makes e_TTTTV = e_VTTTV; the paper uses "
+                          "-2 for Figure 1 and about -3 for Figure 2",
+                          true);
+}
+inline ParameterDescription order_up_to(const std::string& default_order, int highest_order_index) {
+  return order_parameter(default_order,
+                         "any of " + chin_orders_text() + " up to " + Fraction(2 * highest_order_index, 3).to_string());
+}
+// The basic step of `options` (InvalidArgument for t2 = 0 or not finite): t2 is checked before the order.
+inline SeparableBasicStep base(const ChinOptions& options, HamiltonianForm form) {
+  return SeparableBasicStep(ChinBasicStep(form, options.t2));
+}
+}  // namespace chin_scheme
+
+struct BasicScheme {
+  using Options = ChinOptions;
+  using Stepper = SeparableBasicStep;
+  static SchemeDescription description() {
+    return {"basic",
+            "Chin basic 9-stage splitting",
+            "eq. (expalg)",
+            "One palindromic 9-stage splitting of the separable T(p) + V(q) with eps = cbrt(dt); solves H_TTV "
+            "(or H_VVT with T and V interchanged). Order 2/3; 4 grad T + 4 grad V evaluations per step.",
+            "chin",
+            true,
+            true,
+            {order_parameter("2/3", "only 2/3 exists"), chin_scheme::t2_parameter()},
+            1,
+            {}};
+  }
+  static Stepper make(const Options& options, HamiltonianForm form) {
+    Stepper base = chin_scheme::base(options, form);
+    chin_order_index(options.order, 1, "basic");
+    return base;
+  }
+};
+
+struct TripletScheme {
+  using Options = ChinOptions;
+  using Stepper = TripletComposition<SeparableBasicStep>;
+  static constexpr int orders = Stepper::max_levels + 1;  // order 2j/3 has j - 1 levels
+  static SchemeDescription description() {
+    return {"triplet",
+            "Triplet composition of the basic step",
+            "eqs. (sym43), (sym63), applied recursively",
+            "T_{(k+2)/3}(dt) = T_{k/3}(dt/(2-s)) T_{k/3}(-s dt/(2-s)) T_{k/3}(dt/(2-s)), s = 2^(3/(k+3)). "
+            "Symplectic and time-reversible; order 2j/3 costs 3^(j-1) basic steps per step.",
+            "chin",
+            true,
+            true,
+            {chin_scheme::order_up_to("4/3", orders), chin_scheme::t2_parameter()},
+            orders,
+            {}};
+  }
+  static Stepper make(const Options& options, HamiltonianForm form) {
+    SeparableBasicStep base = chin_scheme::base(options, form);
+    return Stepper(std::move(base), chin_order_index(options.order, orders, "triplet") - 1);
+  }
+};
+
+struct MultiProductExpansionScheme {
+  using Options = ChinOptions;
+  using Stepper = MultiProductExpansion<SeparableBasicStep>;
+  static constexpr int orders = Stepper::max_terms;  // order 2m/3 has m terms
+  static SchemeDescription description() {
+    return {"mpe",
+            "Multi-product expansion of the basic step",
+            "eqs. (mpe43), (mpe63), any number of terms",
+            "sum_i c_i T^i(dt/i), c_i = prod_{j != i} i^n/(i^n - j^n), n = 2/3. Not symplectic, not exactly "
+            "time-reversible; order 2m/3 with m terms costs m(m+1)/2 basic steps per step.",
+            "chin",
+            false,
+            false,
+            {chin_scheme::order_up_to("4/3", orders), chin_scheme::t2_parameter()},
+            orders,
+            {}};
+  }
+  static Stepper make(const Options& options, HamiltonianForm form) {
+    SeparableBasicStep base = chin_scheme::base(options, form);
+    return Stepper(std::move(base), chin_order_index(options.order, orders, "mpe"));
+  }
+};
+
+}  // namespace nonsep

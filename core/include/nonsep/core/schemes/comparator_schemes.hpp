@@ -1,0 +1,133 @@
+#pragma once
+// The comparators as the runtime-chosen integrators offer them (stepper.hpp): Tao's extended phase space
+// (tao_extended_phase_space.hpp) and Gauss-Legendre collocation (gauss_legendre.hpp), the implicit midpoint rule
+// being its one-stage case. They integrate H itself from its gradient (hamiltonian_gradient.hpp): their steppers step
+// only a model with Hessians and third derivatives, and their tangent maps need the directional derivative of
+// grad H.
+#include <string>
+#include <tuple>
+
+#include "nonsep/core/schemes/gauss_legendre.hpp"
+#include "nonsep/core/schemes/scheme_options.hpp"
+#include "nonsep/core/schemes/tao_extended_phase_space.hpp"
+
+namespace nonsep {
+
+namespace comparator_scheme {
+inline const std::string cost_note =
+    " Needs the plugin's Hessians and third derivatives (one grad H = grad T or V, two Hessians, one d3 "
+    "contraction); its tangent map (Lyapunov/MEGNO) also the directional derivative of grad H (hvp_H, plugin ABI "
+    "version 5).";
+inline ParameterDescription max_iterations_parameter() {
+  return number_parameter("max_iterations", std::to_string(GaussLegendre::default_max_iterations),
+                          "most fixed-point iterations per step, an integer >= 1; a state that has not converged by "
+                          "then retires as failed, with the reason");
+}
+}  // namespace comparator_scheme
+
+struct TaoOptions {
+  Fraction order = Fraction(2);
+  double omega = TaoExtendedPhaseSpace::default_omega;
+  static constexpr auto members() {
+    return std::tuple{option("order", &TaoOptions::order), option("omega", &TaoOptions::omega)};
+  }
+};
+
+struct TaoScheme {
+  using Options = TaoOptions;
+  using Stepper = TaoExtendedPhaseSpace;
+  static SchemeDescription description() {
+    return {"tao",
+            "Tao's explicit symplectic integrator in extended phase space (comparator)",
+            "M. Tao, Phys. Rev. E 94, 043303 (2016)",
+            "Two copies (q, p), (x, y) bound by omega |(q, p) - (x, y)|^2 / 2; Strang splitting of the three "
+            "exactly solvable parts (order 2), triple jumps for 4 and 6. Explicit; symplectic and symmetric on "
+            "the extended phase space, not on (q, p) alone. Cost 3^(order/2) grad H per step plus 1 at the "
+            "start. Reports the largest distance between the copies (summary.json comparator.max_copy_distance)." +
+                comparator_scheme::cost_note,
+            "comparator",
+            true,
+            true,
+            {order_parameter("2", "2, 4 or 6"),
+             number_parameter("omega", "20",
+                              "binding of the two copies, finite and > 0; Tao's error bound grows "
+                              "with omega and needs dt << omega^(-1/order)")},
+            1,
+            {Fraction(2), Fraction(4), Fraction(6)}};
+  }
+  // Order 2, 4 or 6: the Strang step and its triple jumps.
+  static Stepper make(const Options& options, HamiltonianForm form) {
+    const Fraction& order = options.order;
+    if (order.denominator() != 1 || (order.numerator() != 2 && order.numerator() != 4 && order.numerator() != 6))
+      throw InvalidArgument("Tao's extended phase-space integrator has orders 2, 4 and 6 (found " + order.to_string() +
+                            ")");
+    return Stepper(form, static_cast<int>(order.numerator()), options.omega);
+  }
+};
+
+struct ImplicitMidpointOptions {
+  int max_iterations = GaussLegendre::default_max_iterations;
+  static constexpr auto members() {
+    return std::tuple{option("max_iterations", &ImplicitMidpointOptions::max_iterations)};
+  }
+};
+
+struct ImplicitMidpointScheme {
+  using Options = ImplicitMidpointOptions;
+  using Stepper = GaussLegendre;
+  static SchemeDescription description() {
+    return {"implicit_midpoint",
+            "Implicit midpoint rule (comparator)",
+            "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VIII.6",
+            "z' = z + dt f((z + z')/2), Gauss-Legendre with 1 stage; order 2, symplectic and symmetric. Solved by "
+            "fixed-point iteration from Z = 0 (no Newton), 1 grad H per state per iteration. Stopping rule per "
+            "state: converged when the relative change of the stages is <= 1 ulp, or stops decreasing while "
+            "<= 64 ulp; failed when an iterate is not finite or after max_iterations: the trajectory then "
+            "retires with status failed and the reason, never with an inaccurate step." +
+                comparator_scheme::cost_note,
+            "comparator",
+            true,
+            true,
+            {comparator_scheme::max_iterations_parameter()},
+            1,
+            {Fraction(2)}};
+  }
+  static Stepper make(const Options& options, HamiltonianForm form) { return Stepper(form, 2, options.max_iterations); }
+};
+
+struct GaussOptions {
+  int stages = 2;
+  int max_iterations = GaussLegendre::default_max_iterations;
+  static constexpr auto members() {
+    return std::tuple{option("stages", &GaussOptions::stages), option("max_iterations", &GaussOptions::max_iterations)};
+  }
+};
+
+struct GaussScheme {
+  using Options = GaussOptions;
+  using Stepper = GaussLegendre;
+  static SchemeDescription description() {
+    return {"gauss",
+            "Gauss-Legendre collocation (comparator)",
+            "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6",
+            "s-stage Gauss-Legendre Runge-Kutta method on Hamilton's equations of H, order 2s; symplectic and "
+            "symmetric. Fixed-point iteration from Z = 0 (no Newton), s grad H per state per iteration, with the "
+            "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed)." +
+                comparator_scheme::cost_note,
+            "comparator",
+            true,
+            true,
+            {number_parameter("stages", "2", "number of stages s: 1, 2 or 3 (orders 2, 4, 6)"),
+             comparator_scheme::max_iterations_parameter()},
+            1,
+            {Fraction(2), Fraction(4), Fraction(6)}};
+  }
+  static Stepper make(const Options& options, HamiltonianForm form) {
+    if (options.stages < 1 || options.stages > 3)
+      throw InvalidArgument("Gauss-Legendre collocation has 1, 2 or 3 stages (orders 2, 4, 6); found " +
+                            std::to_string(options.stages));
+    return Stepper(form, 2 * options.stages, options.max_iterations);
+  }
+};
+
+}  // namespace nonsep

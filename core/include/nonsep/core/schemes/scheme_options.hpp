@@ -1,0 +1,111 @@
+#pragma once
+// A scheme's options: one struct per scheme with typed members (ChinOptions, TaoOptions, GaussOptions, ...), each
+// naming its members as the catalogue names the options (ParameterDescription::name), so that a reader that knows
+// only the names (the job reader, a checkpoint's fingerprint, a summary) sets and reads them:
+//
+//   struct TaoOptions {
+//     Fraction order = Fraction(2);
+//     double omega = 20.0;
+//     static constexpr auto members() { return std::tuple{option("order", &TaoOptions::order), ...}; }
+//   };
+//
+// Members are Fraction (an order), double or int. A job file gives an order as a Fraction and every other option as
+// a number (OptionValue); an int member takes only a whole number.
+#include <cmath>
+#include <concepts>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <type_traits>
+#include <variant>
+
+#include "nonsep/core/base/error.hpp"
+#include "nonsep/core/base/fraction.hpp"
+#include "nonsep/core/schemes/integrator_description.hpp"
+
+namespace nonsep {
+
+// An option's value as a job file gives it: a Fraction for an order, a number otherwise.
+using OptionValue = std::variant<Fraction, double>;
+
+// One member of an options struct and its catalogue name.
+template <class Options, class T>
+struct OptionMember {
+  const char* name;
+  T Options::*member;
+};
+template <class Options, class T>
+constexpr OptionMember<Options, T> option(const char* name, T Options::*member) {
+  return {name, member};
+}
+
+template <class O>
+concept SchemeOptions = std::default_initializable<O> && std::copyable<O> && requires {
+  O::members();
+};
+
+// `value` as an int option `name`, or InvalidArgument naming it when it is not a whole number.
+inline int whole_number(double value, const std::string& name) {
+  if (!std::isfinite(value) || value != std::floor(value) || std::abs(value) > 1e9)
+    throw InvalidArgument(name + " must be a whole number (found " + std::to_string(value) + ")");
+  return static_cast<int>(value);
+}
+
+// Calls f(member) for the member of `options` named `name`; std::logic_error when there is none (a programming
+// error: the catalogue entry names an option its options struct lacks; the host's tests read every option).
+template <SchemeOptions O, class F>
+void with_option_member(O& options, const std::string& name, F&& f) {
+  bool found = false;
+  std::apply(
+      [&](const auto&... members) {
+        ((!found && name == members.name ? (f(options.*members.member), found = true) : false), ...);
+      },
+      O::members());
+  if (!found)
+    throw std::logic_error("the options of this scheme have no member for the catalogue option '" + name + "'");
+}
+
+// The option `name` of `options`, as a job file would give it (an int as a double).
+template <SchemeOptions O>
+OptionValue read_option(const O& options, const std::string& name) {
+  OptionValue value;
+  O copy = options;  // with_option_member hands out members to write; here they are only read
+  with_option_member(copy, name, [&](const auto& member) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(member)>, Fraction>)
+      value = member;
+    else
+      value = static_cast<double>(member);
+  });
+  return value;
+}
+
+// Sets option `name` of `options` to `value`: a Fraction for a Fraction member, a number otherwise
+// (std::logic_error for the other kind; InvalidArgument for an int member and a number that is not whole).
+template <SchemeOptions O>
+void write_option(O& options, const std::string& name, const OptionValue& value) {
+  with_option_member(options, name, [&](auto& member) {
+    using T = std::decay_t<decltype(member)>;
+    if constexpr (std::is_same_v<T, Fraction>) {
+      if (const auto* given = std::get_if<Fraction>(&value)) return void(member = *given);
+    } else if (const auto* given = std::get_if<double>(&value)) {
+      if constexpr (std::is_same_v<T, int>)
+        member = whole_number(*given, name);
+      else
+        member = *given;
+      return;
+    }
+    throw std::logic_error("option '" + name + "' set with a value of the other kind");
+  });
+}
+
+// How the catalogue describes an option.
+inline ParameterDescription number_parameter(const std::string& name, const std::string& default_text,
+                                             const std::string& description, bool nonzero = false) {
+  return {name, ParameterDescription::Kind::Number, default_text, description, nonzero};
+}
+inline ParameterDescription order_parameter(const std::string& default_order, const std::string& which) {
+  return {"order", ParameterDescription::Kind::Order, default_order,
+          "order of convergence as an exact fraction; " + which, false};
+}
+
+}  // namespace nonsep
