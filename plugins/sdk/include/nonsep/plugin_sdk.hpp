@@ -149,7 +149,7 @@ class PluginTable {
                                  {"energy_TTV", Adapter::analytic_energy_TTV},
                                  {"energy_VVT", Adapter::analytic_energy_VVT},
                                  {"hvp_H", Adapter::has_hamiltonian_hessian},
-                                 {"chin_tangent_steps", true}}},
+                                 {"chin_tangent_steps", NONSEP_SDK_TANGENT_KERNELS != 0}}},
                                {"derivatives",
                                 {{"grad_T", kind(Adapter::analytic_grad_T)},
                                  {"grad_V", kind(Adapter::analytic_grad_V)},
@@ -414,7 +414,7 @@ class PluginTable {
       Adapter::analytic_energy_TTV ? &product_energy<HamiltonianForm::TTV> : nullptr,
       Adapter::analytic_energy_VVT ? &product_energy<HamiltonianForm::VVT> : nullptr,
       Adapter::has_hamiltonian_hessian ? &hvp_H : nullptr,
-      &chin_tangent_steps,
+      NONSEP_SDK_TANGENT_KERNELS ? &chin_tangent_steps : nullptr,
   };
 };
 

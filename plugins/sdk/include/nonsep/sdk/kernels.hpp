@@ -46,6 +46,14 @@ namespace nonsep::sdk {
 #ifndef NONSEP_SDK_SEPARATE_KERNEL_UNITS
 #define NONSEP_SDK_SEPARATE_KERNEL_UNITS 0
 #endif
+// Whether the plugin carries the tangent kernels (chin_tangent_steps): 1 when built by nonsep_add_model(...
+// TANGENT_KERNELS). They make a Lyapunov, MEGNO, SALI or GALI run of a Chin scheme about as fast as a hand-written
+// tangent step, and cost their compile time: radial's plugin builds in 14 s of wall time on two idle cores without
+// them and 71 s with them (docs/writing-models.md). Without them the host steps tangent vectors through the
+// evaluation path.
+#ifndef NONSEP_SDK_TANGENT_KERNELS
+#define NONSEP_SDK_TANGENT_KERNELS 0
+#endif
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX__)
 #define NONSEP_SDK_KERNEL_V3 \
   (NONSEP_SDK_KERNEL_UNIT == 0 ? (NONSEP_SDK_WIDE_KERNEL_SETS & 1) : NONSEP_SDK_KERNEL_UNIT == 1)
@@ -100,6 +108,7 @@ struct ChinKernels {
   }
 #endif
 
+#if NONSEP_SDK_TANGENT_KERNELS
   // The tangent kernels (chin_tangent_kernel_blocks), one per instruction set as above.
   [[gnu::flatten]] static void tangent_baseline(const Adapter& adapter, const ChinTangentStepsCall& call) {
     chin_tangent_kernel_blocks<fixed_dimension>(adapter, call);
@@ -117,8 +126,14 @@ struct ChinKernels {
   }
 #endif
 
-  // As run, for a tangent call.
-  static bool run_tangent(std::size_t index, const Adapter& adapter, const ChinTangentStepsCall& call) {
+#endif
+
+  // As run, for a tangent call; false for every set when the plugin carries no tangent kernels.
+  static bool run_tangent([[maybe_unused]] std::size_t index, [[maybe_unused]] const Adapter& adapter,
+                          [[maybe_unused]] const ChinTangentStepsCall& call) {
+#if !NONSEP_SDK_TANGENT_KERNELS
+    return false;
+#else
     std::size_t set = 0;
     if (index == set++) {
       tangent_baseline(adapter, call);
@@ -145,6 +160,7 @@ struct ChinKernels {
     }
 #endif
     return false;
+#endif
   }
 
   static bool run(std::size_t index, const Adapter& adapter, const ChinStepsCall& call) {
@@ -181,12 +197,16 @@ struct ChinKernels {
   static void run_unit(const Adapter& adapter, const ChinStepsCall& call) {
     !call.weights.empty() ? v3<true>(adapter, call) : v3<false>(adapter, call);
   }
+#if NONSEP_SDK_TANGENT_KERNELS
   static void run_tangent_unit(const Adapter& adapter, const ChinTangentStepsCall& call) { tangent_v3(adapter, call); }
+#endif
 #elif NONSEP_SDK_KERNEL_UNIT == 2 && NONSEP_SDK_KERNEL_V4
   static void run_unit(const Adapter& adapter, const ChinStepsCall& call) {
     !call.weights.empty() ? v4<true>(adapter, call) : v4<false>(adapter, call);
   }
+#if NONSEP_SDK_TANGENT_KERNELS
   static void run_tangent_unit(const Adapter& adapter, const ChinTangentStepsCall& call) { tangent_v4(adapter, call); }
+#endif
 #endif
 };
 
@@ -201,10 +221,16 @@ struct ChinKernels {
                                                                  const ::nonsep::ChinStepsCall& call) {                \
     ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_unit(*static_cast<const __VA_ARGS__*>(adapter), call);                \
   }                                                                                                                    \
+  NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(__VA_ARGS__)
+#if NONSEP_SDK_TANGENT_KERNELS
+#define NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(...)                                                                     \
   void NONSEP_SDK_KERNEL_UNIT_FUNCTION(tangent_, NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                          \
                                                                          const ::nonsep::ChinTangentStepsCall& call) { \
     ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_tangent_unit(*static_cast<const __VA_ARGS__*>(adapter), call);        \
   }
+#else
+#define NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(...)
+#endif
 #else
 #define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)
 #endif
