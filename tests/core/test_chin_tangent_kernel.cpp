@@ -68,7 +68,7 @@ IntegratorSpec spec_of(const std::string& scheme, HamiltonianForm form) {
   IntegratorSpec spec;
   spec.scheme = scheme;
   spec.form = form;
-  if (scheme == "triplet") spec.order = Fraction(4, 3);
+  if (scheme == "triplet") spec.options = ChinOptions{Fraction(4, 3)};
   return spec;
 }
 
@@ -130,7 +130,7 @@ TEST_CASE("tangent kernel: a model without one, an expansion, or a model refusin
   CHECK_FALSE(basic.step_kernel_n(plain, x, v, 0.01, 5));
   CHECK_FALSE(basic.step_kernel_n(refusing, x, v, 0.01, 5));
   IntegratorSpec mpe = spec_of("mpe", HamiltonianForm::TTV);
-  mpe.order = Fraction(4, 3);
+  mpe.options = ChinOptions{Fraction(4, 3)};
   const WithTangentKernel<Paper1DModel, 1> kernel{};
   CHECK_FALSE(TangentIntegrator(mpe, 1).step_kernel_n(kernel, x, v, 0.01, 5));
   CHECK(kernel.calls == 0);

@@ -216,11 +216,11 @@ struct ChinKernels {
 #if NONSEP_SDK_KERNEL_UNIT != 0 && (NONSEP_SDK_KERNEL_V3 || NONSEP_SDK_KERNEL_V4)
 #define NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(prefix, unit) ::nonsep::sdk::prefix##kernel_unit_##unit
 #define NONSEP_SDK_KERNEL_UNIT_FUNCTION(prefix, unit) NONSEP_SDK_KERNEL_UNIT_FUNCTION_OF(prefix, unit)
-#define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)                                                                             \
-  void NONSEP_SDK_KERNEL_UNIT_FUNCTION(, NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                                  \
-                                                                 const ::nonsep::ChinStepsCall& call) {                \
-    ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_unit(*static_cast<const __VA_ARGS__*>(adapter), call);                \
-  }                                                                                                                    \
+#define NONSEP_SDK_DEFINE_KERNEL_UNIT(...)                                                              \
+  void NONSEP_SDK_KERNEL_UNIT_FUNCTION(, NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                   \
+                                                                 const ::nonsep::ChinStepsCall& call) { \
+    ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_unit(*static_cast<const __VA_ARGS__*>(adapter), call); \
+  }                                                                                                     \
   NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(__VA_ARGS__)
 #if NONSEP_SDK_TANGENT_KERNELS
 #define NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(...)                                                                     \
