@@ -31,6 +31,9 @@ long_runs=(
   '^MEGNO: <Y> -> 2 within 5%'
   '^chaotic orbit: SALI below 1e-8 by t = 50'
   '^regular orbits: SALI stays above 1e-5 to t = 200'
+  '^comparators with tangent vectors: killed and resumed'
+  '^host.sweep$'
+  '^formula commands: formulas at the length limit compile'
 )
 exclude=$(IFS='|'; echo "${long_runs[*]}")
 start=$SECONDS
