@@ -48,7 +48,7 @@ namespace nonsep::sdk {
 #endif
 // Whether the plugin carries the tangent kernels (chin_tangent_steps): 1 when built by nonsep_add_model(...
 // TANGENT_KERNELS). They make a Lyapunov, MEGNO, SALI or GALI run of a Chin scheme about as fast as a hand-written
-// tangent step, and cost their compile time: radial's plugin builds in 14 s of wall time on two idle cores without
+// tangent step, and cost their compile time: radial's plugin builds in 12 s of wall time on two idle cores without
 // them and 71 s with them (docs/writing-models.md). Without them the host steps tangent vectors through the
 // evaluation path.
 #ifndef NONSEP_SDK_TANGENT_KERNELS
