@@ -71,6 +71,8 @@ const nonsep_plugin_api table = {
     nullptr,  // chin_steps
     nullptr,  // energy_TTV
     nullptr,  // energy_VVT
+    nullptr,  // hvp_H
+    nullptr,  // chin_tangent_steps
 };
 
 }  // namespace
