@@ -57,13 +57,12 @@ def job_file(name, hdf5=False):
 
 
 def comparable_summary(folder):
-    """summary.json but for what a resume changes by design (docs/outputs.md): wall_seconds, the folder, the kernel
-    calls of the last process and the evaluation counts (a resumed unit evaluates the first gradient again)."""
+    """summary.json but for what a resume changes by design (docs/outputs.md): wall_seconds, the folder and the
+    evaluation counts (a resumed unit evaluates the first gradient again)."""
     summary = json.loads((folder / "summary.json").read_text())
     summary.pop("wall_seconds")
     summary.pop("evaluations")
     summary["output"].pop("directory")
-    summary["stepping"].pop("kernel_calls")
     return summary
 
 

@@ -1,12 +1,15 @@
-// The `nonsep` executable's ensemble driver: results that do not depend on the number of threads, on stepping in
-// chunks or sample by sample, nor on replaying a chunk; the --threads option.
+// The `nonsep` executable's ensemble driver: results that do not depend on the number of threads, on where chunks
+// end, on stepping in chunks or sample by sample, nor on replaying a chunk; the --threads option.
 #include <doctest/doctest.h>
 
+#include <filesystem>
+#include <map>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "host_run_support.hpp"
+#include "nonsep/host/launch/run_job.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
@@ -54,6 +57,103 @@ TEST_CASE(
     CHECK(summaries[1] == summaries[0]);
     CHECK(summaries[2] == summaries[0]);
   }
+}
+
+namespace {
+
+// Every file a run of `job` writes, read back (summary.json without its wall time and folder), with chunks of
+// `chunk_seconds` on two threads.
+std::map<std::string, std::string> run_in_chunks(const TemporaryFolder& folder, const std::string& name,
+                                                 const json& job, double chunk_seconds) {
+  const auto loaded = nonsep::host::load_job(write_job(folder / (name + ".json"), job));
+  nonsep::host::RunOptions options;
+  options.threads = 2;
+  options.chunk_seconds = chunk_seconds;
+  options.output_directory = folder / (name + "-" + std::to_string(chunk_seconds));
+  const auto outcome = nonsep::host::run_job(loaded, options);
+  REQUIRE(outcome.steps_completed > 0);
+  std::map<std::string, std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(options.output_directory)) {
+    const std::string file = entry.path().filename().string();
+    if (file == "summary.json") {
+      json summary = read_json(entry.path());
+      summary.erase("wall_seconds");
+      summary["output"].erase("directory");
+      files[file] = summary.dump();
+    } else if (file != "results.h5") {  // HDF5 holds the same numbers as the CSV files (test_host_hdf5.cpp)
+      files[file] = read_text(entry.path());
+    }
+  }
+  return files;
+}
+
+}  // namespace
+
+TEST_CASE("no output depends on where chunks end: one step each, sized by the clock, or grown eight times a chunk") {
+  // The driver sizes chunks from the clock (run/chunk_sizer.hpp), so their ends differ from run to run: every path
+  // that steps a chunk in one go must give what one step at a time gives, on the baseline kernel and on the one this
+  // processor runs by default (whose multiply-adds round differently from the evaluation path's). paper2d (its orbits
+  // diverge from step 14 on with dt = 0.01: blocks redo chunks step by step) through the state kernel (basic,
+  // triplet, mpe), the tangent kernels with all four indicators, the comparators and mpe with tangent vectors
+  // through the evaluation path, a Poincare section; blowup with states that diverge mid-run and a plugin that fails
+  // mid-run.
+  TemporaryFolder folder;
+  use_test_plugins();
+  const std::string paper2d = std::string(NONSEP_SHIPPED_PLUGIN_DIR) + "/paper2d.so";
+  json orbits = json::array();
+  for (int i = 0; i < 40; ++i) orbits.push_back({{"q", {0.5 - 0.0125 * i, 0.0}}, {"p", {0.0, 2.5 - 0.0125 * i}}});
+  const json indicators = {{"lyapunov", {{"vectors", 4}, {"renormalize_every", 10}, {"every", 50}}},
+                           {"megno", true},
+                           {"sali", true},
+                           {"gali", 4}};
+  const auto on_paper2d = [&](json integrator, json analysis) {
+    json job = {{"model", {{"plugin", paper2d}, {"parameters", {{"coupling", 0.2}}}}},
+                {"integrator", std::move(integrator)},
+                {"initial", orbits},
+                {"time", {{"dt", 0.01}, {"steps", 300}}},
+                {"output", {{"every", 0}}}};
+    if (!analysis.is_null()) job["analysis"] = std::move(analysis);
+    return job;
+  };
+  json diverging = json::array();
+  for (int i = 0; i < 30; ++i) diverging.push_back(state(0.8 + 0.01 * i, 0.5));
+  json diverging_job = blowup_job(diverging);
+  diverging_job["time"] = {{"dt", 0.001}, {"steps", 500}};
+  diverging_job["output"] = {{"every", 0}};
+  json failing_job = diverging_job;
+  failing_job["model"]["parameters"] = {{"fail_above", 2.0}};
+  const json poincare = {{"poincare", {{"component", "q1"}, {"value", 0.0}, {"direction", "+"}}}};
+  const std::vector<std::pair<std::string, json>> jobs = {
+      {"basic", on_paper2d({{"scheme", "basic"}}, nullptr)},
+      {"triplet", on_paper2d({{"scheme", "triplet"}, {"order", "4/3"}}, nullptr)},
+      {"mpe", on_paper2d({{"scheme", "mpe"}, {"order", 4}}, nullptr)},
+      {"basic_tangents", on_paper2d({{"scheme", "basic"}}, indicators)},
+      {"triplet_tangents", on_paper2d({{"scheme", "triplet"}, {"order", "4/3"}}, indicators)},
+      {"mpe_tangents", on_paper2d({{"scheme", "mpe"}, {"order", 4}}, {{"lyapunov", {{"vectors", 2}}}})},
+      {"gauss_tangents", on_paper2d({{"scheme", "gauss"}, {"stages", 2}}, indicators)},
+      {"tao_tangents", on_paper2d({{"scheme", "tao"}, {"order", 4}}, {{"lyapunov", {{"vectors", 1}}}})},
+      {"poincare", on_paper2d({{"scheme", "basic"}}, poincare)},
+      {"diverging", diverging_job},
+      {"failing", failing_job}};
+  for (const std::string set : {"baseline", "default"}) {
+    CAPTURE(set);
+    if (set == "baseline")
+      ::setenv("NONSEP_INSTRUCTION_SET", "baseline", 1);
+    else
+      ::unsetenv("NONSEP_INSTRUCTION_SET");  // the processor's own choice
+    for (const auto& entry : jobs) {
+      const std::string& name = entry.first;
+      const json& job = entry.second;
+      CAPTURE(name);
+      const std::string run = name + "-" + set;
+      const auto stepwise = run_in_chunks(folder, run, job, 0.0);
+      REQUIRE(stepwise.count("trajectories.csv") == 1);
+      if (name.starts_with("basic")) CHECK(stepwise.at("trajectories.csv").find(",diverged,") != std::string::npos);
+      CHECK(run_in_chunks(folder, run, job, nonsep::host::run_chunk_seconds) == stepwise);
+      CHECK(run_in_chunks(folder, run, job, 1e6) == stepwise);
+    }
+  }
+  ::setenv("NONSEP_INSTRUCTION_SET", "baseline", 1);  // the tests' pin (test_main.cpp)
 }
 
 TEST_CASE("a plugin that declares \"thread_safe\": false runs on one thread with a note, as with --threads 1") {

@@ -36,7 +36,8 @@ EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
           run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count),
           parameter_sets(job),
           run.analysis.megno,
-          run.analysis.alignment_indices()};
+          run.analysis.alignment_indices(),
+          options.chunk_seconds};
 }
 
 // /analysis/error_estimate's second run: every trajectory with half the step (2N steps), recorded at the steps that

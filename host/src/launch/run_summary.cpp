@@ -49,7 +49,6 @@ json stepping_facts(const RunFacts& facts) {
   const bool kernel = facts.driver.kernel_calls() > 0;
   return {{"path", kernel ? "kernel" : "evaluation"},
           {"instruction_set", kernel ? json(kernels.chosen_name()) : json(nullptr)},
-          {"kernel_calls", facts.driver.kernel_calls()},
           {"plugin_kernels", kernels.instruction_sets},
           {"note", kernels.chosen && !kernel ? "every step needed the evaluation path (an every-step observer, tangent "
                                                "vectors of a scheme without a tangent kernel, or a scheme without "

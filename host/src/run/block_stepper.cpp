@@ -25,16 +25,6 @@ void BlockStepper::watch_step(Block& block, std::size_t index, Worker& worker, s
 
 void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker, std::uint64_t from,
                                  std::uint64_t to) {
-  // Through the kernel, the chunk starts from the kernel's gradient at the block's point, kept by begin_chunk: a redo
-  // after a failure starts from it whether or not the integrator had it before (a run just restored from its
-  // checkpoint has none), as a run that never stopped does.
-  if (step_watchers.empty() && !block.tangents) {
-    try {
-      block.integrator.prime(worker.stepping, block.batch);
-    } catch (const ModelError&) {
-      // The model fails there: it fails again in the chunk's steps, which the redo below isolates.
-    }
-  }
   block.begin_chunk();
   for (StepObserver* watcher : step_watchers) watcher->save_block(view(block, index, worker));
   const double dt = time.dt;
@@ -59,20 +49,38 @@ void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker
   }
 }
 
-// One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge.
+// One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge. Without every-step
+// observers the chunk it redoes went through the plugin's kernel (worker.stepping), and so does the step: the states
+// that go on keep the numbers of a chunk that never stopped, wherever chunks end, on any instruction set. A step the
+// plugin fails in goes through the evaluation path, the whole block and then state by state, so that the failed
+// states' messages and the evaluation counts are those of a step-by-step run.
 void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step) {
   const PhaseSpaceBatch before = block.batch;
   const std::optional<BlockTangents> tangents_before = block.tangents;  // vectors and the scheme's private state
   const Integrator integrator_before = block.integrator;  // the scheme's private state, for a redo state by state
-  const auto errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
-    if (block.tangents)
-      block.tangents->step_part(worker.model, x, *tangents_before, first, time.dt);
-    else if (x.count() == before.count())
-      block.integrator.step(worker.model, x, time.dt);
-    else
-      block.integrator.step_part(worker.model, x, integrator_before, first, before.count(), time.dt);
-  });
-  if (block.tangents) block.tangents->after_step(time.dt);
+  std::vector<std::string> errors(before.count());
+  bool stepped = false;
+  if (step_watchers.empty()) {
+    try {
+      block.step_n(worker.stepping, time.dt, 1);
+      stepped = true;
+    } catch (const ModelError&) {
+      block.batch = before;
+      block.tangents = tangents_before;
+      block.integrator = integrator_before;
+    }
+  }
+  if (!stepped) {
+    errors = isolate_failures(block.batch, before, [&](PhaseSpaceBatch& x, std::size_t first) {
+      if (block.tangents)
+        block.tangents->step_part(worker.model, x, *tangents_before, first, time.dt);
+      else if (x.count() == before.count())
+        block.integrator.step(worker.model, x, time.dt);
+      else
+        block.integrator.step_part(worker.model, x, integrator_before, first, before.count(), time.dt);
+    });
+    if (block.tangents) block.tangents->after_step(time.dt);
+  }
   std::vector<bool> retire(block.trajectories.size(), false);
   for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
     Departure departure{0, {block.trajectories[slot], {}}};

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "nonsep/core/base/error.hpp"
 #include "run/block.hpp"
 #include "run/block_stepper.hpp"
+#include "run/chunk_sizer.hpp"
 #include "run/worker_pool.hpp"
 
 namespace nonsep::host {
@@ -38,6 +40,7 @@ struct EnsembleDriver::Impl {
   std::vector<StepObserver*> step_watchers;
   std::unique_ptr<WorkerPool> pool;  // after `workers`: destroyed (its threads joined) before them
   BlockStepper stepper{setup.dimension, setup.time, step_watchers, energy_available};
+  ChunkSizer chunks{setup.chunk_seconds};
   std::uint64_t completed = 0;
   bool resumed = false;
   EvaluationCounts evaluations_before;
@@ -130,9 +133,7 @@ struct EnsembleDriver::Impl {
   std::uint64_t next_event(std::uint64_t from) const {
     std::uint64_t to = setup.time.steps;
     for (Observer* observer : observers) to = std::min(to, std::max(from + 1, observer->next_event(from)));
-    const std::uint64_t longest =
-        std::max<std::uint64_t>(1, run_chunk_state_steps / std::max<std::size_t>(1, active_count()));
-    return std::min(to, from + longest);
+    return std::min(to, from + chunks.longest(active_count()));
   }
 
   // Tells the observers that `trajectory` stopped; its record is final.
@@ -274,7 +275,12 @@ DriverEnd EnsembleDriver::run() {
         interrupted = true;
         break;
       }
-      d.advance(d.completed, d.next_event(d.completed));
+      const std::uint64_t from = d.completed;
+      const std::size_t active = d.active_count();
+      const auto start = std::chrono::steady_clock::now();
+      d.advance(from, d.next_event(from));
+      d.chunks.measured(d.completed - from, active,
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       for (ChunkObserver* observer : d.chunk_observers) observer->after_chunk(d.completed);
     }
     for (ChunkObserver* observer : d.chunk_observers) observer->before_finish(d.completed, interrupted);

@@ -120,19 +120,6 @@ class BasicIntegrator {
         stepper_);
   }
 
-  // Makes the first-same-as-last gradient at x's point available (through the model's kernel when it has one:
-  // ChinBasicStep::prime), for a caller that keeps a copy of this integrator to step again from x (the host's driver
-  // redoing a chunk): the copy then starts from the gradient that steps through `model` would have used. Does nothing
-  // for the schemes without one.
-  template <Model M>
-  void prime(const M& model, const PhaseSpaceBatch& x) {
-    std::visit(
-        [&](auto& stepper) {
-          if constexpr (requires { stepper.prime(model, x); }) stepper.prime(model, x);
-        },
-        stepper_);
-  }
-
   // Redoes one step for part of a batch: `part` holds states first .. first + part.count() - 1 of a batch of
   // `total` states whose step `before` (this integrator as it was before the step) was to take. A stepper with
   // private state per state takes that of those states from `before` and writes it back into its own; the others

@@ -29,6 +29,7 @@
 #include "nonsep/host/observers/progress_bar.hpp"
 #include "nonsep/host/observers/runaway.hpp"
 #include "nonsep/host/output/run_folder.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 namespace nonsep::host {
@@ -46,7 +47,8 @@ struct RunOptions {
   // Checked between chunks (a fraction of a second apart); when true the run stops with status "interrupted"
   // (set from a SIGINT handler).
   const std::atomic<bool>* stop_requested = nullptr;
-  bool resume = false;     // continue from output_directory/checkpoint.json (checkpoint_file.hpp)
+  double chunk_seconds = run_chunk_seconds;  // the wall time of a chunk (EnsembleSetup::chunk_seconds)
+  bool resume = false;                       // continue from output_directory/checkpoint.json (checkpoint_file.hpp)
   bool force = false;      // start over in a folder holding another job's results or a checkpoint (run_folder.hpp)
   unsigned threads = 0;    // worker threads; 0: all cores
   bool work_unit = false;  // a distributed run's unit (its folder's kind is "unit": run_folder.hpp)

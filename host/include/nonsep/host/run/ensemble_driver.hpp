@@ -10,11 +10,13 @@
 // blocks do not depend on the thread count (the evaluation counts do depend on the blocks when trajectories stop
 // early), so every number, and every observer's output, is the same for any number of threads.
 //
-// Chunks. From one event (an observer's next_event, the end; at most `run_chunk_state_steps` state-steps) to the
-// next, each block advances without per-step checks. When a block's chunk ends with a non-finite number or the
-// plugin fails in it, the block goes back to its state at the chunk's start (integrator and every-step observers
-// included) and redoes the chunk step by step with the checks below, so the numbers, evaluation counts and
-// statuses are those of a run checked at every step.
+// Chunks. From one event (an observer's next_event, the end; at most about `chunk_seconds` of stepping, sized from
+// the speed of the chunk before) to the next, each block advances without per-step checks. When a block's chunk ends
+// with a non-finite number or the plugin fails in it, the block goes back to its state at the chunk's start
+// (integrator and every-step observers included) and redoes the chunk step by step with the checks below, through
+// the kernel when the chunk went through it, so the numbers, evaluation counts and statuses are those of a run
+// checked at every step. Where chunks end changes no number: outputs are the same byte for byte however long the
+// chunks are.
 //
 // Per trajectory, at every step:
 //   - a state with a non-finite q or p retires as "diverged" (stop step and the first non-finite variable, e.g.
@@ -47,9 +49,9 @@
 
 namespace nonsep::host {
 
-inline constexpr std::size_t run_block_size = 256;               // the most trajectories per block
-inline constexpr std::size_t run_min_blocks = 8;                 // the fewest blocks, when there are enough states
-inline constexpr std::uint64_t run_chunk_state_steps = 1 << 20;  // largest chunk: state-steps of all active states
+inline constexpr std::size_t run_block_size = 256;  // the most trajectories per block
+inline constexpr std::size_t run_min_blocks = 8;    // the fewest blocks, when there are enough states
+inline constexpr double run_chunk_seconds = 0.1;    // the wall time a chunk aims at (chunk_sizer.hpp)
 
 // Trajectories per block for an ensemble of `trajectories`: the largest power of two from 2 up to run_block_size
 // that still cuts it into at least run_min_blocks blocks (2 for fewer states: states stepped together stay in one
@@ -89,6 +91,9 @@ struct EnsembleSetup {
   // it keeps the factors of SALI and GALI (nonsep/core/analysis/alignment_indices.hpp; tangent_vectors >= 2).
   bool megno = false;
   bool alignment_indices = false;
+  // The wall time each chunk aims at, from the speed of the chunk before (run/chunk_sizer.hpp); 0: one step each.
+  // No number depends on it.
+  double chunk_seconds = run_chunk_seconds;
 };
 
 // The driver's state between two steps, for checkpoints.

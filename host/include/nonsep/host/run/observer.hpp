@@ -15,7 +15,7 @@
 //   on_retire(...)         a trajectory stopped: early (diverged, failed, inaccurate) in the order a step-by-step
 //                          run finds them (step, then energy failures, then trajectory index), or at the end of the
 //                          run (completed, interrupted), in trajectory order. Its record is final.
-//   after_chunk(step)      after every chunk (at most run_chunk_state_steps state-steps, a fraction of a second).
+//   after_chunk(step)      after every chunk (about EnsembleSetup::chunk_seconds of stepping at most: 0.1 s).
 //   before_finish(step, interrupted)  the stepping is over, before the active states are retired.
 //   on_end()               after the last retirement: flush, close.
 // The interface is small, as Odeint's observer is one callable: Observer has the events every observer may want;
