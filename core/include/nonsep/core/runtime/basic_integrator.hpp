@@ -141,46 +141,16 @@ class BasicIntegrator {
   }
 
   // The states with retire[b] true leave the batch: a stepper with private state per state drops theirs.
-  void compact(const std::vector<bool>& retire) {
-    std::visit(
-        [&](auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>) stepper.compact(retire);
-        },
-        stepper_);
-  }
+  void compact(const std::vector<bool>& retire) { compact_private_state(stepper_, retire); }
 
   // The stepper's private state of the batch `states` it steps (empty for a stepper without one), and back: a
   // caller that checkpoints stores it (for any subset of the states, SchemeState::select) and restores it into an
   // integrator of the same spec stepping those states, which then goes on as if never stopped.
-  SchemeState save_state(const PhaseSpaceBatch& states) const {
-    return std::visit(
-        [&](const auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>)
-            return stepper.save_state(states);
-          else
-            return SchemeState{};
-        },
-        stepper_);
-  }
-  void restore_state(const SchemeState& state) {
-    std::visit(
-        [&](auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>) stepper.restore_state(state);
-        },
-        stepper_);
-  }
+  SchemeState save_state(const PhaseSpaceBatch& states) const { return save_private_state(stepper_, states); }
+  void restore_state(const SchemeState& state) { restore_private_state(stepper_, state); }
   // What the scheme reports about the steps this integrator took (Tao: omega and the largest copy distance); empty
   // for most schemes.
-  std::vector<SchemeFigure> report() const {
-    return std::visit(
-        [](const auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>)
-            return stepper.report();
-          else
-            return std::vector<SchemeFigure>{};
-        },
-        stepper_);
-  }
+  std::vector<SchemeFigure> report() const { return private_report(stepper_); }
 
   const EvaluationCounts& evaluations() const {
     return std::visit([](const auto& stepper) -> const EvaluationCounts& { return stepper.evaluations(); }, stepper_);

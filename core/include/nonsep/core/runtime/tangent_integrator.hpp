@@ -107,41 +107,11 @@ class BasicTangentIntegrator {
   }
 
   // The states with retire[b] true leave the batch (with their vectors).
-  void compact(const std::vector<bool>& retire) {
-    std::visit(
-        [&](auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>) stepper.compact(retire);
-        },
-        stepper_);
-  }
+  void compact(const std::vector<bool>& retire) { compact_private_state(stepper_, retire); }
   // The private state of the batch `states` (empty for most schemes), and back, as Integrator's.
-  SchemeState save_state(const PhaseSpaceBatch& states) const {
-    return std::visit(
-        [&](const auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>)
-            return stepper.save_state(states);
-          else
-            return SchemeState{};
-        },
-        stepper_);
-  }
-  void restore_state(const SchemeState& state) {
-    std::visit(
-        [&](auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>) stepper.restore_state(state);
-        },
-        stepper_);
-  }
-  std::vector<SchemeFigure> report() const {
-    return std::visit(
-        [](const auto& stepper) {
-          if constexpr (StepperWithPrivateState<std::decay_t<decltype(stepper)>>)
-            return stepper.report();
-          else
-            return std::vector<SchemeFigure>{};
-        },
-        stepper_);
-  }
+  SchemeState save_state(const PhaseSpaceBatch& states) const { return save_private_state(stepper_, states); }
+  void restore_state(const SchemeState& state) { restore_private_state(stepper_, state); }
+  std::vector<SchemeFigure> report() const { return private_report(stepper_); }
 
   const EvaluationCounts& evaluations() const {
     return std::visit([](const auto& s) -> const EvaluationCounts& { return s.evaluations(); }, stepper_);

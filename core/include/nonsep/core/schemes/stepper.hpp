@@ -67,6 +67,47 @@ concept StepperWithPrivateState = requires(S& stepper, const S& kept, const Phas
   { kept.report() } -> std::same_as<std::vector<SchemeFigure>>;
 };
 
+// The private state of the stepper a variant holds, for the integrators that hold one (BasicIntegrator,
+// BasicTangentIntegrator): what a StepperWithPrivateState does, nothing (an empty state, no figures) for the others.
+template <class... S>
+void compact_private_state(std::variant<S...>& stepper, const std::vector<bool>& retire) {
+  std::visit(
+      [&](auto& s) {
+        if constexpr (StepperWithPrivateState<std::decay_t<decltype(s)>>) s.compact(retire);
+      },
+      stepper);
+}
+template <class... S>
+SchemeState save_private_state(const std::variant<S...>& stepper, const PhaseSpaceBatch& states) {
+  return std::visit(
+      [&](const auto& s) {
+        if constexpr (StepperWithPrivateState<std::decay_t<decltype(s)>>)
+          return s.save_state(states);
+        else
+          return SchemeState{};
+      },
+      stepper);
+}
+template <class... S>
+void restore_private_state(std::variant<S...>& stepper, const SchemeState& state) {
+  std::visit(
+      [&](auto& s) {
+        if constexpr (StepperWithPrivateState<std::decay_t<decltype(s)>>) s.restore_state(state);
+      },
+      stepper);
+}
+template <class... S>
+std::vector<SchemeFigure> private_report(const std::variant<S...>& stepper) {
+  return std::visit(
+      [](const auto& s) {
+        if constexpr (StepperWithPrivateState<std::decay_t<decltype(s)>>)
+          return s.report();
+        else
+          return std::vector<SchemeFigure>{};
+      },
+      stepper);
+}
+
 namespace detail {
 // std::variant of the distinct types among Ts, leaving out void: one alternative per stepper type however many
 // schemes build it (gauss and implicit_midpoint build GaussLegendre).
