@@ -1,7 +1,11 @@
 #pragma once
 // Helpers for the formula tests that run `nonsep`: environment variables set for a scope, a formula twin of
-// paper1d, a job around a model, and a stand-in compiler that copies the shipped paper1d.so instead of compiling.
+// paper1d, a job around a model, its run compared with the shipped paper1d's, and a stand-in compiler that copies the
+// shipped paper1d.so instead of compiling.
+#include <doctest/doctest.h>
+
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <optional>
 #include <string>
@@ -47,6 +51,28 @@ inline json job_with(json model) {
           {"initial", {{{"q", {0.5}}, {"p", {0.25}}}, {{"q", {-1.0}}, {"p", {0.75}}}}},
           {"time", {{"dt", 0.01}, {"steps", 300}}},
           {"output", {{"every", 0}}}};
+}
+
+// Runs job_with the shipped paper1d plugin into folder/plugin and checks that the formula model's run of the same
+// job, in `formula_run`, ends at its final states to `tolerance` relative to |(q, p)| (a component passing near 0 has
+// no relative accuracy of its own). Returns the formula run (read_run).
+inline json check_final_states_match_paper1d(const TemporaryFolder& folder, const fs::path& formula_run,
+                                             double tolerance) {
+  const auto plugin_file = host_testing::write_job(folder / "plugin.json", job_with({{"plugin", "paper1d"}}));
+  REQUIRE(host_testing::run_nonsep({"run", "--quiet", "-o", (folder / "plugin").string(), plugin_file.string()},
+                                   folder.path())
+              .status == 0);
+  const json by_formula = host_testing::read_run(formula_run);
+  const json by_plugin = host_testing::read_run(folder / "plugin");
+  REQUIRE(by_formula["trajectories"].size() == 2);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json& a = by_formula["trajectories"][i]["final"];
+    const json& b = by_plugin["trajectories"][i]["final"];
+    const double scale = std::hypot(b["q"][0].get<double>(), b["p"][0].get<double>());
+    for (const char* part : {"q", "p"})
+      CHECK(std::abs(a[part][0].get<double>() - b[part][0].get<double>()) <= tolerance * scale);
+  }
+  return by_formula;
 }
 
 // A stand-in compiler, steered by variables:

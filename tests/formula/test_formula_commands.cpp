@@ -82,21 +82,7 @@ TEST_CASE(
   CHECK(!contains(second.err, "compiling"));
   CHECK(read_text(folder / "first" / "trajectories.csv") == read_text(folder / "second" / "trajectories.csv"));
 
-  const auto plugin_file = write_job(folder / "plugin.json", job_with({{"plugin", "paper1d"}}));
-  REQUIRE(
-      run_nonsep({"run", "--quiet", "-o", (folder / "plugin").string(), plugin_file.string()}, folder.path()).status ==
-      0);
-  const json by_formula = read_run(folder / "first");
-  const json by_plugin = read_run(folder / "plugin");
-  REQUIRE(by_formula["trajectories"].size() == 2);
-  // Relative to the state (q, p): a component passing near 0 has no relative accuracy of its own.
-  for (std::size_t i = 0; i < 2; ++i) {
-    const json& a = by_formula["trajectories"][i]["final"];
-    const json& b = by_plugin["trajectories"][i]["final"];
-    const double scale = std::hypot(b["q"][0].get<double>(), b["p"][0].get<double>());
-    for (const char* part : {"q", "p"})
-      CHECK(std::abs(a[part][0].get<double>() - b[part][0].get<double>()) <= 1e-13 * scale);
-  }
+  const json by_formula = check_final_states_match_paper1d(folder, folder / "first", 1e-13);
   const json record = by_formula["model"]["formula"];
   CHECK(record["T"] == "p0 + p0^3/6");
   CHECK(record["V"] == "q0^2/2 + q0^4/12");

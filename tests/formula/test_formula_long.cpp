@@ -6,7 +6,6 @@
 #include <doctest/doctest.h>
 #include <sys/resource.h>
 
-#include <cmath>
 #include <string>
 
 #include "formula_test_support.hpp"
@@ -55,18 +54,5 @@ TEST_CASE("formula commands: formulas at the length limit compile in bounded tim
   REQUIRE(run.status == 0);
   CHECK(cpu < 300);
 
-  const auto plugin_file = write_job(folder / "plugin.json", job_with({{"plugin", "paper1d"}}));
-  REQUIRE(
-      run_nonsep({"run", "--quiet", "-o", (folder / "plugin").string(), plugin_file.string()}, folder.path()).status ==
-      0);
-  const json by_formula = read_run(folder / "formula");
-  const json by_plugin = read_run(folder / "plugin");
-  REQUIRE(by_formula["trajectories"].size() == 2);
-  for (std::size_t i = 0; i < 2; ++i) {
-    const json& a = by_formula["trajectories"][i]["final"];
-    const json& b = by_plugin["trajectories"][i]["final"];
-    const double scale = std::hypot(b["q"][0].get<double>(), b["p"][0].get<double>());
-    for (const char* part : {"q", "p"})
-      CHECK(std::abs(a[part][0].get<double>() - b[part][0].get<double>()) <= 1e-12 * scale);
-  }
+  check_final_states_match_paper1d(folder, folder / "formula", 1e-12);
 }
