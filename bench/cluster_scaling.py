@@ -4,7 +4,7 @@
 Run by hand, on a machine with MPI (`nonsep --version` says "MPI: ..."):
 
   python3 bench/cluster_scaling.py [--nonsep build/bin/nonsep] [--mpirun mpirun] [--repeats 3]
-                                   [--steps 2400] [--grid 128] [--work /tmp/nonsep_cluster_scaling]
+                                   [--steps 19200] [--grid 128] [--work /tmp/nonsep_cluster_scaling]
 
 It writes one job (paper2d on the energy shell H = 7, a grid of GRID x GRID points of which about 11000 lie on the
 shell, STEPS steps of dt 0.01, a sample every STEPS/4 steps, no analysis; about 20 s on one core of a 2020s x86
@@ -41,7 +41,7 @@ root = Path(__file__).resolve().parent.parent
 parser.add_argument("--nonsep", default=str(root / "build" / "bin" / "nonsep"))
 parser.add_argument("--mpirun", default="mpirun")
 parser.add_argument("--repeats", type=int, default=3)
-parser.add_argument("--steps", type=int, default=2400)
+parser.add_argument("--steps", type=int, default=19200)
 parser.add_argument("--grid", type=int, default=128)
 parser.add_argument("--work", default="/tmp/nonsep_cluster_scaling")
 args = parser.parse_args()
