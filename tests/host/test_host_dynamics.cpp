@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "host_run_support.hpp"
@@ -158,6 +160,40 @@ TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaoti
   CHECK(summary["analysis"]["tangent_map"]["lyapunov"]["series"] == "lyapunov.csv");
 }
 
+// Every "(....hpp)" a text of `value` names, with where it was found.
+void named_headers(const json& value, const std::string& where, std::vector<std::pair<std::string, std::string>>& out) {
+  if (value.is_object() || value.is_array()) {
+    for (const auto& [key, item] : value.items()) named_headers(item, where + "/" + key, out);
+    return;
+  }
+  if (!value.is_string()) return;
+  static const std::regex header(R"(\(([A-Za-z0-9_/]+\.hpp)\))");
+  const std::string text = value.get<std::string>();
+  for (std::sregex_iterator m(text.begin(), text.end(), header), end; m != end; ++m) out.emplace_back(where, (*m)[1]);
+}
+
+TEST_CASE("the files summary.json's analysis facts name are files of the sources") {
+  TemporaryFolder folder;
+  const json analysis = {{"poincare", {{"component", "q1"}, {"max_crossings", 2}}},
+                         {"lyapunov", {{"vectors", 2}, {"renormalize_every", 5}}},
+                         {"megno", true},
+                         {"sali", true}};
+  const auto result =
+      run_named(folder, "run", paper2d_job(state2(regular_q, regular_p), {{"dt", 0.005}, {"steps", 200}}, analysis));
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  std::vector<std::pair<std::string, std::string>> headers;
+  named_headers(read_json(folder / "run/summary.json")["analysis"], "/analysis", headers);
+  CHECK(headers.size() >= 4);  // the crossing locator, the tangent map, the first vector's block, SALI's factors
+  const std::filesystem::path sources(NONSEP_SOURCE_DIR);
+  for (const auto& [where, name] : headers) {
+    CAPTURE(where);
+    CAPTURE(name);
+    // A repository path (core/include/...), or one of the host's own sources (run/..., relative to host/src).
+    CHECK((std::filesystem::is_regular_file(sources / name) ||
+           std::filesystem::is_regular_file(sources / "host/src" / name)));
+  }
+}
 TEST_CASE("the host's largest exponent and states are the core's, bit for bit, with the documented first vector") {
   TemporaryFolder folder;
   const std::uint64_t steps = 3000;

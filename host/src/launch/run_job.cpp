@@ -45,7 +45,7 @@ nlohmann::ordered_json poincare_facts(const PoincareSection& section, const Poin
           {"crossings", observer.total_crossings()},
           {"located_by",
            "a fractional step of the run's integrator from the state before the step, its length "
-           "found by TOMS 748 (core/poincare_crossing.hpp)"}};
+           "found by TOMS 748 (core/include/nonsep/core/analysis/poincare_crossing.hpp)"}};
 }
 
 nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
@@ -54,7 +54,8 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
       {"first_vector",
        "(1, 1/2, ..., 1/(2n)) over (dq, dp), normalised; vector j >= 1 starts as the unit vector of "
        "component j (run/tangent_block.hpp)"},
-      {"method", "the exact tangent map of the run's integrator (core/tangent_integrator.hpp)"}};
+      {"method",
+       "the exact tangent map of the run's integrator (core/include/nonsep/core/runtime/tangent_integrator.hpp)"}};
   if (const auto& l = analysis.lyapunov)
     facts["lyapunov"] = {{"exponents", l->vectors},
                          {"renormalize_every", l->renormalize_every},
@@ -71,7 +72,7 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
   if (analysis.alignment_indices())
     facts["alignment_indices"] =
         "the vectors of the Lyapunov exponents, with the triangular factors of their orthonormalisations "
-        "(core/alignment_indices.hpp), at the last orthonormalisation";
+        "(core/include/nonsep/core/analysis/alignment_indices.hpp), at the last orthonormalisation";
   return facts;
 }
 

@@ -8,8 +8,8 @@
 // How a crossing is found: an every-step observer. It keeps each trajectory's state before the step (taken from
 // the block at the start of every chunk, then from each step it sees) and, when s changes sign over a step in the
 // asked direction ("+": from s < 0 to s >= 0, "-": from s > 0 to s <= 0, "both"), hands the state before the step
-// to nonsep::PoincareCrossingLocator (core/poincare_crossing.hpp) with the run's own integrator, on the worker
-// thread's plugin instance: a fractional step tau of that integrator from the state before, with TOMS 748 on
+// to nonsep::PoincareCrossingLocator (nonsep/core/analysis/poincare_crossing.hpp) with the run's own integrator, on the
+// worker thread's plugin instance: a fractional step tau of that integrator from the state before, with TOMS 748 on
 // s(tau). The row is the evaluated point with the smallest |s|: on the numerical trajectory, with |s| at round-off
 // (<= 1e-12 (|normal| |(q, p)| + |value|) in the tests). H is that point's energy (empty when the plugin has no
 // Hessians). The stepping of the run itself is not changed.
