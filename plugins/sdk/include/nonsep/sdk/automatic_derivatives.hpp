@@ -6,11 +6,10 @@
 //   gradient_by_dual            grad f(x)                   one pass of Dual<double, K>
 //   hessian_by_dual             the n x n Hessian, row-major  n passes of Dual<Dual<double, K>, 1>, column j seeded
 //                                                            with e_j in the outer slot
-//   directional_third_by_dual   out_k = sum_ij f_ijk(x) u_i u_j, the gradient of u^T H(x) u: one pass of
-//                               Dual<Dual<Dual<double, K>, 1>, 1>, both outer slots seeded with u, so the
-//                               e1 e2 part is d^2/ds dt f(x + (s + t) u) with its gradient in x inside. 4 (K+1)
-//                               doubles per number: cheaper than differencing n Hessian passes, and no Hessian
-//                               is formed.
+//   directional_third_by_dual   out_k = sum_ij f_ijk(x) u_i u_j, the gradient of u^T H(x) u: mixed_third_by_dual
+//                               with a = b = u, one pass of Dual<Dual<Dual<double, K>, 1>, 1>, so the e1 e2 part is
+//                               d^2/ds dt f(x + (s + t) u) with its gradient in x inside. 4 (K+1) doubles per
+//                               number: cheaper than differencing n Hessian passes, and no Hessian is formed.
 //   hessian_vector_by_dual      out = H(x) v, one column pass of hessian_by_dual with the outer slot seeded with v
 //                               instead of e_j: the cost of a single Hessian column.
 //   mixed_third_by_dual         out_k = sum_ij f_kij(x) a_i b_j, one pass of ThirdDerivativeDual<K> with the outer
@@ -94,22 +93,6 @@ double hessian_by_dual(const F& f, const double* x, std::size_t n, double* out) 
 }
 
 template <std::size_t K, class F>
-double directional_third_by_dual(const F& f, const double* x, const double* u, std::size_t n, double* out) {
-  using Inner = Dual<double, K>;
-  using Middle = Dual<Inner, 1>;
-  using D = ThirdDerivativeDual<K>;
-  std::array<D, K> xs;
-  for (std::size_t i = 0; i < n; ++i) {
-    xs[i].value.value = Inner::variable(x[i], i);
-    xs[i].value.derivative[0] = Inner(u[i]);
-    xs[i].derivative[0] = Middle(u[i]);
-  }
-  const D y = f(Vector<D>(xs.data(), n));
-  for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[k];
-  return y.value.value.value;
-}
-
-template <std::size_t K, class F>
 double mixed_third_by_dual(const F& f, const double* x, const double* a, const double* b, std::size_t n, double* out) {
   using Inner = Dual<double, K>;
   using Middle = Dual<Inner, 1>;
@@ -123,6 +106,11 @@ double mixed_third_by_dual(const F& f, const double* x, const double* a, const d
   const D y = f(Vector<D>(xs.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[k];
   return y.value.value.value;
+}
+
+template <std::size_t K, class F>
+double directional_third_by_dual(const F& f, const double* x, const double* u, std::size_t n, double* out) {
+  return mixed_third_by_dual<K>(f, x, u, u, n, out);
 }
 
 template <std::size_t K, class F>
