@@ -140,6 +140,28 @@ TEST_CASE("steps instead of t_end: exactly that many steps of dt") {
   CHECK_FALSE(parsed.job.run().time.from_t_end);
 }
 
+TEST_CASE("a time grid subdivided into m: m times the steps, of dt / m, ending where it ends") {
+  for (const json& time : {json{{"dt", 0.005}, {"t_end", 0.3863765573361232}}, json{{"dt", 0.1}, {"steps", 7}}}) {
+    CAPTURE(time);
+    const auto parsed = parse(with_time(time));
+    REQUIRE(parsed.issues.empty());
+    const TimeGrid& grid = parsed.job.run().time;
+    for (const std::uint64_t m : {1, 2, 3}) {
+      CAPTURE(m);
+      const TimeGrid fine = grid.subdivided(m);
+      CHECK(fine.steps == grid.steps * m);
+      CHECK(fine.from_t_end == grid.from_t_end);
+      CHECK(fine.dt_requested == grid.dt_requested / static_cast<double>(m));
+      // Read as the job reader reads a job with that step, wherever the grid came from.
+      const TimeGrid read = grid.from_t_end ? TimeGrid::to_end(grid.t_end, fine.dt_requested, fine.steps)
+                                            : TimeGrid::of_steps(fine.steps, fine.dt_requested);
+      CHECK(fine.dt == read.dt);
+      CHECK(fine.t_end == read.t_end);
+      if (grid.from_t_end) CHECK(fine.t_end == grid.t_end);
+    }
+  }
+}
+
 TEST_CASE("time: the problems of dt, t_end and steps") {
   CHECK(paths(parse(with_time({{"dt", 0.01}, {"t_end", -1.0}})).issues) == std::vector<std::string>{"/time/t_end"});
   CHECK(paths(parse(with_time({{"dt", 0.0}, {"steps", 3}})).issues) == std::vector<std::string>{"/time/dt"});

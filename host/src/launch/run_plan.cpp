@@ -46,8 +46,7 @@ FineRun run_finer(const LoadedJob& loaded, const RunOptions& options) {
   const SingleRun& run = loaded.job.run();
   const TimeGrid& time = run.time;
   EnsembleSetup setup = driver_setup(loaded, options);
-  setup.time = time.from_t_end ? TimeGrid::to_end(time.t_end, time.dt_requested / 2, 2 * time.steps)
-                               : TimeGrid::of_steps(2 * time.steps, time.dt / 2);
+  setup.time = time.subdivided(2);
   setup.tangent_vectors = 0;
   FineRun fine(loaded.job.initial.count, loaded.job.initial.dimension, error_estimate_steps(time.steps, run.every));
   EnsembleDriver driver(loaded.plugin, loaded.model, setup);

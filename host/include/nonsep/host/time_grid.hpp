@@ -39,6 +39,13 @@ struct TimeGrid {
   static TimeGrid of_steps(std::uint64_t steps, double dt) {
     return {dt, dt, steps, static_cast<double>(steps) * dt, false};
   }
+
+  // The same run with every step cut into m: m times the steps, of dt / m (and dt_requested / m), ending where this
+  // one ends. For /analysis/error_estimate's run with half the step (m = 2) and the step that scheme auto chose.
+  TimeGrid subdivided(std::uint64_t m) const {
+    const double parts = static_cast<double>(m);
+    return from_t_end ? to_end(t_end, dt_requested / parts, steps * m) : of_steps(steps * m, dt / parts);
+  }
 };
 
 }  // namespace nonsep::host
