@@ -62,6 +62,20 @@ TEST_CASE("formula commands: validate checks a formula job's parameters and dime
   CHECK(contains(run.err, "apt-get install g++"));
 }
 
+TEST_CASE("formula commands: a model written with q1 and q2 for two coordinates is told that components count from 0") {
+  TemporaryFolder folder;
+  Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");
+  json job = job_with({{"formula", {{"T", "p1^2/2 + p2^2/2"}, {"V", "q1^2/2 + q2^2/2 + q1^2 * q2^2"}}}});
+  job["initial"] = {{"q", {0.5, 0.25}}, {"p", {0.0, 0.1}}};
+  const auto result = run_nonsep({"validate", write_job(folder / "job.json", job).string()}, folder.path());
+  INFO(result.err);
+  CHECK(result.status == 2);
+  CHECK(contains(result.err, "/initial/q: found 2 components"));
+  CHECK(contains(result.err, "3, the dimension of the model"));
+  CHECK(contains(result.err, "the largest index its formulas use plus one"));
+  CHECK(contains(result.err, "components count from 0, q0 .. q2"));
+}
+
 TEST_CASE(
     "formula commands: a compiled formula model gives the hand-written plugin's states, and the cache is reused") {
   TemporaryFolder folder;

@@ -77,7 +77,7 @@ std::optional<Job> read_formula_job(const std::string& job_file) {
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
   check_model_parameters(job->parameters, formula::declared_parameters(*job->formula), issues);
   check_swept_parameters(*job, formula::declared_parameters(*job->formula), issues);
-  check_dimension(job->initial, job->formula->dimension, issues);
+  check_dimension(job->initial, job->formula->dimension, issues, true);
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
   return job;
 }

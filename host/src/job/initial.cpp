@@ -226,16 +226,21 @@ InitialStates read_initial(Checker& check, const json& document, const std::file
 
 namespace nonsep::host {
 
-void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues) {
+void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues,
+                     bool formula) {
   if (initial.count == 0 || initial.dimension == model_dimension) return;
   const std::string path = initial.shape == "list"   ? "/initial/0/q"
                            : initial.shape == "grid" ? "/initial/grid/q"
                            : initial.shape == "file" ? "/initial/file"
                                                      : "/initial/q";
-  issues.push_back({path,
-                    std::to_string(initial.dimension) + (initial.shape == "grid" ? " axes" : " components") +
-                        (initial.shape == "list" && initial.count > 1 ? " (in every state)" : ""),
-                    std::to_string(model_dimension) + ", the dimension of the model (for q and p alike)"});
+  issues.push_back(
+      {path,
+       std::to_string(initial.dimension) + (initial.shape == "grid" ? " axes" : " components") +
+           (initial.shape == "list" && initial.count > 1 ? " (in every state)" : ""),
+       std::to_string(model_dimension) + ", the dimension of the model (for q and p alike" +
+           (formula ? "; the largest index its formulas use plus one, or its \"dimension\"" : "") +
+           "): components count from 0, " +
+           (model_dimension == 1 ? std::string("q0 only") : "q0 .. q" + std::to_string(model_dimension - 1))});
 }
 
 }  // namespace nonsep::host

@@ -98,7 +98,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   if (job.formula) {
     // What `nonsep validate` checks without the compiler comes first: a job with any problem compiles nothing.
     check_model_parameters(job.parameters, formula::declared_parameters(*job.formula), issues);
-    check_dimension(job.initial, job.formula->dimension, issues);
+    check_dimension(job.initial, job.formula->dimension, issues, true);
     if (!issues.empty() || !attach_formula_plugin(job, issues)) return std::nullopt;
   }
   if (job.plugin.empty()) return std::nullopt;

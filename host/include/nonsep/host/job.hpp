@@ -249,8 +249,11 @@ void check_model_parameters(const nlohmann::json& given, const std::vector<Plugi
 void check_swept_parameters(const Job& job, const std::vector<PluginParameter>& declared,
                             std::vector<JobIssue>& issues);
 
-// Pass 3 (dimension). Checks the initial states against the model's dimension.
-void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues);
+// Pass 3 (dimension). Checks the initial states against the model's dimension; the issue says that components count
+// from 0 (q0 .. q<n-1>) and, for a formula model (`formula`), that its dimension is the largest index its formulas
+// use plus one, so that q1 and q2 written for two coordinates read as the three they are.
+void check_dimension(const InitialStates& initial, std::size_t model_dimension, std::vector<JobIssue>& issues,
+                     bool formula = false);
 
 // A job ready to run: the checked job, its plugin and a model instance created with the job's parameters (those of
 // the first parameter set of a sweep).
