@@ -12,7 +12,8 @@ Which executable: the first of
   3. `nonsep` on PATH.
 
 A job is a path to a job file or a dict. A dict is written to a temporary job file, so relative paths inside it
-(model.plugin given as a path, output.directory) are made absolute first, against the current working directory.
+(model.plugin given as a path, model.formula given as a model file, initial.file, output.directory) are
+made absolute first, against the current working directory.
 A dict without output.directory, run without `output`, writes into a new folder made by tempfile.mkdtemp()
 (Result.directory says where).
 """
@@ -214,16 +215,27 @@ def _job_file(job, workspace):
         return path, None  # the host reports it
 
 
+# The job file's keys that hold paths (docs/job-file.md: each relative to the job file's folder), as (section, key):
+# a dict's are made absolute against the current directory, since its job file is written to a temporary folder.
+# model.plugin is a path only when it contains '/' or ends in .so (otherwise a plugin's name); model.formula only
+# when it is a string (the path of a model file; otherwise the formulas themselves).
+_PATH_KEYS = (("model", "plugin"), ("model", "formula"), ("initial", "file"), ("output", "directory"))
+
+
+def _is_path(section, key, value):
+    if not isinstance(value, str) or not value:
+        return False
+    if (section, key) == ("model", "plugin"):
+        return "/" in value or value.endswith(".so")
+    return True
+
+
 def _absolute_paths(job):
     content = copy.deepcopy(dict(job))
-    model = content.get("model")
-    if isinstance(model, dict) and isinstance(model.get("plugin"), str):
-        plugin = model["plugin"]
-        if "/" in plugin or plugin.endswith(".so"):  # a path, not a name (docs/user-guide.md, model.plugin)
-            model["plugin"] = os.path.abspath(plugin)
-    directory = _output_directory_of(content)
-    if directory:
-        content["output"]["directory"] = os.path.abspath(directory)
+    for section, key in _PATH_KEYS:
+        part = content.get(section)
+        if isinstance(part, dict) and _is_path(section, key, part.get(key)):
+            part[key] = os.path.abspath(part[key])
     return content
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 import nonsep
+from nonsep.formula import write_formula_model
 from support import EXAMPLES, FolderTestCase, blowup_job, paper1d_job, state
 
 
@@ -48,6 +49,16 @@ class RunTest(FolderTestCase):
         self.assertEqual(result.directory.resolve(), (self.folder / "out" / "run").resolve())
         self.assertEqual(result.summary["model"]["path"], str((self.folder / "plugins" / "blowup.so").resolve()))
         self.assertEqual(result.status, "completed")
+
+    def test_a_dicts_model_file_and_initial_file_are_relative_to_the_current_directory(self):
+        os.mkdir("inputs")
+        write_formula_model("inputs/model.json", T="p0 + p0^3/6", V="q0^2/2 + q0^4/12", name="paper1d_twin")
+        Path("inputs/states.csv").write_text("q0,p0\n0.5,0.0\n2.0,0.0\n")
+        formula_job = paper1d_job({"file": "inputs/states.csv"}, steps=5)
+        formula_job["model"] = {"formula": "inputs/model.json"}
+        self.assertEqual(nonsep.validate(formula_job), [])  # validate reads both files and compiles nothing
+        result = nonsep.run(paper1d_job({"file": "inputs/states.csv"}, steps=5), output="out")
+        self.assertEqual([result.orbit(i).q[0, 0] for i in (0, 1)], [0.5, 2.0])
 
     def test_a_dict_without_output_goes_to_a_new_temporary_folder(self):
         result = nonsep.run(paper1d_job(state(1.0, 0.0), steps=5))
