@@ -8,8 +8,13 @@ core/include/nonsep/core/ and core/src/, or of host/include/nonsep/host/ and hos
 belongs to one layer. A part may include its own layer and the layers below it. Every `#include "nonsep/..."` and
 every relative `#include "..."` of every .hpp, .h and .cpp file under core/ and host/ is read (as text) and mapped
 to the part of the file it names. Prints one line per include that runs upward (the file, its line, the include,
-both layers) and a summary; `--list` also prints the arrows counted between parts. Exit status 1 when any include
-runs upward or a file belongs to no part, 0 otherwise.
+both layers) and a summary; `--list` also prints the arrows counted between parts.
+
+Public headers (core/include/nonsep/core/, host/include/nonsep/host/: what other parts, the tests and an installed
+package build on) are held to the layers like every file, and to one rule more: they include no private file (one of
+core/src/ or host/src/), which a user of the headers does not have; such an include is reported with its file and
+line. Exit status 1 when any include runs upward, a public header includes a private file, or a file belongs to no
+part, 0 otherwise.
 """
 import argparse
 import collections
@@ -63,6 +68,15 @@ def part_of(tree, path):
     return None
 
 
+def is_public(tree, path):
+    """Whether `path` (relative to the repository) is one of the tree's public headers (its first root)."""
+    try:
+        path.relative_to(ROOTS[tree][0])
+        return True
+    except ValueError:
+        return False
+
+
 def layer_of(tree, part):
     for index, parts in enumerate(LAYERS[tree]):
         if part in parts:
@@ -96,6 +110,7 @@ def main():
     if arguments.root:
         ROOT = arguments.root.resolve()
     upward, unplaced, arrows = [], [], collections.Counter()
+    private = []
     for tree in LAYERS:
         for root in ROOTS[tree]:
             if not (ROOT / root).is_dir():
@@ -116,6 +131,9 @@ def main():
                     target = target_of(tree, source, match.group(1))
                     if target is None:
                         continue
+                    if is_public(tree, source) and not isinstance(target, str) and not is_public(tree, target):
+                        private.append(f"{source}:{number}: includes {match.group(1)}: a public header includes "
+                                       f"the private file {target}")
                     target_part = target if isinstance(target, str) else part_of(tree, target)
                     target_level = layer_of(tree, target_part)
                     if target_level is None:
@@ -129,11 +147,11 @@ def main():
     if arguments.list:
         for (tree, a, b), count in sorted(arrows.items()):
             print(f"{tree}: {a} -> {b}: {count}")
-    for line in unplaced + upward:
+    for line in unplaced + upward + private:
         print(line)
     print(f"check_layers: {sum(arrows.values())} includes between parts, {len(upward)} upward, "
-          f"{len(unplaced)} outside the layers")
-    return 1 if upward or unplaced else 0
+          f"{len(private)} from public headers to private files, {len(unplaced)} outside the layers")
+    return 1 if upward or private or unplaced else 0
 
 
 if __name__ == "__main__":

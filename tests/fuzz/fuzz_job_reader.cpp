@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/json/strict_json.hpp"
 
 namespace {
 

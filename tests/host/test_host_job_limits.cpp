@@ -9,6 +9,7 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/json/strict_json.hpp"
 
 using nlohmann::json;
 using namespace nonsep::host;

@@ -11,6 +11,7 @@
 #include "host_test_support.hpp"
 #include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/host/job.hpp"
+#include "nonsep/host/json/strict_json.hpp"
 #include "nonsep/host/platform/build_features.hpp"
 
 using nlohmann::json;

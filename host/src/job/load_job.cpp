@@ -9,6 +9,7 @@
 #include "nonsep/host/formula/plugin_cache.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/json/checker.hpp"
+#include "nonsep/host/json/strict_json.hpp"
 
 namespace nonsep::host {
 

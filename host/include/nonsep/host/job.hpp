@@ -27,7 +27,6 @@
 
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/json/issues.hpp"
-#include "nonsep/host/json/strict_json.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/time_grid.hpp"
 
@@ -231,7 +230,7 @@ inline constexpr std::size_t max_hessian_values = std::size_t{1} << 27;
 // Largest job file read (64 MiB); a longer file, or a device that never ends such as /dev/zero, is an issue at "".
 inline constexpr std::size_t max_job_file_bytes = std::size_t{64} << 20;
 
-// Pass 1: parse_job_text (json/strict_json.hpp).
+// Pass 1: parse_job_text (nonsep/host/json/strict_json.hpp, included by those who call it).
 
 // Pass 2. Reads `document` into a Job, adding an issue for everything wrong. `job_file` locates relative paths
 // and names the default output folder. The returned Job is meaningful only if no issue was added.
