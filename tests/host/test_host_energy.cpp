@@ -3,11 +3,16 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "host_run_support.hpp"
 #include "nonsep/host/number_format.hpp"
+#include "nonsep/host/observers/energy_error.hpp"
+#include "nonsep/host/observers/progress_bar.hpp"
 #include "support/nan_aware.hpp"
 
 using nlohmann::json;
@@ -145,4 +150,41 @@ TEST_CASE("the largest |dH/H0| includes the last state of a trajectory that dive
   CHECK((result.out + result.err)
             .find("largest |dH/H0| " + nonsep::host::format_number(final_error) + " (trajectory 0)") !=
         std::string::npos);
+}
+
+TEST_CASE("the progress line's energy error: n/a while H was evaluated at step 0 only, then the largest so far") {
+  using nonsep::host::EnergyErrorObserver;
+  CHECK(nonsep::host::energy_error_text(std::nullopt, ", ").empty());  // no H: nothing shown
+  CHECK(nonsep::host::energy_error_text(std::nan(""), ", ") == ", max |dH/H0| n/a");
+  CHECK(nonsep::host::energy_error_text(1.2e-9, "  ") == "  max |dH/H0| 1.20e-09");
+  // Two trajectories with H0 = 2; H evaluated at step 0 (error 0), then at a sample, step 10.
+  EnergyErrorObserver energy(2, 0, std::nullopt);
+  nonsep::host::TrajectoryRecord record;
+  record.energy_initial = 2.0;
+  const std::vector<double> q{0.0}, p{0.0};
+  const auto event = [&](std::uint64_t step, double h) {
+    const std::vector<nonsep::host::StateView> states{{0, q, p, h, &record}, {1, q, p, 2.0, &record}};
+    std::vector<nonsep::host::StoppedTrajectory> retire;
+    energy.on_event({step, 0.1 * static_cast<double>(step), states, true, &retire});
+  };
+  event(0, 2.0);
+  REQUIRE(energy.largest());
+  CHECK(energy.largest()->value == 0.0);
+  CHECK_FALSE(energy.evaluated_after_start());  // a 0.00e+00 here would be the error nowhere measured
+  event(10, 2.0 + 2e-6);
+  CHECK(energy.evaluated_after_start());
+  CHECK(energy.largest()->value == doctest::Approx(1e-6));
+  // Saved and restored with a checkpoint.
+  EnergyErrorObserver resumed(2, 0, std::nullopt);
+  resumed.restore(energy.save());
+  CHECK(resumed.evaluated_after_start());
+}
+
+TEST_CASE("the time left is estimated from the steps this process ran: after a resume, those since the resumed one") {
+  using nonsep::host::remaining_seconds;
+  CHECK(remaining_seconds(10.0, 0, 50, 100) == 10.0);
+  // Resumed at step 90 of 100: 5 steps took 10 s, 5 are left: 10 s (not 10 s * 5 / 95).
+  CHECK(remaining_seconds(10.0, 90, 95, 100) == 10.0);
+  CHECK(remaining_seconds(10.0, 90, 90, 100) == 0.0);  // nothing measured yet
+  CHECK(remaining_seconds(3.0, 10, 100, 100) == 0.0);
 }

@@ -27,6 +27,7 @@ std::optional<double> EnergyErrorObserver::include(std::size_t trajectory, std::
 
 void EnergyErrorObserver::on_event(const Event& event) {
   if (!event.energy_evaluated) return;
+  if (event.step > 0) evaluated_after_start_ = true;
   for (const StateView& state : event.states) {
     if (!state.energy) continue;
     const auto error = include(state.trajectory, state.energy, state.record->energy_initial);
@@ -53,7 +54,7 @@ std::optional<LargestEnergyError> EnergyErrorObserver::largest() const {
 nlohmann::json EnergyErrorObserver::save() {
   nlohmann::json values = nlohmann::json::array();
   for (const auto& max : max_abs_) values.push_back(max ? nlohmann::json(format_number(*max)) : nlohmann::json());
-  return {{"max_abs", std::move(values)}};
+  return {{"max_abs", std::move(values)}, {"evaluated_after_start", evaluated_after_start_ ? 1 : 0}};
 }
 
 void EnergyErrorObserver::restore(const nlohmann::json& state) {
@@ -63,6 +64,7 @@ void EnergyErrorObserver::restore(const nlohmann::json& state) {
     max_abs_[i] = read.optional_number(values[i], "max_abs");
     if (max_abs_[i] && !(*max_abs_[i] >= 0.0)) read.damaged("max_abs is not a number >= 0");
   }
+  evaluated_after_start_ = read.count(read.member(state, "evaluated_after_start"), "evaluated_after_start", 1) == 1;
 }
 
 void EnergyErrorObserver::columns(std::vector<std::string>& names) const {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <utility>
 
@@ -22,6 +23,24 @@ ProgressBar::ProgressBar(ProgressStyle style, std::uint64_t total_steps, double 
                          : std::make_shared<ProgressSchedule>(ProgressSchedule{
                                start_ + (style == ProgressStyle::lines ? interval_ : std::chrono::seconds(1))})) {}
 
+double remaining_seconds(double elapsed, std::uint64_t start_step, std::uint64_t step, std::uint64_t total) {
+  if (step <= start_step) return 0.0;
+  return elapsed * static_cast<double>(total > step ? total - step : 0) / static_cast<double>(step - start_step);
+}
+
+std::string energy_error_text(std::optional<double> largest, const char* separator) {
+  if (!largest) return "";
+  if (std::isnan(*largest)) return std::string(separator) + "max |dH/H0| n/a";
+  char text[48];
+  std::snprintf(text, sizeof text, "%smax |dH/H0| %.2e", separator, *largest);
+  return text;
+}
+
+void ProgressBar::start_from(std::uint64_t step) {
+  start_step_ = step;
+  start_ = Clock::now();
+}
+
 void ProgressBar::update(std::uint64_t step, double t, std::size_t active_trajectories,
                          std::optional<double> largest_energy_error) {
   if (style_ == ProgressStyle::none) return;
@@ -29,15 +48,14 @@ void ProgressBar::update(std::uint64_t step, double t, std::size_t active_trajec
   if (now < schedule_->next_line) return;
   schedule_->next_line = now + interval_;
   const double fraction = total_ ? static_cast<double>(step) / static_cast<double>(total_) : 1.0;
-  const double elapsed = std::chrono::duration<double>(now - start_).count();
-  const double remaining = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
-  char energy[48] = "";
+  const double remaining =
+      remaining_seconds(std::chrono::duration<double>(now - start_).count(), start_step_, step, total_);
   if (style_ == ProgressStyle::lines) {
-    if (largest_energy_error) std::snprintf(energy, sizeof energy, ", max |dH/H0| %.2e", *largest_energy_error);
+    const std::string energy = energy_error_text(largest_energy_error, ", ");
     std::fprintf(stderr, "nonsep: progress: %s%st = %.6g of %.6g (%.1f%%), step %llu/%llu, %zu active%s, ETA %.0f s\n",
                  label_.c_str(), label_.empty() ? "" : ": ", t, t_end_, 100.0 * fraction,
                  static_cast<unsigned long long>(step), static_cast<unsigned long long>(total_), active_trajectories,
-                 energy, remaining);
+                 energy.c_str(), remaining);
     std::fflush(stderr);
     return;
   }
@@ -46,10 +64,10 @@ void ProgressBar::update(std::uint64_t step, double t, std::size_t active_trajec
   const int filled = static_cast<int>(fraction * width);
   for (int i = 0; i < width; ++i) bar[i] = i < filled ? '#' : '.';
   bar[width] = '\0';
-  if (largest_energy_error) std::snprintf(energy, sizeof energy, "  max |dH/H0| %.2e", *largest_energy_error);
+  const std::string energy = energy_error_text(largest_energy_error, "  ");
   std::fprintf(stderr, "\r[%s] %5.1f%%  step %llu/%llu  t = %.6g  %zu active%s  %.0f s left \033[K", bar,
                100.0 * fraction, static_cast<unsigned long long>(step), static_cast<unsigned long long>(total_), t,
-               active_trajectories, energy, remaining);
+               active_trajectories, energy.c_str(), remaining);
   std::fflush(stderr);
   drawn_ = true;
 }

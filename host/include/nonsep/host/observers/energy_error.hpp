@@ -41,11 +41,14 @@ class EnergyErrorObserver : public Observer, public CheckpointedObserver, public
   std::optional<double> max_abs(std::size_t trajectory) const { return max_abs_[trajectory]; }
   // Over the ensemble; nothing while no error is known.
   std::optional<LargestEnergyError> largest() const;
+  // Whether H was evaluated at a step after step 0 (before that, every error known is step 0's: 0).
+  bool evaluated_after_start() const { return evaluated_after_start_; }
 
  private:
   std::uint64_t energy_every_;
   std::optional<double> bound_;
   std::vector<std::optional<double>> max_abs_;
+  bool evaluated_after_start_ = false;
 
   // Takes (H - H0) / H0 of `trajectory` into its maximum and returns it (nothing when unknown).
   std::optional<double> include(std::size_t trajectory, std::optional<double> energy,

@@ -6,7 +6,9 @@
 //          first after one interval, never redrawn or erased:
 //            nonsep: progress: t = 12.5 of 50 (25.0%), step 2500/10000, 32 active, max |dH/H0| 1.2e-09, ETA 31 s
 // Both show the time reached, the fraction of the steps, the active trajectories, the largest relative energy
-// error so far (when known) and the time left, estimated from the rate so far.
+// error so far ("n/a" while H has been evaluated at step 0 only: H is evaluated at the samples, output.energy_every
+// and the last step) and the time left, estimated from the rate of this process's steps (after a resume, the steps
+// since the resumed one).
 //
 // A rank of a distributed run runs work units one after another, each with a bar of its own: its lines begin with a
 // label naming the rank and the unit, and the moment the next line is due (a ProgressSchedule) carries over from one
@@ -41,8 +43,10 @@ class ProgressBar {
   ProgressBar& operator=(const ProgressBar&) = delete;
   ~ProgressBar() { finish(); }
 
+  // The stepping starts at `step` (a resumed run's step), now: the time left is estimated from the steps after it.
+  void start_from(std::uint64_t step);
   // Called after each chunk; cheap when nothing is drawn (one clock read). Shows the largest relative energy error
-  // of the ensemble so far when it is known.
+  // of the ensemble so far when given: NaN shows as "n/a" (not known yet); nothing shows none.
   void update(std::uint64_t step, double t, std::size_t active_trajectories,
               std::optional<double> largest_energy_error = std::nullopt);
   // Erases the bar if it was drawn (lines stay).
@@ -56,9 +60,16 @@ class ProgressBar {
   double t_end_;
   Clock::duration interval_;
   Clock::time_point start_;
+  std::uint64_t start_step_ = 0;
   std::string label_;
   std::shared_ptr<ProgressSchedule> schedule_;
 };
+
+// The seconds left after `elapsed` seconds that took the steps from `start_step` to `step` of `total`, at that rate
+// (0 before the first step).
+double remaining_seconds(double elapsed, std::uint64_t start_step, std::uint64_t step, std::uint64_t total);
+// ", max |dH/H0| 1.20e-09" (or "n/a" for NaN) after `separator` ("max |dH/H0|" prefixed by it); "" for nothing.
+std::string energy_error_text(std::optional<double> largest, const char* separator);
 
 // True when file descriptor 2 is a terminal.
 bool stderr_is_terminal();
