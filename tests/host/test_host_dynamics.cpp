@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -459,4 +460,60 @@ TEST_CASE("a plugin failing while a crossing is located stops that trajectory as
   CHECK(summary["status"] == "failed");
   CHECK(summary["counts"]["failed"] == 1);
   CHECK(summary["counts"]["completed"] == 1);
+}
+
+namespace {
+
+// The runaway warnings of a run's stderr ("nonsep: warning: trajectory N: max(|q_i|, |p_i|) grew ..."), each line.
+std::vector<std::string> runaway_warnings(const std::string& err) {
+  std::vector<std::string> lines;
+  std::istringstream text(err);
+  for (std::string line; std::getline(text, line);)
+    if (line.find("runs off with bounded energy") != std::string::npos ||
+        line.find("ran off the same way") != std::string::npos)
+      lines.push_back(line);
+  return lines;
+}
+
+// max(|q_i|, |p_i|) of a trajectory.csv row of paper2d.
+double scale_of_row(const std::map<std::string, std::string>& row) {
+  double scale = 0.0;
+  for (const char* column : {"q0", "q1", "p0", "p1"}) scale = std::max(scale, std::abs(cell(row, column)));
+  return scale;
+}
+
+}  // namespace
+
+TEST_CASE("no runaway warning for paper2d's bounded orbits on the compact shell H = 8, sampled at both ends only") {
+  TemporaryFolder folder;
+  // The stability map's set-up at H = 8 with the coupling up to 0.3, Gauss 6 (stable here) and output.every the
+  // number of steps: H is evaluated at step 0 and the last step only.
+  json job = {
+      {"model", {{"plugin", "paper2d"}, {"parameters", {{"coupling", {{"from", 0.0}, {"to", 0.3}, {"count", 4}}}}}}},
+      {"integrator", {{"scheme", "gauss"}, {"stages", 3}}},
+      {"initial",
+       {{"grid", {{"q", {{{"from", -2.5}, {"to", 2.5}, {"count", 21}}, 0.0}}, {"p", {0.0, 0.0}}}},
+        {"energy", 8.0},
+        {"solve_for", "p1"}}},
+      {"time", {{"dt", 0.02}, {"t_end", 100}}},
+      {"output", {{"every", 5000}}}};
+  const auto result = run_named(folder, "run", job);
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  // What the samples alone show: orbits whose scale at the end is more than 3 times their scale at step 0, with a
+  // small energy error (what the check took for a runaway when it saw only the samples); all of them on the shell,
+  // whose extent |q|^2 <= (E - 2)/(2c), |p|^2 <= E - 2 (c = 1/30 at coupling 0.3: docs/dynamics.md) bounds them.
+  std::map<double, double> first_scale;
+  int grown = 0;
+  for (const auto& row : table(folder / "run/trajectory.csv")) {
+    const double trajectory = cell(row, "trajectory"), scale = scale_of_row(row);
+    CHECK(scale <= std::sqrt(6.0 / (2.0 / 30.0)) + 1e-9);
+    if (cell(row, "step") == 0.0)
+      first_scale[trajectory] = scale;
+    else if (scale > 3.0 * first_scale.at(trajectory) && std::abs(cell(row, "relative_energy_error")) <= 1e-2)
+      ++grown;
+  }
+  MESSAGE(grown << " of " << first_scale.size() << " orbits end more than 3 times as far out as they start");
+  CHECK(grown > 0);
+  CHECK(runaway_warnings(result.err).empty());
 }

@@ -73,7 +73,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
       energy(loaded.job.initial.count, driver.energy_available() ? loaded.job.run().energy_every : 0,
              loaded.job.run().analysis.max_relative_energy_error),
       runaway(loaded.job.initial.q, loaded.job.initial.p, loaded.job.initial.count, loaded.job.initial.dimension,
-              driver.time().t_end) {
+              driver.time()) {
   const Job& job = loaded.job;
   const SingleRun& run = job.run();
   const std::size_t count = job.initial.count;

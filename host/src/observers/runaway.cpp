@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/host/run/saved_state.hpp"
+
 namespace nonsep::host {
 
 namespace {
@@ -15,40 +18,111 @@ double scale_of(std::span<const double> q, std::span<const double> p) {
   return scale;
 }
 
+nlohmann::json number_or_null(const std::optional<double>& x) {
+  return x ? nlohmann::json(format_number(*x)) : nlohmann::json();
+}
+
 }  // namespace
 
 RunawayObserver::RunawayObserver(std::span<const double> q, std::span<const double> p, std::size_t count, std::size_t n,
-                                 double t_end)
-    : reference_until_(std::abs(t_end) / 10.0), reference_scale_(count), largest_error_(count, 0.0), runaways_(count) {
-  for (std::size_t b = 0; b < count; ++b) reference_scale_[b] = scale_of(q.subspan(b * n, n), p.subspan(b * n, n));
+                                 const TimeGrid& time)
+    : reference_until_(std::abs(time.t_end) / 10.0),
+      stride_(std::max<std::uint64_t>(1, time.steps / watched_steps)),
+      watches_(count) {
+  for (std::size_t b = 0; b < count; ++b)
+    watches_[b].reference_scale = scale_of(q.subspan(b * n, n), p.subspan(b * n, n));
 }
 
-void RunawayObserver::see(std::size_t trajectory, double t, std::span<const double> q, std::span<const double> p,
-                          std::optional<double> energy, std::optional<double> energy_initial) {
+void RunawayObserver::see_energy(std::size_t trajectory, std::optional<double> energy,
+                                 std::optional<double> energy_initial) {
   const auto error = relative_energy_error(energy, energy_initial);
   if (!error) return;
-  double& largest = largest_error_[trajectory];
-  largest = std::max(largest, std::abs(*error));
-  const double scale = scale_of(q, p);
-  double& reference = reference_scale_[trajectory];
-  if (std::abs(t) <= reference_until_) {
-    reference = std::max(reference, scale);
-    return;
-  }
-  auto& runaway = runaways_[trajectory];
-  if (!(largest <= small_error) || !(scale > growth * reference) || (runaway && scale <= runaway->scale)) return;
-  runaway = Runaway{reference, scale, t, largest};
+  auto& largest = watches_[trajectory].largest_error;
+  largest = std::max(largest.value_or(0.0), std::abs(*error));
 }
 
+// The scale at t, against the largest |dH/H0| known up to there (where H was evaluated).
+void RunawayObserver::see_scale(std::size_t trajectory, double t, std::span<const double> q,
+                                std::span<const double> p) {
+  const double scale = scale_of(q, p);
+  if (!std::isfinite(scale)) return;  // a chunk that will be redone step by step (block_stepper.hpp)
+  Watch& watch = watches_[trajectory];
+  if (std::abs(t) <= reference_until_) {
+    watch.reference_scale = std::max(watch.reference_scale, scale);
+    return;
+  }
+  if (!watch.largest_error || !(*watch.largest_error <= small_error) || !(scale > growth * watch.reference_scale) ||
+      (watch.runaway && scale <= watch.runaway->scale))
+    return;
+  watch.runaway = Runaway{watch.reference_scale, scale, t, *watch.largest_error};
+}
+
+// Only the events where H was evaluated: their steps are the job's (the others end chunks sized by the clock).
 void RunawayObserver::on_event(const Event& event) {
   if (!event.energy_evaluated) return;
-  for (const StateView& state : event.states)
-    see(state.trajectory, event.t, state.q, state.p, state.energy, state.record->energy_initial);
+  for (const StateView& state : event.states) {
+    see_energy(state.trajectory, state.energy, state.record->energy_initial);
+    see_scale(state.trajectory, event.t, state.q, state.p);
+  }
 }
 
 void RunawayObserver::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
-  if (!record.final_q.empty())
-    see(trajectory, record.final_t, record.final_q, record.final_p, record.energy_final, record.energy_initial);
+  if (record.final_q.empty()) return;
+  see_energy(trajectory, record.energy_final, record.energy_initial);
+  see_scale(trajectory, record.final_t, record.final_q, record.final_p);
+}
+
+void RunawayObserver::on_step(std::uint64_t, double t, const BlockView& block) {
+  const std::size_t n = block.dimension;
+  for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
+    see_scale(block.trajectories[slot], t, block.q.subspan(slot * n, n), block.p.subspan(slot * n, n));
+}
+
+void RunawayObserver::save_block(const BlockView& block) {
+  auto& saved = saved_[block.block];
+  saved.clear();
+  for (std::size_t trajectory : block.trajectories) saved.push_back(watches_[trajectory]);
+}
+
+void RunawayObserver::restore_block(const BlockView& block) {
+  const auto& saved = saved_[block.block];
+  for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) watches_[block.trajectories[slot]] = saved[slot];
+}
+
+std::vector<std::optional<Runaway>> RunawayObserver::runaways() const {
+  std::vector<std::optional<Runaway>> result;
+  result.reserve(watches_.size());
+  for (const Watch& watch : watches_) result.push_back(watch.runaway);
+  return result;
+}
+
+// Per trajectory [reference scale, largest |dH/H0| or null, null or [reference, scale, t, largest error]].
+nlohmann::json RunawayObserver::save() {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Watch& watch : watches_) {
+    nlohmann::json runaway;
+    if (const auto& r = watch.runaway)
+      runaway = {format_number(r->reference_scale), format_number(r->scale), format_number(r->t),
+                 format_number(r->largest_error)};
+    list.push_back({format_number(watch.reference_scale), number_or_null(watch.largest_error), std::move(runaway)});
+  }
+  return {{"watches", std::move(list)}};
+}
+
+void RunawayObserver::restore(const nlohmann::json& state) {
+  const SavedState read = SavedState::of_observer(name(), state);
+  const nlohmann::json& list = read.list(read.member(state, "watches"), watches_.size(), "watches");
+  for (std::size_t i = 0; i < watches_.size(); ++i) {
+    const nlohmann::json& entry = read.list(list[i], 3, "watches");
+    Watch& watch = watches_[i];
+    watch.reference_scale = read.number(entry[0], "watches");
+    watch.largest_error = read.optional_number(entry[1], "watches");
+    watch.runaway.reset();
+    if (!entry[2].is_null()) {
+      const auto r = read.numbers(entry[2], 4, "watches");
+      watch.runaway = Runaway{r[0], r[1], r[2], r[3]};
+    }
+  }
 }
 
 std::string runaway_text(const Runaway& runaway) {

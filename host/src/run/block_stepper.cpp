@@ -1,6 +1,8 @@
 #include "run/block_stepper.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "nonsep/core/base/error.hpp"
 
@@ -10,13 +12,27 @@ BlockView BlockStepper::view(const Block& block, std::size_t index, const Worker
   return {index, dimension, block.trajectories, block.batch.q(), block.batch.p(), &worker.model};
 }
 
-// The every-step observers see the block at `step`; the trajectories they ask to stop leave it there.
+bool BlockStepper::every_step() const {
+  return std::any_of(step_watchers.begin(), step_watchers.end(), [](StepObserver* w) { return w->stride() == 0; });
+}
+
+std::uint64_t BlockStepper::next_watched(std::uint64_t step) const {
+  std::uint64_t next = std::numeric_limits<std::uint64_t>::max();
+  for (StepObserver* watcher : step_watchers) {
+    const std::uint64_t stride = std::max<std::uint64_t>(1, watcher->stride());
+    next = std::min(next, (step / stride + 1) * stride);
+  }
+  return next;
+}
+
+// The observers that watch `step` see the block there; the trajectories they ask to stop leave it there.
 void BlockStepper::watch_step(Block& block, std::size_t index, Worker& worker, std::uint64_t step) {
   if (step_watchers.empty()) return;
   std::vector<StoppedTrajectory> requests;
   auto v = view(block, index, worker);
   v.retire = &requests;
-  for (StepObserver* watcher : step_watchers) watcher->on_step(step, time.time_at(step), v);
+  for (StepObserver* watcher : step_watchers)
+    if (watcher->stride() == 0 || step % watcher->stride() == 0) watcher->on_step(step, time.time_at(step), v);
   if (requests.empty()) return;
   sort_requests(requests);
   block.retire_requested(requests, step, time.time_at(step),
@@ -30,8 +46,15 @@ void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker
   const double dt = time.dt;
   bool clean = true;
   try {
-    if (step_watchers.empty())  // the common case: the whole chunk in one call, through the kernel when there is one
-      block.step_n(worker.stepping, dt, to - from);
+    // The common case: the whole chunk in one call, through the kernel when there is one, cut only at the steps a
+    // watcher watches (none without watchers).
+    if (!every_step())
+      for (std::uint64_t step = from; step < to && !block.empty();) {
+        const std::uint64_t next = std::min(to, next_watched(step));
+        block.step_n(worker.stepping, dt, next - step);
+        step = next;
+        watch_step(block, index, worker, step);
+      }
     else
       for (std::uint64_t step = from; step < to && !block.empty(); ++step) {
         block.step(worker.model, dt);
@@ -49,8 +72,8 @@ void BlockStepper::advance_block(Block& block, std::size_t index, Worker& worker
   }
 }
 
-// One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge. Without every-step
-// observers the chunk it redoes went through the plugin's kernel (worker.stepping), and so does the step: the states
+// One step of the block, from `step - 1` to `step`, retiring the states that fail or diverge. Without observers of
+// every step the chunk it redoes went through the plugin's kernel (worker.stepping), and so does the step: the states
 // that go on keep the numbers of a chunk that never stopped, wherever chunks end, on any instruction set. A step the
 // plugin fails in goes through the evaluation path, the whole block and then state by state, so that the failed
 // states' messages and the evaluation counts are those of a step-by-step run.
@@ -60,7 +83,7 @@ void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step
   const Integrator integrator_before = block.integrator;  // the scheme's private state, for a redo state by state
   std::vector<std::string> errors(before.count());
   bool stepped = false;
-  if (step_watchers.empty()) {
+  if (!every_step()) {
     try {
       block.step_n(worker.stepping, time.dt, 1);
       stepped = true;

@@ -2,8 +2,9 @@
 // Internal to the ensemble driver (ensemble_driver.cpp): what a worker thread does to one block of trajectories
 // inside a chunk. It steps the block without checks and, when the chunk ends with a non-finite number or the
 // plugin failed in it, puts the block back and redoes the chunk step by step, retiring the states that fail or
-// diverge (Departure, block.hpp: their records, trajectory.hpp); it shows every step to the observers that watch every
-// step, and evaluates H. The driver decides which blocks run where and when; this class knows one block at a time.
+// diverge (Departure, block.hpp: their records, trajectory.hpp); it shows the observers that watch steps the steps
+// they watch, and evaluates H. The driver decides which blocks run where and when; this class knows one block at a
+// time.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -43,6 +44,10 @@ class BlockStepper {
 
  private:
   BlockView view(const Block& block, std::size_t index, const Worker& worker) const;
+  // Whether a watcher watches every step (then the block steps one step at a time on the evaluation path), and the
+  // first step after `step` that a watcher watches.
+  bool every_step() const;
+  std::uint64_t next_watched(std::uint64_t step) const;
   void watch_step(Block& block, std::size_t index, Worker& worker, std::uint64_t step);
   void checked_step(Block& block, Worker& worker, std::uint64_t step);
   std::optional<double> energy_of(Worker& worker, const PhaseSpaceBatch& x, std::size_t slot) const;

@@ -1,19 +1,24 @@
 #pragma once
 // Orbits that run off with bounded energy: a trajectory whose scale, max(|q_i|, |p_i|), grew more than `growth`
 // times beyond its reference scale while its relative energy error |dH/H0| stayed at most `small_error`. The
-// reference scale is the largest seen in the first tenth of the run (|t| <= |t_end|/10, step 0 included): a bounded
+// reference scale is the largest in the first tenth of the run (|t| <= |t_end|/10, step 0 included): a bounded
 // orbit has shown its extent by then, one on a non-compact shell has not.
 // Such an orbit follows a non-compact energy shell (docs/method.md, "Non-compact energy shells"): the integrator
-// keeps H, and H does not keep the orbit. Seen where H is evaluated (step 0, samples, output.energy_every, the last
-// step) and in the final state of a retired trajectory; not checkpointed (a resumed run reports what it saw
-// after resuming). What it finds goes into the run's messages (run_command), not into files.
+// keeps H, and H does not keep the orbit. The scale is watched where the orbit is, not only where it is sampled: at
+// every stride()-th step of the run (about `watched_steps` steps, evenly spaced, through the plugin's kernel, which
+// the watching does not change), at the steps where H is evaluated and in the final state of a retired trajectory;
+// |dH/H0| where H is evaluated (step 0, samples, output.energy_every, the last step, final states). Checkpointed,
+// so that a resumed run finds what an uninterrupted one finds. What it finds goes into the run's messages
+// (run_command), not into files.
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "nonsep/host/run/observer.hpp"
+#include "nonsep/host/time_grid.hpp"
 
 namespace nonsep::host {
 
@@ -24,26 +29,45 @@ struct Runaway {
   double largest_error = 0.0;                 // the largest |dH/H0| seen up to there
 };
 
-class RunawayObserver : public Observer {
+class RunawayObserver : public Observer, public ChunkObserver, public StepObserver, public CheckpointedObserver {
  public:
   static constexpr double growth = 3.0, small_error = 1e-2;
+  static constexpr std::uint64_t watched_steps = 1000;
 
-  // The initial states, `count` of dimension n (q and p in the job's layout), and the run's end time.
-  RunawayObserver(std::span<const double> q, std::span<const double> p, std::size_t count, std::size_t n, double t_end);
+  // The initial states, `count` of dimension n (q and p in the job's layout), and the run's time grid.
+  RunawayObserver(std::span<const double> q, std::span<const double> p, std::size_t count, std::size_t n,
+                  const TimeGrid& time);
 
   void on_event(const Event& event) override;
   void on_retire(std::size_t trajectory, const TrajectoryRecord& record) override;
 
+  void prepare_blocks(std::size_t blocks) override { saved_.resize(blocks); }
+  std::uint64_t stride() const override { return stride_; }
+  void on_step(std::uint64_t step, double t, const BlockView& block) override;
+  void save_block(const BlockView& block) override;
+  void restore_block(const BlockView& block) override;
+
+  std::string name() const override { return "runaway"; }
+  nlohmann::json save() override;
+  void restore(const nlohmann::json& state) override;
+
   // Per trajectory, in job order; nothing for those that did not run off.
-  const std::vector<std::optional<Runaway>>& runaways() const { return runaways_; }
+  std::vector<std::optional<Runaway>> runaways() const;
 
  private:
+  // What is known of one trajectory.
+  struct Watch {
+    double reference_scale = 0.0;
+    std::optional<double> largest_error;  // the largest |dH/H0| where H was evaluated; nothing while unknown
+    std::optional<Runaway> runaway;
+  };
   double reference_until_;
-  std::vector<double> reference_scale_, largest_error_;
-  std::vector<std::optional<Runaway>> runaways_;
+  std::uint64_t stride_;
+  std::vector<Watch> watches_;             // per trajectory
+  std::vector<std::vector<Watch>> saved_;  // per block: its trajectories' watches at the chunk's start
 
-  void see(std::size_t trajectory, double t, std::span<const double> q, std::span<const double> p,
-           std::optional<double> energy, std::optional<double> energy_initial);
+  void see_scale(std::size_t trajectory, double t, std::span<const double> q, std::span<const double> p);
+  void see_energy(std::size_t trajectory, std::optional<double> energy, std::optional<double> energy_initial);
 };
 
 // The sentence for one runaway: "|q| or |p| grew from 0.5 to 31 by t = 40 while |dH/H0| stayed at most 2e-06: the

@@ -20,11 +20,11 @@
 //   on_end()               after the last retirement: flush, close.
 // The interface is small, as Odeint's observer is one callable: Observer has the events every observer may want;
 // what few observers need are facets, separate small interfaces an observer also derives from: ChunkObserver
-// (prepare_blocks, after_chunk, before_finish) and StepObserver (every step), which the driver finds by dynamic_cast
-// when the observer is added, and CheckpointedObserver (save, restore) and TrajectoryColumns (trajectories.csv),
-// which the run's plan lists by the observers' types (launch/).
-// Observers that watch every step (StepObserver) are called inside chunks, on the worker thread of
-// each block, with that block's states only (on_step); they must touch nothing but their state for those
+// (prepare_blocks, after_chunk, before_finish) and StepObserver (every step, or every k-th), which the driver finds
+// by dynamic_cast when the observer is added, and CheckpointedObserver (save, restore) and TrajectoryColumns
+// (trajectories.csv), which the run's plan lists by the observers' types (launch/).
+// Observers that watch steps (StepObserver) are called inside chunks, on the worker thread of each block, with that
+// block's states only (on_step); they must touch nothing but their state for those
 // trajectories. Before a chunk the driver calls save_block; when a chunk is redone step by step (a state stopped
 // being finite, or the plugin failed, somewhere in it) restore_block puts the block's trajectories back. The view
 // carries the worker thread's plugin instance (BlockView::model), for observers that must evaluate or step a state
@@ -109,10 +109,14 @@ class ChunkObserver {
   virtual void before_finish(std::uint64_t /*step*/, bool /*interrupted*/) {}
 };
 
-// Facet: every step, inside chunks, on the worker threads (see above); an observer with it watches every step.
+// Facet: every step, inside chunks, on the worker threads (see above). stride() 0 (the default): every step, and the
+// block steps one step at a time on the evaluation path (for observers that step states themselves); k >= 1: the
+// steps that are multiples of k, the block stepping between them through the plugin's kernel, as a run without
+// watchers does (the same numbers: a kernel call cut anywhere ends where the whole call ends).
 class StepObserver {
  public:
   virtual ~StepObserver() = default;
+  virtual std::uint64_t stride() const { return 0; }
   virtual void on_step(std::uint64_t step, double t, const BlockView& block) = 0;
   virtual void save_block(const BlockView& block) = 0;
   virtual void restore_block(const BlockView& block) = 0;
