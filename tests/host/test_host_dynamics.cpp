@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -482,22 +483,28 @@ double scale_of_row(const std::map<std::string, std::string>& row) {
   return scale;
 }
 
+// A grid of (q0, p0) on the section q1 = 0 of the shell H = 8 for couplings 0 to 0.3, Gauss 6 (stable here) and
+// output.every the number of steps, as the shipped maps have it: H is evaluated at step 0 and the last step only.
+json compact_shell_job(double t_end) {
+  const auto steps = static_cast<std::uint64_t>(t_end / 0.02 + 0.5);
+  return {
+      {"model", {{"plugin", "paper2d"}, {"parameters", {{"coupling", {{"from", 0.0}, {"to", 0.3}, {"count", 4}}}}}}},
+      {"integrator", {{"scheme", "gauss"}, {"stages", 3}}},
+      {"initial",
+       {{"grid",
+         {{"q", {{{"from", -2.5}, {"to", 2.5}, {"count", 11}}, 0.0}},
+          {"p", {{{"from", -2.0}, {"to", 2.0}, {"count", 9}}, 0.0}}}},
+        {"energy", 8.0},
+        {"solve_for", "p1"}}},
+      {"time", {{"dt", 0.02}, {"t_end", t_end}}},
+      {"output", {{"every", steps}}}};
+}
+
 }  // namespace
 
 TEST_CASE("no runaway warning for paper2d's bounded orbits on the compact shell H = 8, sampled at both ends only") {
   TemporaryFolder folder;
-  // The stability map's set-up at H = 8 with the coupling up to 0.3, Gauss 6 (stable here) and output.every the
-  // number of steps: H is evaluated at step 0 and the last step only.
-  json job = {
-      {"model", {{"plugin", "paper2d"}, {"parameters", {{"coupling", {{"from", 0.0}, {"to", 0.3}, {"count", 4}}}}}}},
-      {"integrator", {{"scheme", "gauss"}, {"stages", 3}}},
-      {"initial",
-       {{"grid", {{"q", {{{"from", -2.5}, {"to", 2.5}, {"count", 21}}, 0.0}}, {"p", {0.0, 0.0}}}},
-        {"energy", 8.0},
-        {"solve_for", "p1"}}},
-      {"time", {{"dt", 0.02}, {"t_end", 100}}},
-      {"output", {{"every", 5000}}}};
-  const auto result = run_named(folder, "run", job);
+  const auto result = run_named(folder, "run", compact_shell_job(100));
   INFO("stderr: " << result.err);
   REQUIRE(result.status == 0);
   // What the samples alone show: orbits whose scale at the end is more than 3 times their scale at step 0, with a
@@ -516,4 +523,29 @@ TEST_CASE("no runaway warning for paper2d's bounded orbits on the compact shell 
   MESSAGE(grown << " of " << first_scale.size() << " orbits end more than 3 times as far out as they start");
   CHECK(grown > 0);
   CHECK(runaway_warnings(result.err).empty());
+}
+
+TEST_CASE("killed after the first tenth and resumed: the runaway warnings of an uninterrupted run, none here") {
+  // H evaluated every 100 steps: an uninterrupted run sees each orbit's extent in the first tenth; a resumed run
+  // must know it too (from its checkpoint), not start again from the initial states.
+  json job = compact_shell_job(200);
+  job["output"]["energy_every"] = 100;
+  job["checkpoint"] = {{"every_steps", 500}, {"every_seconds", 0}};
+  TemporaryFolder reference;
+  const auto uninterrupted = run_named(reference, "out", job);
+  INFO("uninterrupted stderr: " << uninterrupted.err);
+  REQUIRE(uninterrupted.status == 0);
+
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", job);
+  const auto step = kill_after_checkpoint(file, folder / "out", 2000, folder.path());  // the first tenth: 1000
+  INFO("killed after the checkpoint at step " << step);
+  REQUIRE(step < 10000);
+  const auto resumed =
+      run_nonsep({"run", "--resume", "--output", (folder / "out").string(), file.string()}, folder.path());
+  INFO("resumed stderr: " << resumed.err);
+  REQUIRE(resumed.status == 0);
+  CHECK(read_text(folder / "out/trajectories.csv") == read_text(reference / "out/trajectories.csv"));
+  CHECK(runaway_warnings(resumed.err) == runaway_warnings(uninterrupted.err));
+  CHECK(runaway_warnings(resumed.err).empty());
 }

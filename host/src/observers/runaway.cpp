@@ -33,43 +33,44 @@ RunawayObserver::RunawayObserver(std::span<const double> q, std::span<const doub
     watches_[b].reference_scale = scale_of(q.subspan(b * n, n), p.subspan(b * n, n));
 }
 
-void RunawayObserver::see_energy(std::size_t trajectory, std::optional<double> energy,
-                                 std::optional<double> energy_initial) {
-  const auto error = relative_energy_error(energy, energy_initial);
-  if (!error) return;
-  auto& largest = watches_[trajectory].largest_error;
-  largest = std::max(largest.value_or(0.0), std::abs(*error));
-}
-
-// The scale at t, against the largest |dH/H0| known up to there (where H was evaluated).
+// The scale at t: into the reference in the first tenth, else into the furthest point.
 void RunawayObserver::see_scale(std::size_t trajectory, double t, std::span<const double> q,
                                 std::span<const double> p) {
   const double scale = scale_of(q, p);
   if (!std::isfinite(scale)) return;  // a chunk that will be redone step by step (block_stepper.hpp)
   Watch& watch = watches_[trajectory];
-  if (std::abs(t) <= reference_until_) {
+  if (std::abs(t) <= reference_until_)
     watch.reference_scale = std::max(watch.reference_scale, scale);
+  else if (!watch.furthest || scale > watch.furthest->scale)
+    watch.furthest = Furthest{scale, t};
+}
+
+void RunawayObserver::see_energy(std::size_t trajectory, std::optional<double> energy,
+                                 std::optional<double> energy_initial) {
+  const auto error = relative_energy_error(energy, energy_initial);
+  if (!error) return;
+  Watch& watch = watches_[trajectory];
+  watch.largest_error = std::max(watch.largest_error.value_or(0.0), std::abs(*error));
+  const auto& furthest = watch.furthest;
+  if (!(*watch.largest_error <= small_error) || !furthest || !(furthest->scale > growth * watch.reference_scale) ||
+      (watch.runaway && furthest->scale <= watch.runaway->scale))
     return;
-  }
-  if (!watch.largest_error || !(*watch.largest_error <= small_error) || !(scale > growth * watch.reference_scale) ||
-      (watch.runaway && scale <= watch.runaway->scale))
-    return;
-  watch.runaway = Runaway{watch.reference_scale, scale, t, *watch.largest_error};
+  watch.runaway = Runaway{watch.reference_scale, furthest->scale, furthest->t, *watch.largest_error};
 }
 
 // Only the events where H was evaluated: their steps are the job's (the others end chunks sized by the clock).
 void RunawayObserver::on_event(const Event& event) {
   if (!event.energy_evaluated) return;
   for (const StateView& state : event.states) {
-    see_energy(state.trajectory, state.energy, state.record->energy_initial);
     see_scale(state.trajectory, event.t, state.q, state.p);
+    see_energy(state.trajectory, state.energy, state.record->energy_initial);
   }
 }
 
 void RunawayObserver::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
   if (record.final_q.empty()) return;
-  see_energy(trajectory, record.energy_final, record.energy_initial);
   see_scale(trajectory, record.final_t, record.final_q, record.final_p);
+  see_energy(trajectory, record.energy_final, record.energy_initial);
 }
 
 void RunawayObserver::on_step(std::uint64_t, double t, const BlockView& block) {
@@ -96,15 +97,18 @@ std::vector<std::optional<Runaway>> RunawayObserver::runaways() const {
   return result;
 }
 
-// Per trajectory [reference scale, largest |dH/H0| or null, null or [reference, scale, t, largest error]].
+// Per trajectory [reference scale, largest |dH/H0| or null, null or the furthest [scale, t], null or the runaway
+// [reference, scale, t, largest error]].
 nlohmann::json RunawayObserver::save() {
   nlohmann::json list = nlohmann::json::array();
   for (const Watch& watch : watches_) {
-    nlohmann::json runaway;
+    nlohmann::json furthest, runaway;
+    if (const auto& f = watch.furthest) furthest = {format_number(f->scale), format_number(f->t)};
     if (const auto& r = watch.runaway)
       runaway = {format_number(r->reference_scale), format_number(r->scale), format_number(r->t),
                  format_number(r->largest_error)};
-    list.push_back({format_number(watch.reference_scale), number_or_null(watch.largest_error), std::move(runaway)});
+    list.push_back({format_number(watch.reference_scale), number_or_null(watch.largest_error), std::move(furthest),
+                    std::move(runaway)});
   }
   return {{"watches", std::move(list)}};
 }
@@ -113,13 +117,18 @@ void RunawayObserver::restore(const nlohmann::json& state) {
   const SavedState read = SavedState::of_observer(name(), state);
   const nlohmann::json& list = read.list(read.member(state, "watches"), watches_.size(), "watches");
   for (std::size_t i = 0; i < watches_.size(); ++i) {
-    const nlohmann::json& entry = read.list(list[i], 3, "watches");
+    const nlohmann::json& entry = read.list(list[i], 4, "watches");
     Watch& watch = watches_[i];
     watch.reference_scale = read.number(entry[0], "watches");
     watch.largest_error = read.optional_number(entry[1], "watches");
-    watch.runaway.reset();
+    watch.furthest.reset();
     if (!entry[2].is_null()) {
-      const auto r = read.numbers(entry[2], 4, "watches");
+      const auto f = read.numbers(entry[2], 2, "watches");
+      watch.furthest = Furthest{f[0], f[1]};
+    }
+    watch.runaway.reset();
+    if (!entry[3].is_null()) {
+      const auto r = read.numbers(entry[3], 4, "watches");
       watch.runaway = Runaway{r[0], r[1], r[2], r[3]};
     }
   }

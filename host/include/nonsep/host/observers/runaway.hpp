@@ -7,7 +7,8 @@
 // keeps H, and H does not keep the orbit. The scale is watched where the orbit is, not only where it is sampled: at
 // every stride()-th step of the run (about `watched_steps` steps, evenly spaced, through the plugin's kernel, which
 // the watching does not change), at the steps where H is evaluated and in the final state of a retired trajectory;
-// |dH/H0| where H is evaluated (step 0, samples, output.energy_every, the last step, final states). Checkpointed,
+// |dH/H0| where H is evaluated (step 0, samples, output.energy_every, the last step, final states): the furthest
+// point so far counts as a runaway where H is next evaluated, with the largest |dH/H0| up to there. Checkpointed,
 // so that a resumed run finds what an uninterrupted one finds. What it finds goes into the run's messages
 // (run_command), not into files.
 #include <cstddef>
@@ -55,10 +56,15 @@ class RunawayObserver : public Observer, public ChunkObserver, public StepObserv
   std::vector<std::optional<Runaway>> runaways() const;
 
  private:
+  // The largest scale after the first tenth, and where.
+  struct Furthest {
+    double scale = 0.0, t = 0.0;
+  };
   // What is known of one trajectory.
   struct Watch {
     double reference_scale = 0.0;
     std::optional<double> largest_error;  // the largest |dH/H0| where H was evaluated; nothing while unknown
+    std::optional<Furthest> furthest;     // after the first tenth; taken for a runaway where H is next evaluated
     std::optional<Runaway> runaway;
   };
   double reference_until_;
@@ -67,6 +73,8 @@ class RunawayObserver : public Observer, public ChunkObserver, public StepObserv
   std::vector<std::vector<Watch>> saved_;  // per block: its trajectories' watches at the chunk's start
 
   void see_scale(std::size_t trajectory, double t, std::span<const double> q, std::span<const double> p);
+  // Where H is evaluated: takes its error into the largest, then the furthest point so far for a runaway when it
+  // is one and the error stayed small.
   void see_energy(std::size_t trajectory, std::optional<double> energy, std::optional<double> energy_initial);
 };
 
