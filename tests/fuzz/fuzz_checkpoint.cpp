@@ -1,7 +1,7 @@
 // libFuzzer harness over reading checkpoints (`nonsep run --resume`): arbitrary bytes as checkpoint.json of a fixed
 // job (paper1d, three trajectories, analysis on), read by load_checkpoint and, when accepted, restored into the
-// observers that keep state (energy error, closest return). Every input is tried twice: as it is (the format and
-// the checksum must refuse what was damaged) and, when it is a JSON object, signed anew with this job's fingerprint
+// observers that keep state (energy error, closest return, runaway). Every input is tried twice: as it is (the format
+// and the checksum must refuse what was damaged) and, when it is a JSON object, signed anew with this job's fingerprint
 // and a correct checksum, so that the fuzzer reaches the content checks behind them (what an edited checkpoint
 // with a recomputed checksum would meet). Any crash, hang, sanitizer report or exception other than
 // CheckpointError is a finding, and so is an accepted checkpoint that breaks what load_checkpoint promises.
@@ -25,6 +25,7 @@
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/observers/closest_return.hpp"
 #include "nonsep/host/observers/energy_error.hpp"
+#include "nonsep/host/observers/runaway.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 
 namespace {
@@ -94,8 +95,11 @@ void try_checkpoint(const std::string& text) {
     nonsep::host::EnergyErrorObserver energy(job.initial.count, 0, job.run().analysis.max_relative_energy_error);
     nonsep::host::ClosestReturnObserver closest(*job.run().analysis.closest_return_after, job.initial.dimension,
                                                 job.initial.q, job.initial.p);
+    nonsep::host::RunawayObserver runaway(job.initial.q, job.initial.p, job.initial.count, job.initial.dimension,
+                                          job.run().time);
     for (nonsep::host::CheckpointedObserver* observer : {static_cast<nonsep::host::CheckpointedObserver*>(&energy),
-                                                         static_cast<nonsep::host::CheckpointedObserver*>(&closest)})
+                                                         static_cast<nonsep::host::CheckpointedObserver*>(&closest),
+                                                         static_cast<nonsep::host::CheckpointedObserver*>(&runaway)})
       if (checkpoint.observers.contains(observer->name())) observer->restore(checkpoint.observers[observer->name()]);
   } catch (const nonsep::host::CheckpointError&) {
   }
