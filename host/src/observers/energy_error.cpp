@@ -54,7 +54,7 @@ std::optional<LargestEnergyError> EnergyErrorObserver::largest() const {
 nlohmann::json EnergyErrorObserver::save() {
   nlohmann::json values = nlohmann::json::array();
   for (const auto& max : max_abs_) values.push_back(max ? nlohmann::json(format_number(*max)) : nlohmann::json());
-  return {{"max_abs", std::move(values)}, {"evaluated_after_start", evaluated_after_start_ ? 1 : 0}};
+  return {{"max_abs", std::move(values)}, {"evaluated_after_start", std::uint64_t{evaluated_after_start_ ? 1u : 0u}}};
 }
 
 void EnergyErrorObserver::restore(const nlohmann::json& state) {
