@@ -215,7 +215,9 @@ schema_json definitions() {
            {"minItems", 1},
            {"maxItems", max_initial_states},
            {"items", {{"type", {"number", "boolean"}}}}},
-          object_schema(range_axis_keys(), "A sweep over count evenly spaced values from `from` to `to`."),
+          object_schema(range_axis_keys(),
+                        "A sweep over count evenly spaced values from `from` to `to`, both included (count 1: just "
+                        "`from`); between them the doubles nearest the decimal values (0 to 0.3 in 16 values: 0.06)."),
           object_schema(values_axis_keys(), "A sweep over the values listed.")}},
         {"description",
          "A parameter of the plugin by its name (`nonsep inspect PLUGIN` lists them): checked against the plugin's "
@@ -237,7 +239,7 @@ schema_json definitions() {
                    {std::move(fixed),
                     object_schema(range_axis_keys(),
                                   "count evenly spaced values from `from` to `to`, both included (count 1: "
-                                  "just `from`)."),
+                                  "just `from`); between them the doubles nearest the decimal values."),
                     object_schema(values_axis_keys(), "The values listed.")}}};
   return defs;
 }

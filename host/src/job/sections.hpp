@@ -51,6 +51,12 @@ std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt,
 // One axis of a grid (initial.cpp): a number, {"from", "to", "count"} or {"values": [...]}; nothing and an issue
 // when invalid.
 std::optional<std::vector<double>> read_axis(Checker& check, const json& value, const std::string& path);
+// Value k of the range {"from", "to", "count"} (a grid's axis, a swept parameter): `from` for k = 0 (and for a count
+// of 1) and `to` for k = count - 1, exactly; between them the double nearest to from + (to - from) k / (count - 1)
+// computed exactly from the shortest decimals of from and to (0 to 0.3 in 16 values: 0.06 at k = 3, as written;
+// ends whose decimals lie more than 20 digits apart, such as 1e-30 and 1e10, in double arithmetic). Never outside
+// [from, to], never infinite.
+double range_value(double from, double to, std::size_t count, std::size_t k);
 // /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
 // `first_path` names the state whose dimension the others must have.
 InitialStates read_initial(Checker& check, const json& document, const std::filesystem::path& directory);
