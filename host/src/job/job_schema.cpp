@@ -224,7 +224,8 @@ schema_json definitions() {
          "metadata (known name, type, minimum and maximum); an integer parameter takes an integral number of "
          "magnitude at most 2^53. Several values (an array, {\"values\": [...]} or {\"from\", \"to\", "
          "\"count\"}) make a sweep: the run takes every parameter set of the product of the swept parameters with "
-         "every initial state (docs/dynamics.md)."}}}};
+         "every initial state (docs/dynamics.md). Every set must give the model the same dimension: a sweep of a "
+         "parameter that sets it (lattice_chain's sites) is refused."}}}};
   defs["vector"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("finite")}};
   defs["state"] = object_schema(state_keys());
   defs["initial"] = {{"oneOf",

@@ -5,6 +5,7 @@
 // meaningful only if it added none.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,3 +83,15 @@ void read_dynamics(Checker& check, const json& value, std::size_t dimension, Ana
 CheckpointPolicy read_checkpoint(Checker& check, const json& value);
 
 }  // namespace nonsep::host::job_reader
+
+namespace nonsep::host {
+
+// Every parameter set s of the job, in order, with an instance of its parameters (set 0: loaded.model) (sweep.cpp):
+// the one place where what a run needs of every set is checked (make_trajectories runs it for every sweep). A set the
+// plugin refuses (an issue at /model/parameters), or whose model's dimension differs from set 0's (an issue at the
+// swept parameter, naming both sets: a sweep cannot change the dimension), is reported and ends the loop: false
+// then. Otherwise calls visit(s, model) for each set and returns true.
+bool for_each_parameter_set(const LoadedJob& loaded, std::vector<JobIssue>& issues,
+                            const std::function<void(std::size_t, const PluginModel&)>& visit);
+
+}  // namespace nonsep::host
