@@ -123,3 +123,33 @@ TEST_CASE("a job with \"dimension\": 2.0 loads: the plugin and the reader agree 
   CHECK(loaded.model.dimension() == 2);
   CHECK(loaded.model.parameters()["dimension"] == 2.0);
 }
+
+TEST_CASE("a sweep of one value says each trajectory's parameter set, as a sweep of several does") {
+  nonsep::host_testing::TemporaryFolder folder;
+  json document = nonsep::host_testing::quickstart_job();
+  document["model"] = {{"plugin", "paper2d"}, {"parameters", {{"coupling", {0.2}}}}};
+  document["initial"] = {{"q", {0.5, 0.1}}, {"p", {0.2, -0.1}}};
+  const LoadedJob one = load_job(nonsep::host_testing::write_job(folder / "one.json", document));
+  CHECK(one.job.initial.parameter_set == std::vector<std::size_t>{0});
+  document["model"]["parameters"]["coupling"] = {0.1, 0.2};
+  const LoadedJob two = load_job(nonsep::host_testing::write_job(folder / "two.json", document));
+  CHECK(two.job.initial.parameter_set == std::vector<std::size_t>{0, 1});
+}
+
+TEST_CASE("a sweep that changes the model's dimension is refused at the swept key, naming the set") {
+  nonsep::host_testing::TemporaryFolder folder;
+  json document = nonsep::host_testing::quickstart_job();
+  document["model"] = {{"plugin", "radial"}, {"parameters", {{"dimension", {2, 3}}}}};
+  document["initial"] = {{"q", {1.0, 0.0}}, {"p", {0.5, 0.5}}};
+  for (const bool shell : {false, true}) {
+    if (shell)
+      document["initial"] = {{"grid", {{"q", {1.0, 0.0}}, {"p", {0.5, 0.5}}}}, {"energy", 5.0}, {"solve_for", "p0"}};
+    std::vector<JobIssue> issues;
+    auto job = read_job(nonsep::host_testing::write_job(folder / "job.json", document), issues);
+    REQUIRE(job);
+    REQUIRE(issues.empty());
+    CHECK_FALSE(load_model(std::move(*job), issues));
+    REQUIRE(paths(issues) == std::vector<std::string>{"/model/parameters/dimension"});
+    CHECK(issues[0].found.find("(set 1 of the sweep), whose model has dimension 3 where set 0") != std::string::npos);
+  }
+}

@@ -240,6 +240,46 @@ TEST_CASE("initial states: one, a list, or a grid in row-major order (last axis 
   CHECK(wide.issues[0].found == "a grid of 1000000 states of dimension 151");
 }
 
+TEST_CASE("a range {from, to, count}: its ends exactly, count 1 is `from`, every value finite and between the ends") {
+  const auto axis = [](double from, double to, int count) {
+    json document = host_testing::quickstart_job();
+    document["initial"] = {{"grid", {{"q", {{{"from", from}, {"to", to}, {"count", count}}}}, {"p", {0.0}}}}};
+    const auto parsed = parse(document);
+    REQUIRE(parsed.issues.empty());
+    return parsed.job.initial.q;
+  };
+  CHECK(axis(2.0, 3.0, 1) == std::vector<double>{2.0});
+  CHECK(axis(2.0, 3.0, 2) == std::vector<double>{2.0, 3.0});
+  // The ends exactly and the values between them the doubles nearest the decimal ones: 0 to 0.3 in 16 values has
+  // 0.06 (not 0.05999999999999999) and 0.3 itself, which a parameter of maximum 0.3 accepts; 0 to 0.4 in 9 values has
+  // 0.3 (not 0.30000000000000004).
+  const std::vector<double> fine = axis(0.0, 0.3, 16);
+  REQUIRE(fine.size() == 16);
+  CHECK(fine[3] == 0.06);
+  CHECK(fine[15] == 0.3);
+  CHECK(axis(0.0, 0.4, 9)[6] == 0.3);
+  CHECK(axis(0.1, 0.7, 7) == std::vector<double>{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7});
+  CHECK(axis(-1.0, 1.0, 3)[1] == 0.0);
+  CHECK(axis(1e-30, 1e10, 5)[2] == 5e9);
+  // Ends near the largest double: (to - from) overflows, yet every value is finite and between the ends.
+  CHECK(axis(-1e308, 1e308, 3) == std::vector<double>{-1e308, 0.0, 1e308});
+  const std::vector<double> wide = axis(-1e308, 1e308, 4);
+  REQUIRE(wide.size() == 4);
+  CHECK(wide.front() == -1e308);
+  CHECK(wide.back() == 1e308);
+  CHECK(std::is_sorted(wide.begin(), wide.end()));
+  CHECK(std::all_of(wide.begin(), wide.end(), [](double x) { return std::isfinite(x); }));
+  CHECK(axis(1.7e308, 1.75e308, 3)[1] == doctest::Approx(1.725e308));
+
+  // A swept parameter's range alike: count 1 is the value `from`.
+  json document = host_testing::quickstart_job();
+  document["model"]["parameters"] = {{"coupling", {{"from", 0.2}, {"to", 0.3}, {"count", 1}}}};
+  const auto parsed = parse(document);
+  REQUIRE(parsed.issues.empty());
+  REQUIRE(parsed.job.sweep.size() == 1);
+  CHECK(parsed.job.sweep[0].values == std::vector<json>{0.2});
+}
+
 TEST_CASE("checkpoint: every_steps and every_seconds, with defaults, and each problem with its path") {
   json document = host_testing::quickstart_job();
   auto parsed = parse(document);

@@ -2,7 +2,8 @@
 // for n > 1 the Hessians of T and V symmetric (the gradients are gradients of functions: a formula's dT and dV are
 // checked this way), and grad T and grad V against 5-point finite differences of value_T and value_V (the SDK's
 // derivative checker, nonsep/derivative_checker.hpp), at up to gradient_check_states states spread evenly over the
-// ensemble, on an instance of the plugin of its own (the run's instance, and any call counts it keeps, are left alone).
+// ensemble, on an instance of the plugin of its own with the state's parameters (a sweep's states, each with its own
+// parameter set's; the run's instance, and any call counts it keeps, are left alone).
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -84,15 +85,18 @@ void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobI
   const std::size_t n = loaded.model.dimension();
   if (n == 0 || n > gradient_check_largest_dimension || initial.count == 0 || initial.q.size() != initial.count * n)
     return;
-  std::optional<PluginModel> own;
-  try {
-    own.emplace(loaded.plugin.create(loaded.job.parameters));
-  } catch (const std::exception&) {
-    return;  // the job's instance was created with these parameters; a second refusal is the plugin's to explain
-  }
+  std::optional<PluginModel> own;  // of the parameter set `own_set` (a sweep: each state's own set's)
+  std::size_t own_set = 0;
   const std::size_t checked = std::min(initial.count, gradient_check_states);
   for (std::size_t k = 0; k < checked; ++k) {
     const std::size_t state = k * initial.count / checked;
+    const std::size_t set = initial.parameter_set.empty() ? 0 : initial.parameter_set[state];
+    if (!own || set != own_set) try {
+        own.emplace(loaded.plugin.create(loaded.job.parameter_set(set)));
+        own_set = set;
+      } catch (const std::exception&) {
+        return;  // the run's instances were created with these parameters; a second refusal is the plugin's to explain
+      }
     const auto at = [&](const std::vector<double>& x) {
       return std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(state * n),
                                  x.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));

@@ -1,6 +1,12 @@
 // /initial: one state, a list of states, a grid or a file (initial_file.cpp), into InitialStates (state-major:
 // component i of state b at b * dimension + i). Every shape is held to max_initial_states and max_initial_values,
 // checked on the sizes of the JSON arrays before their numbers are copied.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -18,6 +24,84 @@ std::size_t array_size(const json& value, const char* key) {
 }
 
 }  // namespace
+
+namespace {
+
+// A double as its shortest round-trip decimal (std::to_chars): sign * digits * 10^exponent.
+struct Decimal {
+  bool negative = false;
+  std::uint64_t digits = 0;  // at most 17 decimal digits
+  int exponent = 0;
+  int length = 0;  // decimal digits in `digits`
+};
+
+Decimal decimal(double x) {
+  char text[40];
+  const auto end = std::to_chars(text, text + sizeof text, x, std::chars_format::scientific).ptr;
+  Decimal d;
+  const char* c = text;
+  if (*c == '-') {
+    d.negative = true;
+    ++c;
+  }
+  for (; c < end && *c != 'e'; ++c)
+    if (*c != '.') {
+      d.digits = d.digits * 10 + static_cast<std::uint64_t>(*c - '0');
+      ++d.length;
+    }
+  int exponent = 0;
+  std::from_chars(c + (c[1] == '+' ? 2 : 1), end, exponent);
+  d.exponent = exponent - (d.length - 1);
+  return d;
+}
+
+}  // namespace
+
+double range_value(double from, double to, std::size_t count, std::size_t k) {
+  if (k == 0) return from;
+  if (k + 1 == count) return to;
+  // Exactly, from the shortest decimals of the ends: N = a (count - 1 - k) + b k in units of 10^e, then N / (count - 1)
+  // written with 30 decimals after the point and a last digit 1 for a remainder, which std::from_chars rounds to the
+  // nearest double (the digits kept are more than any midpoint between doubles needs to be told from it here).
+  Decimal a = decimal(from), b = decimal(to);
+  if (a.digits == 0) a.exponent = b.exponent;
+  if (b.digits == 0) b.exponent = a.exponent;
+  const int e = std::min(a.exponent, b.exponent);
+  const std::uint64_t d = count - 1;
+  if (a.length + (a.exponent - e) <= 20 && b.length + (b.exponent - e) <= 20 && d <= 1'000'000'000) {
+    const auto scaled = [e](const Decimal& x) {
+      __int128 value = static_cast<__int128>(x.digits);
+      for (int i = e; i < x.exponent; ++i) value *= 10;
+      return x.negative ? -value : value;
+    };
+    const __int128 n = scaled(a) * static_cast<__int128>(d - k) + scaled(b) * static_cast<__int128>(k);
+    unsigned __int128 magnitude = static_cast<unsigned __int128>(n < 0 ? -n : n);
+    unsigned __int128 quotient = magnitude / d, remainder = magnitude % d;
+    char integer[48], *i = integer + sizeof integer;
+    do {
+      *--i = static_cast<char>('0' + static_cast<int>(quotient % 10));
+      quotient /= 10;
+    } while (quotient != 0);
+    std::string text = n < 0 ? "-" : "";
+    text.append(i, integer + sizeof integer);
+    text += '.';
+    for (int digit = 0; digit < 30; ++digit) {
+      remainder *= 10;
+      text += static_cast<char>('0' + static_cast<int>(remainder / d));
+      remainder %= d;
+    }
+    if (remainder != 0) text += '1';
+    text += 'e' + std::to_string(e);
+    double value = 0.0;
+    if (std::from_chars(text.data(), text.data() + text.size(), value).ec == std::errc()) return value;
+  }
+  // Ends of very different scales (1e-30 and 1e10): in double arithmetic, the value kept between the ends and finite
+  // when from * (count - 1 - k) would overflow.
+  const double wa = static_cast<double>(d - k), wb = static_cast<double>(k), wd = static_cast<double>(d);
+  const double value = (from * wa + to * wb) / wd;
+  return std::clamp(std::isfinite(value) ? value : from * (wa / wd) + to * (wb / wd), std::min(from, to),
+                    std::max(from, to));
+}
 
 std::optional<std::vector<double>> read_axis(Checker& check, const json& value, const std::string& path) {
   const std::string what =
@@ -57,9 +141,7 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
                               std::to_string(keys["count"].maximum));
   if (!from || !to || !count) return std::nullopt;
   std::vector<double> values(static_cast<std::size_t>(*count));
-  const auto n = values.size();
-  for (std::size_t i = 0; i < n; ++i)
-    values[i] = i + 1 == n && n > 1 ? *to : *from + (*to - *from) * static_cast<double>(i) / static_cast<double>(n - 1);
+  for (std::size_t k = 0; k < values.size(); ++k) values[k] = range_value(*from, *to, values.size(), k);
   return values;
 }
 

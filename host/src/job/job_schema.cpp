@@ -215,14 +215,17 @@ schema_json definitions() {
            {"minItems", 1},
            {"maxItems", max_initial_states},
            {"items", {{"type", {"number", "boolean"}}}}},
-          object_schema(range_axis_keys(), "A sweep over count evenly spaced values from `from` to `to`."),
+          object_schema(range_axis_keys(),
+                        "A sweep over count evenly spaced values from `from` to `to`, both included (count 1: just "
+                        "`from`); between them the doubles nearest the decimal values (0 to 0.3 in 16 values: 0.06)."),
           object_schema(values_axis_keys(), "A sweep over the values listed.")}},
         {"description",
          "A parameter of the plugin by its name (`nonsep inspect PLUGIN` lists them): checked against the plugin's "
          "metadata (known name, type, minimum and maximum); an integer parameter takes an integral number of "
          "magnitude at most 2^53. Several values (an array, {\"values\": [...]} or {\"from\", \"to\", "
          "\"count\"}) make a sweep: the run takes every parameter set of the product of the swept parameters with "
-         "every initial state (docs/dynamics.md)."}}}};
+         "every initial state (docs/dynamics.md). Every set must give the model the same dimension: a sweep of a "
+         "parameter that sets it (lattice_chain's sites) is refused."}}}};
   defs["vector"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("finite")}};
   defs["state"] = object_schema(state_keys());
   defs["initial"] = {{"oneOf",
@@ -237,7 +240,7 @@ schema_json definitions() {
                    {std::move(fixed),
                     object_schema(range_axis_keys(),
                                   "count evenly spaced values from `from` to `to`, both included (count 1: "
-                                  "just `from`)."),
+                                  "just `from`); between them the doubles nearest the decimal values."),
                     object_schema(values_axis_keys(), "The values listed.")}}};
   return defs;
 }

@@ -5,6 +5,7 @@
 // meaningful only if it added none.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,6 +52,12 @@ std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt,
 // One axis of a grid (initial.cpp): a number, {"from", "to", "count"} or {"values": [...]}; nothing and an issue
 // when invalid.
 std::optional<std::vector<double>> read_axis(Checker& check, const json& value, const std::string& path);
+// Value k of the range {"from", "to", "count"} (a grid's axis, a swept parameter): `from` for k = 0 (and for a count
+// of 1) and `to` for k = count - 1, exactly; between them the double nearest to from + (to - from) k / (count - 1)
+// computed exactly from the shortest decimals of from and to (0 to 0.3 in 16 values: 0.06 at k = 3, as written;
+// ends whose decimals lie more than 20 digits apart, such as 1e-30 and 1e10, in double arithmetic). Never outside
+// [from, to], never infinite.
+double range_value(double from, double to, std::size_t count, std::size_t k);
 // /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
 // `first_path` names the state whose dimension the others must have.
 InitialStates read_initial(Checker& check, const json& document, const std::filesystem::path& directory);
@@ -76,3 +83,15 @@ void read_dynamics(Checker& check, const json& value, std::size_t dimension, Ana
 CheckpointPolicy read_checkpoint(Checker& check, const json& value);
 
 }  // namespace nonsep::host::job_reader
+
+namespace nonsep::host {
+
+// Every parameter set s of the job, in order, with an instance of its parameters (set 0: loaded.model) (sweep.cpp):
+// the one place where what a run needs of every set is checked (make_trajectories runs it for every sweep). A set the
+// plugin refuses (an issue at /model/parameters), or whose model's dimension differs from set 0's (an issue at the
+// swept parameter, naming both sets: a sweep cannot change the dimension), is reported and ends the loop: false
+// then. Otherwise calls visit(s, model) for each set and returns true.
+bool for_each_parameter_set(const LoadedJob& loaded, std::vector<JobIssue>& issues,
+                            const std::function<void(std::size_t, const PluginModel&)>& visit);
+
+}  // namespace nonsep::host

@@ -3,6 +3,7 @@
 // trajectories, the job's states once per parameter set, each set's on its own energy shell (make_trajectories).
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <utility>
 
 #include "nonsep/core/runtime/integrator.hpp"
@@ -104,11 +105,57 @@ void check_swept_parameters(const Job& job, const std::vector<PluginParameter>& 
   }
 }
 
+namespace {
+
+// The path of the first swept parameter whose value differs between sets a and b (the one a message names).
+std::string differing_key(const Job& job, std::size_t a, std::size_t b) {
+  const nlohmann::json first = job.parameter_set(a), second = job.parameter_set(b);
+  for (const SweptParameter& swept : job.sweep)
+    if (first[swept.name] != second[swept.name]) return job_reader::child("/model/parameters", swept.name);
+  return "/model/parameters";
+}
+
+}  // namespace
+
+bool for_each_parameter_set(const LoadedJob& loaded, std::vector<JobIssue>& issues,
+                            const std::function<void(std::size_t, const PluginModel&)>& visit) {
+  const Job& job = loaded.job;
+  const std::size_t sets = job.parameter_sets(), n = loaded.model.dimension();
+  for (std::size_t s = 0; s < sets; ++s) {
+    if (s == 0) {
+      visit(0, loaded.model);
+      continue;
+    }
+    const std::string set = job.parameter_set(s).dump() + " (set " + std::to_string(s) + " of the sweep)";
+    PluginModel model;
+    try {
+      model = loaded.plugin.create(job.parameter_set(s));
+    } catch (const std::exception& error) {
+      issues.push_back({"/model/parameters", "the parameter set " + set + ", refused by the plugin: " + error.what(),
+                        "parameter sets the plugin accepts (see `nonsep inspect " + job.plugin + "`)"});
+      return false;
+    }
+    if (model.dimension() != n) {
+      issues.push_back({differing_key(job, 0, s),
+                        "the parameter set " + set + ", whose model has dimension " +
+                            std::to_string(model.dimension()) + " where set 0 (" + job.parameter_set(0).dump() +
+                            ") has " + std::to_string(n),
+                        "parameter sets of one dimension: a sweep cannot change the model's dimension (its "
+                        "trajectories are stepped as one ensemble of states of one dimension, with one column per "
+                        "component in its files); run one job per dimension"});
+      return false;
+    }
+    visit(s, model);
+  }
+  return true;
+}
+
 void make_trajectories(LoadedJob& loaded, std::vector<JobIssue>& issues) {
   Job& job = loaded.job;
   InitialStates& initial = job.initial;
   const std::size_t sets = job.parameter_sets(), n = initial.dimension;
-  if (!initial.shell && sets == 1) return;
+  // A sweep of one set still says whose each trajectory is (InitialStates::parameter_set).
+  if (!initial.shell && job.sweep.empty()) return;
   // Too many trajectories: check_sweep_size reported it (this pass runs after a reader's issues too).
   if (n == 0 || sets > max_initial_states / std::max<std::size_t>(1, initial.count) ||
       sets * initial.count > max_initial_values / n)
@@ -122,25 +169,14 @@ void make_trajectories(LoadedJob& loaded, std::vector<JobIssue>& issues) {
   std::vector<double> all_q, all_p;
   std::vector<std::size_t> parameter_set;
   std::size_t left_out = 0;
-  for (std::size_t s = 0; s < sets; ++s) {
-    PluginModel created;
-    const PluginModel* model = &loaded.model;  // created with set 0's parameters
-    if (s > 0) try {
-        created = loaded.plugin.create(job.parameter_set(s));
-        model = &created;
-      } catch (const std::exception& error) {
-        issues.push_back({"/model/parameters",
-                          "the parameter set " + job.parameter_set(s).dump() + " (set " + std::to_string(s) +
-                              " of the sweep), refused by the plugin: " + error.what(),
-                          "parameter sets the plugin accepts (see `nonsep inspect " + job.plugin + "`)"});
-        continue;
-      }
+  const bool every_set = for_each_parameter_set(loaded, issues, [&](std::size_t s, const PluginModel& model) {
     std::vector<double> q = initial.q, p = initial.p;
-    if (initial.shell) left_out += solve_on_energy_shell(*model, form, *initial.shell, n, q, p);
+    if (initial.shell) left_out += solve_on_energy_shell(model, form, *initial.shell, n, q, p);
     all_q.insert(all_q.end(), q.begin(), q.end());
     all_p.insert(all_p.end(), p.begin(), p.end());
     parameter_set.insert(parameter_set.end(), q.size() / n, s);
-  }
+  });
+  if (!every_set) return;
   if (initial.shell && all_q.empty()) {
     const EnergyShell& shell = *initial.shell;
     issues.push_back({"/initial/energy",

@@ -270,16 +270,17 @@ std::size_t solve_on_energy_shell(const PluginModel& model, HamiltonianForm form
 // The run's trajectories (pass 3, sweep.cpp): loaded.job.initial becomes the job's states once per parameter set
 // (Job::parameter_sets; InitialStates::parameter_set says whose), each set's states put on the energy shell (when
 // /initial/energy is given; EnergyShell::left_out is then the total over the sets) with an instance of the set's
-// own parameters. Issues: a value outside the plugin's range (/model/parameters/<name>/<i>, naming the value), a
-// set the plugin refuses (/model/parameters), too many trajectories (/model/parameters), a plugin without Hessians
-// or a shell no state of any set reaches (/initial/energy).
+// own parameters; for every sweep, of one value too. Every set passes the checks of for_each_parameter_set
+// (job/sections.hpp): a set the plugin refuses (/model/parameters) or whose model's dimension differs from set 0's
+// (the swept key) is refused. Other issues: too many trajectories (/model/parameters), a plugin without Hessians or
+// a shell no state of any set reaches (/initial/energy).
 void make_trajectories(LoadedJob& loaded, std::vector<JobIssue>& issues);
 
 // Checks the plugin's grad T and grad V against finite differences of its value_T and value_V at up to 16 of the
-// job's initial states (evenly spread), on an instance of its own, when the plugin has values and a dimension of at
-// most 512. The first disagreement beyond 1e-4 relative to max(1, |finite difference|) is an issue at
-// /model/plugin naming the function, the state and both numbers, and `nonsep inspect PLUGIN --check`. States where
-// the plugin fails or a number is not finite are left to the run.
+// job's initial states (evenly spread), on an instance of its own (of the state's parameter set in a sweep), when the
+// plugin has values and a dimension of at most 512. The first disagreement beyond 1e-4 relative to max(1, |finite
+// difference|) is an issue at /model/plugin naming the function, the state and both numbers, and `nonsep inspect PLUGIN
+// --check`. States where the plugin fails or a number is not finite are left to the run.
 void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobIssue>& issues);
 
 // Passes 1 and 2 on the file at `job_file`. Nothing when the file cannot be read (missing, a directory, larger than
