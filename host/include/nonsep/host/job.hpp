@@ -290,8 +290,9 @@ void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobI
 //   /analysis/poincare, /analysis/closest_return_after  one more state per trajectory each
 //   /output/every         one sample of every trajectory waiting: trajectory.csv's rows as text (about 25 bytes a
 //                         number), or results.h5's rows and their chunk buffer: 2 x (2n + 1)
-//   /checkpoint           checkpoint.json's states and tangent vectors as numbers, as JSON values and as text,
-//                         checkpoint_bytes_per_number a number (written every minute by default, and on SIGINT)
+//   /checkpoint           checkpoint.json's states, tangent vectors and Lyapunov sums as numbers, as JSON values
+//                         and as text, checkpoint_bytes_per_number a number (written every minute by default, and on
+//                         SIGINT)
 // Each part names the job file's key that asks for it; the total is a floor (buffers of a few MB, the plugin's
 // own memory and the scheme's private state are left out).
 struct MemoryEstimate {
@@ -303,8 +304,9 @@ struct MemoryEstimate {
   std::vector<Part> parts;  // largest first
   double total() const;
 };
-// Bytes per number of checkpoint.json while it is written: the saved copy (8), two JSON documents of strings
-// (format_number's shortest text, as nlohmann::json values) and the text itself, measured (docs/user-guide.md).
+// Bytes per number of checkpoint.json while it is written: the saved copy (8), a JSON document of strings
+// (format_number's shortest text, as nlohmann::json values: about 100), its text for the checksum and its text
+// (about 20 each); measured about 145 a number more for paper2d's tangent vectors (docs/user-guide.md, Memory).
 inline constexpr double checkpoint_bytes_per_number = 160.0;
 // `trajectories` of the job stepped by this process (its share under mpirun), the job's states all held.
 MemoryEstimate estimate_run_memory(const LoadedJob& loaded, std::size_t trajectories);
