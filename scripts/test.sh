@@ -6,8 +6,8 @@
 #   2. ctest    every ctest test of build/ (labels core, plugins, host, examples, python, slow);
 #   3. sanitize the C++ suites again, built by clang with ASan + UBSan in build-sanitize/, less the longest runs
 #               (tests/ci/run_sanitized_suite.sh);
-#   4. fuzz     30 s of libFuzzer on job-file reading and 30 s on checkpoint reading, from the kept corpora, with
-#               the harnesses of that same build (tests/fuzz/run_fuzz_smoke.sh);
+#   4. fuzz     20 s of libFuzzer each on reading job files, checkpoints and initial-state files, from the kept
+#               corpora, with the harnesses of that same build (tests/fuzz/run_fuzz_smoke.sh);
 #   5. valgrind memcheck of loading, using and unloading every shipped plugin (tests/ci/run_valgrind_plugins.sh).
 # Steps 2 to 5 each run even when an earlier one failed; a failed setup stops everything (nothing to test).
 # Output: each step's own output, a line "test.sh: STEP passed|failed (N s)" after it, and as the last line
@@ -44,7 +44,7 @@ step() {
 
 step ctest ctest --test-dir build --output-on-failure -j2
 step sanitize bash tests/ci/run_sanitized_suite.sh "$root"
-step fuzz bash tests/fuzz/run_fuzz_smoke.sh "$root" 30
+step fuzz bash tests/fuzz/run_fuzz_smoke.sh "$root" 20
 step valgrind bash tests/ci/run_valgrind_plugins.sh "$root/build/bin/nonsep" "$root"
 
 ((failed == 0)) || echo "test.sh: failed steps: ${failed_steps[*]}"

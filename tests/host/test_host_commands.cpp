@@ -108,6 +108,22 @@ TEST_CASE("usage: --version, --help with the schemes, options and exit statuses,
   for (const char* command : {"models", "example"}) CHECK(unknown.err.find(command) != std::string::npos);
 }
 
+TEST_CASE("number options take finite numbers in their range: --progress-every nan, inf or -1 is a usage error") {
+  TemporaryFolder folder;
+  const auto job = write_job(folder / "job.json", quickstart_job());
+  for (const char* bad : {"nan", "inf", "-1", "1e400"}) {
+    CAPTURE(bad);
+    const auto result = run_nonsep({"run", "--quiet", "--progress-every", bad, job.string()}, folder.path());
+    CHECK(result.status == 2);
+    CHECK(result.err.find("\"" + std::string(bad) + "\" is not a finite number >= 0") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(folder / "job.out"));
+  }
+  const auto tolerance = run_nonsep({"inspect", "paper1d", "--check", "--tolerance", "nan"}, folder.path());
+  CHECK(tolerance.status == 2);
+  CHECK(tolerance.err.find("\"nan\" is not a finite number > 0") != std::string::npos);
+  CHECK(run_nonsep({"run", "--quiet", "--progress-every", "0", job.string()}, folder.path()).status == 0);
+}
+
 TEST_CASE("models lists every plugin on the search path, one line each") {
   TemporaryFolder folder;
   const auto result = run_nonsep({"models"}, folder.path());

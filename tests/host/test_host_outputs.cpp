@@ -204,3 +204,49 @@ TEST_CASE("CsvReader reads what CsvAppender writes: cells unquoted, each row's t
   CHECK_THROWS_WITH_AS(CsvReader(folder / "missing.csv", "to test it"), doctest::Contains(missing.c_str()),
                        OutputError);
 }
+
+TEST_CASE("CsvReader with Rules: a hand-written file's last line without newline and CRLF ends, bounds as it reads") {
+  const TemporaryFolder folder;
+  using Rows = std::vector<std::vector<std::string>>;
+  std::vector<std::uint64_t> lines;
+  const auto rows_of = [&](const std::string& name, const std::string& text, const CsvReader::Rules& rules) {
+    write_file_atomically(folder / name, text);
+    CsvReader reader(folder / name, "to test it", rules);
+    Rows rows;
+    lines.clear();
+    for (std::vector<std::string> cells; reader.next(cells);) {
+      rows.push_back(cells);
+      lines.push_back(reader.line());
+    }
+    return rows;
+  };
+  CsvReader::Rules by_hand;
+  by_hand.hand_written = true;
+  // The last row without '\n' is a row of a file written by hand, a cut row of one written by nonsep.
+  CHECK(rows_of("last.csv", "q0,p0\n2,0\n1,0", by_hand) == Rows{{"q0", "p0"}, {"2", "0"}, {"1", "0"}});
+  CHECK(lines == std::vector<std::uint64_t>{1, 2, 3});
+  CHECK(rows_of("last.csv", "q0,p0\n2,0\n1,0", {}) == Rows{{"q0", "p0"}, {"2", "0"}});
+  CHECK(rows_of("one.csv", "q0,p0\n2,0", by_hand) == Rows{{"q0", "p0"}, {"2", "0"}});
+  CHECK(rows_of("ended.csv", "q0,p0\n2,0\n", by_hand) == Rows{{"q0", "p0"}, {"2", "0"}});
+  // "\r\n" ends a line; a '\r' elsewhere, or inside quotes, is the cell's.
+  CHECK(rows_of("crlf.csv", "q0,p0\r\n2,\"a\r\nb\"\r\n1,x\ry\r\n", by_hand) ==
+        Rows{{"q0", "p0"}, {"2", "a\r\nb"}, {"1", "x\ry"}});
+  CHECK(lines == std::vector<std::uint64_t>{1, 3, 4});
+  CHECK(rows_of("crlf_last.csv", "q0,p0\r\n2,0", by_hand) == Rows{{"q0", "p0"}, {"2", "0"}});
+  CHECK(rows_of("crlf_nonsep.csv", "q0,p0\r\n", {}) == Rows{{"q0", "p0\r"}});
+
+  // The bounds are checked as the row is read: the line is the reader's, the rest of the file is never read.
+  const CsvReader::Rules bounded{.hand_written = true, .max_cells = 3, .max_cell_bytes = 4, .name = "the file"};
+  std::vector<std::string> cells;
+  write_file_atomically(folder / "wide.csv", "a,b,c\n1,2,3,4,5\n");
+  CsvReader wide(folder / "wide.csv", "to test it", bounded);
+  CHECK(wide.next(cells));
+  CHECK_THROWS_WITH_AS(wide.next(cells), "the file:2: a row of more than 3 cells", OutputError);
+  write_file_atomically(folder / "quoted.csv", "a,\"bb\"\"cc\",d\n");
+  CsvReader quoted(folder / "quoted.csv", "to test it", bounded);
+  CHECK_THROWS_WITH_AS(quoted.next(cells), "the file:1: cell 2, longer than 4 bytes", OutputError);
+  write_file_atomically(folder / "endless.csv", std::string(std::size_t{3} << 20, '7'));
+  CsvReader endless(folder / "endless.csv", "to test it", bounded);
+  CHECK_THROWS_WITH_AS(endless.next(cells), "the file:1: cell 1, longer than 4 bytes", OutputError);
+  CHECK(endless.text().size() <= (std::size_t{1} << 20));  // at most a buffer's worth was taken
+}

@@ -92,9 +92,12 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
   for (const SchemeState::Column& column : state.scheme.columns)
     document["active"][column.name] = encode(column.values);
   for (const SchemeState::Largest& number : state.scheme.largest) document[number.name] = encode(number.value);
-  json signed_document = document;
-  signed_document["checksum"] = checkpoint_checksum(document);
-  write_file_atomically(path, signed_document.dump() + "\n");
+  // Signed in place (the checksum is of the document without it): a copy would double the checkpoint's memory.
+  document["checksum"] = checkpoint_checksum(document);
+  std::string text = document.dump();
+  document = json();  // freed before the text is written
+  text += '\n';
+  write_file_atomically(path, text);
 }
 
 }  // namespace

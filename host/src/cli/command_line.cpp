@@ -1,6 +1,7 @@
 #include "nonsep/host/command_line.hpp"
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -28,6 +29,19 @@ const CLI::Validator non_empty_path(
                           : std::string();
     },
     "PATH");
+
+// A number option's value: finite, and positive (or zero when `zero` is its meaning). CLI11's NonNegativeNumber and
+// PositiveNumber let "nan" and "inf" through (every comparison with NaN is false).
+CLI::Validator finite_number(bool zero_allowed) {
+  return CLI::Validator(
+      [zero_allowed](const std::string& text) {
+        double value = 0.0;
+        const bool number = CLI::detail::lexical_cast(text, value);
+        if (number && std::isfinite(value) && (value > 0.0 || (zero_allowed && value == 0.0))) return std::string();
+        return "\"" + text + "\" is not a finite " + (zero_allowed ? "number >= 0" : "number > 0");
+      },
+      zero_allowed ? "NUMBER >= 0" : "NUMBER > 0");
+}
 
 }  // namespace
 
@@ -63,7 +77,7 @@ int run_command_line(int argc, char** argv) {
                     "when stderr is not a terminal (a batch log), a plain progress line every SECONDS (time, percent, "
                     "max |dH/H0|, ETA; under mpirun each rank's, labelled with the rank and its work unit); 0: none")
         ->default_val(10.0)
-        ->check(CLI::NonNegativeNumber);
+        ->check(finite_number(true));
     run->add_flag("--resume", arguments.resume,
                   "continue an interrupted run from checkpoint.json in its output folder; the outputs end as those of "
                   "an uninterrupted run");
@@ -109,7 +123,7 @@ int run_command_line(int argc, char** argv) {
     inspect
         ->add_option("--tolerance", inspect_arguments.tolerance,
                      "allowed error relative to max(1, |finite difference|) (default 1e-6)")
-        ->check(CLI::PositiveNumber)
+        ->check(finite_number(false))
         ->needs(check);
     inspect->footer(exit_status_text());
 

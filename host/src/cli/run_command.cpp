@@ -347,7 +347,7 @@ int run_on_ranks(const RunArguments& arguments, const Ranks* ranks) {
   std::optional<LoadedJob> loaded;
   std::string invalid;
   try {
-    loaded.emplace(load_job(arguments.job_file));
+    loaded.emplace(load_job(arguments.job_file, ranks->size()));  // the memory check: a share per rank
   } catch (const InvalidJob& error) {
     invalid = error.what();
   }

@@ -3,9 +3,12 @@
 // Both hold one state per row, q then p: row b is q0 .. q(n-1), p0 .. p(n-1) of state b, so a file of 2n columns
 // gives states of dimension n.
 //   .npy: a little-endian float64 array ('<f8'), C or Fortran order, of shape (states, 2n), or (2n,) for one state
-//         (numpy.save(path, states)); format versions 1, 2 and 3. The shape is checked against the limits before
-//         any number is read, and the file must end where the array does.
-//   .csv: a header row q0,...,q(n-1),p0,...,p(n-1) (the names say the order), then one row of 2n numbers per state.
+//         (numpy.save(path, states)); format versions 1, 2 and 3. The header is numpy's dictionary, each of descr,
+//         fortran_order and shape once (parse_npy_header: a linear scan). The shape is checked against the limits
+//         before any number is read, and the file must end where the array does.
+//   .csv: a header row q0,...,q(n-1),p0,...,p(n-1) (the names say the order), then one row of 2n numbers per state;
+//         the last row may end without '\n', and lines may end with "\r\n". Read a row at a time (CsvReader), each
+//         within max_initial_csv_columns cells of max_initial_csv_cell_bytes, checked as it is read.
 // The same limits as states written in the job: at most max_initial_states states and max_initial_values numbers
 // in q; every number finite. The file is opened without blocking and must be a regular file (a FIFO or a device is
 // refused, never waited on). Every problem is an issue at /initial/file naming the file, and the row or byte offset.
@@ -13,12 +16,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <regex>
+#include <string_view>
 
 #include "nonsep/host/output/csv_reader.hpp"
 #include "sections.hpp"
@@ -40,6 +44,8 @@ const std::string npy_allowed =
     "then p0..p(n-1) (numpy.save)";
 const std::string csv_allowed =
     "a CSV file with the header q0,...,q(n-1),p0,...,p(n-1) and one row of 2n finite numbers per state";
+const std::string csv_bounds = csv_allowed + ", of at most " + std::to_string(max_initial_csv_columns) +
+                               " columns and " + std::to_string(max_initial_csv_cell_bytes) + " bytes per cell";
 
 // The states of `columns` numbers per row (q then p) into `states`, or a problem when they break the limits.
 std::optional<Problem> check_shape(std::size_t rows, std::size_t columns, const std::string& where) {
@@ -68,6 +74,113 @@ void store(const std::vector<double>& rows, std::size_t count, std::size_t colum
       const double x = fortran ? rows[c * count + b] : rows[b * columns + c];
       (c < n ? states.q[b * n + c] : states.p[b * n + c - n]) = x;
     }
+}
+
+// `text` quoted for a message: at most 40 characters, other than printable ASCII shown as '?'.
+std::string excerpt(std::string_view text) {
+  std::string shown(text.substr(0, 40));
+  for (char& c : shown)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+  return "'" + shown + (text.size() > 40 ? "...'" : "'");
+}
+
+// The header of a .npy file as numpy writes it and reads it (ast.literal_eval of a dict): exactly the keys descr
+// (a string), fortran_order (True or False) and shape (a tuple of non-negative decimal integers), each once, in
+// any order, with an optional trailing comma, then only white space. A linear scan (the header is at most 64 KiB):
+// no recursion, no backtracking. The numbers of the shape are kept as written, so that a message shows them as
+// they are in the file.
+struct NpyHeader {
+  std::string descr;
+  bool fortran = false;
+  std::vector<std::string> shape;
+};
+
+// `header` into `parsed`, or what is wrong with it (found) and where (the offset in the header).
+std::optional<std::string> parse_npy_header(std::string_view header, NpyHeader& parsed) {
+  std::size_t at = 0;
+  const auto white = [&] {
+    while (at < header.size() && (header[at] == ' ' || header[at] == '\t' || header[at] == '\n' || header[at] == '\r'))
+      ++at;
+  };
+  const auto here = [&](const std::string& what) {
+    return what + " at character " + std::to_string(at) + " of the header" +
+           (at < header.size() ? " (" + excerpt(header.substr(at)) + ")" : " (its end)");
+  };
+  const auto take = [&](char c) {
+    white();
+    if (at < header.size() && header[at] == c) {
+      ++at;
+      return true;
+    }
+    return false;
+  };
+  // A Python string literal without escapes, quoted by ' or ".
+  const auto string = [&](std::string& into) {
+    white();
+    if (at == header.size() || (header[at] != '\'' && header[at] != '"')) return false;
+    const char quote = header[at];
+    const std::size_t begin = ++at;
+    while (at < header.size() && header[at] != quote && header[at] != '\\' && header[at] != '\n') ++at;
+    if (at == header.size() || header[at] != quote) return false;
+    into.assign(header.substr(begin, at - begin));
+    ++at;
+    return true;
+  };
+  if (!take('{')) return here("no '{'");
+  bool descr = false, fortran = false, shape = false;
+  while (!take('}')) {
+    std::string key;
+    white();
+    const std::size_t key_at = at;
+    if (!string(key)) return here("no quoted key");
+    bool* seen = key == "descr" ? &descr : key == "fortran_order" ? &fortran : key == "shape" ? &shape : nullptr;
+    if (!seen || *seen) {
+      at = key_at;
+      return here(seen ? "the key " + excerpt(key) + " a second time"
+                       : "the key " + excerpt(key) + ", not one of 'descr', 'fortran_order' and 'shape',");
+    }
+    *seen = true;
+    if (!take(':')) return here("no ':'");
+    white();
+    if (key == "descr") {
+      if (!string(parsed.descr)) return here("a descr that is not a quoted string without escapes");
+    } else if (key == "fortran_order") {
+      if (header.substr(at, 4) == "True") {
+        parsed.fortran = true;
+        at += 4;
+      } else if (header.substr(at, 5) == "False") {
+        parsed.fortran = false;
+        at += 5;
+      } else {
+        return here("a fortran_order that is neither True nor False");
+      }
+    } else {
+      if (!take('(')) return here("a shape that is not a tuple");
+      parsed.shape.clear();
+      bool comma = false;  // a tuple of one number needs its trailing comma: (3) is 3, not a tuple
+      while (!take(')')) {
+        white();
+        const std::size_t begin = at;
+        while (at < header.size() && header[at] >= '0' && header[at] <= '9') ++at;
+        const std::string_view digits = header.substr(begin, at - begin);
+        if (digits.empty() || (digits.size() > 1 && digits.front() == '0'))
+          return here("a shape that is not a tuple of decimal integers");
+        parsed.shape.emplace_back(digits);
+        comma = take(',');
+        if (!comma && !take(')')) return here("a shape that is not a tuple of decimal integers");
+        if (!comma) break;
+      }
+      if (parsed.shape.size() == 1 && !comma) return here("a shape that is not a tuple (a number in parentheses)");
+    }
+    if (!take(',')) {
+      if (!take('}')) return here("no ',' or '}'");
+      break;
+    }
+  }
+  white();
+  if (at != header.size()) return here("more after the dictionary");
+  if (!descr || !fortran || !shape) return here("a dictionary without all of 'descr', 'fortran_order' and 'shape'");
+  return std::nullopt;
 }
 
 std::optional<Problem> read_npy(int descriptor, std::uint64_t size, const std::string& shown, InitialStates& states) {
@@ -101,24 +214,24 @@ std::optional<Problem> read_npy(int descriptor, std::uint64_t size, const std::s
   std::string header(static_cast<std::size_t>(header_length), '\0');
   if (!read_at(header.data(), header.size(), header_start))
     return Problem{shown + ", which cannot be read", npy_allowed};
-  std::smatch descr, order, shape;
-  static const std::regex descr_key(R"('descr'\s*:\s*'([^']*)')"), order_key(R"('fortran_order'\s*:\s*(True|False))"),
-      shape_key(R"('shape'\s*:\s*\(\s*(\d+)\s*(?:,\s*(\d*)\s*)?(,\s*\d+\s*)*\))");
-  if (!std::regex_search(header, descr, descr_key) || !std::regex_search(header, order, order_key) ||
-      !std::regex_search(header, shape, shape_key))
-    return Problem{shown + ", a .npy header without descr, fortran_order and shape: " + header, npy_allowed};
-  if (descr[1] != "<f8") return Problem{shown + ", an array of dtype '" + descr[1].str() + "'", npy_allowed};
-  if (shape[3].matched) return Problem{shown + ", an array of more than two dimensions", npy_allowed};
-  const auto number = [](const std::string& digits) {
+  NpyHeader parsed;
+  if (const auto problem = parse_npy_header(header, parsed))
+    return Problem{shown + ", a .npy header that is not numpy's dictionary: " + *problem, npy_allowed};
+  if (parsed.descr != "<f8") return Problem{shown + ", an array of dtype " + excerpt(parsed.descr), npy_allowed};
+  if (parsed.shape.empty()) return Problem{shown + ", an array of shape () (a single number)", npy_allowed};
+  if (parsed.shape.size() > 2) return Problem{shown + ", an array of more than two dimensions", npy_allowed};
+  // The shape's numbers, each at most a limit (larger ones are shown as written in the file).
+  const std::uint64_t limit = std::max<std::uint64_t>(max_initial_states, 2 * max_initial_values);
+  const auto number = [&](const std::string& digits) {
     std::uint64_t value = 0;
     const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-    return error == std::errc() && end == digits.data() + digits.size() ? value : ~std::uint64_t{0};
+    return error == std::errc() && end == digits.data() + digits.size() && value <= limit ? value : limit + 1;
   };
-  const bool one_state = !shape[2].matched || shape[2].length() == 0;
-  const std::uint64_t rows = one_state ? 1 : number(shape[1]);
-  const std::uint64_t columns = one_state ? number(shape[1]) : number(shape[2]);
+  const bool one_state = parsed.shape.size() == 1;
+  const std::uint64_t rows = one_state ? 1 : number(parsed.shape[0]);
+  const std::uint64_t columns = number(parsed.shape.back());
   if (rows > max_initial_states || columns > 2 * max_initial_values)
-    return Problem{shown + " of shape (" + std::to_string(rows) + ", " + std::to_string(columns) + ")",
+    return Problem{shown + " of shape (" + parsed.shape[0] + (one_state ? "," : ", " + parsed.shape[1]) + ")",
                    "at most " + std::to_string(max_initial_states) + " states and " +
                        std::to_string(max_initial_values) + " numbers in q"};
   if (auto problem = check_shape(static_cast<std::size_t>(rows), static_cast<std::size_t>(columns), shown + ":"))
@@ -139,15 +252,22 @@ std::optional<Problem> read_npy(int descriptor, std::uint64_t size, const std::s
       return Problem{
           shown + ": a number that is not finite at byte offset " + std::to_string(data_start + i * sizeof(double)),
           "finite numbers"};
-  store(values, static_cast<std::size_t>(rows), static_cast<std::size_t>(columns), order[1] == "True", states);
+  store(values, static_cast<std::size_t>(rows), static_cast<std::size_t>(columns), parsed.fortran, states);
   return std::nullopt;
 }
 
 std::optional<Problem> read_csv(int descriptor, const std::string& shown, InitialStates& states) {
-  CsvReader reader("/proc/self/fd/" + std::to_string(descriptor), "(the initial states)");
+  // Each row is read within its bounds: the header at most max_initial_csv_columns cells, a state's row as many as
+  // the header, every cell at most max_initial_csv_cell_bytes.
+  CsvReader reader("/proc/self/fd/" + std::to_string(descriptor), "(the initial states)",
+                   {.hand_written = true,
+                    .max_cells = max_initial_csv_columns,
+                    .max_cell_bytes = max_initial_csv_cell_bytes,
+                    .name = shown});
   std::vector<std::string> cells;
   if (!reader.next(cells)) return Problem{shown + ", which has no header row", csv_allowed};
   const std::size_t columns = cells.size();
+  reader.rules().max_cells = columns;
   if (auto problem = check_shape(1, columns, shown + ": a header of")) return problem;
   const std::size_t n = columns / 2;
   for (std::size_t c = 0; c < columns; ++c) {
@@ -207,7 +327,7 @@ void read_initial_file(Checker& check, const json& initial, const fs::path& dire
     try {
       problem = read_csv(descriptor, shown, states);
     } catch (const std::exception& error) {
-      problem = Problem{shown + ": " + error.what(), csv_allowed};
+      problem = Problem{error.what(), csv_bounds};  // the reader's messages begin with `shown`
     }
   if (descriptor >= 0) ::close(descriptor);
   if (problem) {

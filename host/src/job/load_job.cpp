@@ -95,7 +95,7 @@ std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<J
   return parse_job(*document, job_file, issues);
 }
 
-std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
+std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std::size_t processes) {
   if (job.formula) {
     // What `nonsep validate` checks without the compiler comes first: a job with any problem compiles nothing.
     check_model_parameters(job.parameters, formula::declared_parameters(*job.formula), issues);
@@ -142,21 +142,12 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
                         "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
                         "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them "
                         "by automatic differentiation)"});
-  // /analysis/error_estimate keeps the half-step run's states at every comparison (observers/error_estimate.hpp).
-  if (!checked.is_study() && checked.run().analysis.error_estimate) {
-    const SingleRun& run = checked.run();
-    const double points = run.every > 0 ? static_cast<double>(run.time.steps / run.every + 1) : 101.0;
-    const double bytes = points * static_cast<double>(checked.initial.count) *
-                         static_cast<double>(2 * loaded.model.dimension() + 2) * sizeof(double);
-    if (bytes > 1073741824.0)
-      issues.push_back({"/analysis/error_estimate",
-                        "true with " + std::to_string(checked.initial.count) + " trajectories and " +
-                            std::to_string(static_cast<std::uint64_t>(points)) +
-                            " comparison steps, whose half-step states would take " +
-                            gibibytes(static_cast<std::size_t>(bytes)) + " GiB",
-                        "a run whose trajectories x samples x (2n + 2) doubles fit in 1 GiB: a larger output.every "
-                        "(fewer samples) or fewer trajectories"});
-  }
+  // What the run keeps, against the memory this process can take, before anything runs (a share of the
+  // trajectories per process under mpirun).
+  if (issues.size() == before)
+    if (auto issue =
+            memory_issue(loaded, (checked.initial.count + processes - 1) / std::max<std::size_t>(1, processes)))
+      issues.push_back(*std::move(issue));
   // Comparators integrate H from its gradient: Hessians and third derivatives of the plugin (ABI 3).
   const bool has_gradient_of_h = loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives();
   const auto check_comparator = [&](const IntegratorSpec& spec, const std::string& path) {
@@ -197,11 +188,11 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues) {
   return loaded;
 }
 
-LoadedJob load_job(const std::filesystem::path& job_file) {
+LoadedJob load_job(const std::filesystem::path& job_file, std::size_t processes) {
   std::vector<JobIssue> issues;
   auto job = read_job(job_file, issues);
   if (!job) throw InvalidJob(job_file, std::move(issues));
-  auto loaded = load_model(std::move(*job), issues);
+  auto loaded = load_model(std::move(*job), issues, processes);
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
   if (!loaded) throw std::logic_error("load_model refused " + job_file.string() + " without saying why");
   return std::move(*loaded);

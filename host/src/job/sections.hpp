@@ -61,6 +61,11 @@ double range_value(double from, double to, std::size_t count, std::size_t k);
 // /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
 // `first_path` names the state whose dimension the others must have.
 InitialStates read_initial(Checker& check, const json& document, const std::filesystem::path& directory);
+// A CSV file of initial states (/initial/file) is read a row at a time within these bounds, checked as it is read
+// (a file without line ends is refused after at most this many cells of its first line): at most 2^21 columns
+// (states of dimension 2^20; larger ones as .npy) and 32 bytes per cell (a float64 needs at most 24).
+inline constexpr std::size_t max_initial_csv_columns = std::size_t{1} << 21;
+inline constexpr std::size_t max_initial_csv_cell_bytes = 32;
 // /initial/file (initial_file.cpp): the states of a .npy or .csv file, relative to `directory` (the job's folder).
 void read_initial_file(Checker& check, const json& initial, const std::filesystem::path& directory,
                        InitialStates& states);

@@ -283,17 +283,60 @@ void make_trajectories(LoadedJob& loaded, std::vector<JobIssue>& issues);
 // --check`. States where the plugin fails or a number is not finite are left to the run.
 void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobIssue>& issues);
 
+// What a single run keeps in memory, estimated before anything runs (load_model: `nonsep validate` and `nonsep run`)
+// from the job alone, for the `trajectories` one process steps (all of them, or its share under mpirun) of
+// dimension n with k tangent vectors, 8 bytes a number:
+//   /initial              the job's states (every process holds all of them), and per trajectory stepped the
+//                         driver's state, its copy at each chunk's start and the final state recorded: 4 x 2n
+//   <the tangent key>     the k vectors and their copy at each chunk's start, and SALI/GALI's factor: 2 x (2nk + k^2)
+//   /analysis/error_estimate  the half-step states at every comparison step, (2n + 2) each, and that run's states
+//   /analysis/poincare, /analysis/closest_return_after  one more state per trajectory each
+//   /output/every         one sample of every trajectory waiting: trajectory.csv's rows as text (about 25 bytes a
+//                         number), or results.h5's rows and their chunk buffer: 2 x (2n + 1)
+//   /checkpoint           checkpoint.json's states, tangent vectors and Lyapunov sums as numbers, as JSON values
+//                         and as text, checkpoint_bytes_per_number a number (written every minute by default, and on
+//                         SIGINT)
+// Each part names the job file's key that asks for it; the total is a floor (buffers of a few MB, the plugin's
+// own memory and the scheme's private state are left out).
+struct MemoryEstimate {
+  struct Part {
+    std::string key;   // the job file's key that asks for it ("/initial", "/analysis/lyapunov", ...)
+    std::string what;  // "the tangent vectors (32 per trajectory)"
+    double bytes = 0.0;
+  };
+  std::vector<Part> parts;  // largest first
+  double total() const;
+};
+// Bytes per number of checkpoint.json while it is written: the saved copy (8), a JSON document of strings
+// (format_number's shortest text, as nlohmann::json values: about 100), its text for the checksum and its text
+// (about 20 each); measured about 145 a number more for paper2d's tangent vectors (docs/user-guide.md, Memory).
+inline constexpr double checkpoint_bytes_per_number = 160.0;
+// `trajectories` of the job stepped by this process (its share under mpirun), the job's states all held.
+MemoryEstimate estimate_run_memory(const LoadedJob& loaded, std::size_t trajectories);
+// The bytes this process can still take, with where the figure comes from: the least of /proc/meminfo's
+// MemAvailable, a cgroup's memory.max less memory.current, and RLIMIT_AS (ulimit -v) less the address space in use;
+// sysconf's free pages when /proc/meminfo cannot be read. Nothing when none can be known.
+struct AvailableMemory {
+  double bytes = 0.0;
+  std::string source;  // "MemAvailable in /proc/meminfo", "RLIMIT_AS (ulimit -v) less the address space in use", ...
+};
+std::optional<AvailableMemory> available_memory();
+// An issue at the key of the largest part when estimate_run_memory's total exceeds available_memory(), naming
+// both figures and the largest parts; nothing otherwise (or when the available memory cannot be known).
+std::optional<JobIssue> memory_issue(const LoadedJob& loaded, std::size_t trajectories);
+
 // Passes 1 and 2 on the file at `job_file`. Nothing when the file cannot be read (missing, a directory, larger than
 // max_job_file_bytes: an issue at "") or is not strict JSON; otherwise the Job, meaningful only if no issue was added.
 std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<JobIssue>& issues);
 
 // Pass 3 on a job read by read_job, whether or not it had issues (so that all are reported at once): loads
 // job.plugin, checks the parameters, creates the model and checks the states' dimension. Nothing when the job
-// names no plugin (/model/plugin was missing or invalid) or this pass added an issue.
-std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues);
+// names no plugin (/model/plugin was missing or invalid) or this pass added an issue. A single run must fit the
+// available memory (memory_issue) with its trajectories shared by `processes` (mpirun's ranks).
+std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std::size_t processes = 1);
 
 // All three passes on the file at `job_file`. Throws InvalidJob listing every issue (an unreadable file is an
 // issue at path ""). Exceptions other than InvalidJob mean a bug or an exhausted machine.
-LoadedJob load_job(const std::filesystem::path& job_file);
+LoadedJob load_job(const std::filesystem::path& job_file, std::size_t processes = 1);
 
 }  // namespace nonsep::host
