@@ -92,6 +92,7 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
   for (const SchemeState::Column& column : state.scheme.columns)
     document["active"][column.name] = encode(column.values);
   for (const SchemeState::Largest& number : state.scheme.largest) document[number.name] = encode(number.value);
+  if (!identity.scheme_choice.empty()) document["scheme_choice"] = identity.scheme_choice;
   json signed_document = document;
   signed_document["checksum"] = checkpoint_checksum(document);
   write_file_atomically(path, signed_document.dump() + "\n");
