@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 
-extern "C" void* dlopen(const char* file, int mode) {
+extern "C" __attribute__((visibility("default"))) void* dlopen(const char* file, int mode) {
   using Dlopen = void* (*)(const char*, int);
   static const auto real = reinterpret_cast<Dlopen>(dlsym(RTLD_NEXT, "dlopen"));
   static bool swapped = false;
