@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "address_sanitizer.hpp"
 #include "formula_test_support.hpp"
 
 using namespace nonsep::host_testing;
@@ -141,6 +142,29 @@ TEST_CASE("formula cache: a lock that is a link is not followed, and entry files
   CHECK(zero.status == 0);
   CHECK(count_lines(folder / "calls.log") == 4);
   CHECK(read_text(folder / "first" / "trajectories.csv") == read_text(folder / "zero" / "trajectories.csv"));
+}
+
+TEST_CASE("formula cache: the plugin loaded is the file checked, even when its path leads elsewhere by the load") {
+#if defined(NONSEP_TEST_ADDRESS_SANITIZER)
+  return;  // a preloaded library must not come before AddressSanitizer's runtime
+#endif
+  Setup setup;
+  const TemporaryFolder& folder = setup.folder;
+  REQUIRE(setup.run("first").status == 0);
+  const fs::path entry = folder / "cache" / "formula" / setup.key("first") / "paper1d.so";
+  const fs::path intruder = folder / "cache" / "intruder.so";
+  fs::copy_file(NONSEP_TEST_INTRUDER, intruder);
+  // Between the entry's check and its load, another library takes the plugin's path (swap_before_load.cpp).
+  const Environment preload("LD_PRELOAD", NONSEP_TEST_SWAP_PRELOAD);
+  const Environment from("NONSEP_TEST_SWAP_FROM", intruder.string());
+  const Environment to("NONSEP_TEST_SWAP_TO", entry.string());
+  const Environment marker("NONSEP_TEST_INTRUDER_MARKER", (folder / "intruder-ran").string());
+  const auto swapped = setup.run("swapped");
+  INFO(swapped.err);
+  CHECK(!fs::exists(intruder));  // the swap was made
+  CHECK(!fs::exists(folder / "intruder-ran"));
+  CHECK(swapped.status == 0);
+  CHECK(count_lines(folder / "calls.log") == 1);
 }
 
 TEST_CASE("formula cache: the compile time limit ends a hanging compiler and all its processes, exit 2") {

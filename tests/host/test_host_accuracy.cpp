@@ -289,6 +289,28 @@ TEST_CASE("scheme auto meets its tolerance against the exact solution and record
   }
 }
 
+TEST_CASE("scheme auto with a sweep meets its tolerance on every set, whose steps differ, against the exact solution") {
+  const TemporaryFolder folder;
+  // alpha sets the frequency: alpha = 3 or 20 needs a much smaller step than alpha = 1, whichever set comes first.
+  for (const std::vector<double>& alphas : {std::vector<double>{1.0, 3.0}, std::vector<double>{1.0, 20.0}}) {
+    CAPTURE(alphas[1]);
+    const json job = run_of({{"plugin", "mathews_lakshmanan"}, {"parameters", {{"alpha", alphas}}}},
+                            {{"scheme", "auto"}, {"tolerance", 1e-8}}, {{"q", {1.5}}, {"p", {0.0}}}, 1.0, 10.0, 0);
+    const auto ran = run_job(folder, "sweep-" + std::to_string(static_cast<int>(alphas[1])), job);
+    CHECK(ran.status == 0);
+    const auto rows = table(ran.folder / "trajectories.csv");
+    REQUIRE(rows.size() == alphas.size());
+    for (std::size_t set = 0; set < alphas.size(); ++set) {
+      CAPTURE(set);
+      const nonsep::reference::MathewsLakshmanan exact{0.5, alphas[set]};
+      const auto end = exact.at(1.5, std::acos(-1.0) / 2, 10.0);
+      CHECK(rows[set].at("status") == "completed");
+      CHECK(distance(number(rows[set], "q0"), number(rows[set], "p0"), end.q, end.p) <= 1e-8);
+    }
+    CHECK(read_json(ran.folder / "summary.json")["scheme_choice"]["pilot_states"] == 2);
+  }
+}
+
 TEST_CASE("scheme auto: validate says what would be tried, and bad tolerances and measures are refused") {
   const TemporaryFolder folder;
   json job = run_of({{"plugin", "paper1d"}}, {{"scheme", "auto"}, {"tolerance", 1e-6}}, {{"q", {2.0}}, {"p", {0.0}}},

@@ -7,6 +7,7 @@
 // refused with exit status 2, naming both and the variable that chooses the stepping.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
@@ -232,4 +233,106 @@ TEST_CASE("resume under another instruction set or path than its checkpoint's: e
     CHECK(run_nonsep({"run", "--quiet", "--resume", "--output", out.string(), file.string()}, folder.path()).status ==
           0);
   }
+}
+
+TEST_CASE("a resume with analysis.error_estimate added belongs to a different job: exit 2 naming analysis") {
+  TemporaryFolder folder;
+  json job = grid_job({{"scheme", "triplet"}, {"order", "4/3"}}, 32, 6000, 1000, false);
+  const auto file = write_job(folder / "job.json", job);
+  const auto out = folder / "out";
+  kill_after_checkpoint(file, out, 1000, folder.path());
+  job["analysis"] = {{"error_estimate", true}};
+  const auto added = write_job(folder / "added.json", job);
+  const auto resumed =
+      run_nonsep({"run", "--quiet", "--resume", "--output", out.string(), added.string()}, folder.path());
+  INFO(resumed.err);
+  CHECK(resumed.status == 2);
+  CHECK(resumed.err.find("belongs to a different job: its analysis differ") != std::string::npos);
+  CHECK(resumed.err.find("damaged") == std::string::npos);
+}
+
+TEST_CASE("scheme auto: an interrupted run resumes with the choice its checkpoint recorded, as the run it chose") {
+  TemporaryFolder folder;
+  // dt 0.05 is the output grid: the step chosen for 1e-9 is a fraction of it (output.every and the checkpoint's
+  // every_steps count the grid's steps).
+  json job = grid_job({{"scheme", "auto"}, {"tolerance", 1e-9}}, 16, 200, 20, false);
+  job["time"]["dt"] = 0.05;
+  const auto file = write_job(folder / "auto.json", job);
+  const auto out = folder / "out";
+  const auto process = start_nonsep({"run", "--output", out.string(), file.string()}, folder.path());
+  const bool saved = wait_until([&] { return std::filesystem::exists(out / "checkpoint.json"); });
+  ::kill(process.pid, SIGINT);
+  const auto stopped = finish(process, std::chrono::seconds(120));
+  REQUIRE(saved);
+  INFO("stopped: " << stopped.err);
+  REQUIRE(stopped.status == 130);
+  CHECK(stopped.err.find("--resume` continues from there") != std::string::npos);
+  const json recorded = json::parse(read_json(out / "checkpoint.json")["scheme_choice"].get<std::string>());
+  const auto resumed = run_nonsep({"run", "--resume", "--output", out.string(), file.string()}, folder.path());
+  INFO("resumed: " << resumed.err);
+  REQUIRE(resumed.status == 0);
+  CHECK(resumed.out.find("as the interrupted run chose") != std::string::npos);
+  const json summary = read_json(out / "summary.json");
+  // No pilots again: the choice (its pilots' wall time included) is the recorded one.
+  CHECK(summary["scheme_choice"]["pilot_cost"] == recorded["pilot_cost"]);
+  CHECK(summary["scheme_choice"]["chosen"] == recorded["chosen"]);
+  const std::uint64_t m = recorded["subdivision"].get<std::uint64_t>();
+  // The run it chose, written out as a job: the same files, bit for bit.
+  const std::string chosen = recorded["chosen"].get<std::string>();  // "gauss 6", "triplet 8/3": scheme and order
+  const std::string scheme = chosen.substr(0, chosen.find(' ')), order = chosen.substr(chosen.find(' ') + 1);
+  json fixed = job;
+  fixed["integrator"] = {{"scheme", scheme}};
+  if (scheme == "gauss")
+    fixed["integrator"]["stages"] = std::stoi(order) / 2;
+  else
+    fixed["integrator"]["order"] = order;
+  fixed["time"] = {{"dt", 0.05 / static_cast<double>(m)}, {"steps", 200 * m}};
+  fixed["output"]["every"] = 10 * m;
+  const auto fixed_file = write_job(folder / "fixed.json", fixed);
+  const auto reference =
+      run_nonsep({"run", "--quiet", "--output", (folder / "fixed").string(), fixed_file.string()}, folder.path());
+  INFO("fixed: " << reference.err);
+  REQUIRE(reference.status == 0);
+  CHECK(read_text(out / "trajectories.csv") == read_text(folder / "fixed" / "trajectories.csv"));
+  CHECK(read_text(out / "trajectory.csv") == read_text(folder / "fixed" / "trajectory.csv"));
+}
+
+TEST_CASE("scheme auto: a folder the run may not use is refused before the pilots run") {
+  TemporaryFolder folder;
+  const auto file =
+      write_job(folder / "auto.json", grid_job({{"scheme", "auto"}, {"tolerance", 1e-8}}, 2, 100, 10, false));
+  std::filesystem::create_directories(folder / "out");
+  write_text(folder / "out" / "checkpoint.json", "{}");
+  const auto refused = run_nonsep({"run", "--output", (folder / "out").string(), file.string()}, folder.path());
+  CHECK(refused.status == 2);
+  CHECK(refused.err.find("holds the checkpoint of an interrupted run") != std::string::npos);
+  CHECK(refused.out.find("auto: ") == std::string::npos);  // nothing chosen: no pilot ran
+}
+
+TEST_CASE(
+    "scheme auto: SIGINT during the pilots stops them with exit status 130 and a message, leaving no checkpoint") {
+  TemporaryFolder folder;
+  // One state of a chain of 2^16 sites: pilots of seconds, stopped within a chunk.
+  const std::size_t sites = std::size_t{1} << 16;
+  std::vector<double> q(sites), p(sites, 0.0);
+  for (std::size_t i = 0; i < sites; ++i) q[i] = 0.1 * std::sin(0.01 * static_cast<double>(i));
+  const json job = {{"model", {{"plugin", "lattice_chain"}, {"parameters", {{"sites", sites}}}}},
+                    {"integrator", {{"scheme", "auto"}, {"tolerance", 1e-12}}},
+                    {"initial", {{"q", q}, {"p", p}}},
+                    {"time", {{"dt", 0.5}, {"t_end", 1000.0}}},
+                    {"output", {{"every", 0}}}};
+  const auto file = write_job(folder / "chain.json", job);
+  const auto out = folder / "out";
+  const auto process = start_nonsep({"run", "--output", out.string(), file.string()}, folder.path());
+  // The folder is taken before the pilots start.
+  const bool taken = wait_until([&] { return std::filesystem::exists(out / ".nonsep-run.json"); });
+  ::kill(process.pid, SIGINT);
+  const auto stopped = finish(process, std::chrono::seconds(120));
+  REQUIRE(taken);
+  INFO(stopped.err);
+  CHECK(!stopped.killed);
+  CHECK(stopped.status == 130);
+  CHECK(stopped.err.find("stopped by SIGINT during the pilot runs of scheme auto") != std::string::npos);
+  CHECK(!std::filesystem::exists(out / "checkpoint.json"));
+  CHECK(!std::filesystem::exists(out / "summary.json"));
 }

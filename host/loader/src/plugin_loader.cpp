@@ -217,13 +217,16 @@ Plugin load_plugin(const std::string& name_or_path, const fs::path& base_directo
                         "plugin folder and the build tree's, trying:" +
                         tried);
   }
+  return load_plugin_file(file, file);
+}
+
+Plugin load_plugin_file(const fs::path& load_from, const fs::path& path) {
   // The checks of plugin_abi.h, in its order.
-  const fs::path& path = file;
   auto loaded = std::make_shared<Plugin::Loaded>();
   loaded->path = path;
   boost::dll::shared_library library;
   try {
-    library.load(path, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
+    library.load(load_from, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
   } catch (const std::exception& e) {
     throw PluginError("cannot load " + quoted(path) + " as a shared library: " + e.what());
   }

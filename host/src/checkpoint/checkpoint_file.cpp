@@ -97,6 +97,12 @@ std::string job_fingerprint(const LoadedJob& loaded) {
                                    content_hash_hex(file_hash(loaded.plugin.path())));
   parts.emplace_back("parameters", loaded.model.parameters().dump());
   add_integrator_parts(parts, run.integrator);
+  if (const auto& asked = run.auto_scheme) {  // what the choice was made for (the integrator part is the chosen one)
+    std::string text;
+    append_bits(text, asked->tolerance);
+    text += asked->measure == AutoScheme::Measure::phase ? "phase" : "energy";
+    parts.emplace_back("auto", std::move(text));
+  }
   std::string initial = std::to_string(job.initial.dimension) + ' ' + std::to_string(job.initial.count) + '\n';
   for (double x : job.initial.q) append_bits(initial, x);
   for (double x : job.initial.p) append_bits(initial, x);
@@ -133,6 +139,7 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   if (run.analysis.megno) analysis += "|megno";
   if (run.analysis.sali) analysis += "|sali";
   if (run.analysis.gali > 0) analysis += "|gali " + std::to_string(run.analysis.gali);
+  if (run.analysis.error_estimate) analysis += "|error_estimate";
   parts.emplace_back("analysis", std::move(analysis));
   std::string fingerprint;
   for (const auto& [name, text] : parts)
@@ -180,15 +187,15 @@ void check_stepping(const std::string& recorded, const LoadedJob& job, const std
   refuse_other_stepping(recorded, stepping_identity(job), job, written);
 }
 
-CheckpointIdentity checkpoint_identity(const LoadedJob& job) { return {job_fingerprint(job), stepping_identity(job)}; }
-
-Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& job) {
-  return load_checkpoint(path, job, checkpoint_identity(job));
+CheckpointIdentity checkpoint_identity(const LoadedJob& job, const nlohmann::ordered_json& scheme_choice) {
+  return {job_fingerprint(job), stepping_identity(job), scheme_choice.is_null() ? "" : scheme_choice.dump()};
 }
 
-Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded,
-                           const CheckpointIdentity& identity) {
-  const Job& job = loaded.job;
+namespace {
+
+// The checkpoint at `path` read whole and checked as a file: JSON, its format, its checksum (removed from the
+// document). Throws CheckpointError.
+json read_checkpoint_document(const std::filesystem::path& path) {
   std::optional<std::string> text;
   try {
     text = read_regular_file(path);
@@ -216,13 +223,41 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   document.erase("checksum");
   if (checksum != checkpoint_checksum(document))
     read.damaged("its content does not match its checksum: it was edited or damaged");
+  return document;
+}
+
+}  // namespace
+
+nlohmann::ordered_json recorded_scheme_choice(const std::filesystem::path& path) {
+  const json document = read_checkpoint_document(path);
+  if (!document.contains("scheme_choice"))
+    throw CheckpointError(path.string() +
+                          " belongs to a different job: it was written by a run with a fixed integrator, not by one "
+                          "of scheme \"auto\"; run with --force to start over, or resume with the job that wrote it");
+  const SavedState read = reader(path);
+  const nlohmann::ordered_json choice =
+      nlohmann::ordered_json::parse(read.string(document["scheme_choice"], "scheme_choice"), nullptr, false);
+  if (!choice.is_object()) read.damaged("its scheme_choice is not a JSON object");
+  return choice;
+}
+
+Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& job) {
+  return load_checkpoint(path, job, checkpoint_identity(job));
+}
+
+Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& loaded,
+                           const CheckpointIdentity& identity) {
+  const Job& job = loaded.job;
+  json document = read_checkpoint_document(path);
+  const SavedState read = reader(path);
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
   if (fingerprint != identity.fingerprint)
     throw CheckpointError(
         path.string() + " belongs to a different job: its " +
         fingerprint_difference(fingerprint, identity.fingerprint) +
         " differ (the plugin part covers the plugin file's bytes, integrator.NAME is the integrator's option NAME, "
-        "output covers output.every, energy_every and format); run with --force to start over, or resume with the "
+        "output covers output.every, energy_every and format, auto scheme auto's tolerance and measure); run with "
+        "--force to start over, or resume with the "
         "job that wrote it");
   refuse_other_stepping(read.string(read.member(document, "stepping"), "stepping"), identity.stepping, loaded, path);
   Checkpoint checkpoint;

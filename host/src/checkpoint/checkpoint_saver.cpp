@@ -92,6 +92,7 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
   for (const SchemeState::Column& column : state.scheme.columns)
     document["active"][column.name] = encode(column.values);
   for (const SchemeState::Largest& number : state.scheme.largest) document[number.name] = encode(number.value);
+  if (!identity.scheme_choice.empty()) document["scheme_choice"] = identity.scheme_choice;
   // Signed in place (the checksum is of the document without it): a copy would double the checkpoint's memory.
   document["checksum"] = checkpoint_checksum(document);
   std::string text = document.dump();

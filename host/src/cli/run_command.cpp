@@ -261,17 +261,13 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
                         "`nonsep inspect PLUGIN --check`\n");
 }
 
-// Runs `run` (run_job or run_study) with SIGINT and SIGTERM caught. Nothing, after saying why on stderr, when it
-// could not start (the output folder, a checkpoint to resume from); an interrupted outcome becomes "terminated"
-// after SIGTERM or SIGUSR1.
-template <class Run>
-auto run_guarded(Run run) -> std::optional<decltype(run())> {
-  InterruptGuard guard;
+// Calls `start`; false, after saying why on stderr, when it threw what keeps a run from starting (the output
+// folder, a checkpoint to resume from).
+template <class Start>
+bool started(Start start) {
   try {
-    auto outcome = run();
-    if (outcome.exit_status == ExitStatus::interrupted && stop_signal.load() != SIGINT)
-      outcome.exit_status = ExitStatus::terminated;
-    return outcome;
+    start();
+    return true;
   } catch (const OutputError& error) {
     std::cerr << "nonsep: " << error.what() << "\n";
   } catch (const FolderInUse& error) {
@@ -279,7 +275,19 @@ auto run_guarded(Run run) -> std::optional<decltype(run())> {
   } catch (const CheckpointError& error) {
     std::cerr << "nonsep: cannot resume: " << error.what() << "\n";
   }
-  return std::nullopt;
+  return false;
+}
+
+// Runs `run` (run_job or run_study) with SIGINT and SIGTERM caught. Nothing, after saying why on stderr, when it
+// could not start (started); an interrupted outcome becomes "terminated" after SIGTERM or SIGUSR1.
+template <class Run>
+auto run_guarded(Run run) -> std::optional<decltype(run())> {
+  InterruptGuard guard;
+  std::optional<decltype(run())> outcome;
+  if (!started([&] { outcome.emplace(run()); })) return std::nullopt;
+  if (outcome->exit_status == ExitStatus::interrupted && stop_signal.load() != SIGINT)
+    outcome->exit_status = ExitStatus::terminated;
+  return outcome;
 }
 
 const char* signal_name(int signal) { return signal == SIGTERM ? "SIGTERM" : signal == SIGUSR1 ? "SIGUSR1" : "SIGINT"; }
@@ -319,9 +327,24 @@ int report_run(const RunOutcome& outcome, const Job& job, const RunArguments& ar
   return to_int(outcome.exit_status);
 }
 
-// Scheme "auto": runs the pilots, puts the choice into the job and `options` and says what was chosen. False, after
-// saying why on stderr, when no scheme could be chosen (or the pilots were interrupted).
-bool choose(LoadedJob& loaded, RunOptions& options, const RunArguments& arguments) {
+// Scheme "auto": puts the choice into the job and `options` and says what was chosen: on --resume the one the
+// checkpoint recorded, else the pilots'. Nothing when the run can go on; else, after saying why on stderr, the exit
+// status: the checkpoint cannot be resumed (2), no scheme could be chosen (1), a signal stopped the pilots (130, or
+// 143 after SIGTERM or SIGUSR1; nothing was run, so nothing is left to resume).
+std::optional<int> choose(LoadedJob& loaded, RunOptions& options, const RunArguments& arguments) {
+  if (options.resume) {
+    const std::filesystem::path checkpoint = options.output_directory / checkpoint_file_name;
+    if (!started([&] {
+          options.scheme_choice = recorded_scheme_choice(checkpoint);
+          apply_recorded_choice(loaded, options.scheme_choice, checkpoint);
+        }))
+      return to_int(ExitStatus::invalid_input);
+    if (!arguments.quiet)
+      std::cout << "auto: " << options.scheme_choice["chosen"].get<std::string>()
+                << " with dt = " << format_number(loaded.job.run().time.dt) << " (" << loaded.job.run().time.steps
+                << " steps), as the interrupted run chose\n";
+    return std::nullopt;
+  }
   try {
     const SchemeChoice choice = choose_scheme(loaded, options);
     apply_choice(loaded.job, choice);
@@ -333,11 +356,33 @@ bool choose(LoadedJob& loaded, RunOptions& options, const RunArguments& argument
                 << format_number(chosen.predicted_error) << " for tolerance " << format_number(choice.tolerance)
                 << "; pilots " << format_number(choice.pilot_seconds) << " s\n";
     }
-    return true;
+    return std::nullopt;
+  } catch (const PilotsInterrupted&) {
+    const int signal = stop_signal.load();
+    std::cerr << "nonsep: stopped by " << signal_name(signal)
+              << " during the pilot runs of scheme auto, before the run began: nothing was run and nothing is left "
+                 "to resume; run the job again to start over\n";
+    return to_int(signal == SIGINT ? ExitStatus::interrupted : ExitStatus::terminated);
   } catch (const ChoiceFailed& error) {
     std::cerr << "nonsep: " << error.what() << "\n";
-    return false;
+    return to_int(ExitStatus::run_failed);
   }
+}
+
+// Scheme "auto" in one process: signals are caught from before the pilots (a stop during them ends the command
+// with a message), and the output folder is taken first, so that one the run may not use is refused before any
+// pilot runs; then the choice and the run.
+int run_auto(LoadedJob& loaded, RunOptions& options, const RunArguments& arguments) {
+  const InterruptGuard guard;
+  if (!started([&] {
+        options.folder =
+            std::make_shared<const RunFolder>(options.output_directory, "run", loaded.job.file, folder_use(options));
+      }))
+    return to_int(ExitStatus::invalid_input);
+  if (const auto stopped = choose(loaded, options, arguments)) return *stopped;
+  auto outcome = run_guarded([&] { return run_job(loaded, options); });
+  return outcome ? report_run(*outcome, loaded.job, arguments, options.output_directory, stop_signal.load())
+                 : to_int(ExitStatus::invalid_input);
 }
 
 // The run on this rank: every rank of a distributed run returns the same status; on the paths that rank 0 runs alone
@@ -410,14 +455,8 @@ int run_on_ranks(const RunArguments& arguments, const Ranks* ranks) {
       status = outcome ? report_study(*outcome, options.output_directory, arguments.quiet)
                        : to_int(ExitStatus::invalid_input);
     } else {
-      if (loaded->job.run().auto_scheme && options.resume) {
-        std::cerr << "nonsep: cannot resume " << arguments.job_file
-                  << ": scheme \"auto\" chooses from timed pilot runs, which a resumed run would repeat and might "
-                     "answer differently; write the chosen integrator (summary.json integrator) into the job to "
-                     "resume it\n";
-        status = to_int(ExitStatus::invalid_input);
-      } else if (loaded->job.run().auto_scheme && !choose(*loaded, options, arguments)) {
-        status = to_int(ExitStatus::run_failed);
+      if (loaded->job.run().auto_scheme) {
+        status = run_auto(*loaded, options, arguments);
       } else {
         auto outcome = run_guarded([&] { return run_job(*loaded, options); });
         status = outcome ? report_run(*outcome, loaded->job, arguments, options.output_directory, stop_signal.load())

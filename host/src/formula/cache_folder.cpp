@@ -219,15 +219,34 @@ std::optional<std::string> read_entry_file(int folder, const std::string& name, 
   return text;
 }
 
-std::optional<std::pair<std::uint64_t, std::uint64_t>> entry_file_size_and_hash(int folder, const std::string& name) {
+OpenFile& OpenFile::operator=(OpenFile&& other) noexcept {
+  if (this != &other) {
+    if (descriptor_ >= 0) ::close(descriptor_);
+    descriptor_ = std::exchange(other.descriptor_, -1);
+  }
+  return *this;
+}
+
+OpenFile::~OpenFile() {
+  if (descriptor_ >= 0) ::close(descriptor_);
+}
+
+fs::path OpenFile::reopen_path() const { return fs::path("/proc/self/fd") / std::to_string(descriptor_); }
+
+std::optional<CheckedFile> open_entry_file(int folder, const std::string& name) {
   struct stat status = {};
-  const int descriptor = open_regular(folder, name, status);
-  if (descriptor < 0) return std::nullopt;
+  OpenFile file(open_regular(folder, name, status));
+  if (file.descriptor() < 0) return std::nullopt;
   const auto size = static_cast<std::uint64_t>(status.st_size);
-  const auto hash = descriptor_content_hash(descriptor, size);
-  ::close(descriptor);
+  const auto hash = descriptor_content_hash(file.descriptor(), size);
   if (!hash) return std::nullopt;
-  return std::pair{size, *hash};
+  return CheckedFile{std::move(file), size, *hash};
+}
+
+std::optional<std::pair<std::uint64_t, std::uint64_t>> entry_file_size_and_hash(int folder, const std::string& name) {
+  const auto checked = open_entry_file(folder, name);
+  if (!checked) return std::nullopt;
+  return std::pair{checked->size, checked->hash};
 }
 
 void write_entry_file(int folder, const std::string& name, const std::string& text, const fs::path& shown) {

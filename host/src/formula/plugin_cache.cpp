@@ -33,19 +33,22 @@ std::string unique_suffix() {
          std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "-" + std::to_string(++counter);
 }
 
-// Whether formula/<key>/ is a complete entry for `source` (plugin_cache.hpp), its files read through descriptors.
-bool entry_is_complete(const CacheFolder& cache, const std::string& key, const std::string& source,
-                       const std::string& name) {
+// The plugin of formula/<key>/, held open, when that is a complete entry for `source` (plugin_cache.hpp), its files
+// read through descriptors; nothing otherwise.
+std::optional<OpenFile> complete_entry_plugin(const CacheFolder& cache, const std::string& key,
+                                              const std::string& source, const std::string& name) {
   const int entry = cache.open_folder(key);
-  if (entry < 0) return false;
+  if (entry < 0) return std::nullopt;
   const auto text = read_entry_file(entry, "model.cpp", source.size());
   const auto record_text = read_entry_file(entry, "entry.json", max_entry_json_bytes);
-  const auto plugin = entry_file_size_and_hash(entry, name + ".so");
+  auto plugin = open_entry_file(entry, name + ".so");
   ::close(entry);
-  if (!text || *text != source || !record_text || !plugin) return false;
+  if (!text || *text != source || !record_text || !plugin) return std::nullopt;
   const json record = json::parse(*record_text, nullptr, false);
-  return record.is_object() && record.value("size", json()) == plugin->first &&
-         record.value("content_hash", json()) == content_hash_hex(plugin->second);
+  if (!record.is_object() || record.value("size", json()) != plugin->size ||
+      record.value("content_hash", json()) != content_hash_hex(plugin->hash))
+    return std::nullopt;
+  return std::move(plugin->file);
 }
 
 // Removes the build folders of nonsep processes that died compiling (.building-<key>-* whose key's lock is free)
@@ -157,12 +160,19 @@ std::string cache_key(const std::string& source, const Toolchain& toolchain) {
 CachedPlugin cached_plugin(const FormulaModel& model, const std::function<void(const std::string&)>& say) {
   const Toolchain toolchain = find_toolchain();
   const std::string source = cpp_source(model);
-  CachedPlugin result{{}, cache_key(source, toolchain)};
+  CachedPlugin result;
+  result.key = cache_key(source, toolchain);
   const CacheFolder cache = CacheFolder::open(say);
   result.path = cache.path() / result.key / (model.name + ".so");
-  if (entry_is_complete(cache, result.key, source, model.name)) return result;
+  if (auto plugin = complete_entry_plugin(cache, result.key, source, model.name)) {
+    result.file = std::move(*plugin);
+    return result;
+  }
   const CacheLock lock(cache, result.key + ".lock");
-  if (entry_is_complete(cache, result.key, source, model.name)) return result;
+  if (auto plugin = complete_entry_plugin(cache, result.key, source, model.name)) {
+    result.file = std::move(*plugin);
+    return result;
+  }
   remove_abandoned_builds(cache);
   cache.remove(result.key);
   say("compiling the formula model '" + model.name + "' into a plugin (first use; cached in " + cache.path().string() +
@@ -177,12 +187,21 @@ CachedPlugin cached_plugin(const FormulaModel& model, const std::function<void(c
     cache.remove(building);
     throw;
   }
+  auto plugin = complete_entry_plugin(cache, result.key, source, model.name);
+  if (!plugin)
+    throw FormulaCompileError("the cache entry " + (cache.path() / result.key).string() +
+                              " changed while it was being made; run again");
+  result.file = std::move(*plugin);
   result.compiled = true;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.1f", result.seconds);
   say("compiled in " + std::string(seconds) + " s; later runs reuse it");
   return result;
+}
+
+Plugin load_cached_plugin(const CachedPlugin& cached) {
+  return load_plugin_file(cached.file.reopen_path(), cached.path);
 }
 
 }  // namespace nonsep::host::formula

@@ -15,19 +15,20 @@ namespace nonsep::host {
 
 namespace {
 
-// The plugin of job.formula from the cache (compiling it first, saying so on standard error), into job.plugin and
-// job.formula_cache_key; false with an issue at /model/formula when it cannot be had.
-bool attach_formula_plugin(Job& job, std::vector<JobIssue>& issues) {
+// The plugin of job.formula from the cache (compiling it first, saying so on standard error), its path into
+// job.plugin and its entry into job.formula_cache_key; nothing, with an issue at /model/formula, when it cannot be
+// had.
+std::optional<formula::CachedPlugin> attach_formula_plugin(Job& job, std::vector<JobIssue>& issues) {
   try {
-    const formula::CachedPlugin plugin = formula::cached_plugin(
+    formula::CachedPlugin plugin = formula::cached_plugin(
         *job.formula, [](const std::string& line) { std::cerr << "nonsep: " << line << std::endl; });
     job.plugin = plugin.path.string();
     job.formula_cache_key = plugin.key;
-    return true;
+    return plugin;
   } catch (const std::exception& error) {
     issues.push_back({"/model/formula", "a formula model that cannot be compiled: " + std::string(error.what()),
                       "a formula model and a working C++ compiler (docs/formula-models.md)"});
-    return false;
+    return std::nullopt;
   }
 }
 
@@ -96,17 +97,19 @@ std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<J
 }
 
 std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std::size_t processes) {
+  std::optional<formula::CachedPlugin> cached;
   if (job.formula) {
     // What `nonsep validate` checks without the compiler comes first: a job with any problem compiles nothing.
     check_model_parameters(job.parameters, formula::declared_parameters(*job.formula), issues);
     check_dimension(job.initial, job.formula->dimension, issues, true);
-    if (!issues.empty() || !attach_formula_plugin(job, issues)) return std::nullopt;
+    if (!issues.empty() || !(cached = attach_formula_plugin(job, issues))) return std::nullopt;
   }
   if (job.plugin.empty()) return std::nullopt;
   LoadedJob loaded{std::move(job), {}, {}};
   const Job& checked = loaded.job;
   try {
-    loaded.plugin = load_plugin(checked.plugin, checked.directory);
+    // A formula's plugin is loaded through the descriptor of the file the cache checked, not by its path.
+    loaded.plugin = cached ? formula::load_cached_plugin(*cached) : load_plugin(checked.plugin, checked.directory);
   } catch (const std::exception& error) {
     issues.push_back({"/model/plugin", "\"" + checked.plugin + "\", which cannot be loaded: " + error.what(),
                       "a plugin name listed by `nonsep models`, or the path of a plugin file"});

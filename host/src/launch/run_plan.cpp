@@ -7,19 +7,17 @@
 
 namespace nonsep::host {
 
-namespace {
-
-// An earlier run's file that this run does not write would mislead.
-void remove_stale(const std::filesystem::path& path) { remove_file(path); }
-
-// A sweep's trajectories grouped by parameter set (InitialStates::parameter_set), for the driver.
-std::vector<ParameterSet> parameter_sets(const Job& job) {
+std::vector<ParameterSet> parameter_sets(const Job& job, const std::vector<std::size_t>& set_of) {
   std::vector<ParameterSet> sets;
-  const std::vector<std::size_t>& set_of = job.initial.parameter_set;
   for (std::size_t b = 0; b < set_of.size(); ++b)
     if (b == 0 || set_of[b] != set_of[b - 1]) sets.push_back({b, job.parameter_set(set_of[b])});
   return sets;
 }
+
+namespace {
+
+// An earlier run's file that this run does not write would mislead.
+void remove_stale(const std::filesystem::path& path) { remove_file(path); }
 
 EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
   const Job& job = loaded.job;
@@ -34,7 +32,7 @@ EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
           run.analysis.tangent_vectors(),
           run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1,
           run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count),
-          parameter_sets(job),
+          parameter_sets(job, job.initial.parameter_set),
           run.analysis.megno,
           run.analysis.alignment_indices(),
           options.chunk_seconds};
@@ -66,8 +64,10 @@ std::optional<Checkpoint> resumed_state(const LoadedJob& loaded, const RunOption
 
 RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
     : directory(options.output_directory),
-      folder_(directory, options.work_unit ? "unit" : "run", loaded.job.file, folder_use(options)),
-      identity_(checkpoint_identity(loaded)),
+      folder_(options.folder ? options.folder
+                             : std::make_shared<const RunFolder>(directory, options.work_unit ? "unit" : "run",
+                                                                 loaded.job.file, folder_use(options))),
+      identity_(checkpoint_identity(loaded, options.scheme_choice)),
       resumed_(resumed_state(loaded, options, identity_)),
       driver(loaded.plugin, loaded.model, driver_setup(loaded, options)),
       energy(loaded.job.initial.count, driver.energy_available() ? loaded.job.run().energy_every : 0,

@@ -8,6 +8,7 @@
 // (run_job.hpp) runs the driver and writes the run's files from what the plan's observers hold. Internal to
 // src/launch/.
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <type_traits>
 #include <vector>
@@ -43,9 +44,9 @@ class RunPlan {
   const std::filesystem::path directory;
 
  private:
-  RunFolder folder_;
-  const CheckpointIdentity identity_;  // the saver writes it into every checkpoint
-  std::optional<Checkpoint> resumed_;  // until the constructor hands it to the driver and the observers
+  std::shared_ptr<const RunFolder> folder_;  // RunOptions::folder, or taken here
+  const CheckpointIdentity identity_;        // the saver writes it into every checkpoint
+  std::optional<Checkpoint> resumed_;        // until the constructor hands it to the driver and the observers
 
  public:
   EnsembleDriver driver;

@@ -8,6 +8,7 @@
 
 #include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/core/runtime/tangent_integrator.hpp"
+#include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
@@ -101,20 +102,45 @@ double largest_length(const std::vector<double>& a, std::size_t width) {
   return largest_distance(a, std::vector<double>(a.size(), 0.0), width);
 }
 
+// The pilot states (indices into the job's states, increasing): up to auto_pilot_states of them, evenly spread; with
+// a sweep, of every parameter set's states alike, at least one each, so that the choice meets the tolerance on every
+// set.
+std::vector<std::size_t> pilot_indices(const InitialStates& initial) {
+  const std::vector<std::size_t>& set_of = initial.parameter_set;
+  std::vector<std::pair<std::size_t, std::size_t>> sets;  // each set's states: [first, end)
+  for (std::size_t b = 0; b < initial.count; ++b) {
+    if (b == 0 || (!set_of.empty() && set_of[b] != set_of[b - 1]))
+      sets.emplace_back(b, b + 1);
+    else
+      sets.back().second = b + 1;
+  }
+  std::vector<std::size_t> indices;
+  const std::size_t each = sets.empty() ? 0 : std::max<std::size_t>(1, auto_pilot_states / sets.size());
+  for (const auto& [first, end] : sets) {
+    const std::size_t size = end - first, count = std::min(size, each);
+    for (std::size_t k = 0; k < count; ++k) indices.push_back(first + k * size / count);
+  }
+  return indices;
+}
+
 class Pilots {
  public:
   Pilots(const LoadedJob& loaded, const RunOptions& options, SchemeChoice& choice, double fraction)
       : loaded_(loaded), options_(options), choice_(choice), run_(loaded.job.run()) {
     const InitialStates& initial = loaded.job.initial;
-    const std::size_t n = initial.dimension, count = std::min(initial.count, auto_pilot_states);
-    for (std::size_t k = 0; k < count; ++k) {
-      const std::size_t index = k * initial.count / count;
+    const std::size_t n = initial.dimension;
+    const std::vector<std::size_t> indices = pilot_indices(initial);
+    std::vector<std::size_t> set_of;  // each pilot state's parameter set (empty without a sweep)
+    for (const std::size_t index : indices) {
+      if (!initial.parameter_set.empty()) set_of.push_back(initial.parameter_set[index]);
       q_.insert(q_.end(), initial.q.begin() + static_cast<std::ptrdiff_t>(index * n),
                 initial.q.begin() + static_cast<std::ptrdiff_t>(index * n + n));
       p_.insert(p_.end(), initial.p.begin() + static_cast<std::ptrdiff_t>(index * n),
                 initial.p.begin() + static_cast<std::ptrdiff_t>(index * n + n));
     }
-    choice_.pilot_states = count;
+    // Each pilot state is stepped with its own set's parameters, as the run steps it.
+    sets_ = parameter_sets(loaded.job, set_of);
+    choice_.pilot_states = indices.size();
     choice_.pilot_horizon = run_.time.t_end / fraction;
   }
 
@@ -229,6 +255,7 @@ class Pilots {
                         p_,
                         options_.threads,
                         options_.stop_requested};
+    setup.parameter_sets = sets_;
     EnsembleDriver driver(loaded_.plugin, loaded_.model, setup);
     PilotObserver observer(count, loaded_.job.initial.dimension, steps, energy);
     driver.add_observer(observer);
@@ -245,7 +272,7 @@ class Pilots {
     total.grad_H += e.grad_H;
     total.grad_K += e.grad_K;
     total.grad_U += e.grad_U;
-    if (end == DriverEnd::interrupted) throw ChoiceFailed("interrupted during the pilot runs of scheme auto");
+    if (end == DriverEnd::interrupted) throw PilotsInterrupted("interrupted during the pilot runs of scheme auto");
     if (end == DriverEnd::failed) result.problem = "failed: " + driver.error();
     if (result.problem.empty()) result.problem = observer.problem_;
     result.half = std::move(observer.half_);
@@ -260,6 +287,7 @@ class Pilots {
   SchemeChoice& choice_;
   const SingleRun& run_;
   std::vector<double> q_, p_;
+  std::vector<ParameterSet> sets_;  // of the pilot states; empty without a sweep
 };
 
 json number_or_null(double x, bool known) { return known && std::isfinite(x) ? json(x) : json(nullptr); }
@@ -340,6 +368,31 @@ void apply_choice(Job& job, const SchemeChoice& choice) {
   }
 }
 
+void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& recorded,
+                           const std::filesystem::path& checkpoint) {
+  const auto refuse = [&](const std::string& why) {
+    throw CheckpointError(checkpoint.string() + " belongs to a different job: its choice of scheme auto " + why +
+                          "; run with --force to start over, or resume with the job that wrote it");
+  };
+  const nlohmann::ordered_json& chosen = recorded.contains("chosen") ? recorded["chosen"] : nlohmann::ordered_json();
+  const nlohmann::ordered_json& m =
+      recorded.contains("subdivision") ? recorded["subdivision"] : nlohmann::ordered_json();
+  if (!chosen.is_string() || !m.is_number_unsigned() || m.get<std::uint64_t>() == 0)
+    refuse("has no scheme and subdivision");
+  SchemeChoice choice;
+  for (AutoCandidate& candidate : auto_candidates(loaded))
+    if (candidate.label == chosen.get<std::string>()) {
+      choice.pilots.emplace_back();
+      choice.pilots.back().candidate = std::move(candidate);
+    }
+  if (choice.pilots.empty()) refuse("is " + chosen.get<std::string>() + ", which this job does not offer");
+  choice.subdivision = m.get<std::uint64_t>();
+  if (loaded.job.run().time.steps > max_steps / choice.subdivision)
+    refuse("subdivides the steps by " + std::to_string(choice.subdivision) + ", past " + std::to_string(max_steps) +
+           " steps");
+  apply_choice(loaded.job, choice);
+}
+
 json to_json(const SchemeChoice& choice) {
   json candidates = json::array();
   for (const PilotResult& pilot : choice.pilots) {
@@ -390,7 +443,7 @@ std::string describe_auto(const LoadedJob& loaded) {
   const AutoScheme& asked = *loaded.job.run().auto_scheme;
   std::string names;
   for (const AutoCandidate& candidate : auto_candidates(loaded)) names += (names.empty() ? "" : ", ") + candidate.label;
-  const std::size_t states = std::min(loaded.job.initial.count, auto_pilot_states);
+  const std::size_t states = pilot_indices(loaded.job.initial).size();
   return "scheme auto: tolerance " + format_number(asked.tolerance) + " on the " +
          (asked.measure == AutoScheme::Measure::phase ? "phase-space error at t_end" : "largest |dH/H0|") +
          "; would try " + names + " with pilot runs of " + std::to_string(states) +

@@ -17,9 +17,11 @@
 // fuse multiplications and additions, so its numbers would be those of neither uninterrupted run.
 //
 // The fingerprint covers what determines the numbers: the plugin (name, version and its file's bytes), the model's
-// parameters, the integrator (its scheme, form and every option of its catalogue entry), the initial states, the time
-// grid, output.every, output.energy_every, output.format (hdf5 only) and /analysis. It leaves out the output folder and
-// the checkpoint policy, which may change between the interrupted run and the resumed one.
+// parameters, the integrator (its scheme, form and every option of its catalogue entry; with scheme "auto" the chosen
+// one, and the tolerance and measure asked for), the initial states, the time grid, output.every,
+// output.energy_every, output.format (hdf5 only) and /analysis (error_estimate included: its state is in the
+// checkpoint). A run of scheme "auto" also records the choice its pilots made, which its resume reuses. It leaves out
+// the output folder and the checkpoint policy, which may change between the interrupted run and the resumed one.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -62,8 +64,15 @@ std::string stepping_identity(const LoadedJob& job);
 // chooses the stepping.
 void check_stepping(const std::string& recorded, const LoadedJob& job, const std::filesystem::path& written);
 
-// The job's identity as a checkpoint records it: job_fingerprint and stepping_identity.
-CheckpointIdentity checkpoint_identity(const LoadedJob& job);
+// The job's identity as a checkpoint records it: job_fingerprint and stepping_identity, and with scheme "auto" the
+// choice its pilots made (`scheme_choice`, null without "auto").
+CheckpointIdentity checkpoint_identity(const LoadedJob& job, const nlohmann::ordered_json& scheme_choice = nullptr);
+
+// Scheme "auto": the choice recorded in the checkpoint at `path` (CheckpointIdentity::scheme_choice), which a resumed
+// run applies (study/scheme_choice.hpp apply_recorded_choice) before its identity, which covers the chosen integrator,
+// can be known; load_checkpoint then checks the rest. Throws CheckpointError: the file is missing or damaged, or was
+// written by a run without "auto".
+nlohmann::ordered_json recorded_scheme_choice(const std::filesystem::path& path);
 
 // Reads the checkpoint at `path` and checks it against the job, whose identity is `identity` (fingerprint,
 // stepping), and against its number of trajectories, dimension and steps. The observers' states are checked by the

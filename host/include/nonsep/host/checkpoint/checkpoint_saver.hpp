@@ -35,6 +35,9 @@ inline std::string checkpoint_checksum(const nlohmann::json& document) {
 struct CheckpointIdentity {
   std::string fingerprint;  // job_fingerprint
   std::string stepping;     // stepping_identity
+  // Scheme "auto": what its pilots chose (study/scheme_choice.hpp to_json), as JSON text (its keys in their order),
+  // the "scheme_choice" key that a resumed run reuses instead of running the pilots again; "" without "auto".
+  std::string scheme_choice;
 };
 
 class CheckpointSaver : public Observer, public ChunkObserver {

@@ -20,6 +20,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace nonsep::host::formula {
 
@@ -66,6 +67,34 @@ class CacheLock {
   int descriptor_ = -1;
   bool held_ = false;
 };
+
+// A descriptor, closed with the object.
+class OpenFile {
+ public:
+  OpenFile() = default;
+  explicit OpenFile(int descriptor) : descriptor_(descriptor) {}
+  OpenFile(OpenFile&& other) noexcept : descriptor_(std::exchange(other.descriptor_, -1)) {}
+  OpenFile& operator=(OpenFile&& other) noexcept;
+  OpenFile(const OpenFile&) = delete;
+  OpenFile& operator=(const OpenFile&) = delete;
+  ~OpenFile();
+  int descriptor() const { return descriptor_; }
+  // The name that opens this very file again while the descriptor is open, wherever the file's path now leads:
+  // /proc/self/fd/<descriptor>.
+  std::filesystem::path reopen_path() const;
+
+ private:
+  int descriptor_ = -1;
+};
+
+// The regular file `name` in `folder`, held open, with its size and content hash (content_hash.hpp); nothing on the
+// terms of read_entry_file.
+struct CheckedFile {
+  OpenFile file;
+  std::uint64_t size = 0;
+  std::uint64_t hash = 0;
+};
+std::optional<CheckedFile> open_entry_file(int folder, const std::string& name);
 
 // The content of the regular file `name` in the folder `folder` (a descriptor), or nothing when it is missing, a
 // link, not a regular file, longer than max_bytes or unreadable.

@@ -32,6 +32,7 @@
 #include "nonsep/host/formula/cache_folder.hpp"
 #include "nonsep/host/formula/compiler_process.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
+#include "nonsep/host/plugin_loader.hpp"
 
 namespace nonsep::host::formula {
 
@@ -61,10 +62,17 @@ struct CachedPlugin {
   std::string key;
   bool compiled = false;  // false: found in the cache
   double seconds = 0.0;   // the compile's wall time
+  // The plugin file whose size and hash were checked against entry.json, held open: what load_cached_plugin loads.
+  OpenFile file;
 };
 
 // The model's plugin from the cache, compiled first when absent. `say` receives progress lines ("compiling ...",
 // "compiled in 9.4 s", a fallback note). Throws FormulaCompileError.
 CachedPlugin cached_plugin(const FormulaModel& model, const std::function<void(const std::string&)>& say);
+
+// Loads the plugin `cached` checked: through its open descriptor (/proc/self/fd/N), never by its path, which
+// leads through the cache's folders again and could by then lead to another file (a cache under a folder that
+// others can write: docs/trust-model.md). Its path is the one reported (Plugin::path). Throws PluginError.
+Plugin load_cached_plugin(const CachedPlugin& cached);
 
 }  // namespace nonsep::host::formula

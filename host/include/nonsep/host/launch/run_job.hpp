@@ -56,8 +56,12 @@ struct RunOptions {
   // the unit keeps, so that it counts evaluations as one process does. 0: the job's states are the whole.
   std::size_t whole_ensemble = 0;
   // Scheme "auto": what the pilots chose (study/scheme_choice.hpp to_json), written to summary.json as
-  // "scheme_choice" with the run's own measurement against the tolerance; null for a run without "auto".
+  // "scheme_choice" with the run's own measurement against the tolerance, and into every checkpoint, from which a
+  // resumed run takes it (checkpoint_file.hpp recorded_scheme_choice); null for a run without "auto".
   nlohmann::ordered_json scheme_choice;
+  // The output folder, when the caller has taken it already (scheme "auto" takes it before its pilots, so that a
+  // folder the run may not use is refused at once); null: run_job takes output_directory as `resume` and `force` say.
+  std::shared_ptr<const RunFolder> folder;
 };
 
 // How many trajectories ended with each status.
@@ -93,6 +97,11 @@ ExitStatus exit_status_of(TrajectoryStatus status);
 
 // The output folder as `options` ask to use it (output/run_folder.hpp).
 FolderUse folder_use(const RunOptions& options);
+
+// The parameter sets of states whose sets are `set_of` (InitialStates::parameter_set, or a selection of its states
+// in their order), for the driver (EnsembleSetup::parameter_sets): one per run of equal sets, with
+// Job::parameter_set's parameters; empty without a sweep.
+std::vector<ParameterSet> parameter_sets(const Job& job, const std::vector<std::size_t>& set_of);
 
 // Runs `job`. Throws, before anything is computed: FolderInUse when the output folder is another run's or holds
 // results this run may not replace (run_folder.hpp), OutputError when the folder or trajectory.csv cannot be

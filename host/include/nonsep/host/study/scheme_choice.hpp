@@ -8,7 +8,9 @@
 // schemes that have a tangent map (nonsep::has_tangent_map). A separable part K(p) + U(q) is solved by every one of
 // them.
 //
-// Pilots: up to auto_pilot_states of the job's states (evenly spread), from t = 0 to the pilot horizon t_p, each
+// Pilots: up to auto_pilot_states of the job's states (evenly spread; with a sweep, as many of each parameter set's
+// states, at least one per set, each stepped with its set's parameters as the run steps it, so that the choice
+// meets the tolerance on every set), from t = 0 to the pilot horizon t_p, each
 // candidate at n, 2n and 4n steps (n = 4, doubled until the three are in the
 // scheme's asymptotic range: their differences fall by 2^order within a factor 2.5, or the finest is at round-off;
 // at most auto_pilot_max_steps steps). The error at t_p of the 4n run is, by Richardson extrapolation,
@@ -26,6 +28,7 @@
 // diverges, fails, or does not reach its asymptotic range is left out with the reason. When none is left the choice
 // fails (ChoiceFailed).
 #include <cstdint>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -84,15 +87,27 @@ class ChoiceFailed : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+// The pilots were stopped (options.stop_requested): nothing was chosen, nothing run.
+class PilotsInterrupted : public ChoiceFailed {
+ public:
+  using ChoiceFailed::ChoiceFailed;
+};
 
 // Runs the pilots of `loaded` and returns the choice. Throws ChoiceFailed when no candidate is left (with every
-// candidate's reason), or when interrupted (options.stop_requested).
+// candidate's reason), PilotsInterrupted when interrupted (options.stop_requested).
 SchemeChoice choose_scheme(const LoadedJob& loaded, const RunOptions& options);
 
 // The run `loaded` would make with `choice`: the chosen integrator, the time grid divided by the subdivision m, and
 // the strides counted in steps (output.every, checkpoint.every_steps, the Lyapunov strides) times m, so that every
 // output stays at the same times; output.energy_every keeps counting the run's steps (1: H at every step).
 void apply_choice(Job& job, const SchemeChoice& choice);
+
+// The choice `recorded` (to_json's, as a checkpoint keeps it: checkpoint_file.hpp recorded_scheme_choice) put into
+// the job as apply_choice puts it, without pilots: a resumed run continues with the interrupted run's choice. Throws
+// CheckpointError, naming `checkpoint`, when it is not a choice this job could have made (another candidate list or
+// grid).
+void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& recorded,
+                           const std::filesystem::path& checkpoint);
 
 // summary.json's "scheme_choice": the tolerance, the candidates with their pilot measurements (or why they were
 // left out), the choice, its predicted error and the pilots' cost.

@@ -105,7 +105,7 @@ class Plugin {
   PluginModel create(const nlohmann::json& parameters) const;
 
  private:
-  friend Plugin load_plugin(const std::string&, const std::filesystem::path&);
+  friend Plugin load_plugin_file(const std::filesystem::path&, const std::filesystem::path&);
   struct Loaded;
   std::shared_ptr<const Loaded> loaded_;
 };
@@ -116,6 +116,11 @@ class Plugin {
 // N" and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
 // (including capabilities that disagree with the table and a missing "thread_safe").
 Plugin load_plugin(const std::string& name_or_path, const std::filesystem::path& base_directory);
+
+// Loads the plugin file that `load_from` names (the name the dynamic loader opens, such as /proc/self/fd/N for a file
+// held open and checked) as the plugin at `path` (Plugin::path, messages); what load_plugin does once it has found
+// the file, with the same checks and errors.
+Plugin load_plugin_file(const std::filesystem::path& load_from, const std::filesystem::path& path);
 
 std::vector<std::filesystem::path> plugin_search_path();
 
