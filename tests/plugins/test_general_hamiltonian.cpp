@@ -99,3 +99,30 @@ TEST_CASE("the shipped models given by H: grad_H and hvp_H agree with finite dif
     CHECK(report.comparisons == 16 * 2 * 2 * model.dimension());
   }
 }
+
+TEST_CASE("schwarzschild_charged: gauss keeps H on the mass shell and p_t, p_phi exactly") {
+  const double E = 0.995, L = 4.6, beta = 8.9e-4, r = 11.0;
+  const PluginModel model = shipped("schwarzschild_charged", {{"beta", beta}});
+  // p_theta from H = -1/2 at theta = pi/2, p_r = 0.
+  const double f = 1 - 2 / r, l = L - beta / 2 * r * r;
+  const double p_theta = r * std::sqrt(-1 + E * E / f - l * l / (r * r));
+  const std::vector<double> q{0.0, r, M_PI / 2, 0.0}, p{-E, 0.0, p_theta, L};
+  auto x = nonsep::PhaseSpaceBatch::single(q, p);
+  nonsep::EnergyEvaluator energy(nonsep::HamiltonianForm::TTV);
+  const double h0 = energy.evaluate_one(model, x);
+  CHECK(h0 == doctest::Approx(-0.5).epsilon(1e-14));
+  nonsep::GaussLegendre gauss(nonsep::HamiltonianForm::TTV, 6);
+  double largest_h = 0.0, r_min = r, r_max = r;
+  for (int s = 0; s < 10000; ++s) {
+    gauss.step(model, x, 1.0);
+    largest_h = std::max(largest_h, std::abs(energy.evaluate_one(model, x) - h0));
+    r_min = std::min(r_min, x.q()[1]);
+    r_max = std::max(r_max, x.q()[1]);
+  }
+  MESSAGE("schwarzschild_charged, gauss 3 stages, dtau = 1 to tau = 10000: r in ["
+          << r_min << ", " << r_max << "], largest |H - H0| " << largest_h);
+  CHECK(largest_h < 1e-10);
+  CHECK(x.p()[0] == -E);  // H does not depend on t or phi: their momenta are constant exactly
+  CHECK(x.p()[3] == L);
+  CHECK(r_min > 2.0);
+}

@@ -3,6 +3,7 @@
 // checked this way), and grad T and grad V against 5-point finite differences of value_T and value_V (the SDK's
 // derivative checker, nonsep/derivative_checker.hpp), at up to gradient_check_states states spread evenly over the
 // ensemble, on an instance of the plugin of its own (the run's instance, and any call counts it keeps, are left alone).
+// A model given by H itself (plugin ABI version 6): grad_H against the differences of value_H at the states (q, p).
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -91,6 +92,46 @@ void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobI
     return;  // the job's instance was created with these parameters; a second refusal is the plugin's to explain
   }
   const std::size_t checked = std::min(initial.count, gradient_check_states);
+  if (loaded.plugin.general_hamiltonian()) {
+    DerivativeCheckOptions options;
+    options.random_points = 0;
+    options.tolerance = gradient_check_tolerance;
+    options.check_hessian_vector_products = false;
+    std::vector<std::size_t> states;
+    for (std::size_t k = 0; k < checked; ++k) {
+      const std::size_t state = k * initial.count / checked;
+      std::vector<double> z(initial.q.begin() + static_cast<std::ptrdiff_t>(state * n),
+                            initial.q.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));
+      z.insert(z.end(), initial.p.begin() + static_cast<std::ptrdiff_t>(state * n),
+               initial.p.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));
+      options.points.push_back(std::move(z));
+      states.push_back(state);
+    }
+    DerivativeCheckReport report;
+    try {
+      report = check_hamiltonian_derivatives(*own, options);
+    } catch (const std::exception&) {
+      return;  // the model cannot be evaluated there: the run reports it for that trajectory
+    }
+    for (const DerivativeMismatch& mismatch : report.mismatches) {
+      if (!std::isfinite(mismatch.computed) || !std::isfinite(mismatch.finite_difference)) continue;
+      const auto at = std::find(options.points.begin(), options.points.end(), mismatch.point) - options.points.begin();
+      const std::string component = mismatch.component < n ? "dH/dq" + std::to_string(mismatch.component)
+                                                           : "dH/dp" + std::to_string(mismatch.component - n);
+      issues.push_back({"/model/plugin",
+                        "the plugin '" + loaded.plugin.name() + "', whose grad_H (" + component +
+                            ") at initial state " + std::to_string(states[static_cast<std::size_t>(at)]) +
+                            " ((q, p) = " + vector_text(mismatch.point) + ") is " +
+                            DerivativeCheckReport::scientific(mismatch.computed, 6) +
+                            " where the finite difference of value_H gives " +
+                            DerivativeCheckReport::scientific(mismatch.finite_difference, 6),
+                        "a plugin whose grad_H is the derivative of its value_H (a wrong gradient makes every step "
+                        "wrong); `nonsep inspect " +
+                            loaded.plugin.path().string() + " --check` compares them at sample points"});
+      return;
+    }
+    return;
+  }
   for (std::size_t k = 0; k < checked; ++k) {
     const std::size_t state = k * initial.count / checked;
     const auto at = [&](const std::vector<double>& x) {
