@@ -44,6 +44,11 @@ SHORTENED = {
                                                "p": [{"from": -1.8, "to": 1.8, "count": 5}, 0.0]},
                                       "energy": 7.0, "solve_for": "p1"},
                           "time": {"dt": 0.005, "t_end": 200}},
+    # models given by H itself: a 16 x 16 grid to t = 500, tau = 10000: shorter
+    "magnetic_bottle_chaos_map": {"initial": {"grid": {"q": [{"from": 0.2, "to": 2.0, "count": 4}, 0.0, 0.0],
+                                                       "p": [0.0, {"from": -1.0, "to": 1.0, "count": 4}, 0.5]}},
+                                  "time": {"dt": 0.02, "t_end": 20}},
+    "schwarzschild_charged_orbit": {"time": {"dt": 1.0, "t_end": 500}},
 }
 
 QUICK = {"model": {"plugin": "paper1d"}, "hamiltonian": "TTV",

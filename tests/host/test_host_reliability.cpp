@@ -99,7 +99,7 @@ TEST_CASE(
   const std::pair<const char*, const char*> cases[] = {
       {"missing_entry_symbol", "does not export the symbol 'nonsep_plugin'"},
       {"version_1_entry", "uses plugin ABI version 1 (it exports 'nonsep_plugin_entry')"},
-      {"wrong_abi_version", "uses plugin ABI version 2 but this host uses version 5"},
+      {"wrong_abi_version", "uses plugin ABI version 2 but this host uses version 6"},
       {"wrong_table_size", "has a function table of"},
       {"invalid_metadata_json", "is not valid JSON"},
       {"metadata_names_another", "declares the name 'someone_else'"},

@@ -121,18 +121,18 @@ TEST_CASE("no plugin symbol") {
 
 TEST_CASE("a plugin of ABI version 1 (its entry function, no plugin symbol): expected and found") {
   const std::string file = (test_plugins / "version_1_entry.so").string();
-  CHECK(
-      load_error("version_1_entry.so") ==
-      "plugin '" + file +
-          "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
-          "version 5 (expected 5, 4 or 3, found 1); rebuild the plugin against the installed SDK (find_package(nonsep) "
-          "and "
-          "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
+  CHECK(load_error("version_1_entry.so") ==
+        "plugin '" + file +
+            "' uses plugin ABI version 1 (it exports 'nonsep_plugin_entry') but this host uses "
+            "version 6 (expected 6, 5, 4 or 3, found 1); rebuild the plugin against the installed SDK "
+            "(find_package(nonsep) "
+            "and "
+            "nonsep_add_model, or the headers of this nonsep's include/nonsep/plugin_abi.h)");
 }
 
 TEST_CASE("a plugin of ABI version 2 (the one with integrate): expected and found, and how to rebuild") {
   const std::string message = load_error("wrong_abi_version.so");
-  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 5 (expected 5, 4 or 3, found 2)"));
+  CHECK(contains(message, "uses plugin ABI version 2 but this host uses version 6 (expected 6, 5, 4 or 3, found 2)"));
   CHECK(contains(message, "rebuild the plugin against the installed SDK"));
 }
 
@@ -140,7 +140,7 @@ TEST_CASE("a plugin of ABI version 3 loads: its shorter table, none of version 4
   const Plugin plugin = load_plugin("version_3_table.so", test_plugins);
   CHECK(plugin.name() == "version_3_table");
   CHECK(plugin.abi_version() == 3);
-  CHECK(load_plugin("hand_written.so", test_plugins).abi_version() == 5);
+  CHECK(load_plugin("hand_written.so", test_plugins).abi_version() == 6);
   const PluginModel model = plugin.create(nlohmann::json::object());
   const double p[] = {0.5};
   double out[1] = {0.0};
@@ -181,7 +181,7 @@ TEST_CASE("a version-4 table loads without hvp_H past its end, and its calls are
     CHECK(contains(e.what(), "plugin 'version_4_table' does not provide hvp_H"));
   }
   // Version 4's struct sizes: the whole table and its first edition; a version-4 table of version 5's size is refused.
-  CHECK(NONSEP_PLUGIN_V4_STRUCT_SIZE + 2 * sizeof(void*) == sizeof(nonsep_plugin_api));  // hvp_H, chin_tangent_steps
+  CHECK(NONSEP_PLUGIN_V4_STRUCT_SIZE + 2 * sizeof(void*) == NONSEP_PLUGIN_V5_STRUCT_SIZE);  // hvp_H, chin_tangent_steps
 }
 
 TEST_CASE("an hvp_H the metadata does not claim") {
@@ -345,8 +345,51 @@ TEST_CASE("discovery lists good plugins and the failures with their errors, firs
   CHECK(entry("paper1d")->plugin.has_value());
   REQUIRE(entry("wrong_abi_version") != nullptr);
   CHECK_FALSE(entry("wrong_abi_version")->plugin.has_value());
-  CHECK(contains(entry("wrong_abi_version")->error, "(expected 5, 4 or 3, found 2)"));
+  CHECK(contains(entry("wrong_abi_version")->error, "(expected 6, 5, 4 or 3, found 2)"));
   REQUIRE(entry("not_a_library") != nullptr);
   CHECK(contains(entry("not_a_library")->error, "invalid ELF header"));
   CHECK(entry("hand_written")->path == test_plugins / "hand_written.so");
+}
+
+TEST_CASE("a version-5 table loads without value_H and grad_H past its end, as a product-form model") {
+  const Plugin plugin = load_plugin("version_5_table.so", test_plugins);
+  CHECK(plugin.abi_version() == 5);
+  CHECK_FALSE(plugin.general_hamiltonian());
+  // The table it was built with holds value_H past version 5's size: a loader reading it would refuse the plugin.
+  const PluginModel model = plugin.create(nlohmann::json::object());
+  const double q[] = {0.5}, p[] = {0.25};
+  double out[1] = {0.0};
+  model.grad_V(q, out, 1);
+  CHECK(out[0] == 0.5);
+  try {
+    model.value_H(q, p, out, 1);
+    FAIL("value_H of a product-form plugin did not throw");
+  } catch (const nonsep::ModelError& e) {
+    CHECK(contains(e.what(), "plugin 'version_5_table' does not provide value_H"));
+  }
+  CHECK(NONSEP_PLUGIN_V5_STRUCT_SIZE + 2 * sizeof(void*) == sizeof(nonsep_plugin_api));  // value_H, grad_H
+}
+
+TEST_CASE("a model given by H: its required entries, and no entry of the product form") {
+  CHECK(contains(load_error("general_without_grad_H.so"),
+                 "lacks the required function grad_H (its table entry is null), which a model given by H "
+                 "(\"hamiltonian_form\": \"general\") needs"));
+  CHECK(contains(load_error("general_with_grad_T.so"),
+                 "says \"hamiltonian_form\": \"general\" but the table's grad_T pointer is set"));
+  CHECK(contains(load_error("product_with_value_H.so"),
+                 "has value_H or grad_H in its table, which only a model given by H has"));
+  const Plugin plugin = load_plugin("general_hand_written.so", test_plugins);
+  CHECK(plugin.general_hamiltonian());
+  CHECK(plugin.has_energy());
+  CHECK_FALSE(plugin.has_hessians());
+  const PluginModel model = plugin.create(nlohmann::json::object());
+  CHECK(model.general_hamiltonian());
+  const double q[] = {0.5, -1.0}, p[] = {0.25, 2.0};
+  double h[2] = {}, dq[2] = {}, dp[2] = {};
+  model.value_H(q, p, h, 2);
+  model.grad_H(q, p, dq, dp, 2);
+  CHECK(h[1] == 2.5);
+  CHECK(dq[1] == -1.0);
+  CHECK(dp[0] == 0.25);
+  CHECK_THROWS_AS(model.grad_T(p, dq, 1), nonsep::ModelError);
 }

@@ -22,6 +22,7 @@ struct Plugin::Loaded {
   const nonsep_plugin_api* api = nullptr;            // &entries
   nlohmann::json metadata;
   KernelChoice kernels;
+  bool general = false;  // the metadata's "hamiltonian_form" is "general": a model given by H(q, p) itself
 };
 
 struct PluginModel::Instance {
@@ -53,7 +54,8 @@ const char* status_name(nonsep_status status);
 KernelChoice choose_kernel(const nlohmann::json& metadata, const nonsep_plugin_api& api, unsigned abi_version);
 
 // The metadata checks of plugin_abi.h on the parsed metadata `m` of the plugin at `path` whose table is `api`, of ABI
-// version `abi_version`. Throws PluginError naming the field.
+// version `abi_version`, including the functions its kind of model requires (plugin_abi.h, check 3: grad_T and grad_V
+// for the product form, value_H and grad_H for a general H). Throws PluginError naming the field or the function.
 void check_metadata(const nlohmann::json& m, const nonsep_plugin_api& api, unsigned abi_version,
                     const std::filesystem::path& path);
 

@@ -36,10 +36,12 @@ const std::string rebuild_hint =
 
 // The versions this host loads, as its refusals name them, and the table sizes of each (plugin_abi.h; none for a
 // version it does not load). The first size is the version's own; version 4 also had a shorter first edition.
-const std::string accepted_versions = std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", 4 or 3";
+const std::string accepted_versions = std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", 5, 4 or 3";
 std::vector<std::size_t> table_sizes(std::uint32_t version) {
   switch (version) {
     case NONSEP_PLUGIN_ABI_VERSION:
+      return {NONSEP_PLUGIN_V6_STRUCT_SIZE};
+    case 5:
       return {NONSEP_PLUGIN_V5_STRUCT_SIZE};
     case 4:
       return {NONSEP_PLUGIN_V4_STRUCT_SIZE, NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE};
@@ -90,6 +92,8 @@ bool Plugin::has_hessians() const {
   return api.hessian_T != nullptr && api.hessian_V != nullptr && (api.grad_K == nullptr || api.hessian_K != nullptr) &&
          (api.grad_U == nullptr || api.hessian_U != nullptr);
 }
+bool Plugin::general_hamiltonian() const { return loaded_->general; }
+bool Plugin::has_energy() const { return general_hamiltonian() || has_hessians(); }
 bool Plugin::has_K() const { return loaded_->api->grad_K != nullptr; }
 bool Plugin::has_U() const { return loaded_->api->grad_U != nullptr; }
 bool Plugin::has_hamiltonian_hessian_products() const { return loaded_->api->hvp_H != nullptr; }
@@ -283,8 +287,6 @@ Plugin load_plugin_file(const fs::path& load_from, const fs::path& path) {
                                                    {"create", api->create != nullptr},
                                                    {"destroy", api->destroy != nullptr},
                                                    {"dimension", api->dimension != nullptr},
-                                                   {"grad_T", api->grad_T != nullptr},
-                                                   {"grad_V", api->grad_V != nullptr},
                                                    {"last_error", api->last_error != nullptr}};
   for (const auto& [function, present] : required)
     if (!present)
@@ -300,6 +302,7 @@ Plugin load_plugin_file(const fs::path& load_from, const fs::path& path) {
                       " (metadata begins: \"" + shown + "\")");
   }
   check_metadata(loaded->metadata, *api, version, path);
+  loaded->general = loaded->metadata.value("hamiltonian_form", "product") == "general";
   loaded->api = &loaded->entries;
   loaded->kernels = choose_kernel(loaded->metadata, *loaded->api, version);
   Plugin plugin;

@@ -71,6 +71,48 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, unsigned abi_ve
         "share no mutable state, false to be run as one instance on one thread" +
         (m.contains("thread_safe") ? "; found " + m["thread_safe"].dump() : std::string()) + ")");
 
+  // The kind of model (version 6): its required functions, and no entry of the other kind.
+  const json form = m.value("hamiltonian_form", json("product"));
+  if (form != "product" && form != "general")
+    fail("gives \"hamiltonian_form\" " + form.dump() + " (expected \"product\" or \"general\")");
+  const bool general = form == "general";
+  if (general && abi_version < 6)
+    fail("says \"hamiltonian_form\": \"general\", which needs plugin ABI version 6 (found version " +
+         std::to_string(abi_version) + ")");
+  const std::pair<const char*, bool> required[] = {{"grad_T", api.grad_T != nullptr && !general},
+                                                   {"grad_V", api.grad_V != nullptr && !general},
+                                                   {"value_H", api.value_H != nullptr && general},
+                                                   {"grad_H", api.grad_H != nullptr && general}};
+  for (std::size_t i = general ? 2 : 0, end = i + 2; i < end; ++i)
+    if (!required[i].second)
+      throw PluginError("plugin " + quoted(path) + " lacks the required function " + required[i].first +
+                        " (its table entry is null)" +
+                        (general ? std::string(", which a model given by H (\"hamiltonian_form\": \"general\") needs")
+                                 : std::string()));
+  if (general) {
+    const std::pair<const char*, bool> product_entries[] = {{"grad_T", api.grad_T != nullptr},
+                                                            {"grad_V", api.grad_V != nullptr},
+                                                            {"value_T", api.value_T != nullptr},
+                                                            {"value_V", api.value_V != nullptr},
+                                                            {"hessian_T", api.hessian_T != nullptr},
+                                                            {"hessian_V", api.hessian_V != nullptr},
+                                                            {"d3T", api.d3T != nullptr},
+                                                            {"d3V", api.d3V != nullptr},
+                                                            {"grad_K", api.grad_K != nullptr},
+                                                            {"grad_U", api.grad_U != nullptr},
+                                                            {"hvp_T", api.hvp_T != nullptr},
+                                                            {"hvp_V", api.hvp_V != nullptr},
+                                                            {"chin_steps", api.chin_steps != nullptr},
+                                                            {"energy_TTV", api.energy_TTV != nullptr},
+                                                            {"energy_VVT", api.energy_VVT != nullptr}};
+    for (const auto& [entry, present] : product_entries)
+      if (present)
+        fail("says \"hamiltonian_form\": \"general\" but the table's " + std::string(entry) +
+             " pointer is set (a model given by H has no T, V, K, U or kernels: leave them null)");
+  } else if (api.value_H != nullptr || api.grad_H != nullptr) {
+    fail("has value_H or grad_H in its table, which only a model given by H has (\"hamiltonian_form\": \"general\")");
+  }
+
   if (!m.contains("capabilities") || !m["capabilities"].is_object()) fail("lacks the object \"capabilities\"");
   const std::pair<const char*, bool> present[] = {{"value_T", api.value_T != nullptr},
                                                   {"value_V", api.value_V != nullptr},
@@ -92,7 +134,9 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, unsigned abi_ve
                                                   {"energy_TTV", api.energy_TTV != nullptr},
                                                   {"energy_VVT", api.energy_VVT != nullptr},
                                                   {"hvp_H", api.hvp_H != nullptr},
-                                                  {"chin_tangent_steps", api.chin_tangent_steps != nullptr}};
+                                                  {"chin_tangent_steps", api.chin_tangent_steps != nullptr},
+                                                  {"value_H", api.value_H != nullptr},
+                                                  {"grad_H", api.grad_H != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");

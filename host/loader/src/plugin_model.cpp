@@ -129,8 +129,34 @@ void PluginModel::hvp_H(HamiltonianForm form, std::span<const double> q, std::sp
   const nonsep_plugin_api& api = *instance_->api;
   evaluate(*this, instance_->handle, api, api.hvp_H != nullptr, "hvp_H", n, q, out_q, count, n,
            [&](nonsep_instance* handle, const double* in, double* result, std::size_t states) {
-             return api.hvp_H(handle, form == HamiltonianForm::TTV ? NONSEP_FORM_TTV : NONSEP_FORM_VVT, in, p.data(),
-                              dq.data(), dp.data(), result, out_p.data(), states);
+             const std::uint32_t abi_form = general_hamiltonian()          ? NONSEP_FORM_GENERAL
+                                            : form == HamiltonianForm::TTV ? NONSEP_FORM_TTV
+                                                                           : NONSEP_FORM_VVT;
+             return api.hvp_H(handle, abi_form, in, p.data(), dq.data(), dp.data(), result, out_p.data(), states);
+           });
+}
+
+bool PluginModel::general_hamiltonian() const { return instance_->plugin.general_hamiltonian(); }
+
+void PluginModel::value_H(std::span<const double> q, std::span<const double> p, std::span<double> out,
+                          std::size_t count) const {
+  const std::size_t n = instance_->dimension;
+  if (p.size() < count * n) throw_bad_spans("value_H", count, n, 1, p.size(), out.size());
+  const nonsep_plugin_api& api = *instance_->api;
+  evaluate(*this, instance_->handle, api, api.value_H != nullptr, "value_H", n, q, out, count, 1,
+           [&](nonsep_instance* handle, const double* in, double* result, std::size_t states) {
+             return api.value_H(handle, in, p.data(), result, states);
+           });
+}
+
+void PluginModel::grad_H(std::span<const double> q, std::span<const double> p, std::span<double> dH_dq,
+                         std::span<double> dH_dp, std::size_t count) const {
+  const std::size_t n = instance_->dimension, size = count * n;
+  if (p.size() < size || dH_dp.size() < size) throw_bad_spans("grad_H", count, n, n, p.size(), dH_dp.size());
+  const nonsep_plugin_api& api = *instance_->api;
+  evaluate(*this, instance_->handle, api, api.grad_H != nullptr, "grad_H", n, q, dH_dq, count, n,
+           [&](nonsep_instance* handle, const double* in, double* result, std::size_t states) {
+             return api.grad_H(handle, in, p.data(), result, dH_dp.data(), states);
            });
 }
 

@@ -47,7 +47,7 @@ std::string describe_derivative_costs(const Plugin& plugin, const PluginModel& m
   const std::size_t count = std::clamp<std::size_t>(4096 / n, 1, 32);
   std::mt19937_64 random(2009);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  std::vector<double> x(count * n), u(count * n), out(count * n), matrix;
+  std::vector<double> x(count * n), u(count * n), out(count * n), out2(count * n), matrix;
   for (auto* v : {&x, &u})
     for (double& value : *v) value = uniform(random);
   const bool hessians_fit = n <= 1024;
@@ -58,9 +58,14 @@ std::string describe_derivative_costs(const Plugin& plugin, const PluginModel& m
     bool present;
     std::function<void()> call;
   };
+  const bool general = plugin.general_hamiltonian();  // H itself at (q, p) = (x, u)
   const std::vector<Function> functions = {
-      {"grad_T", true, [&] { model.grad_T(x, out, count); }},
-      {"grad_V", true, [&] { model.grad_V(x, out, count); }},
+      {"value_H", general, [&] { model.value_H(x, u, out, count); }},
+      {"grad_H", general, [&] { model.grad_H(x, u, out, out2, count); }},
+      {"hvp_H", general && plugin.has_hamiltonian_hessian_products(),
+       [&] { model.hvp_H(HamiltonianForm::TTV, x, u, u, x, out, out2, count); }},
+      {"grad_T", !general, [&] { model.grad_T(x, out, count); }},
+      {"grad_V", !general, [&] { model.grad_V(x, out, count); }},
       {"hessian_T", plugin.has_hessians() && hessians_fit, [&] { model.hessian_T(x, matrix, count); }},
       {"hessian_V", plugin.has_hessians() && hessians_fit, [&] { model.hessian_V(x, matrix, count); }},
       {"hvp_T", plugin.has_hessian_vector_products(), [&] { model.hvp_T(x, u, out, count); }},

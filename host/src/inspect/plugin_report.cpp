@@ -57,7 +57,15 @@ std::string describe_plugin(const Plugin& plugin) {
   const json capabilities_object = metadata.value("capabilities", json::object());
   for (const auto& [name, present] : capabilities_object.items())
     capabilities += (capabilities.empty() ? "" : ", ") + name + (present == true ? "" : " (absent)");
-  out += "  functions:   grad_T, grad_V" + (capabilities.empty() ? "" : ", " + capabilities) + "\n";
+  const bool general = plugin.general_hamiltonian();
+  out +=
+      std::string("  form:        ") +
+      (general ? "given by H(q, p) itself (plugin ABI version 6): the schemes gauss, implicit_midpoint and tao; Chin's "
+                 "schemes need the product form"
+               : "product form T_i V_ij T_j (+ K + U): every scheme") +
+      "\n";
+  out += std::string("  functions:   ") + (general ? "" : "grad_T, grad_V") +
+         (capabilities.empty() ? "" : (general ? "" : ", ") + capabilities) + "\n";
   if (metadata.contains("derivatives") && metadata["derivatives"].is_object()) {
     std::string derivatives;
     for (const auto& [name, how] : metadata["derivatives"].items())
@@ -81,7 +89,8 @@ std::string describe_plugin(const Plugin& plugin) {
     if (plugin.has_product_energy(form))
       written += std::string(written.empty() ? "" : " and ") + (form == HamiltonianForm::TTV ? "H_TTV" : "H_VVT");
   out += "  energy:      " +
-         std::string(plugin.has_hessians()
+         std::string(general ? "available (value_H)"
+                     : plugin.has_hessians()
                          ? "available (the plugin has both Hessians" +
                                (written.empty() ? std::string() : "; writes out " + written + ", one pass") + ")"
                          : "not available: the plugin lacks hessian_T or hessian_V") +
@@ -161,6 +170,22 @@ std::vector<EvaluationFunction> evaluation_functions(const Plugin& plugin, std::
   using Out = std::span<double>;
   using M = const PluginModel&;
   using C = std::size_t;
+  if (plugin.general_hamiltonian()) {
+    // H and its gradient at q with the directions as the momenta; grad_H's dH/dq and dH/dp side by side per state.
+    std::vector<EvaluationFunction> general{
+        {"value_H", "q", 1, [](M m, X q, X p, Out out, C c) { m.value_H(q, p, out, c); }},
+        {"grad_H", "q", 2 * n, [](M m, X q, X p, Out out, C c) {
+           const std::size_t size = q.size() < p.size() ? q.size() : p.size(), per = c == 0 ? 0 : size / c;
+           std::vector<double> dq(c * per), dp(c * per);
+           m.grad_H(q, p, dq, dp, c);
+           for (std::size_t b = 0; b < c; ++b)
+             for (std::size_t i = 0; i < per; ++i) {
+               out[b * 2 * per + i] = dq[b * per + i];
+               out[b * 2 * per + per + i] = dp[b * per + i];
+             }
+         }}};
+    return general;
+  }
   std::vector<EvaluationFunction> functions{{"grad_T", "p", n, [](M m, X x, X, Out out, C c) { m.grad_T(x, out, c); }},
                                             {"grad_V", "q", n, [](M m, X x, X, Out out, C c) { m.grad_V(x, out, c); }}};
   if (plugin.has_hessians()) {
@@ -292,58 +317,80 @@ double derivative_check_bytes(std::size_t n, bool third_derivatives, const Deriv
 DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin,
                                   const DerivativeCheckSettings& settings) {
   const std::size_t n = model.dimension();
-  DerivativeCheckOptions options;
-  options.check_gradients = plugin.has_values();
-  options.check_hessians = plugin.has_hessians();
-  options.check_third_derivatives = plugin.has_third_derivatives() && plugin.has_hessians();
-  options.check_hessian_vector_products = plugin.has_hessian_vector_products();
-  options.tolerance = settings.tolerance;
-  options.random_points = 0;
   const Samples samples(n, settings);
-  // The T functions at the p points, then the V functions at the q points: two runs of the SDK's checker.
-  DerivativeCheckReport report;
-  for (const bool kinetic : {true, false}) {
-    const Samples::Points& sample = kinetic ? samples.p : samples.q;
-    options.check_kinetic = kinetic;
-    options.check_potential = !kinetic;
-    options.points.clear();
-    for (std::size_t k = 0; k < sample.count; ++k)
-      options.points.emplace_back(sample.at.begin() + static_cast<std::ptrdiff_t>(k * n),
-                                  sample.at.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
-    // The separable part K(p) + U(q), where the plugin has one, at the same points (K at p, U at q).
-    DerivativeCheckOptions separable = options;
-    separable.check_hessian_vector_products = false;
-    for (const DerivativeCheckReport& part :
-         {nonsep::check_derivatives(model, options), plugin.has_K() || plugin.has_U()
-                                                         ? nonsep::check_separable_derivatives(model, separable)
-                                                         : DerivativeCheckReport{}}) {
-      report.comparisons += part.comparisons;
-      report.not_a_number += part.not_a_number;
-      report.largest_error = std::max(report.largest_error, part.largest_error);
-      report.mismatches.insert(report.mismatches.end(), part.mismatches.begin(), part.mismatches.end());
-      report.culprits.insert(report.culprits.end(), part.culprits.begin(), part.culprits.end());
-    }
-  }
   DerivativeCheck result;
-  result.comparisons = report.comparisons;
+  DerivativeCheckReport report;
   std::string points;
   if (settings.random_points > 0)
     points = std::to_string(settings.random_points) + " random in [" +
              DerivativeCheckReport::scientific(settings.box_low, 3) + ", " +
              DerivativeCheckReport::scientific(settings.box_high, 3) + "]^" + std::to_string(n);
-  if (!settings.p_points.empty())
-    points += (points.empty() ? "" : " and ") + std::to_string(settings.p_points.size()) + " given (p for T, q for V)";
-  result.text =
-      "sample points: " + points + "; tolerance " + DerivativeCheckReport::scientific(settings.tolerance, 3) + "\n";
-  result.text += report.summary();
-  if (!options.check_gradients) result.text += "  skipped: gradients: the plugin has no value_T/value_V\n";
-  if (!options.check_hessians) result.text += "  skipped: Hessians: the plugin has no hessian_T/hessian_V\n";
-  if (!options.check_third_derivatives)
-    result.text += plugin.has_third_derivatives()
-                       ? "  skipped: third derivatives: differencing them needs hessian_T/hessian_V\n"
-                       : "  skipped: third derivatives: the plugin has no d3T/d3V\n";
-  if (!options.check_hessian_vector_products)
-    result.text += "  skipped: Hessian-vector products: the plugin has no hvp_T/hvp_V\n";
+  if (plugin.general_hamiltonian()) {
+    // A model given by H: grad_H against differences of value_H and hvp_H against differences of grad_H, at the
+    // phase points (q_k, p_k) of the samples.
+    DerivativeCheckOptions options;
+    options.tolerance = settings.tolerance;
+    options.random_points = 0;
+    options.check_hessian_vector_products = plugin.has_hamiltonian_hessian_products();
+    for (std::size_t k = 0; k < std::min(samples.q.count, samples.p.count); ++k) {
+      std::vector<double> z(samples.q.at.begin() + static_cast<std::ptrdiff_t>(k * n),
+                            samples.q.at.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+      z.insert(z.end(), samples.p.at.begin() + static_cast<std::ptrdiff_t>(k * n),
+               samples.p.at.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+      options.points.push_back(std::move(z));
+    }
+    report = nonsep::check_hamiltonian_derivatives(model, options);
+    if (!settings.p_points.empty())
+      points += (points.empty() ? "" : " and ") + std::to_string(settings.p_points.size()) + " given";
+    result.text = "sample points (q, p): " + points + "; tolerance " +
+                  DerivativeCheckReport::scientific(settings.tolerance, 3) + "\n" + report.summary();
+  } else {
+    DerivativeCheckOptions options;
+    options.check_gradients = plugin.has_values();
+    options.check_hessians = plugin.has_hessians();
+    options.check_third_derivatives = plugin.has_third_derivatives() && plugin.has_hessians();
+    options.check_hessian_vector_products = plugin.has_hessian_vector_products();
+    options.tolerance = settings.tolerance;
+    options.random_points = 0;
+    // The T functions at the p points, then the V functions at the q points: two runs of the SDK's checker.
+    for (const bool kinetic : {true, false}) {
+      const Samples::Points& sample = kinetic ? samples.p : samples.q;
+      options.check_kinetic = kinetic;
+      options.check_potential = !kinetic;
+      options.points.clear();
+      for (std::size_t k = 0; k < sample.count; ++k)
+        options.points.emplace_back(sample.at.begin() + static_cast<std::ptrdiff_t>(k * n),
+                                    sample.at.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+      // The separable part K(p) + U(q), where the plugin has one, at the same points (K at p, U at q).
+      DerivativeCheckOptions separable = options;
+      separable.check_hessian_vector_products = false;
+      for (const DerivativeCheckReport& part :
+           {nonsep::check_derivatives(model, options), plugin.has_K() || plugin.has_U()
+                                                           ? nonsep::check_separable_derivatives(model, separable)
+                                                           : DerivativeCheckReport{}}) {
+        report.comparisons += part.comparisons;
+        report.not_a_number += part.not_a_number;
+        report.largest_error = std::max(report.largest_error, part.largest_error);
+        report.mismatches.insert(report.mismatches.end(), part.mismatches.begin(), part.mismatches.end());
+        report.culprits.insert(report.culprits.end(), part.culprits.begin(), part.culprits.end());
+      }
+    }
+    if (!settings.p_points.empty())
+      points +=
+          (points.empty() ? "" : " and ") + std::to_string(settings.p_points.size()) + " given (p for T, q for V)";
+    result.text =
+        "sample points: " + points + "; tolerance " + DerivativeCheckReport::scientific(settings.tolerance, 3) + "\n";
+    result.text += report.summary();
+    if (!options.check_gradients) result.text += "  skipped: gradients: the plugin has no value_T/value_V\n";
+    if (!options.check_hessians) result.text += "  skipped: Hessians: the plugin has no hessian_T/hessian_V\n";
+    if (!options.check_third_derivatives)
+      result.text += plugin.has_third_derivatives()
+                         ? "  skipped: third derivatives: differencing them needs hessian_T/hessian_V\n"
+                         : "  skipped: third derivatives: the plugin has no d3T/d3V\n";
+    if (!options.check_hessian_vector_products)
+      result.text += "  skipped: Hessian-vector products: the plugin has no hvp_T/hvp_V\n";
+  }
+  result.comparisons = report.comparisons;
   const std::string difference = batch_difference(model, plugin, samples);
   result.text += difference.empty() ? "batch consistency: one call on all points equals one call per point\n"
                                     : "batch consistency FAILED: " + difference + "\n";

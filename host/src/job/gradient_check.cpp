@@ -4,6 +4,7 @@
 // derivative checker, nonsep/derivative_checker.hpp), at up to gradient_check_states states spread evenly over the
 // ensemble, on an instance of the plugin of its own with the state's parameters (a sweep's states, each with its own
 // parameter set's; the run's instance, and any call counts it keeps, are left alone).
+// A model given by H itself (plugin ABI version 6): grad_H against the differences of value_H at the states (q, p).
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -88,15 +89,60 @@ void check_gradients_at_initial_states(const LoadedJob& loaded, std::vector<JobI
   std::optional<PluginModel> own;  // of the parameter set `own_set` (a sweep: each state's own set's)
   std::size_t own_set = 0;
   const std::size_t checked = std::min(initial.count, gradient_check_states);
+  // The instance of state `state`'s parameter set (created anew when the set changes); false when the plugin refuses
+  // it a second time, which is the plugin's to explain.
+  const auto own_instance = [&](std::size_t state) {
+    const std::size_t set = initial.parameter_set.empty() ? 0 : initial.parameter_set[state];
+    if (own && set == own_set) return true;
+    try {
+      own.emplace(loaded.plugin.create(loaded.job.parameter_set(set)));
+      own_set = set;
+      return true;
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  if (loaded.plugin.general_hamiltonian()) {
+    DerivativeCheckOptions options;
+    options.random_points = 0;
+    options.tolerance = gradient_check_tolerance;
+    options.check_hessian_vector_products = false;
+    for (std::size_t k = 0; k < checked; ++k) {
+      const std::size_t state = k * initial.count / checked;
+      if (!own_instance(state)) return;
+      std::vector<double> z(initial.q.begin() + static_cast<std::ptrdiff_t>(state * n),
+                            initial.q.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));
+      z.insert(z.end(), initial.p.begin() + static_cast<std::ptrdiff_t>(state * n),
+               initial.p.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));
+      options.points.assign(1, std::move(z));
+      DerivativeCheckReport report;
+      try {
+        report = check_hamiltonian_derivatives(*own, options);
+      } catch (const std::exception&) {
+        return;  // the model cannot be evaluated there: the run reports it for that trajectory
+      }
+      for (const DerivativeMismatch& mismatch : report.mismatches) {
+        if (!std::isfinite(mismatch.computed) || !std::isfinite(mismatch.finite_difference)) continue;
+        const std::string component = mismatch.component < n ? "dH/dq" + std::to_string(mismatch.component)
+                                                             : "dH/dp" + std::to_string(mismatch.component - n);
+        issues.push_back({"/model/plugin",
+                          "the plugin '" + loaded.plugin.name() + "', whose grad_H (" + component +
+                              ") at initial state " + std::to_string(state) +
+                              " ((q, p) = " + vector_text(mismatch.point) + ") is " +
+                              DerivativeCheckReport::scientific(mismatch.computed, 6) +
+                              " where the finite difference of value_H gives " +
+                              DerivativeCheckReport::scientific(mismatch.finite_difference, 6),
+                          "a plugin whose grad_H is the derivative of its value_H (a wrong gradient makes every step "
+                          "wrong); `nonsep inspect " +
+                              loaded.plugin.path().string() + " --check` compares them at sample points"});
+        return;
+      }
+    }
+    return;
+  }
   for (std::size_t k = 0; k < checked; ++k) {
     const std::size_t state = k * initial.count / checked;
-    const std::size_t set = initial.parameter_set.empty() ? 0 : initial.parameter_set[state];
-    if (!own || set != own_set) try {
-        own.emplace(loaded.plugin.create(loaded.job.parameter_set(set)));
-        own_set = set;
-      } catch (const std::exception&) {
-        return;  // the run's instances were created with these parameters; a second refusal is the plugin's to explain
-      }
+    if (!own_instance(state)) return;
     const auto at = [&](const std::vector<double>& x) {
       return std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(state * n),
                                  x.begin() + static_cast<std::ptrdiff_t>((state + 1) * n));

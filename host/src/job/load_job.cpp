@@ -15,6 +15,24 @@ namespace nonsep::host {
 
 namespace {
 
+// The schemes that integrate H itself (the catalogue's comparators), which a model given by H takes.
+std::string schemes_integrating_h() {
+  std::string names;
+  for (const auto& scheme : Integrator::catalogue())
+    if (scheme.family == "comparator") names += (names.empty() ? "" : ", ") + scheme.name;
+  return names;
+}
+
+// The refusal of a Chin scheme for a model given by H, and what applies instead.
+std::string chin_scheme_with_general_hamiltonian(const std::string& scheme, const std::string& plugin) {
+  return "\"" + scheme + "\" with the plugin '" + plugin +
+         "', a model given by H(q, p) itself: Chin's schemes (basic, triplet, mpe) split H into T(p) and V(q) and "
+         "need H in product form, T_i V_ij T_j (+ K + U)";
+}
+std::string schemes_for_general_hamiltonian() {
+  return "a scheme that integrates H itself: " + schemes_integrating_h() + ", or \"auto\"";
+}
+
 // The plugin of job.formula from the cache (compiling it first, saying so on standard error), its path into
 // job.plugin and its entry into job.formula_cache_key; nothing, with an issue at /model/formula, when it cannot be
 // had.
@@ -138,9 +156,17 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
                       "Hessian-vector products (hvp_T, hvp_V)"});
   if (issues.size() == before) make_trajectories(loaded, issues);
   if (issues.size() == before) check_gradients_at_initial_states(loaded, issues);
+  // A model given by H (plugin ABI version 6) is served by the schemes that integrate H itself, in the form it has.
+  const bool general = loaded.plugin.general_hamiltonian();
+  if (general && (checked.is_study() ? checked.study().form : checked.run().integrator.form) == HamiltonianForm::VVT)
+    issues.push_back({"/hamiltonian",
+                      "\"VVT\" with the plugin '" + loaded.plugin.name() +
+                          "', a model given by H(q, p) itself, which has no T and V to exchange",
+                      "no form (TTV, the default): the forms choose between the product-form Hamiltonians "
+                      "T_i V_ij T_j and V_i T_ij V_j"});
   if (!checked.is_study())
     if (const Analysis& analysis = checked.run().analysis;
-        analysis.tangent_vectors() > 0 && !loaded.plugin.has_hessians())
+        analysis.tangent_vectors() > 0 && !general && !loaded.plugin.has_hessians())
       issues.push_back({analysis.tangent_key(),
                         "the plugin '" + loaded.plugin.name() + "', which has no Hessians (hessian_T and hessian_V)",
                         "a plugin with Hessians: the tangent map of a step needs T'' and V'' (the SDK provides them "
@@ -151,9 +177,15 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
     if (auto issue =
             memory_issue(loaded, (checked.initial.count + processes - 1) / std::max<std::size_t>(1, processes)))
       issues.push_back(*std::move(issue));
-  // Comparators integrate H from its gradient: Hessians and third derivatives of the plugin (ABI 3).
-  const bool has_gradient_of_h = loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives();
+  // Comparators integrate H from its gradient: Hessians and third derivatives of the plugin (ABI 3), or a general
+  // plugin's grad_H. Chin's schemes split H into T and V: a general plugin has neither.
+  const bool has_gradient_of_h = general || (loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives());
   const auto check_comparator = [&](const IntegratorSpec& spec, const std::string& path) {
+    if (general && !Integrator(spec).is_comparator()) {
+      issues.push_back({path, chin_scheme_with_general_hamiltonian(spec.scheme, loaded.plugin.name()),
+                        schemes_for_general_hamiltonian()});
+      return;
+    }
     if (!Integrator(spec).is_comparator() || has_gradient_of_h) return;
     issues.push_back(
         {path,
@@ -171,7 +203,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
   } else {
     if (!checked.run().auto_scheme) check_comparator(checked.run().integrator, "/integrator/scheme");
     if (checked.run().auto_scheme && checked.run().auto_scheme->measure == AutoScheme::Measure::energy &&
-        !loaded.plugin.has_hessians())
+        !loaded.plugin.has_energy())
       issues.push_back({"/integrator/measure",
                         "\"energy\" with the plugin '" + loaded.plugin.name() + "', which has no Hessians",
                         "\"phase\": the energy H = T_i V_ij T_j needs the Hessians (hessian_T, hessian_V)"});

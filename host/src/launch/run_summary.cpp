@@ -16,13 +16,15 @@ json optional_number(std::optional<double> value) {
   return value && std::isfinite(*value) ? json(*value) : json(nullptr);
 }
 
-std::string hamiltonian_text(HamiltonianForm form) {
-  return form == HamiltonianForm::TTV ? "H = T_i(p) V_ij(q) T_j(p)" : "H = V_i(q) T_ij(p) V_j(q)";
+std::string hamiltonian_text(const Plugin& plugin, HamiltonianForm form) {
+  return plugin.general_hamiltonian()   ? "H(q, p), the model's own"
+         : form == HamiltonianForm::TTV ? "H = T_i(p) V_ij(q) T_j(p)"
+                                        : "H = V_i(q) T_ij(p) V_j(q)";
 }
 
 json energy_facts(const RunFacts& facts) {
   const SingleRun& run = facts.loaded.job.run();
-  const std::string hamiltonian = hamiltonian_text(run.integrator.form);
+  const std::string hamiltonian = hamiltonian_text(facts.loaded.plugin, run.integrator.form);
   if (!facts.driver.energy_available())
     return {{"available", false},
             {"hamiltonian", hamiltonian},
@@ -87,7 +89,7 @@ json run_summary(const RunFacts& facts) {
         {"columns", "trajectories.csv: one column per swept parameter, after the others"}};
   }
   if (job.formula) summary["model"]["formula"] = formula::formula_record(*job.formula, job.formula_cache_key);
-  summary["hamiltonian"] = run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT";
+  summary["hamiltonian"] = hamiltonian_name(facts.loaded.plugin, run.integrator.form);
   summary["integrator"] = {{"scheme", description.scheme},
                            {"family", description.family},
                            {"order", description.order.to_string()},

@@ -47,7 +47,7 @@ struct EnsembleDriver::Impl {
   std::string error;
 
   Impl(const Plugin& p, const PluginModel& model, EnsembleSetup s)
-      : plugin(p), setup(std::move(s)), energy_available(p.has_hessians()), records(setup.q.size() / setup.dimension) {
+      : plugin(p), setup(std::move(s)), energy_available(p.has_energy()), records(setup.q.size() / setup.dimension) {
     const std::size_t n = setup.dimension, count = records.size();
     // A plugin that is not thread-safe ("thread_safe": false, plugin_abi.h) gets one instance on one thread.
     const unsigned requested = !plugin.thread_safe() ? 1u

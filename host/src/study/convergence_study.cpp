@@ -259,7 +259,7 @@ class StudyExecution {
                         {"dimension", job_.initial.dimension},
                         {"parameters", json(loaded_.model.parameters())}};
     if (job_.formula) summary["model"]["formula"] = formula::formula_record(*job_.formula, job_.formula_cache_key);
-    summary["hamiltonian"] = study_.form == HamiltonianForm::TTV ? "TTV" : "VVT";
+    summary["hamiltonian"] = hamiltonian_name(loaded_.plugin, study_.form);
     json study;
     study["t_end"] = study_.t_end;
     study["initial"] = {{"q", job_.initial.q}, {"p", job_.initial.p}};

@@ -305,10 +305,12 @@ std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
       {"triplet 8/3", spec_of("triplet", Fraction(8, 3), 2, form)},
       {"triplet 2", spec_of("triplet", Fraction(2), 2, form)},
   };
-  const bool gradient_of_h = loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives();
+  // A model given by H (general_hamiltonian) has the gradient of H and no product form for Chin's schemes.
+  const bool general = loaded.plugin.general_hamiltonian();
+  const bool gradient_of_h = general || (loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives());
   std::vector<AutoCandidate> usable;
   for (auto& candidate : all) {
-    if (Integrator(candidate.spec).is_comparator() && !gradient_of_h) continue;
+    if (Integrator(candidate.spec).is_comparator() ? !gradient_of_h : general) continue;
     // A comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
     if (run.analysis.tangent_vectors() > 0 &&
         (!has_tangent_map(candidate.spec) ||

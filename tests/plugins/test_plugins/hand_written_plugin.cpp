@@ -19,6 +19,11 @@
 //  16  none: a valid version-4 table that ends after chin_steps (before energy_TTV, energy_VVT), as first published
 //  17  none: a valid version-4 table (before hvp_H of version 5)
 //  18  the table has hvp_H but the metadata does not claim it
+//  19  none: a valid version-5 table (before value_H and grad_H of version 6)
+//  20  a model given by H ("hamiltonian_form": "general") without its required grad_H
+//  21  a model given by H whose table still has grad_T and grad_V
+//  22  a product-form model whose table has value_H and grad_H
+//  23  none: a valid model given by H, H = (p^2 + q^2)/2
 #include <cstddef>
 #include <cstring>
 
@@ -61,6 +66,14 @@ const char* metadata_json() {
   return METADATA_BODY(NONSEP_TEST_NAME, "\"grad_U\": true");
 #elif NONSEP_TEST_DEFECT == 15
   return METADATA_BODY(NONSEP_TEST_NAME, "\"hvp_K\": true");
+#elif NONSEP_TEST_DEFECT == 20
+  return METADATA_WITH(NONSEP_TEST_NAME, "\"hamiltonian_form\": \"general\", \"thread_safe\": true, ",
+                       "\"value_H\": true");
+#elif NONSEP_TEST_DEFECT == 21 || NONSEP_TEST_DEFECT == 23
+  return METADATA_WITH(NONSEP_TEST_NAME, "\"hamiltonian_form\": \"general\", \"thread_safe\": true, ",
+                       "\"value_H\": true, \"grad_H\": true");
+#elif NONSEP_TEST_DEFECT == 22
+  return METADATA_BODY(NONSEP_TEST_NAME, "\"value_H\": true, \"grad_H\": true");
 #else
   return METADATA_BODY(NONSEP_TEST_NAME, "");
 #endif
@@ -87,6 +100,20 @@ const char* last_error(const nonsep_instance* instance) { return instance->last_
 nonsep_status hvp_H_past_the_end(nonsep_instance*, uint32_t, const double*, const double*, const double*, const double*,
                                  double*, double*, size_t) {
   return NONSEP_INTERNAL_ERROR;
+}
+#endif
+#if NONSEP_TEST_DEFECT >= 19 && NONSEP_TEST_DEFECT <= 23
+// H = (p^2 + q^2)/2 (n = 1) and its gradient.
+nonsep_status value_H(nonsep_instance*, const double* q, const double* p, double* out, size_t count) {
+  for (size_t b = 0; b < count; ++b) out[b] = (p[b] * p[b] + q[b] * q[b]) / 2;
+  return NONSEP_OK;
+}
+#endif
+#if NONSEP_TEST_DEFECT >= 21 && NONSEP_TEST_DEFECT <= 23
+nonsep_status grad_H(nonsep_instance*, const double* q, const double* p, double* dq, double* dp, size_t count) {
+  std::memcpy(dq, q, count * sizeof(double));
+  std::memcpy(dp, p, count * sizeof(double));
+  return NONSEP_OK;
 }
 #endif
 #if NONSEP_TEST_DEFECT == 16
@@ -124,6 +151,20 @@ nonsep_plugin_api make_table() {
   table.hvp_K = &zero_third_derivative;  // a directional function of the same signature
 #elif NONSEP_TEST_DEFECT == 18
   table.hvp_H = &hvp_H_past_the_end;
+#elif NONSEP_TEST_DEFECT == 19
+  table.abi_version = 5u;
+  table.struct_size = static_cast<uint32_t>(NONSEP_PLUGIN_V5_STRUCT_SIZE);
+  table.value_H = &value_H;  // past a version-5 table's end: never read
+#elif NONSEP_TEST_DEFECT == 20
+  table.grad_T = table.grad_V = nullptr;
+  table.value_H = &value_H;
+#elif NONSEP_TEST_DEFECT == 21 || NONSEP_TEST_DEFECT == 22
+  table.value_H = &value_H;
+  table.grad_H = &grad_H;
+#elif NONSEP_TEST_DEFECT == 23
+  table.grad_T = table.grad_V = nullptr;
+  table.value_H = &value_H;
+  table.grad_H = &grad_H;
 #endif
   return table;
 }

@@ -262,6 +262,12 @@ struct LoadedJob {
   PluginModel model;
 };
 
+// The solved Hamiltonian as summary.json's "hamiltonian" names it: "TTV" or "VVT" (the form of a product-form
+// model), or "general" for a model given by H(q, p) itself.
+inline std::string hamiltonian_name(const Plugin& plugin, HamiltonianForm form) {
+  return plugin.general_hamiltonian() ? "general" : form == HamiltonianForm::TTV ? "TTV" : "VVT";
+}
+
 // Puts the `q`, `p` (states of dimension n, state-major) on `shell` with `model`'s H of the form `form`, keeping in
 // place the states that reach it; returns how many were left out.
 std::size_t solve_on_energy_shell(const PluginModel& model, HamiltonianForm form, const EnergyShell& shell,

@@ -22,6 +22,8 @@
 // h = options.step * max(1, max_i |x_i|): 4 gradient evaluations, so products are checked without any Hessian.
 // Every stencil of one check is one batched call, so a plugin is crossed once per function and sample point.
 //
+// A model given by H(q, p) itself: check_hamiltonian_derivatives (below), grad_H and hvp_H the same way.
+//
 // Output: a DerivativeCheckReport. A comparison fails when |analytic - finite difference| >
 // options.tolerance * max(1, |finite difference|). A NaN derivative where the finite difference is NaN too (a
 // point outside the model's domain, such as log(q) at q < 0) agrees: it is counted in report.not_a_number, not
@@ -42,6 +44,8 @@
 #include <span>
 #include <string>
 #include <vector>
+
+#include "nonsep/core/base/model.hpp"
 
 namespace nonsep {
 
@@ -91,8 +95,9 @@ struct DerivativeCheckReport {
       std::string point;
       for (double x : m.point) point += (point.empty() ? "" : ", ") + scientific(x, 6);
       const bool kinetic = m.function.back() == 'T' || m.function.back() == 'K';
-      text += "  " + m.function + "[" + std::to_string(m.component) + "] at " + (kinetic ? "p" : "q") + " = (" + point +
-              "): computed " + scientific(m.computed, 6) + ", finite difference " + scientific(m.finite_difference, 6) +
+      const char* at = m.function.back() == 'H' ? "(q, p)" : kinetic ? "p" : "q";
+      text += "  " + m.function + "[" + std::to_string(m.component) + "] at " + at + " = (" + point + "): computed " +
+              scientific(m.computed, 6) + ", finite difference " + scientific(m.finite_difference, 6) +
               ", relative error " +
               scientific(std::abs(m.computed - m.finite_difference) / std::max(1.0, std::abs(m.finite_difference)), 3) +
               "\n";
@@ -382,6 +387,83 @@ DerivativeCheckReport check_separable_derivatives(const M& model, DerivativeChec
   options.check_potential = options.check_potential && model.has_U();
   DerivativeCheckReport report = check_derivatives(detail::SeparablePartView<M>{model}, options);
   for (auto& mismatch : report.mismatches) mismatch.function.back() = mismatch.function.back() == 'T' ? 'K' : 'U';
+  return report;
+}
+
+namespace detail {
+// A model given by H(q, p) itself (nonsep/core/base/model.hpp, ModelWithGeneralHamiltonian, with hvp_H) seen as a
+// function of the phase point z = (q, p) of 2n numbers, in the place of T: value_T is H, grad_T is (dH/dq, dH/dp),
+// hvp_T is the Hessian of H times a tangent (dq, dp).
+template <class M>
+struct PhasePointView {
+  const M& model;
+  mutable std::vector<double> q, p, a, b, dq, dp;
+  std::size_t dimension() const { return 2 * model.dimension(); }
+  // Splits `count` phase points z into q and p (and tangents into dq, dp).
+  void split(std::span<const double> z, std::vector<double>& first, std::vector<double>& second,
+             std::size_t count) const {
+    const std::size_t n = model.dimension();
+    first.resize(count * n);
+    second.resize(count * n);
+    for (std::size_t k = 0; k < count; ++k)
+      for (std::size_t i = 0; i < n; ++i) {
+        first[k * n + i] = z[k * 2 * n + i];
+        second[k * n + i] = z[k * 2 * n + n + i];
+      }
+  }
+  void join(std::span<double> z, std::size_t count) const {
+    const std::size_t n = model.dimension();
+    for (std::size_t k = 0; k < count; ++k)
+      for (std::size_t i = 0; i < n; ++i) {
+        z[k * 2 * n + i] = a[k * n + i];
+        z[k * 2 * n + n + i] = b[k * n + i];
+      }
+  }
+  void value_T(std::span<const double> z, std::span<double> out, std::size_t count) const {
+    split(z, q, p, count);
+    model.value_H(q, p, out, count);
+  }
+  void grad_T(std::span<const double> z, std::span<double> out, std::size_t count) const {
+    split(z, q, p, count);
+    a.resize(q.size());
+    b.resize(q.size());
+    model.grad_H(q, p, a, b, count);
+    join(out, count);
+  }
+  void hvp_T(std::span<const double> z, std::span<const double> v, std::span<double> out,
+             std::size_t count) const requires requires(const M& m, std::span<const double> x, std::span<double> o) {
+    m.hvp_H(HamiltonianForm::TTV, x, x, x, x, o, o, count);
+  }
+  {
+    split(z, q, p, count);
+    split(v, dq, dp, count);
+    a.resize(q.size());
+    b.resize(q.size());
+    model.hvp_H(HamiltonianForm::TTV, q, p, dq, dp, a, b, count);
+    join(out, count);
+  }
+  // Never called (check_derivatives is asked for neither the V functions nor Hessians).
+  void value_V(std::span<const double>, std::span<double>, std::size_t) const {}
+  void grad_V(std::span<const double>, std::span<double>, std::size_t) const {}
+  void hvp_V(std::span<const double>, std::span<const double>, std::span<double>, std::size_t) const {}
+};
+}  // namespace detail
+
+// A model given by H(q, p) itself checked as check_derivatives checks T: grad_H against differences of value_H, and
+// hvp_H (where the model has it) against differences of grad_H along a seeded tangent, at sample points z = (q, p):
+// the random ones drawn in [-box, box]^(2n), options.points each of 2n numbers (q then p). Mismatches name grad_H
+// and hvp_H, with the point z = (q, p) and the component of (dH/dq, dH/dp) (n + i for dH/dp_i).
+template <class M>
+DerivativeCheckReport check_hamiltonian_derivatives(const M& model, DerivativeCheckOptions options = {}) {
+  options.check_hessians = options.check_third_derivatives = false;
+  options.check_potential = false;
+  options.check_kinetic = true;
+  DerivativeCheckReport report = check_derivatives(detail::PhasePointView<M>{model, {}, {}, {}, {}, {}, {}}, options);
+  for (auto& mismatch : report.mismatches) mismatch.function.back() = 'H';
+  for (auto& skipped : report.skipped)
+    if (skipped.rfind("Hessian-vector products", 0) == 0) skipped = "hvp_H: the model has none";
+  std::erase_if(report.skipped,
+                [](const std::string& s) { return s.rfind("Hessians", 0) == 0 || s.rfind("third", 0) == 0; });
   return report;
 }
 

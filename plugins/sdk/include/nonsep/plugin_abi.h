@@ -1,4 +1,4 @@
-/* nonsep plugin ABI, version 5. The boundary evaluates: the host owns every scheme and crosses the boundary once
+/* nonsep plugin ABI, version 6. The boundary evaluates: the host owns every scheme and crosses the boundary once
  * per batch of states for a gradient (or a Hessian, a value, a third derivative, a Hessian-vector product).
  * One number says everything a plugin offers: abi_version fixes the table's size (one struct size per version) and
  * the arguments of the stepping kernel. Each version appends optional entries to the previous one's table, so an
@@ -12,6 +12,8 @@
  *   5  + the directional derivative of grad H, hvp_H (the tangent maps of the comparators), the tangent kernel
  *        chin_tangent_steps; chin_steps takes the arguments below and the metadata's "kernels" has no "version"
  *                                                                                  NONSEP_PLUGIN_V5_STRUCT_SIZE
+ *   6  + models given by H(q, p) itself: value_H, grad_H, and hvp_H with the form NONSEP_FORM_GENERAL; the metadata's
+ *        "hamiltonian_form" says which kind a plugin is                          NONSEP_PLUGIN_V6_STRUCT_SIZE
  * docs/plugin-abi.md lists the versions and their entries. Version 2 had a fused stepping function integrate() with
  * a stepper of its own; version 1 exported a function, nonsep_plugin_entry, returning the table instead of the
  * pointer below. Plugins of either are refused: rebuild them against the installed SDK.
@@ -25,11 +27,12 @@
  * Checks the host makes, in this order, before using anything else in the table:
  *   0. the symbol holds an aligned address inside a loaded library (refused otherwise: a library that exports
  *      the table itself under the name, instead of a pointer to it)
- *   1. abi_version is 5 (NONSEP_PLUGIN_ABI_VERSION), 4 or 3   (refused with "expected 5, 4 or 3, found N")
+ *   1. abi_version is 6 (NONSEP_PLUGIN_ABI_VERSION), 5, 4 or 3   (refused with "expected 6, 5, 4 or 3, found N")
  *   2. struct_size is the size of that version's table (the list above; refused with expected and found sizes);
  *      the entries an older table lacks are absent
- *   3. the required functions are non-null        (metadata_json, create, destroy, dimension, grad_T, grad_V,
- *                                                   last_error)
+ *   3. the required functions are non-null        (metadata_json, create, destroy, dimension, last_error; and
+ *                                                   grad_T, grad_V for the product form, value_H, grad_H for a
+ *                                                   general H)
  *   4. metadata_json() returns valid JSON of the shape below, whose capabilities match the table.
  *
  * Batch layout (same as nonsep/core/base/model.hpp): `count` states of dimension n, state-major and contiguous.
@@ -55,6 +58,7 @@
  *   {
  *     "name": "paper1d", "version": "1.0.0", "description": "...",
  *     "hamiltonian": "what T, V and H_TTV / H_VVT are, in words",
+ *     "hamiltonian_form": "product" | "general",   (version 6; absent: "product")
  *     "dimension": { "fixed": 1 }                  or  { "parameter": "dimension" },
  *     "parameters": [ { "name": "dimension", "type": "integer" | "number" | "boolean",
  *                       "default": 2, "minimum": 1, "maximum": 64, "unit": "", "description": "..." } ],
@@ -68,6 +72,13 @@
  *   }
  * "minimum", "maximum" and "unit" may be absent; "thread_safe" is required. Each capability is true exactly
  * when the table's pointer of that name is non-null (an absent capability counts as false).
+ *
+ * Two kinds of model (version 6). "product": H = T_i V_ij T_j (+ K + U) or its VVT form, given by T and V and
+ * their derivatives (every entry up to version 5; grad_T and grad_V required, value_H and grad_H null); Chin's
+ * schemes split it, and the schemes that integrate H itself take it too. "general": H(q, p) of any shape, given by
+ * value_H and grad_H (both required) and optionally hvp_H with the form NONSEP_FORM_GENERAL; every entry of T, V, K,
+ * U, the kernels and energy_TTV/VVT is null. Only the schemes that integrate H itself (Gauss-Legendre, implicit
+ * midpoint, Tao's extended phase space) take it; the host refuses Chin's schemes for it before anything runs.
  */
 #ifndef NONSEP_PLUGIN_ABI_H
 #define NONSEP_PLUGIN_ABI_H
@@ -79,7 +90,7 @@
 extern "C" {
 #endif
 
-#define NONSEP_PLUGIN_ABI_VERSION 5u
+#define NONSEP_PLUGIN_ABI_VERSION 6u
 #define NONSEP_PLUGIN_SYMBOL "nonsep_plugin"
 /* The symbol of ABI version 1 (a function returning the table); the host names it when refusing such a plugin. */
 #define NONSEP_PLUGIN_V1_ENTRY_SYMBOL "nonsep_plugin_entry"
@@ -95,8 +106,9 @@ typedef enum nonsep_status {
 typedef struct nonsep_instance nonsep_instance; /* opaque, owned by the plugin */
 
 /* The forms of the solved Hamiltonian (nonsep/core/schemes/integrator_description.hpp's HamiltonianForm). */
-#define NONSEP_FORM_TTV 0u /* H = T_i V_ij T_j (+ K + U) */
-#define NONSEP_FORM_VVT 1u /* H = V_i T_ij V_j (+ K + U) */
+#define NONSEP_FORM_TTV 0u     /* H = T_i V_ij T_j (+ K + U) */
+#define NONSEP_FORM_VVT 1u     /* H = V_i T_ij V_j (+ K + U) */
+#define NONSEP_FORM_GENERAL 2u /* H(q, p) of a "general" plugin (hvp_H only) */
 
 /* The arguments of chin_steps (below): `steps` times a schedule of `substeps` basic steps of eq. (expalg) of every
  * state, in place (a triplet composition's step is its schedule of 3^levels basic steps); or, with `terms` >= 2,
@@ -223,7 +235,8 @@ typedef struct nonsep_plugin_api {
    *   out_p_k = T''''_ijkl g_i g_j dp_l + 2 T'''_ijk g_i dg_j + K''_kl dp_l
    *   out_q_k = 2 V'''_kil dq_l w_i + 2 V''_ki (T'''_ijl g_j dp_l + T''_ij dg_j) + U''_kl dq_l.
    * The tangent maps of the schemes that integrate H itself (Gauss-Legendre, Tao's extended phase space) need it;
-   * the host refuses them a plugin without it. Another form returns NONSEP_UNSUPPORTED. */
+   * the host refuses them a plugin without it. A "general" plugin (version 6) takes NONSEP_FORM_GENERAL: out_q and
+   * out_p are then the Hessian of its H(q, p) times (dq, dp). Another form returns NONSEP_UNSUPPORTED. */
   nonsep_status (*hvp_H)(nonsep_instance* instance, uint32_t form, const double* q, const double* p, const double* dq,
                          const double* dp, double* out_q, double* out_p, size_t count);
 
@@ -234,6 +247,14 @@ typedef struct nonsep_plugin_api {
    * A failed evaluation returns its status with the arrays undefined: the host then redoes the steps through the
    * evaluations. */
   nonsep_status (*chin_tangent_steps)(nonsep_instance* instance, const nonsep_chin_tangent_steps_args* args);
+
+  /* ---- Version 6. Present exactly in a "general" plugin (metadata "hamiltonian_form": "general"). ---- */
+
+  /* H(q, p) itself, one number per state (out[b] = H(q_b, p_b)). */
+  nonsep_status (*value_H)(nonsep_instance* instance, const double* q, const double* p, double* out, size_t count);
+  /* Its gradient: dH_dq[b*n + i] = dH/dq_i, dH_dp[b*n + i] = dH/dp_i at (q_b, p_b), the gradient layout. */
+  nonsep_status (*grad_H)(nonsep_instance* instance, const double* q, const double* p, double* dH_dq, double* dH_dp,
+                          size_t count);
 } nonsep_plugin_api;
 
 /* The size of a version-3 table: the entries before grad_K. */
@@ -242,8 +263,10 @@ typedef struct nonsep_plugin_api {
 #define NONSEP_PLUGIN_V4_STRUCT_SIZE offsetof(nonsep_plugin_api, hvp_H)
 /* The size of a version-4 table as first published, ending with chin_steps: also loaded as version 4. */
 #define NONSEP_PLUGIN_V4_KERNEL_STRUCT_SIZE offsetof(nonsep_plugin_api, energy_TTV)
-/* The size of a version-5 table. */
-#define NONSEP_PLUGIN_V5_STRUCT_SIZE sizeof(nonsep_plugin_api)
+/* The size of a version-5 table: the entries before value_H. */
+#define NONSEP_PLUGIN_V5_STRUCT_SIZE offsetof(nonsep_plugin_api, value_H)
+/* The size of a version-6 table. */
+#define NONSEP_PLUGIN_V6_STRUCT_SIZE sizeof(nonsep_plugin_api)
 
 #ifdef __cplusplus
 }

@@ -26,6 +26,14 @@
 // A model class with K(p) or U(q) (model_adapter.hpp) also fills grad_K, value_K, hessian_K (resp. the U ones) of
 // ABI version 4, announces them as capabilities and adds them to "derivatives"; the absent part's entries are null.
 //
+// A model class given by H(q, p) itself (nonsep/sdk/hamiltonian_adapter.hpp) is exported with
+//
+//   NONSEP_EXPORT_HAMILTONIAN(HenonHeiles, "henon_heiles", "1.0.0", "one-line description", "what H is");
+//
+// whose table (plugin_abi.h version 6, "hamiltonian_form": "general") has value_H, grad_H and hvp_H (form
+// NONSEP_FORM_GENERAL), by automatic differentiation of H over (q, p) where the class does not write them, and none
+// of the entries of T, V, K, U or the kernels.
+//
 // Thread safety (as plugin_abi.h promises): metadata_json and create may be called concurrently; an instance
 // holds its model and its last error message, so one instance is for one thread at a time. The metadata says
 // "thread_safe": true: distinct instances share nothing mutable, provided the model class keeps no mutable
@@ -45,6 +53,7 @@
 
 #include "nonsep/plugin_abi.h"
 #include "nonsep/sdk/dual.hpp"
+#include "nonsep/sdk/hamiltonian_adapter.hpp"
 #include "nonsep/sdk/kernels.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 #include "nonsep/sdk/parameters.hpp"
@@ -64,16 +73,18 @@ struct ModelIdentity {
   const char* hamiltonian;
 };
 
-// The constant function table exported for model class M. Identity is a type with a static constexpr
-// ModelIdentity member `value`.
-template <ModelClass M, Derivatives policy, class Identity>
-class PluginTable {
+// What every table of the SDK shares, for an adapter type (ModelAdapter, HamiltonianAdapter) of a model class M: the
+// instance holding the adapter and its last error, the mapping of exceptions to statuses, create, destroy,
+// dimension, last_error, and the metadata's identity, dimension and parameters.
+template <class Adapter>
+class PluginTableBase {
+ protected:
+  using M = typename Adapter::Model;
   static_assert(parameter_names_are_unique<M>(), "two parameters of the model have the same name");
   static_assert(parameter_defaults_are_in_range<M>(), "a parameter's default lies outside its minimum..maximum");
   static_assert(dimension_parameter_is_bounded<M>(),
                 "dimension_parameter must name an integer parameter with minimum >= 1 and maximum <= max_dimension");
 
-  using Adapter = ModelAdapter<M, policy>;
   struct Instance : nonsep_instance {
     explicit Instance(const ParameterValues& values) : adapter(values) {}
     Adapter adapter;
@@ -119,70 +130,31 @@ class PluginTable {
     }
   }
 
-  static std::string build_metadata() {
-    constexpr ModelIdentity id = Identity::value;
+  // The metadata's identity, dimension, parameters and thread safety (plugin_abi.h).
+  static nlohmann::json common_metadata(const ModelIdentity& id) {
     nlohmann::json dimension;
     if constexpr (HasFixedDimension<M>)
       dimension = {{"fixed", M::dimension}};
     else
       dimension = {{"parameter", M::dimension_parameter}, {"max_dimension", M::max_dimension}};
-    auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
-    nlohmann::json kernel_sets = nlohmann::json::array();
-    for (const auto name : kernel_instruction_sets) kernel_sets.push_back(std::string(name));
-    nlohmann::json metadata = {{"name", id.name},
-                               {"version", id.version},
-                               {"description", id.description},
-                               {"hamiltonian", id.hamiltonian},
-                               {"dimension", dimension},
-                               {"parameters", parameters_metadata(parameter_table<M>())},
-                               {"thread_safe", true},
-                               {"capabilities",
-                                {{"value_T", true},
-                                 {"value_V", true},
-                                 {"hessian_T", true},
-                                 {"hessian_V", true},
-                                 {"d3T", true},
-                                 {"d3V", true},
-                                 {"hvp_T", true},
-                                 {"hvp_V", true},
-                                 {"chin_steps", true},
-                                 {"energy_TTV", Adapter::analytic_energy_TTV},
-                                 {"energy_VVT", Adapter::analytic_energy_VVT},
-                                 {"hvp_H", Adapter::has_hamiltonian_hessian},
-                                 {"chin_tangent_steps", NONSEP_SDK_TANGENT_KERNELS != 0}}},
-                               {"derivatives",
-                                {{"grad_T", kind(Adapter::analytic_grad_T)},
-                                 {"grad_V", kind(Adapter::analytic_grad_V)},
-                                 {"hessian_T", kind(Adapter::analytic_hessian_T)},
-                                 {"hessian_V", kind(Adapter::analytic_hessian_V)},
-                                 {"d3T", kind(Adapter::analytic_d3T)},
-                                 {"d3V", kind(Adapter::analytic_d3V)},
-                                 {"hvp_T", kind(Adapter::analytic_hvp_T)},
-                                 {"hvp_V", kind(Adapter::analytic_hvp_V)}}},
-                               {"automatic_differentiation", automatic_differentiation_text<Adapter>()},
-                               {"kernels", {{"instruction_sets", kernel_sets}}}};
-    for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
-    for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
-    if constexpr (HasK<M>) {
-      metadata["derivatives"]["grad_K"] = kind(Adapter::analytic_grad_K);
-      metadata["derivatives"]["hessian_K"] = kind(Adapter::analytic_hessian_K);
-    }
-    if constexpr (HasU<M>) {
-      metadata["derivatives"]["grad_U"] = kind(Adapter::analytic_grad_U);
-      metadata["derivatives"]["hessian_U"] = kind(Adapter::analytic_hessian_U);
-    }
-    return metadata.dump();
+    return {{"name", id.name},
+            {"version", id.version},
+            {"description", id.description},
+            {"hamiltonian", id.hamiltonian},
+            {"dimension", dimension},
+            {"parameters", parameters_metadata(parameter_table<M>())},
+            {"thread_safe", true}};
   }
-
-  static const char* metadata_json() noexcept {
+  template <std::string (*build)()>
+  static const char* metadata_text() noexcept {
     try {
-      static const std::string text = build_metadata();
+      static const std::string text = build();
       return text.c_str();
     } catch (...) {
       return "metadata could not be built (out of memory)";  // not JSON: the host reports it
     }
   }
-
+  // (the rest of the base below: create, destroy, dimension, last_error)
   static nonsep_status create(const char* parameters_json, nonsep_instance** out, char* message,
                               std::size_t message_size) noexcept {
     if (out == nullptr) return NONSEP_INTERNAL_ERROR;
@@ -217,6 +189,66 @@ class PluginTable {
   static const char* last_error(const nonsep_instance* instance) noexcept {
     return instance == nullptr ? "no instance" : instance->last_error.c_str();
   }
+};
+
+// The constant function table exported for model class M. Identity is a type with a static constexpr
+// ModelIdentity member `value`.
+template <ModelClass M, Derivatives policy, class Identity>
+class PluginTable : PluginTableBase<ModelAdapter<M, policy>> {
+  using Adapter = ModelAdapter<M, policy>;
+  using Base = PluginTableBase<Adapter>;
+  using Base::create;
+  using Base::destroy;
+  using Base::dimension;
+  using Base::guarded;
+  using Base::last_error;
+  using Base::record_error;
+  using typename Base::Instance;
+
+  static std::string build_metadata() {
+    auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
+    nlohmann::json kernel_sets = nlohmann::json::array();
+    for (const auto name : kernel_instruction_sets) kernel_sets.push_back(std::string(name));
+    nlohmann::json metadata = Base::common_metadata(Identity::value);
+    metadata.update({{"capabilities",
+                      {{"value_T", true},
+                       {"value_V", true},
+                       {"hessian_T", true},
+                       {"hessian_V", true},
+                       {"d3T", true},
+                       {"d3V", true},
+                       {"hvp_T", true},
+                       {"hvp_V", true},
+                       {"chin_steps", true},
+                       {"energy_TTV", Adapter::analytic_energy_TTV},
+                       {"energy_VVT", Adapter::analytic_energy_VVT},
+                       {"hvp_H", Adapter::has_hamiltonian_hessian},
+                       {"chin_tangent_steps", NONSEP_SDK_TANGENT_KERNELS != 0}}},
+                     {"derivatives",
+                      {{"grad_T", kind(Adapter::analytic_grad_T)},
+                       {"grad_V", kind(Adapter::analytic_grad_V)},
+                       {"hessian_T", kind(Adapter::analytic_hessian_T)},
+                       {"hessian_V", kind(Adapter::analytic_hessian_V)},
+                       {"d3T", kind(Adapter::analytic_d3T)},
+                       {"d3V", kind(Adapter::analytic_d3V)},
+                       {"hvp_T", kind(Adapter::analytic_hvp_T)},
+                       {"hvp_V", kind(Adapter::analytic_hvp_V)}}},
+                     {"automatic_differentiation", automatic_differentiation_text<Adapter>()},
+                     {"kernels", {{"instruction_sets", kernel_sets}}}});
+    for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
+    for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
+    if constexpr (HasK<M>) {
+      metadata["derivatives"]["grad_K"] = kind(Adapter::analytic_grad_K);
+      metadata["derivatives"]["hessian_K"] = kind(Adapter::analytic_hessian_K);
+    }
+    if constexpr (HasU<M>) {
+      metadata["derivatives"]["grad_U"] = kind(Adapter::analytic_grad_U);
+      metadata["derivatives"]["hessian_U"] = kind(Adapter::analytic_hessian_U);
+    }
+    return metadata.dump();
+  }
+
+  static const char* metadata_json() noexcept { return Base::template metadata_text<&build_metadata>(); }
 
   // The batched functions: spans over the caller's arrays (sizes from the batch layout of plugin_abi.h).
 #define NONSEP_SDK_BATCHED(function, per_state_of)                                                                     \
@@ -415,6 +447,105 @@ class PluginTable {
       Adapter::analytic_energy_VVT ? &product_energy<HamiltonianForm::VVT> : nullptr,
       Adapter::has_hamiltonian_hessian ? &hvp_H : nullptr,
       NONSEP_SDK_TANGENT_KERNELS ? &chin_tangent_steps : nullptr,
+      nullptr,  // value_H: a product-form model
+      nullptr,  // grad_H
+  };
+};
+
+// The constant function table exported for a model class M given by H itself (hamiltonian_adapter.hpp): the
+// metadata says "hamiltonian_form": "general", the table has value_H, grad_H and hvp_H (form NONSEP_FORM_GENERAL)
+// and none of the entries of T, V, K, U or the kernels (plugin_abi.h version 6).
+template <HamiltonianClass M, Derivatives policy, class Identity>
+class HamiltonianPluginTable : PluginTableBase<HamiltonianAdapter<M, policy>> {
+  using Adapter = HamiltonianAdapter<M, policy>;
+  using Base = PluginTableBase<Adapter>;
+  using Base::create;
+  using Base::destroy;
+  using Base::dimension;
+  using Base::guarded;
+  using Base::last_error;
+  using Base::record_error;
+  using typename Base::Instance;
+
+  static std::string build_metadata() {
+    auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
+    nlohmann::json metadata = Base::common_metadata(Identity::value);
+    metadata.update(
+        {{"hamiltonian_form", "general"},
+         {"capabilities", {{"value_H", true}, {"grad_H", true}, {"hvp_H", true}}},
+         {"derivatives", {{"grad_H", kind(Adapter::analytic_grad_H)}, {"hvp_H", kind(Adapter::analytic_hvp_H)}}},
+         {"automatic_differentiation", hamiltonian_differentiation_text<Adapter>()}});
+    return metadata.dump();
+  }
+  static const char* metadata_json() noexcept { return Base::template metadata_text<&build_metadata>(); }
+
+  static nonsep_status value_H(nonsep_instance* instance, const double* q, const double* p, double* out,
+                               std::size_t count) noexcept {
+    return guarded(instance, "value_H", [&](const Instance& self) {
+      const std::size_t size = count * self.adapter.dimension();
+      self.adapter.value_H(std::span<const double>(q, size), std::span<const double>(p, size),
+                           std::span<double>(out, count), count);
+    });
+  }
+  static nonsep_status grad_H(nonsep_instance* instance, const double* q, const double* p, double* dH_dq, double* dH_dp,
+                              std::size_t count) noexcept {
+    return guarded(instance, "grad_H", [&](const Instance& self) {
+      const std::size_t size = count * self.adapter.dimension();
+      self.adapter.grad_H(std::span<const double>(q, size), std::span<const double>(p, size),
+                          std::span<double>(dH_dq, size), std::span<double>(dH_dp, size), count);
+    });
+  }
+  // The Hessian of H times (dq, dp); a form other than NONSEP_FORM_GENERAL is NONSEP_UNSUPPORTED.
+  static nonsep_status hvp_H(nonsep_instance* instance, std::uint32_t form, const double* q, const double* p,
+                             const double* dq, const double* dp, double* out_q, double* out_p,
+                             std::size_t count) noexcept {
+    if (instance != nullptr && form != NONSEP_FORM_GENERAL) {
+      record_error(*instance, "hvp_H: form " + std::to_string(form) +
+                                  " of a model given by H itself (expected NONSEP_FORM_GENERAL, 2)");
+      return NONSEP_UNSUPPORTED;
+    }
+    return guarded(instance, "hvp_H", [&](const Instance& self) {
+      const std::size_t size = count * self.adapter.dimension();
+      self.adapter.hvp_H(HamiltonianForm::TTV, std::span<const double>(q, size), std::span<const double>(p, size),
+                         std::span<const double>(dq, size), std::span<const double>(dp, size),
+                         std::span<double>(out_q, size), std::span<double>(out_p, size), count);
+    });
+  }
+
+ public:
+  static constexpr nonsep_plugin_api api = {
+      NONSEP_PLUGIN_ABI_VERSION,
+      static_cast<std::uint32_t>(sizeof(nonsep_plugin_api)),
+      &metadata_json,
+      &create,
+      &destroy,
+      &dimension,
+      nullptr,  // grad_T
+      nullptr,  // grad_V
+      nullptr,  // value_T
+      nullptr,  // value_V
+      nullptr,  // hessian_T
+      nullptr,  // hessian_V
+      &last_error,
+      nullptr,  // d3T
+      nullptr,  // d3V
+      nullptr,  // grad_K
+      nullptr,  // grad_U
+      nullptr,  // value_K
+      nullptr,  // value_U
+      nullptr,  // hessian_K
+      nullptr,  // hessian_U
+      nullptr,  // hvp_T
+      nullptr,  // hvp_V
+      nullptr,  // hvp_K
+      nullptr,  // hvp_U
+      nullptr,  // chin_steps
+      nullptr,  // energy_TTV
+      nullptr,  // energy_VVT
+      &hvp_H,
+      nullptr,  // chin_tangent_steps
+      &value_H,
+      &grad_H,
   };
 };
 
@@ -430,6 +561,22 @@ class PluginTable {
 #define NONSEP_EXPORT_MODEL(Model, name, version, description, hamiltonian)                                      \
   NONSEP_EXPORT_MODEL_WITH_DERIVATIVES(Model, ::nonsep::sdk::Derivatives::preferred, name, version, description, \
                                        hamiltonian)
+
+// Exports model class `Model` given by H(q, p) itself (nonsep/sdk/hamiltonian_adapter.hpp) as this library's plugin,
+// with the same four strings as NONSEP_EXPORT_MODEL (`hamiltonian`: what H is, in words). Such a plugin carries no
+// stepping kernels: Chin's schemes need the product form, and the host refuses them for it.
+#if NONSEP_SDK_KERNEL_UNIT != 0
+#define NONSEP_EXPORT_HAMILTONIAN(Model, name, version, description, hamiltonian)
+#else
+#define NONSEP_EXPORT_HAMILTONIAN(Model, name, version, description, hamiltonian)                           \
+  namespace {                                                                                               \
+  struct nonsep_exported_model_identity {                                                                   \
+    static constexpr ::nonsep::sdk::ModelIdentity value{name, version, description, hamiltonian};           \
+  };                                                                                                        \
+  }                                                                                                         \
+  NONSEP_DEFINE_PLUGIN((::nonsep::sdk::HamiltonianPluginTable<Model, ::nonsep::sdk::Derivatives::preferred, \
+                                                              nonsep_exported_model_identity>::api))
+#endif
 
 // As NONSEP_EXPORT_MODEL, choosing the derivative policy (::nonsep::sdk::Derivatives::automatic ignores the
 // class's analytic derivatives; used to compare the two).

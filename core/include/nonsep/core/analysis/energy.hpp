@@ -6,7 +6,8 @@
 // Needs a model with Hessians (model.hpp); one with Hessian-vector products is evaluated through them instead
 // (hessian_products.hpp: one gradient and one product per state, O(n) numbers), and one that writes out the
 // product term itself (ModelWithProductEnergy below: one pass per state) through that. Not part of stepping: used
-// for reporting and testing.
+// for reporting and testing. A model given by H itself (model.hpp, ModelWithGeneralHamiltonian) gives H by its
+// value_H, in one batched call.
 #include <algorithm>
 #include <concepts>
 #include <span>
@@ -34,13 +35,37 @@ class EnergyEvaluator {
  public:
   explicit EnergyEvaluator(HamiltonianForm form) : form_(form) {}
 
-  // Writes H of each state of x into energies (size x.count()).
-  template <ModelWithHessians M>
+  // Writes H of each state of x into energies (size x.count()). Throws InvalidArgument for a batch that does not
+  // fit the model or energies, or a model that is neither given by H nor of the product form with Hessians.
+  template <class M>
+  requires ModelWithHessians<M> || ModelWithGeneralHamiltonian<M>
   void evaluate(const M& model, const PhaseSpaceBatch& x, std::span<double> energies) {
     check_batch_fits(model, x);
     if (energies.size() != x.count())
       throw InvalidArgument("energy output has " + std::to_string(energies.size()) + " entries for " +
                             std::to_string(x.count()) + " states");
+    if constexpr (ModelWithGeneralHamiltonian<M>)
+      if (is_general_hamiltonian(model)) {
+        model.value_H(x.q(), x.p(), energies, x.count());
+        return;
+      }
+    if constexpr (ModelWithHessians<M>)
+      evaluate_product_form(model, x, energies);
+    else
+      throw InvalidArgument("the energy: this model is neither given by H nor of the product form");
+  }
+
+  template <class M>
+  requires ModelWithHessians<M> || ModelWithGeneralHamiltonian<M>
+  double evaluate_one(const M& model, const PhaseSpaceBatch& x) {
+    double e = 0.0;
+    evaluate(model, x, std::span<double>(&e, 1));
+    return e;
+  }
+
+ private:
+  template <ModelWithHessians M>
+  void evaluate_product_form(const M& model, const PhaseSpaceBatch& x, std::span<double> energies) {
     if constexpr (ModelWithProductEnergy<M>)
       if (model.has_product_energy(form_)) {
         model.product_energy(form_, x.q(), x.p(), energies, x.count());
@@ -85,14 +110,6 @@ class EnergyEvaluator {
     }
   }
 
-  template <ModelWithHessians M>
-  double evaluate_one(const M& model, const PhaseSpaceBatch& x) {
-    double e = 0.0;
-    evaluate(model, x, std::span<double>(&e, 1));
-    return e;
-  }
-
- private:
   template <class M>
   void add_separable_part(const M& model, std::span<const double> q, std::span<const double> p,
                           std::span<double> energies, std::size_t count) {

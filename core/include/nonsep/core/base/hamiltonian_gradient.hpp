@@ -11,7 +11,9 @@
 // costs the model one gradient, two Hessians and one third-derivative contraction per state, in four batched
 // calls, and counts one grad_H per state (EvaluationCounts). A model with Hessian-vector products is evaluated
 // through them instead (hessian_products.hpp): one gradient, two products and one third-derivative contraction,
-// O(n) numbers per state.
+// O(n) numbers per state. A model given by H itself (model.hpp, ModelWithGeneralHamiltonian) writes dH/dq and dH/dp
+// in one batched call of its grad_H, counted the same way: so every scheme that integrates H sees one interface,
+// whichever kind of model it steps.
 //
 // Layout: q, p, dH/dq and dH/dp are batches of `count` states of dimension n (component i of state b at b*n + i).
 // Model exceptions propagate; the outputs are then unspecified.
@@ -33,10 +35,10 @@ namespace nonsep {
 // nonsep::ModelWithHamiltonianHessian when it is a Model and moreover, for spans x (size count*n, read) and out
 // (size count*n, written):
 //   m.hvp_H(form, q, p, dq, dp, out_q, out_p, count)   writes out_q = d(dH/dq), out_p = d(dH/dp) at each state
-// A type may have the member and still lack it at run time (a plugin without hvp_H): it then has
-// `bool has_hamiltonian_hessian_products() const`, which says so.
+// (a model given by H itself ignores `form`). A type may have the member and still lack it at run time (a plugin
+// without hvp_H): it then has `bool has_hamiltonian_hessian_products() const`, which says so.
 template <class M>
-concept ModelWithHamiltonianHessian = Model<M> &&
+concept ModelWithHamiltonianHessian = HamiltonianModel<M> &&
     requires(const M& m, HamiltonianForm form, std::span<const double> x, std::span<double> out, std::size_t count) {
   m.hvp_H(form, x, x, x, x, out, out, count);
 };
@@ -73,8 +75,9 @@ class HamiltonianGradient {
   void add_evaluations(const EvaluationCounts& counts) { evaluations_ += counts; }
 
   // Writes dH/dq and dH/dp at each of the count points (q, p). All four spans hold at least count*n numbers.
-  // Throws InvalidArgument when a span is too short.
-  template <ModelWithThirdDerivatives M>
+  // Throws InvalidArgument when a span is too short, or for a model that is neither of the product form with third
+  // derivatives nor given by H.
+  template <HamiltonianModel M>
   void evaluate(const M& model, std::span<const double> q, std::span<const double> p, std::span<double> dH_dq,
                 std::span<double> dH_dp, std::size_t count) {
     const auto n = static_cast<std::size_t>(model.dimension());
@@ -86,6 +89,26 @@ class HamiltonianGradient {
     p = p.first(size);
     dH_dq = dH_dq.first(size);
     dH_dp = dH_dp.first(size);
+    if constexpr (ModelWithGeneralHamiltonian<M>) {
+      if (is_general_hamiltonian(model)) {
+        model.grad_H(q, p, dH_dq, dH_dp, count);
+        evaluations_.grad_H += count;
+        return;
+      }
+    }
+    if constexpr (ModelWithThirdDerivatives<M>)
+      evaluate_product_form(model, q, p, dH_dq, dH_dp, count);
+    else
+      throw InvalidArgument("the gradient of H: this model is neither given by H nor of the product form");
+  }
+
+ private:
+  // evaluate() of a product-form model (spans checked and cut to size).
+  template <ModelWithThirdDerivatives M>
+  void evaluate_product_form(const M& model, std::span<const double> q, std::span<const double> p,
+                             std::span<double> dH_dq, std::span<double> dH_dp, std::size_t count) {
+    const auto n = static_cast<std::size_t>(model.dimension());
+    const std::size_t size = n * count;
     if constexpr (ModelWithHessianProducts<M>) {
       if (has_hessian_products(model)) {
         hamiltonian_gradient_by_products(model, form_, q, p, dH_dq, dH_dp, count, products_);
@@ -119,7 +142,6 @@ class HamiltonianGradient {
     evaluations_.grad_H += count;
   }
 
- private:
   template <class M>
   void add_separable_part(const M& model, std::span<const double> q, std::span<const double> p, std::span<double> dH_dq,
                           std::span<double> dH_dp, std::size_t size, std::size_t count) {

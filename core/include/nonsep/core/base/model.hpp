@@ -50,6 +50,43 @@ concept ModelWithThirdDerivatives = ModelWithHessians<M> &&
   m.d3V(x, u, out, count);
 };
 
+// A model given by H(q, p) itself, of any shape (a charged particle in a magnetic field, a geodesic, ...), instead
+// of the product form above. A type M models nonsep::ModelWithGeneralHamiltonian when, for `const M m`, spans q, p
+// (size count*n, read), out (size count, written) and dH_dq, dH_dp (size count*n, written):
+//   m.dimension()                        -> std::size_t, n
+//   m.value_H(q, p, out, count)          writes H of each of the count states (q_b, p_b)
+//   m.grad_H(q, p, dH_dq, dH_dp, count)  writes dH/dq_i and dH/dp_i at each state
+// and, for the tangent maps, the directional derivative of grad H, hvp_H (hamiltonian_gradient.hpp), whose
+// HamiltonianForm argument such a model ignores. A type that serves both kinds of model (a plugin) has
+// `bool general_hamiltonian() const`, which says which kind this object is. The schemes that integrate H itself
+// (Gauss-Legendre, Tao's extended phase space) and the energy take either kind (HamiltonianModel below); Chin's
+// schemes split T(p) and V(q) and need the product form.
+template <class M>
+concept ModelWithGeneralHamiltonian = requires(const M& m, std::span<const double> x, std::span<double> out,
+                                               std::size_t count) {
+  { m.dimension() } -> std::convertible_to<std::size_t>;
+  m.value_H(x, x, out, count);
+  m.grad_H(x, x, out, out, count);
+};
+
+// Whether `model` is given by H itself (its type has the concept and, where it says, the object is of that kind).
+template <class M>
+bool is_general_hamiltonian(const M& model) {
+  if constexpr (!ModelWithGeneralHamiltonian<M>)
+    return false;
+  else if constexpr (requires {
+                       { model.general_hamiltonian() } -> std::convertible_to<bool>;
+                     })
+    return static_cast<bool>(model.general_hamiltonian());
+  else
+    return true;
+}
+
+// The models of the schemes that integrate H itself: the product form with its third derivatives (the gradient of
+// H_TTV reaches them), or H itself.
+template <class M>
+concept HamiltonianModel = ModelWithThirdDerivatives<M> || ModelWithGeneralHamiltonian<M>;
+
 // The optional separable part. A model may add K(p) + U(q) to the product form, so that the solved Hamiltonian is
 //   H = T_i V_ij T_j + K(p) + U(q)   (TTV)      H = V_i T_ij V_j + K(p) + U(q)   (VVT)
 // (separable_composition.hpp integrates it). M models nonsep::ModelWithSeparablePart when moreover

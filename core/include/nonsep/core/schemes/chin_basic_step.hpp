@@ -80,7 +80,7 @@ inline void check_step_size(double dt) {
     throw_bad_step_size(dt);
 }
 
-template <Model M>
+template <class M>
 void check_batch_fits(const M& model, const PhaseSpaceBatch& x) {
   const auto dimension = static_cast<std::size_t>(model.dimension());
   if (dimension != x.dimension()) [[unlikely]]

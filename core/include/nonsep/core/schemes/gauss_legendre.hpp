@@ -131,7 +131,7 @@ class GaussLegendre {
   // Advances every state of x by dt (finite, non-zero). Throws InvalidArgument on a bad dt or a batch whose
   // dimension differs from the model's, ModelError naming the states whose iteration failed (see above);
   // propagates the model's exceptions.
-  template <ModelWithThirdDerivatives M>
+  template <HamiltonianModel M>
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
     const auto failures = try_step(model, x, dt);
     if (failures.empty()) return;
@@ -149,7 +149,7 @@ class GaussLegendre {
   }
 
   // As step(), but returns the failed states instead of throwing ModelError; they keep their starting point.
-  template <ModelWithThirdDerivatives M>
+  template <HamiltonianModel M>
   std::vector<StateFailure> try_step(const M& model, PhaseSpaceBatch& x, double dt) {
     check_step_size(dt);
     check_batch_fits(model, x);
@@ -228,7 +228,7 @@ class GaussLegendre {
   // dH/dq, dH/dp at z + Z_i for every stage of every state, in one batched evaluation. A state that stopped iterating
   // is evaluated again at the stage points of its last iteration (its stages no longer change): model time spent for
   // nothing, but no gathering, and no point the model has not seen before.
-  template <ModelWithThirdDerivatives M>
+  template <HamiltonianModel M>
   void evaluate_whole_batch(const M& model, std::size_t s, std::size_t count) {
     const std::size_t size = start_q_.size();
     q_.resize(s * size);
@@ -253,7 +253,7 @@ class GaussLegendre {
 
   // The same for the states still iterating only: their stage points gathered, evaluated, the gradients scattered
   // back to their places.
-  template <ModelWithThirdDerivatives M>
+  template <HamiltonianModel M>
   void evaluate_gathered(const M& model, std::size_t s, std::size_t n, std::size_t size) {
     const std::size_t points = s * active_.size();
     q_.resize(points * n);

@@ -106,7 +106,7 @@ class TaoExtendedPhaseSpace {
   // exceptions (x and copies are then unspecified).
   // With an observer: observer(const TaoFlow&, const PhaseSpaceBatch& x, const PhaseSpaceBatch& copies) after each
   // sub-flow, in order.
-  template <ModelWithThirdDerivatives M, class Observer = NoTaoObserver>
+  template <HamiltonianModel M, class Observer = NoTaoObserver>
   void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt, Observer&& observer = {}) {
     check_step_size(dt);
     check_batch_fits(model, x);
@@ -118,7 +118,7 @@ class TaoExtendedPhaseSpace {
   }
 
   // The same with the copies held by the stepper (initialised to x when empty); tracks the largest copy distance.
-  template <ModelWithThirdDerivatives M, class Observer = NoTaoObserver>
+  template <HamiltonianModel M, class Observer = NoTaoObserver>
   void step(const M& model, PhaseSpaceBatch& x, double dt, Observer&& observer = {}) {
     if (copies_.count() == 0) copies_ = x;
     step(model, x, copies_, dt, observer);
@@ -129,7 +129,7 @@ class TaoExtendedPhaseSpace {
   // first + part.count() - 1 of a batch of `total` states whose step `before` (this stepper as it was before the
   // step) was to take. Their copies come from `before` (from the states when it held none yet) and are written
   // back into this stepper's copies.
-  template <ModelWithThirdDerivatives M, class Observer = NoTaoObserver>
+  template <HamiltonianModel M, class Observer = NoTaoObserver>
   void step_part(const M& model, PhaseSpaceBatch& part, const TaoExtendedPhaseSpace& before, std::size_t first,
                  std::size_t total, double dt, Observer&& observer = {}) {
     PhaseSpaceBatch copies = before.copies_.count() == total ? slice(before.copies_, first, part.count()) : part;
@@ -237,7 +237,7 @@ class TaoExtendedPhaseSpace {
     for (double d : distances_) max_copy_distance_ = std::max(max_copy_distance_, d);
   }
 
-  template <ModelWithThirdDerivatives M, class Observer>
+  template <HamiltonianModel M, class Observer>
   void compose(int level, const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt, Observer& observer) {
     if (level == 0) {
       strang(model, x, copies, dt, observer);
@@ -251,7 +251,7 @@ class TaoExtendedPhaseSpace {
   }
 
   // phi_A(dt/2) phi_B(dt/2) phi_C(dt) phi_B(dt/2) phi_A(dt/2).
-  template <ModelWithThirdDerivatives M, class Observer>
+  template <HamiltonianModel M, class Observer>
   void strang(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& copies, double dt, Observer& observer) {
     const std::size_t size = x.size();
     const double h = dt / 2.0;
@@ -300,7 +300,7 @@ class TaoExtendedPhaseSpace {
            std::memcmp(cached_y_.data(), y.data(), y.size() * sizeof(double)) == 0;
   }
 
-  template <ModelWithThirdDerivatives M>
+  template <HamiltonianModel M>
   void evaluate_at_a(const M& model, std::span<const double> q, std::span<const double> y, std::size_t count) {
     at_a_dq_.resize(q.size());
     at_a_dp_.resize(q.size());

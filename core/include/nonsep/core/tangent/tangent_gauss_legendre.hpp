@@ -56,7 +56,7 @@ class TangentGaussLegendre {
 
   // Advances x by dt as GaussLegendre::step does and maps the tangent vectors by the step's derivative. Errors above.
   template <class M>
-  requires ModelWithThirdDerivatives<M> && ModelWithHamiltonianHessian<M>
+  requires ModelWithHamiltonianHessian<M>
   void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, double dt) {
     const std::size_t k = check_tangents_fit(x, tangents);
     require_hamiltonian_hessian(model, base_.stages() == 1 ? "implicit_midpoint" : "gauss");

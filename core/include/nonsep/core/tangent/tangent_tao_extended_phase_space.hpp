@@ -60,7 +60,7 @@ class TangentTaoExtendedPhaseSpace {
 
   // Advances x by dt as TaoExtendedPhaseSpace::step (with the copies it holds) and maps the tangent vectors.
   template <class M>
-  requires ModelWithThirdDerivatives<M> && ModelWithHamiltonianHessian<M>
+  requires ModelWithHamiltonianHessian<M>
   void step(const M& model, PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, double dt) {
     k_ = check_tangents_fit(x, tangents);
     require_hamiltonian_hessian(model, "tao");
@@ -73,7 +73,7 @@ class TangentTaoExtendedPhaseSpace {
   // step_part of TaoExtendedPhaseSpace with the vectors: `part_tangents` hold the k vectors of states first ..
   // first + part.count() - 1 of a batch of `total` states, whose private state comes from `before`.
   template <class M>
-  requires ModelWithThirdDerivatives<M> && ModelWithHamiltonianHessian<M>
+  requires ModelWithHamiltonianHessian<M>
   void step_part(const M& model, PhaseSpaceBatch& part, PhaseSpaceBatch& part_tangents,
                  const TangentTaoExtendedPhaseSpace& before, std::size_t first, std::size_t total, double dt) {
     k_ = check_tangents_fit(part, part_tangents);

@@ -78,6 +78,12 @@ class Plugin {
   std::string version() const;
   std::string description() const;
   std::vector<PluginParameter> parameters() const;
+  // Whether the plugin is a model given by H(q, p) itself (plugin_abi.h version 6, "hamiltonian_form": "general"):
+  // it has value_H, grad_H (and hvp_H) and none of T, V, K, U; only the schemes that integrate H take it.
+  bool general_hamiltonian() const;
+  // Whether H itself can be evaluated (the energy, energy shells, `measure` "energy"): a general plugin's value_H, or
+  // a product-form plugin's Hessians.
+  bool has_energy() const;
   // hessian_T and hessian_V, and the Hessians of the separable parts the plugin has (hessian_K with grad_K,
   // hessian_U with grad_U): what the energy and the tangent maps need.
   bool has_hessians() const;
@@ -93,7 +99,7 @@ class Plugin {
   bool has_hessian_vector_products() const;
   // energy_TTV (resp. energy_VVT): the plugin writes out the product term of H in that form.
   bool has_product_energy(HamiltonianForm form) const;
-  // The plugin ABI version its table was built for (5, or 4 or 3 for an older table without the later entries).
+  // The plugin ABI version its table was built for (6, or 5, 4 or 3 for an older table without the later entries).
   unsigned abi_version() const;
   // The metadata's "thread_safe": false means one instance, used on one thread, for a whole run (plugin_abi.h).
   bool thread_safe() const;
@@ -112,8 +118,8 @@ class Plugin {
 
 // Throws PluginError: NONSEP_INSTRUCTION_SET naming an instruction set the plugin lacks or this processor cannot
 // run; file not found (listing every place tried), not a shared library, no plugin symbol,
-// ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 5, 4 or 3, found
-// N" and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
+// ABI version mismatch (also a version-1 plugin, recognised by its entry function; both say "expected 6, 5, 4 or 3,
+// found N" and to rebuild against the installed SDK), wrong table size, a required function missing, invalid metadata
 // (including capabilities that disagree with the table and a missing "thread_safe").
 Plugin load_plugin(const std::string& name_or_path, const std::filesystem::path& base_directory);
 
@@ -134,8 +140,10 @@ struct DiscoveredPlugin {
 std::vector<DiscoveredPlugin> discover_plugins();
 
 // A plugin instance as a nonsep::ModelWithThirdDerivatives and a nonsep::ModelWithSeparablePart (has_K() and
-// has_U() say whether the plugin has K and U; a model without them is the pure product form). One instance must
-// be used by one thread at a time.
+// has_U() say whether the plugin has K and U; a model without them is the pure product form), and as a
+// nonsep::ModelWithGeneralHamiltonian (general_hamiltonian() says whether the plugin is given by H itself: then its
+// value_H, grad_H and hvp_H serve, and the functions of T, V, K and U throw). One instance must be used by one thread
+// at a time.
 class PluginModel {
  public:
   std::size_t dimension() const;
@@ -164,6 +172,12 @@ class PluginModel {
   void hvp_H(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<const double> dq,
              std::span<const double> dp, std::span<double> out_q, std::span<double> out_p, std::size_t count) const;
   bool has_hamiltonian_hessian_products() const;
+  // A model given by H itself (plugin_abi.h version 6): H, one number per state, and its gradient, every span count*n
+  // numbers. Throw nonsep::ModelError when the plugin lacks them (a product-form plugin), or they fail.
+  bool general_hamiltonian() const;
+  void value_H(std::span<const double> q, std::span<const double> p, std::span<double> out, std::size_t count) const;
+  void grad_H(std::span<const double> q, std::span<const double> p, std::span<double> dH_dq, std::span<double> dH_dp,
+              std::size_t count) const;
   // The product term of H in `form` (plugin_abi.h energy_TTV, energy_VVT), one number per state into out: as a
   // core model a nonsep::ModelWithProductEnergy (energy.hpp), whose EnergyEvaluator uses it where the plugin has it.
   // Throws nonsep::ModelError when the plugin lacks it, or it fails.

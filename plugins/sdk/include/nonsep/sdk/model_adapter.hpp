@@ -290,6 +290,38 @@ consteval bool dimension_parameter_is_bounded() {
   }
 }
 
+// A model object of class M (a product-form model here, or one given by H: hamiltonian_adapter.hpp) from checked
+// parameters: M(values) where M has that constructor, else M().
+template <class M>
+M construct_model(const ParameterValues& values) {
+  if constexpr (std::is_constructible_v<M, const ParameterValues&>)
+    return M(values);
+  else
+    return M();
+}
+// Its dimension: the fixed one, or the dimension parameter's value. Throws InvalidParameter for one outside
+// 1..max_dimension.
+template <class M>
+std::size_t model_dimension(const ParameterValues& values) {
+  if constexpr (HasFixedDimension<M>) {
+    return M::dimension;
+  } else {
+    const std::int64_t n = values.integer(M::dimension_parameter);
+    if (n < 1 || static_cast<std::size_t>(n) > M::max_dimension)
+      throw InvalidParameter(M::dimension_parameter, "parameter '" + std::string(M::dimension_parameter) +
+                                                         "' = " + std::to_string(n) + " is outside 1.." +
+                                                         std::to_string(M::max_dimension));
+    return static_cast<std::size_t>(n);
+  }
+}
+// The failure of a batch whose spans are too short for its states (a caller's bug).
+[[noreturn, gnu::cold, gnu::noinline]] inline void throw_bad_batch_sizes(std::size_t count, std::size_t n,
+                                                                         std::size_t in_size, std::size_t out_size) {
+  throw nonsep::InvalidArgument("batch of " + std::to_string(count) + " states of dimension " + std::to_string(n) +
+                                " given spans of " + std::to_string(in_size) + " and " + std::to_string(out_size) +
+                                " numbers");
+}
+
 // A model class behind the batched interface of nonsep/core/base/model.hpp (it models
 // nonsep::ModelWithThirdDerivatives), plus value_T / value_V and hvp_T / hvp_V. Batch layout as in model.hpp. Spans
 // must hold at least count*n (count*n*n for Hessians, count for values) entries; shorter spans are a caller bug and
@@ -509,8 +541,8 @@ class ModelAdapter {
     const std::size_t size = count * dimension_;
     for (const std::size_t found : {q.size(), p.size(), dq.size(), dp.size(), out_q.size(), out_p.size()})
       if (found < size) [[unlikely]]
-        throw_bad_sizes(count, dimension_, std::min({q.size(), p.size(), dq.size(), dp.size()}),
-                        std::min(out_q.size(), out_p.size()));
+        throw_bad_batch_sizes(count, dimension_, std::min({q.size(), p.size(), dq.size(), dp.size()}),
+                              std::min(out_q.size(), out_p.size()));
     const std::size_t n = batch_dimension();
     auto& scratch = detail::GradientScratch<double>::of_size(3 * n);
     double* g = scratch.x.data();
@@ -707,37 +739,15 @@ class ModelAdapter {
     std::fill_n(out.begin(), count * per_state, 0.0);
   }
 
-  static M construct(const ParameterValues& values) {
-    if constexpr (std::is_constructible_v<M, const ParameterValues&>)
-      return M(values);
-    else
-      return M();
-  }
-  static std::size_t dimension_of(const ParameterValues& values) {
-    if constexpr (HasFixedDimension<M>) {
-      return M::dimension;
-    } else {
-      const std::int64_t n = values.integer(M::dimension_parameter);
-      if (n < 1 || static_cast<std::size_t>(n) > M::max_dimension)
-        throw InvalidParameter(M::dimension_parameter, "parameter '" + std::string(M::dimension_parameter) +
-                                                           "' = " + std::to_string(n) + " is outside 1.." +
-                                                           std::to_string(M::max_dimension));
-      return static_cast<std::size_t>(n);
-    }
-  }
+  static M construct(const ParameterValues& values) { return construct_model<M>(values); }
+  static std::size_t dimension_of(const ParameterValues& values) { return model_dimension<M>(values); }
   // Inline, its failure out of line: the plugin table calls with spans of exactly count*n numbers (the ABI's batch
   // layout), for which the comparison folds away, so a call through the ABI checks its sizes once, on the host's
   // side.
   void check_sizes(std::span<const double> in, std::span<double> out, std::size_t count,
                    std::size_t out_per_state) const {
     if (in.size() < count * dimension_ || out.size() < count * out_per_state) [[unlikely]]
-      throw_bad_sizes(count, dimension_, in.size(), out.size());
-  }
-  [[noreturn, gnu::cold, gnu::noinline]] static void throw_bad_sizes(std::size_t count, std::size_t n,
-                                                                     std::size_t in_size, std::size_t out_size) {
-    throw nonsep::InvalidArgument("batch of " + std::to_string(count) + " states of dimension " + std::to_string(n) +
-                                  " given spans of " + std::to_string(in_size) + " and " + std::to_string(out_size) +
-                                  " numbers");
+      throw_bad_batch_sizes(count, dimension_, in.size(), out.size());
   }
 
   M model_;

@@ -1,0 +1,100 @@
+// Models given by H(q, p) itself (plugin ABI version 6) through the executable: Chin's schemes refused before
+// anything runs, with the schemes that apply named; a dimension mismatch and the VVT form refused; gauss with
+// Lyapunov exponents and the energy from H; scheme auto choosing among the schemes that apply.
+#include <doctest/doctest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "host_run_support.hpp"
+
+using json = nlohmann::json;
+using namespace nonsep::host_testing;
+
+namespace {
+
+json henon_heiles_job(json integrator) {
+  return {{"model", {{"plugin", "henon_heiles"}}},
+          {"integrator", std::move(integrator)},
+          {"initial", {{"q", {0.0, 0.1}}, {"p", {0.49, 0.0}}}},
+          {"time", {{"dt", 0.01}, {"steps", 100}}},
+          {"output", {{"every", 10}}}};
+}
+
+Result run_and_validate(const TemporaryFolder& folder, const std::string& name, const json& job,
+                        const std::string& command) {
+  const auto file = write_job(folder / (name + ".json"), job);
+  if (command == "validate") return run_nonsep({"validate", file.string()}, folder.path());
+  return run_nonsep({"run", "--quiet", "--output", (folder / name).string(), file.string()}, folder.path());
+}
+
+}  // namespace
+
+TEST_CASE("a model given by H: Chin's schemes refused before anything runs, naming the schemes that apply") {
+  TemporaryFolder folder;
+  for (const char* command : {"run", "validate"})
+    for (const json& integrator : {json{{"scheme", "basic"}}, json{{"scheme", "triplet"}, {"order", "4/3"}},
+                                   json{{"scheme", "mpe"}, {"order", 4}}}) {
+      const std::string scheme = integrator["scheme"];
+      CAPTURE(scheme);
+      CAPTURE(std::string(command));
+      const Result result = run_and_validate(folder, scheme, henon_heiles_job(integrator), command);
+      CHECK(result.status == 2);
+      CHECK(result.err.find("/integrator/scheme") != std::string::npos);
+      CHECK(result.err.find("\"" + scheme + "\" with the plugin 'henon_heiles', a model given by H(q, p) itself") !=
+            std::string::npos);
+      CHECK(result.err.find("need H in product form") != std::string::npos);
+      CHECK(result.err.find("a scheme that integrates H itself: tao, implicit_midpoint, gauss") != std::string::npos);
+      CHECK_FALSE(std::filesystem::exists(folder / scheme / "summary.json"));
+    }
+}
+
+TEST_CASE("a model given by H: a dimension mismatch and the VVT form refused with exit status 2") {
+  TemporaryFolder folder;
+  json job = henon_heiles_job({{"scheme", "gauss"}, {"stages", 3}});
+  job["initial"] = {{"q", {0.1}}, {"p", {0.2}}};
+  const Result mismatch = run_and_validate(folder, "mismatch", job, "run");
+  CHECK(mismatch.status == 2);
+  CHECK(mismatch.err.find("/initial") != std::string::npos);
+  CHECK(mismatch.err.find("dimension") != std::string::npos);
+  json vvt = henon_heiles_job({{"scheme", "gauss"}, {"stages", 3}});
+  vvt["hamiltonian"] = "VVT";
+  const Result form = run_and_validate(folder, "vvt", vvt, "validate");
+  CHECK(form.status == 2);
+  CHECK(form.err.find("/hamiltonian") != std::string::npos);
+  CHECK(form.err.find("which has no T and V to exchange") != std::string::npos);
+}
+
+TEST_CASE("a model given by H: gauss with Lyapunov exponents and MEGNO, the energy from H, tao and the midpoint") {
+  TemporaryFolder folder;
+  json job = henon_heiles_job({{"scheme", "gauss"}, {"stages", 3}});
+  job["initial"] = json::array({{{"q", {0.0, 0.1}}, {"p", {0.49, 0.0}}}, {{"q", {0.0, -0.2}}, {"p", {0.4, 0.2}}}});
+  job["time"] = {{"dt", 0.01}, {"steps", 2000}};
+  job["analysis"] = {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}}}, {"megno", true}};
+  const json summary = run_job(folder, "gauss", job);
+  CHECK(summary["status"] == "completed");
+  CHECK(summary["hamiltonian"] == "general");
+  CHECK(summary["evaluations"]["grad_T"] == 0);
+  CHECK(summary["evaluations"]["grad_H"].get<std::uint64_t>() > 2 * 3 * 2000);
+  CHECK(summary["energy"]["available"] == true);
+  CHECK(number(summary["energy"]["largest_relative_error"]["value"]) < 1e-12);
+  CHECK(summary["trajectories"].size() == 2);
+  for (const json& integrator : {json{{"scheme", "tao"}, {"order", 4}}, json{{"scheme", "implicit_midpoint"}}}) {
+    const std::string scheme = integrator["scheme"];
+    const json other = run_job(folder, scheme, henon_heiles_job(integrator));
+    CHECK(other["status"] == "completed");
+  }
+}
+
+TEST_CASE("a model given by H: scheme auto chooses among the schemes that integrate H") {
+  TemporaryFolder folder;
+  json job = henon_heiles_job({{"scheme", "auto"}, {"tolerance", 1e-8}});
+  job["time"] = {{"dt", 0.1}, {"steps", 100}};
+  const json summary = run_job(folder, "auto", job);
+  const json& choice = summary["scheme_choice"];
+  CHECK(choice["candidates"].size() == 2);
+  CHECK(choice["chosen"].get<std::string>().rfind("gauss", 0) == 0);
+  CHECK(summary["integrator"]["scheme"] == "gauss");
+}
