@@ -99,7 +99,7 @@ alone, _ = run_job("alone", base)
 for label, value in (("list", [0.2]), ("values", {"values": [0.2]}), ("range", {"from": 0.2, "to": 0.3, "count": 1})):
     job = dict(base, model={"plugin": "paper2d", "parameters": {"coupling": value}})
     r = run(["validate", str(write_job(f"one_{label}", job))])
-    check("1 parameter sets x 1 states = 1 trajectories" in r.stdout, f"validate names a one-value sweep: {r.stdout}")
+    check("(1 value): 1 parameter set x 1 state = 1 trajectory" in r.stdout, f"validate names a one-value sweep: {r.stdout}")
     for threads in ("1", "2"):
         if mpiexec:
             folder, r = run_job(f"one_{label}_ranks", job, "--threads", "1", prefix=(mpiexec, "-n", "2"))

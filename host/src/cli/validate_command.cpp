@@ -47,17 +47,22 @@ std::string parameters_text(nlohmann::json parameters, const Job& job) {
   return parameters.dump();
 }
 
+// "1 value", "2 values": a count with its noun (`plural` where it is not the noun and an s).
+std::string counted(std::size_t count, const std::string& noun, const std::string& plural = "") {
+  return std::to_string(count) + " " + (count == 1 ? noun : plural.empty() ? noun + "s" : plural);
+}
+
 std::string sweep_text(const Job& job, bool loaded) {
   if (job.sweep.empty()) return "";
   std::string text = "  sweep:       ";
   for (const SweptParameter& swept : job.sweep)
-    text += (&swept == &job.sweep.front() ? "" : " x ") + swept.name + " (" + std::to_string(swept.values.size()) +
-            " values)";
+    text +=
+        (&swept == &job.sweep.front() ? "" : " x ") + swept.name + " (" + counted(swept.values.size(), "value") + ")";
   const std::size_t sets = job.parameter_sets();
   const std::size_t states =
       loaded ? (job.initial.count + (job.initial.shell ? job.initial.shell->left_out : 0)) / sets : job.initial.count;
-  text += ": " + std::to_string(sets) + " parameter sets x " + std::to_string(states) +
-          " states = " + std::to_string(sets * states) + " trajectories";
+  text += ": " + counted(sets, "parameter set") + " x " + counted(states, "state") + " = " +
+          counted(sets * states, "trajectory", "trajectories");
   if (!job.initial.shell) return text + "\n";
   if (!loaded) return text + ", less those the energy shell leaves out\n";
   return text + ", " + std::to_string(job.initial.count) + " of them on the energy shell\n";
