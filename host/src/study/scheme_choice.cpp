@@ -359,9 +359,7 @@ void apply_choice(Job& job, const SchemeChoice& choice) {
   SingleRun& run = std::get<SingleRun>(job.plan);
   const std::uint64_t m = choice.subdivision;
   run.integrator = choice.pilots[choice.chosen].candidate.spec;
-  const TimeGrid& time = run.time;
-  run.time = time.from_t_end ? TimeGrid::to_end(time.t_end, time.dt_requested / static_cast<double>(m), time.steps * m)
-                             : TimeGrid::of_steps(time.steps * m, time.dt / static_cast<double>(m));
+  run.time = run.time.subdivided(m);
   run.every *= m;  // energy_every keeps counting the run's own steps: 1 is still every step
   run.checkpoint.every_steps *= m;
   if (run.analysis.lyapunov) {
