@@ -14,6 +14,7 @@
 #include "nonsep/core/schemes/gauss_legendre.hpp"
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
+#include "nonsep/plugin_abi.h"
 
 using nonsep::host::load_plugin;
 using nonsep::host::PluginModel;
@@ -82,7 +83,7 @@ TEST_CASE("magnetic_bottle: gauss conserves the canonical angular momentum (a qu
   MESSAGE("magnetic bottle, gauss 3 stages, dt 0.01 to t = 200: largest change of x p_y - y p_x "
           << largest_l << ", of H (relative) " << largest_h);
   CHECK(largest_l < 1e-12);
-  CHECK(largest_h < 1e-9);
+  CHECK(largest_h < 1e-8);  // the scheme's accuracy at dt 0.01: H is not quadratic
 }
 
 TEST_CASE("the shipped models given by H: grad_H and hvp_H agree with finite differences of their values") {

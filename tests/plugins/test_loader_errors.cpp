@@ -211,8 +211,8 @@ TEST_CASE("wrong table size: expected and found") {
   const std::string message = load_error("wrong_table_size.so");
   CHECK(contains(message, "(expected " + std::to_string(expected) + ", found " + std::to_string(found) + ")"));
   CHECK(contains(message, "has a function table of " + std::to_string(found) + " bytes"));
-  // Version 5 has one size.
-  CHECK(contains(message, "ABI version 5 defines " + std::to_string(expected) + " (expected"));
+  // Version 6 has one size.
+  CHECK(contains(message, "ABI version 6 defines " + std::to_string(expected) + " (expected"));
 }
 
 TEST_CASE("metadata that is not valid JSON") {
