@@ -3,6 +3,7 @@
 // Lyapunov exponents and the energy from H; scheme auto choosing among the schemes that apply.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -97,4 +98,25 @@ TEST_CASE("a model given by H: scheme auto chooses among the schemes that integr
   CHECK(choice["candidates"].size() == 2);
   CHECK(choice["chosen"].get<std::string>().rfind("gauss", 0) == 0);
   CHECK(summary["integrator"]["scheme"] == "gauss");
+}
+
+TEST_CASE("a model given by H: initial states on an energy shell, solved for p1 through value_H") {
+  // Henon-Heiles, H = (px^2 + py^2)/2 + (x^2 + y^2)/2 + x^2 y - y^3/3, on the shell H = 1/8 from the line x = 0,
+  // px = 0, y from -0.3 to 0.3: every state's H is the shell's to round-off.
+  TemporaryFolder folder;
+  json job = henon_heiles_job({{"scheme", "gauss"}, {"stages", 3}});
+  const json y_axis = {{"from", -0.3}, {"to", 0.3}, {"count", 5}};
+  json grid = json::object();
+  grid["q"] = json::array({0.0, y_axis});
+  grid["p"] = json::array({0.0, 0.0});
+  job["initial"] = json::object();
+  job["initial"]["grid"] = grid;
+  job["initial"]["energy"] = 0.125;
+  job["initial"]["solve_for"] = "p1";
+  job["time"] = {{"dt", 0.01}, {"steps", 10}};
+  const json summary = run_job(folder, "shell", job);
+  CHECK(summary["status"] == "completed");
+  REQUIRE(summary["trajectories"].size() == 5);
+  for (const json& trajectory : summary["trajectories"])
+    CHECK(std::abs(trajectory["energy"]["initial"].get<double>() - 0.125) < 1e-15);
 }

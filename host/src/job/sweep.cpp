@@ -160,9 +160,10 @@ void make_trajectories(LoadedJob& loaded, std::vector<JobIssue>& issues) {
   if (n == 0 || sets > max_initial_states / std::max<std::size_t>(1, initial.count) ||
       sets * initial.count > max_initial_values / n)
     return;
-  if (initial.shell && !loaded.plugin.has_hessians()) {
-    issues.push_back({"/initial/energy", "the plugin '" + loaded.plugin.name() + "', which has no Hessians",
-                      "a plugin with Hessians (hessian_T and hessian_V): H needs them"});
+  if (initial.shell && !loaded.plugin.has_energy()) {
+    issues.push_back({"/initial/energy", "the plugin '" + loaded.plugin.name() + "', which cannot evaluate H",
+                      "a plugin that evaluates H: value_H (a model given by H) or the Hessians hessian_T and "
+                      "hessian_V (the product form)"});
     return;
   }
   const HamiltonianForm form = job.is_study() ? job.study().form : job.run().integrator.form;
