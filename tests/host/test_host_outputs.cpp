@@ -234,6 +234,9 @@ TEST_CASE("CsvReader with Rules: a hand-written file's last line without newline
   CHECK(lines == std::vector<std::uint64_t>{1, 3, 4});
   CHECK(rows_of("crlf_last.csv", "q0,p0\r\n2,0", by_hand) == Rows{{"q0", "p0"}, {"2", "0"}});
   CHECK(rows_of("crlf_nonsep.csv", "q0,p0\r\n", {}) == Rows{{"q0", "p0\r"}});
+  // A '\r' that ends the file, or the reader's buffer, is the cell's (the look-ahead for '\n' found none).
+  CHECK(rows_of("cr_last.csv", "q0,p0\n2,0\r", by_hand) == Rows{{"q0", "p0"}, {"2", "0\r"}});
+  CHECK(rows_of("cr_only.csv", "\"a\"\r3\r", by_hand) == Rows{{"a\r3\r"}});
 
   // The bounds are checked as the row is read: the line is the reader's, the rest of the file is never read.
   const CsvReader::Rules bounded{.hand_written = true, .max_cells = 3, .max_cell_bytes = 4, .name = "the file"};

@@ -64,6 +64,10 @@ bool CsvReader::next(std::vector<std::string>& cells) {
       quoted = true;
     } else if (c == ',') {
       start_cell();
+    } else if (c == '\r') {
+      // Not a line end's (the check above looked ahead, which may have refilled the buffer): one character.
+      cells[count - 1] += '\r';
+      check_cell();
     } else {
       // The rest of an unquoted cell in the buffer at once: most cells are numbers with no quote.
       const std::size_t begin = next_ - 1;
