@@ -188,7 +188,9 @@ TEST_CASE("the files summary.json's analysis facts name are files of the sources
   named_headers(read_json(folder / "run/summary.json")["analysis"], "/analysis", headers);
   CHECK(headers.size() >= 4);  // the crossing locator, the tangent map, the first vector's block, SALI's factors
   const std::filesystem::path sources(NONSEP_SOURCE_DIR);
-  for (const auto& [where, name] : headers) {
+  for (const auto& header : headers) {
+    const std::string& where = header.first;  // named, not bound: clang 14's CAPTURE cannot take a structured binding
+    const std::string& name = header.second;
     CAPTURE(where);
     CAPTURE(name);
     // A repository path (core/include/...), or one of the host's own sources (run/..., relative to host/src).
