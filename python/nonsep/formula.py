@@ -3,8 +3,9 @@
     from nonsep.formula import formula_model, write_formula_model
     job["model"] = {"formula": formula_model(T="p0^2/2", V="q0^2/2 + lam*q0^4", parameters={"lam": 0.1})}
     write_formula_model("quartic.json", T=p0**2 / 2, V=q0**2 / 2, name="quartic")   # SymPy expressions
+    job["model"] = {"formula": formula_model(H="(p0 - q1)^2/2 + p1^2/2 + q0^2/2")}  # a Hamiltonian of any shape
 
-T, V, K and U are strings or SymPy expressions (anything whose str() is a formula: SymPy writes ** for powers,
+H (a Hamiltonian H(q, p) of any shape), or T, V, K and U of the product form, are strings or SymPy expressions (anything whose str() is a formula: SymPy writes ** for powers,
 which the grammar accepts). The host parses them with its strict grammar (`nonsep validate` reports a bad formula
 at its column); nothing here checks them beyond turning SymPy's names for abs and e into the grammar's.
 """
@@ -26,14 +27,21 @@ def formula_text(expression):
     return text
 
 
-def formula_model(T, V, *, K=None, U=None, parameters=None, dimension=None, name=None):
-    """The object of /model/formula (or of a model file): T(p) and V(q), optionally the separable part K(p) + U(q),
-    parameters {name: default}, the dimension and the plugin's name."""
+def formula_model(T=None, V=None, *, H=None, K=None, U=None, parameters=None, dimension=None, name=None):
+    """The object of /model/formula (or of a model file): either H(q, p) alone, or T(p) and V(q) with optionally the
+    separable part K(p) + U(q); parameters {name: default}, the dimension and the plugin's name."""
+    if H is not None and any(part is not None for part in (T, V, K, U)):
+        raise ValueError("formula_model: give either H alone or T and V (with K and U), not both")
+    if H is None and (T is None or V is None):
+        raise ValueError("formula_model: give H, or both T and V")
     model = {}
     if name is not None:
         model["name"] = name
-    model["T"] = formula_text(T)
-    model["V"] = formula_text(V)
+    if H is not None:
+        model["H"] = formula_text(H)
+    else:
+        model["T"] = formula_text(T)
+        model["V"] = formula_text(V)
     if K is not None:
         model["K"] = formula_text(K)
     if U is not None:
@@ -45,7 +53,7 @@ def formula_model(T, V, *, K=None, U=None, parameters=None, dimension=None, name
     return model
 
 
-def write_formula_model(path, T, V, **options):
+def write_formula_model(path, T=None, V=None, **options):
     """Writes the model file `path` (JSON) for `"formula": "path"` in a job or `nonsep model compile`; returns path."""
     with open(path, "w", encoding="utf-8") as file:
         json.dump(formula_model(T, V, **options), file, indent=2)

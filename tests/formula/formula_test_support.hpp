@@ -45,20 +45,28 @@ inline json paper1d_formula(const std::string& name) {
   return {{"name", name}, {"T", "p0 + p0^3/6"}, {"V", "q0^2/2 + q0^4/12"}};
 }
 
-inline json job_with(json model) {
+// paper1d's H = T'(p)^2 V''(q) written as one formula of q0 and p0, a model given by H.
+inline json paper1d_hamiltonian_formula(const std::string& name) {
+  return {{"name", name}, {"H", "(1 + p0^2/2)^2 * (1 + q0^2)"}};
+}
+
+inline const json triplet_integrator = {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}};
+
+inline json job_with(json model, const json& integrator = triplet_integrator) {
   return {{"model", std::move(model)},
-          {"integrator", {{"scheme", "triplet"}, {"order", "4/3"}, {"t2", -2.0}}},
+          {"integrator", integrator},
           {"initial", {{{"q", {0.5}}, {"p", {0.25}}}, {{"q", {-1.0}}, {"p", {0.75}}}}},
           {"time", {{"dt", 0.01}, {"steps", 300}}},
           {"output", {{"every", 0}}}};
 }
 
-// Runs job_with the shipped paper1d plugin into folder/plugin and checks that the formula model's run of the same
-// job, in `formula_run`, ends at its final states to `tolerance` relative to |(q, p)| (a component passing near 0 has
-// no relative accuracy of its own). Returns the formula run (read_run).
+// Runs job_with the shipped paper1d plugin (and `integrator`) into folder/plugin and checks that the formula model's
+// run of the same job, in `formula_run`, ends at its final states to `tolerance` relative to |(q, p)| (a component
+// passing near 0 has no relative accuracy of its own). Returns the formula run (read_run).
 inline json check_final_states_match_paper1d(const TemporaryFolder& folder, const fs::path& formula_run,
-                                             double tolerance) {
-  const auto plugin_file = host_testing::write_job(folder / "plugin.json", job_with({{"plugin", "paper1d"}}));
+                                             double tolerance, const json& integrator = triplet_integrator) {
+  const auto plugin_file =
+      host_testing::write_job(folder / "plugin.json", job_with({{"plugin", "paper1d"}}, integrator));
   REQUIRE(host_testing::run_nonsep({"run", "--quiet", "-o", (folder / "plugin").string(), plugin_file.string()},
                                    folder.path())
               .status == 0);

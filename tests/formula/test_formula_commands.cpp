@@ -104,6 +104,52 @@ TEST_CASE(
   CHECK(fs::exists(folder / "cache" / "formula" / record["cache_key"].get<std::string>() / "paper1d_formula.so"));
 }
 
+TEST_CASE("formula commands: paper1d written as one H gives the product-form plugin's states with gauss 3 stages") {
+  TemporaryFolder folder;
+  Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());
+  const json gauss = {{"scheme", "gauss"}, {"stages", 3}};
+  const json formula_job = job_with({{"formula", paper1d_hamiltonian_formula("paper1d_h")}}, gauss);
+  // A Chin scheme is refused by validate and by run before anything is compiled.
+  const auto chin_file = write_job(folder / "chin.json", job_with(formula_job["model"]));
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"validate"}, std::vector<std::string>{"run", "--quiet"}}) {
+    std::vector<std::string> arguments = command;
+    arguments.push_back(chin_file.string());
+    const auto refused = run_nonsep(arguments, folder.path());
+    INFO(command[0] << " stderr: " << refused.err);
+    CHECK(refused.status == 2);
+    CHECK(contains(refused.err, "/integrator/scheme: found \"triplet\""));
+    CHECK(contains(refused.err, "need H in product form"));
+    CHECK(!contains(refused.err, "compiling"));
+  }
+  CHECK(!fs::exists(folder / "cache" / "formula"));
+  const auto formula_file = write_job(folder / "formula.json", formula_job);
+  const auto validated = run_nonsep({"validate", formula_file.string()}, folder.path());
+  CHECK(validated.status == 0);
+  CHECK(contains(validated.out, "H = (1 + p0^2/2)^2*(1 + q0^2)"));
+  // The compile takes seconds on an idle machine and minutes on a loaded one: a generous limit, not a timing.
+  const auto run =
+      finish(start_nonsep({"run", "--quiet", "-o", (folder / "first").string(), formula_file.string()}, folder.path()),
+             std::chrono::seconds(900));
+  INFO("stderr: " << run.err);
+  REQUIRE(run.status == 0);
+  // The same method on the same H, evaluated in another order: equal to round-off over 300 steps.
+  const json by_formula = check_final_states_match_paper1d(folder, folder / "first", 1e-13, gauss);
+  const json record = by_formula["model"]["formula"];
+  CHECK(record["H"] == "(1 + p0^2/2)^2*(1 + q0^2)");
+  CHECK(record["T"].is_null());
+  CHECK(by_formula["hamiltonian"] == "general");
+  const std::string key = record["cache_key"].get<std::string>();
+  const json entry = json::parse(read_text(folder / "cache" / "formula" / key / "entry.json"));
+  CHECK(entry["H"] == record["H"]);
+  // The gradient is written from the tree (grad_H), the Hessian-vector products differentiate H; both checked.
+  const auto check =
+      run_nonsep({"inspect", (folder / "cache" / "formula" / key / "paper1d_h.so").string(), "--check"}, folder.path());
+  INFO("inspect: " << check.out << check.err);
+  CHECK(check.status == 0);
+  CHECK(contains(check.out, "derivative check passed"));
+}
+
 TEST_CASE("formula commands: every function compiles, and the gradients written from the trees pass the check") {
   TemporaryFolder folder;
   Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());

@@ -102,7 +102,7 @@ S evaluate(const Node& node, std::span<const S> x) {
 }
 
 Node tree_of(const std::string& text) {
-  auto result = parse_formula(text, Symbols{'q', {"lambda", "k"}});
+  auto result = parse_formula(text, Symbols{"q", {"lambda", "k"}});
   REQUIRE_MESSAGE(std::holds_alternative<Node>(result), "refused: " << text);
   return std::get<Node>(result);
 }
@@ -199,7 +199,7 @@ TEST_CASE("formula derivatives: the SDK's derivative rules are names a formula c
   for (const char* rule : {"log_derivative", "log1p_derivative", "acosh_derivative", "atanh_derivative",
                            "abs_derivative", "min_derivative", "max_derivative", "pow_exponent_derivative"}) {
     CHECK(is_derivative_rule(rule));
-    const auto result = parse_formula(std::string(rule) + "(q0)", Symbols{'q', {}});
+    const auto result = parse_formula(std::string(rule) + "(q0)", Symbols{"q", {}});
     CHECK_MESSAGE(std::holds_alternative<FormulaError>(result), rule);
   }
   CHECK_FALSE(is_derivative_rule("log"));

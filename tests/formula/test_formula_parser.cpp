@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "nonsep/host/formula/cpp_source.hpp"
+#include "nonsep/host/formula/derivative.hpp"
 #include "nonsep/host/formula/expression.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 
@@ -16,7 +17,7 @@ using namespace nonsep::host::formula;
 
 namespace {
 
-const Symbols q_symbols{'q', {"lambda", "k"}};
+const Symbols q_symbols{"q", {"lambda", "k"}};
 
 FormulaError error_of(const std::string& text, const Symbols& symbols = q_symbols) {
   auto result = parse_formula(text, symbols);
@@ -104,7 +105,7 @@ TEST_CASE("formula parser: every malformed formula is refused at its column, say
 }
 
 TEST_CASE("formula parser: T refuses q, names the allowed letter, and lists the functions at a bad term") {
-  const FormulaError error = error_of("p0 + q0", Symbols{'p', {}});
+  const FormulaError error = error_of("p0 + q0", Symbols{"p", {}});
   CHECK(error.column == 6);
   CHECK(error.allowed.find("p0, p1") != std::string::npos);
   const FormulaError term = error_of("q0 + )");
@@ -298,4 +299,58 @@ TEST_CASE("formula models: bad keys, parameter names, names and dimensions are i
   CHECK(!read_formula_model(nlohmann::json{{"T", "p0 + p3"}, {"V", "q0"}, {"dimension", 2}}, "/f", ".", issues));
   REQUIRE(issues.size() == 1);
   CHECK(issues[0].path == "/f/dimension");
+}
+
+TEST_CASE("formula parser: H takes q and p, prints each variable with its letter, differentiates by each") {
+  const Symbols both{"qp", {"e"}};
+  const Node tree = tree_of("(p0 - e*q1)^2/2 + p1^2/2 + q0^2*p1", both);
+  CHECK(print(tree) == "(p0 - e*q1)^2/2 + p1^2/2 + q0^2*p1");
+  CHECK(tree_of(print(tree), both) == tree);
+  CHECK(dimension_used(tree) == 2);
+  CHECK(dimension_used(tree_of("p4 + q1", both)) == 5);
+  // d/dq1 and d/dp1 are different derivatives of the same index.
+  CHECK(print(*derivative(tree, 1, 'q')) == "-((p0 - e*q1)*e)");
+  CHECK(print(*derivative(tree, 1, 'p')) == "p1 + q0^2");
+  CHECK(print(*derivative(tree, 0, 'q')) == "2*p1*q0");
+  CHECK_FALSE(derivative(tree_of("p0^2 + q1", both), 0, 'q').has_value());
+  const FormulaError unknown = error_of("q0 + x1", both);
+  CHECK(unknown.column == 6);
+  CHECK(unknown.allowed.find("q0, q1, ..., p0, p1, ...") != std::string::npos);
+}
+
+TEST_CASE("formula models: H alone or T and V, never both; H's dimension counts q and p; its C++ is a Hamiltonian") {
+  std::vector<nonsep::host::JobIssue> issues;
+  CHECK(!read_formula_model(nlohmann::json{{"H", "p0^2/2 + q0^2/2"}, {"T", "p0^2/2"}, {"U", "q0"}}, "/f", ".", issues));
+  std::vector<std::string> paths;
+  for (const auto& issue : issues) paths.push_back(issue.path);
+  CHECK(paths == std::vector<std::string>{"/f/T", "/f/U"});
+  REQUIRE(!issues.empty());
+  CHECK(issues[0].found == "both H and T");
+  issues.clear();
+  CHECK(!read_formula_model(nlohmann::json{{"H", nlohmann::json::array({"p0^2"})}}, "/f", ".", issues));
+  REQUIRE(issues.size() == 1);
+  CHECK(issues[0].path == "/f/H");
+  CHECK(issues[0].allowed.find("q0, q1, ..., p0, p1, ...") != std::string::npos);
+  issues.clear();
+  CHECK(!read_formula_model(nlohmann::json{{"H", "p0^2/2 + r0"}}, "/f", ".", issues));
+  REQUIRE(issues.size() == 1);
+  CHECK(issues[0].found.find("the unknown name r0") != std::string::npos);
+  issues.clear();
+  const auto model = read_formula_model(
+      nlohmann::json{{"name", "gauge"}, {"H", "(p0 - b*q1)^2/2 + p2^2/2"}, {"parameters", {{"b", 0.5}}}}, "/f", ".",
+      issues);
+  REQUIRE(issues.empty());
+  REQUIRE(model);
+  CHECK(model->dimension == 3);
+  CHECK(model->H == "(p0 - b*q1)^2/2 + p2^2/2");
+  CHECK(formula_record(*model, "k")["H"] == model->H);
+  CHECK(formula_record(*model, "k")["T"].is_null());
+  const std::string source = cpp_source(*model);
+  CHECK(source.find("NONSEP_EXPORT_HAMILTONIAN(Formula, \"gauge\"") != std::string::npos);
+  CHECK(source.find("S H([[maybe_unused]] nonsep::sdk::Vector<S> q, [[maybe_unused]] nonsep::sdk::Vector<S> p)") !=
+        std::string::npos);
+  CHECK(source.find("void grad_H(") != std::string::npos);
+  CHECK(source.find("dH_dq[1] = S(") != std::string::npos);
+  CHECK(source.find("dH_dp[2] = S(p[2])") != std::string::npos);
+  CHECK(source.find("S T(") == std::string::npos);
 }

@@ -39,6 +39,22 @@ class FormulaTest(unittest.TestCase):
                 self.assertEqual(json.load(file), {"name": "harmonic", "T": "p0^2/2", "V": "q0^2/2"})
             self.assertEqual(nonsep.validate(job(path)), [])
 
+    def test_a_hamiltonian_of_any_shape(self):
+        q0, q1, p0, p1 = sympy.symbols("q0 q1 p0 p1")
+        model = formula_model(H=(p0 - q1)**2 / 2 + p1**2 / 2 + q0**2 / 2, name="gauge")
+        self.assertEqual(set(model), {"name", "H"})
+        gauss = dict(job(model), integrator={"scheme": "gauss", "stages": 3},
+                     initial={"q": [0.5, 0.0], "p": [0.0, 0.1]})
+        self.assertEqual(nonsep.validate(gauss), [])
+        # Chin's schemes need the product form: refused before anything is compiled.
+        problems = nonsep.validate(dict(gauss, integrator={"scheme": "triplet", "order": "4/3"}))
+        self.assertEqual([problem.path for problem in problems], ["/integrator/scheme"])
+        self.assertIn("product form", problems[0].message)
+        with self.assertRaises(ValueError):
+            formula_model(H="p0^2/2", T="p0^2/2")
+        with self.assertRaises(ValueError):
+            formula_model(T="p0^2/2")
+
 
 if __name__ == "__main__":
     unittest.main()

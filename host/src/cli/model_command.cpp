@@ -75,9 +75,7 @@ std::optional<Job> read_formula_job(const std::string& job_file) {
   // Not a formula job: load_job reads it again and reports its issues together with the plugin's.
   if (!job || !job->formula) return std::nullopt;
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
-  check_model_parameters(job->parameters, formula::declared_parameters(*job->formula), issues);
-  check_swept_parameters(*job, formula::declared_parameters(*job->formula), issues);
-  check_dimension(job->initial, job->formula->dimension, issues, true);
+  check_formula_job(*job, issues);
   if (!issues.empty()) throw InvalidJob(job_file, std::move(issues));
   return job;
 }
@@ -87,8 +85,9 @@ int report_formula_job(const std::string& job_file, const Job& job) {
   std::cout << "valid: " << job_file << "\n"
             << "  model:       formula '" << model.name << "', dimension " << model.dimension
             << (model.file.empty() ? "" : " (" + model.file.string() + ")") << "\n"
-            << "    " << (model.t_gradient.empty() ? "T = " : "") << model.T << "\n"
-            << "    " << (model.v_gradient.empty() ? "V = " : "") << model.V << "\n"
+            << (model.h_tree ? "    H = " + model.H + "\n"
+                             : "    " + std::string(model.t_gradient.empty() ? "T = " : "") + model.T + "\n" + "    " +
+                                   (model.v_gradient.empty() ? "V = " : "") + model.V + "\n")
             << "  parameters:  " << parameters_with_defaults(job, formula::declared_parameters(model)) << "\n"
             << sweep_text(job, false)
             << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "

@@ -40,25 +40,30 @@ std::size_t node_count(const Node& tree) {
   return count;
 }
 
-// The C++ of trees over the variables `letter`. A sum or product of more than max_part_nodes nodes is cut into parts
-// of consecutive operands of at most that many nodes together, each part a member function of its own that the
-// compiler does not inline ([[gnu::noinline]]): the optimiser's work grows faster than the function it works on
-// (with the nested dual numbers of the third derivatives, a product of 50 distinct factors took twice the CPU time of
-// one of 25), so a formula is compiled as functions of bounded size, and its compile time grows with its length.
-// The parts' definitions collect in `parts`, numbered across the whole class by `count`.
+// The C++ of trees over the variables of `letters` ("q", "p", or "qp" for H). A sum or product of more than
+// max_part_nodes nodes is cut into parts of consecutive operands of at most that many nodes together, each part a
+// member function of its own that the compiler does not inline ([[gnu::noinline]]): the optimiser's work grows faster
+// than the function it works on (with the nested dual numbers of the third derivatives, a product of 50 distinct
+// factors took twice the CPU time of one of 25), so a formula is compiled as functions of bounded size, and its compile
+// time grows with its length. The parts' definitions collect in `parts`, numbered across the whole class by `count`.
 class ExpressionWriter {
  public:
-  ExpressionWriter(char letter, std::string& parts, std::size_t& count)
-      : letter_(letter), parts_(parts), count_(count) {}
+  ExpressionWriter(std::string letters, std::string& parts, std::size_t& count)
+      : letters_(std::move(letters)), parts_(parts), count_(count) {}
 
-  char letter() const { return letter_; }
+  // The function parameters of the variables: "[[maybe_unused]] nonsep::sdk::Vector<S> q" (and p), of type `type`.
+  std::string parameters(const std::string& type = "nonsep::sdk::Vector<S>") const {
+    std::string text;
+    for (const char letter : letters_) text += (text.empty() ? "" : ", ") + ("[[maybe_unused]] " + type + " ") + letter;
+    return text;
+  }
 
   std::string emit(const Node& node) {
     switch (node.kind) {
       case Node::Kind::number:
         return literal(node.value);
       case Node::Kind::variable:
-        return std::string(1, letter_) + "[" + std::to_string(node.index) + "]";
+        return node.name + "[" + std::to_string(node.index) + "]";
       case Node::Kind::parameter:
         return "parameter_" + node.name;
       case Node::Kind::pi:
@@ -160,12 +165,14 @@ class ExpressionWriter {
   // A new part returning `text`, and its call.
   std::string part(const std::string& text) {
     const std::string name = "part_" + std::to_string(count_++);
-    parts_ += "  template <class S>\n  [[gnu::noinline]] S " + name + "([[maybe_unused]] nonsep::sdk::Vector<S> " +
-              letter_ + ") const {\n    return S(" + text + ");\n  }\n";
-    return name + "<S>(" + letter_ + ")";
+    parts_ += "  template <class S>\n  [[gnu::noinline]] S " + name + "(" + parameters() + ") const {\n    return S(" +
+              text + ");\n  }\n";
+    std::string arguments;
+    for (const char letter : letters_) arguments += (arguments.empty() ? "" : ", ") + std::string(1, letter);
+    return name + "<S>(" + arguments + ")";
   }
 
-  char letter_;
+  std::string letters_;
   std::string& parts_;
   std::size_t& count_;
 };
@@ -176,24 +183,36 @@ class ExpressionWriter {
 // tree (gradient_is_written): the SDK then differentiates the function itself.
 std::string gradient(const char* function, const Node& tree, const std::vector<Node>& given, ExpressionWriter writer,
                      std::size_t dimension) {
-  const char letter = writer.letter();
   std::vector<std::optional<Node>> components;
   for (std::size_t i = 0; i < dimension; ++i)
     components.push_back(given.empty() ? derivative(tree, i) : std::optional<Node>(given[i]));
   if (given.empty() && !gradient_is_written(tree, components)) return "";
-  std::string text = std::string("  template <class S>\n  void ") + function +
-                     "([[maybe_unused]] nonsep::sdk::Vector<S> " + letter + ", std::span<S> out) const {\n";
+  std::string text = std::string("  template <class S>\n  void ") + function + "(" + writer.parameters() +
+                     ", std::span<S> out) const {\n";
   for (std::size_t i = 0; i < dimension; ++i)
     text += "    out[" + std::to_string(i) + "] = S(" + (components[i] ? writer.emit(*components[i]) : "0.0") + ");\n";
   return text + "  }\n";
 }
 
-// T or V as a template: the formula, or, for one given by its gradient, an evaluation error (H_TTV and H_VVT never
+// The gradient of H(q, p), written out as gradient() writes grad_T (hamiltonian_adapter.hpp's grad_H, in doubles;
+// the SDK differentiates H itself for the Hessian-vector products), or nothing when it would outgrow the tree.
+std::string hamiltonian_gradient(const Node& tree, ExpressionWriter writer, std::size_t dimension) {
+  std::vector<std::optional<Node>> components;
+  for (const char letter : {'q', 'p'})
+    for (std::size_t i = 0; i < dimension; ++i) components.push_back(derivative(tree, i, letter));
+  if (!gradient_is_written(tree, components)) return "";
+  std::string text = "  void grad_H(" + writer.parameters("nonsep::sdk::Vector<double>") +
+                     ", std::span<double> dH_dq, std::span<double> dH_dp) const {\n    using S = double;\n";
+  for (std::size_t k = 0; k < components.size(); ++k)
+    text += std::string("    ") + (k < dimension ? "dH_dq[" : "dH_dp[") + std::to_string(k % dimension) + "] = S(" +
+            (components[k] ? writer.emit(*components[k]) : "0.0") + ");\n";
+  return text + "  }\n";
+}
+
+// T, V (or H) as a template: the formula, or, for one given by its gradient, an evaluation error (H_TTV and H_VVT never
 // need the value; the gradient check and `inspect --check` skip what throws).
 std::string function(const char* name, const Node& tree, const std::vector<Node>& given, ExpressionWriter writer) {
-  const char letter = writer.letter();
-  const std::string head = std::string("  template <class S>\n  S ") + name +
-                           "([[maybe_unused]] nonsep::sdk::Vector<S> " + letter + ") const {\n";
+  const std::string head = std::string("  template <class S>\n  S ") + name + "(" + writer.parameters() + ") const {\n";
   if (!given.empty())
     return head + "    throw nonsep::sdk::EvaluationError(\"" + name + " is given by its gradient d" + name +
            " only: its value is not known (H needs only the gradient and the Hessian)\");\n  }\n";
@@ -209,9 +228,11 @@ bool gradient_is_written(const Node& tree, const std::vector<std::optional<Node>
 }
 
 std::string cpp_source(const FormulaModel& model) {
-  const std::string formulas = (model.t_gradient.empty() ? "T = " : "") + model.T + ", " +
-                               (model.v_gradient.empty() ? "V = " : "") + model.V +
-                               (model.k_tree ? ", K = " + model.K : "") + (model.u_tree ? ", U = " + model.U : "");
+  const std::string formulas =
+      model.h_tree
+          ? "H = " + model.H
+          : (model.t_gradient.empty() ? "T = " : "") + model.T + ", " + (model.v_gradient.empty() ? "V = " : "") +
+                model.V + (model.k_tree ? ", K = " + model.K : "") + (model.u_tree ? ", U = " + model.U : "");
   std::string source =
       "// A formula model, generated by nonsep from " + formulas +
       "\n#include <cstddef>\n#include <span>\n#include <nonsep/plugin_sdk.hpp>\n\nnamespace {\n\n"
@@ -239,7 +260,17 @@ std::string cpp_source(const FormulaModel& model) {
   }
   std::string parts;
   std::size_t part_count = 0;
-  const ExpressionWriter p('p', parts, part_count), q('q', parts, part_count);
+  if (model.h_tree) {
+    const ExpressionWriter qp("qp", parts, part_count);
+    source += function("H", *model.h_tree, {}, qp);
+    source += hamiltonian_gradient(*model.h_tree, qp, model.dimension);
+    source += parts;
+    source += "};\n\n}  // namespace\n\n";
+    source += "NONSEP_EXPORT_HAMILTONIAN(Formula, \"" + model.name + "\", \"1.0.0\", \"A formula model: " + formulas +
+              "\", \"" + formulas + "\");\n";
+    return source;
+  }
+  const ExpressionWriter p("p", parts, part_count), q("q", parts, part_count);
   source += function("T", model.t_tree, model.t_gradient, p);
   source += function("V", model.v_tree, model.v_gradient, q);
   if (model.k_tree) source += function("K", *model.k_tree, {}, p);

@@ -155,17 +155,17 @@ Node function_derivative(const std::string& f, const Node& u) {
   return sum({{'+', number(1.0)}, {'-', square(call_u("tanh"))}});  // tanh: the last of formula_functions()
 }
 
-std::optional<Node> call_derivative(const Node& node, std::size_t index) {
+std::optional<Node> call_derivative(const Node& node, std::size_t index, char letter) {
   const auto& arguments = node.operands;
   if (arguments.size() == 1) {
-    auto d = derivative(arguments[0], index);
+    auto d = derivative(arguments[0], index, letter);
     if (!d) return std::nullopt;
     return times(function_derivative(node.name, arguments[0]), std::move(*d));
   }
   const Node& a = arguments[0];
   const Node& b = arguments[1];
-  const auto da = derivative(a, index);
-  const auto db = derivative(b, index);
+  const auto da = derivative(a, index, letter);
+  const auto db = derivative(b, index, letter);
   if (!da && !db) return std::nullopt;
   if (node.name == "pow") return power_derivative(a, b, da, db);
   if (node.name == "min" || node.name == "max")
@@ -183,28 +183,29 @@ std::optional<Node> call_derivative(const Node& node, std::size_t index) {
 
 }  // namespace
 
-std::optional<Node> derivative(const Node& tree, std::size_t index) {
+std::optional<Node> derivative(const Node& tree, std::size_t index, char letter) {
   switch (tree.kind) {
     case Kind::number:
     case Kind::parameter:
     case Kind::pi:
       return std::nullopt;
     case Kind::variable:
-      return tree.index == index ? std::optional<Node>(number(1.0)) : std::nullopt;
+      return tree.index == index && (letter == '\0' || tree.name[0] == letter) ? std::optional<Node>(number(1.0))
+                                                                               : std::nullopt;
     case Kind::negate: {
-      auto d = derivative(tree.operands[0], index);
+      auto d = derivative(tree.operands[0], index, letter);
       return d ? std::optional<Node>(negate(std::move(*d))) : std::nullopt;
     }
     case Kind::sum: {
       Terms terms;
       for (std::size_t i = 0; i < tree.operands.size(); ++i)
-        if (auto d = derivative(tree.operands[i], index)) terms.emplace_back(tree.signs[i], std::move(*d));
+        if (auto d = derivative(tree.operands[i], index, letter)) terms.emplace_back(tree.signs[i], std::move(*d));
       return terms.empty() ? std::nullopt : std::optional<Node>(sum(std::move(terms)));
     }
     case Kind::product: {
       Terms terms;
       for (std::size_t k = 0; k < tree.operands.size(); ++k) {
-        auto d = derivative(tree.operands[k], index);
+        auto d = derivative(tree.operands[k], index, letter);
         if (!d) continue;
         Terms factors;
         for (std::size_t j = 0; j < tree.operands.size(); ++j)
@@ -220,13 +221,13 @@ std::optional<Node> derivative(const Node& tree, std::size_t index) {
       return terms.empty() ? std::nullopt : std::optional<Node>(sum(std::move(terms)));
     }
     case Kind::power: {
-      const auto d_base = derivative(tree.operands[0], index);
-      const auto d_exponent = derivative(tree.operands[1], index);
+      const auto d_base = derivative(tree.operands[0], index, letter);
+      const auto d_exponent = derivative(tree.operands[1], index, letter);
       if (!d_base && !d_exponent) return std::nullopt;
       return power_derivative(tree.operands[0], tree.operands[1], d_base, d_exponent);
     }
     case Kind::call:
-      return call_derivative(tree, index);
+      return call_derivative(tree, index, letter);
   }
   return std::nullopt;
 }

@@ -76,8 +76,9 @@ class Parser {
 
  private:
   std::string term_text() const {
-    std::string names = "a number, the variables " + std::string(1, symbols_.variable) + "0, " +
-                        std::string(1, symbols_.variable) + "1, ...";
+    std::string names = "a number, the variables ";
+    for (const char letter : symbols_.variables)
+      names += std::string(letter == symbols_.variables.front() ? "" : ", ") + letter + "0, " + letter + "1, ...";
     for (const auto& parameter : symbols_.parameters) names += ", the parameter " + parameter;
     names += ", pi, a function (";
     for (std::size_t i = 0; i < std::size(functions); ++i)
@@ -245,20 +246,21 @@ class Parser {
       return {};
     }
     if (name == "pi") return Node{.kind = Node::Kind::pi};
-    if (const auto index = variable_index(name, symbols_.variable)) {
-      if (*index >= max_formula_dimension)
-        fail(token.column, "the variable " + name,
-             "indices 0.." + std::to_string(max_formula_dimension - 1) + " (at most " +
-                 std::to_string(max_formula_dimension) + " dimensions)");
-      return Node{.kind = Node::Kind::variable, .index = *index};
-    }
+    for (const char letter : symbols_.variables)
+      if (const auto index = variable_index(name, letter)) {
+        if (*index >= max_formula_dimension)
+          fail(token.column, "the variable " + name,
+               "indices 0.." + std::to_string(max_formula_dimension - 1) + " (at most " +
+                   std::to_string(max_formula_dimension) + " dimensions)");
+        return Node{.kind = Node::Kind::variable, .name = std::string(1, letter), .index = *index};
+      }
     if (std::find(symbols_.parameters.begin(), symbols_.parameters.end(), name) != symbols_.parameters.end())
       return Node{.kind = Node::Kind::parameter, .name = name};
-    const char other = symbols_.variable == 'q' ? 'p' : 'q';
-    if (variable_index(name, other))
-      fail(token.column, "the variable " + name + " in " + (symbols_.variable == 'q' ? "V(q)" : "T(p)"),
-           std::string("only ") + symbols_.variable + "0, " + symbols_.variable +
-               "1, ... here: " + (symbols_.variable == 'q' ? "V depends on q alone" : "T depends on p alone"));
+    const bool in_v = symbols_.variables == "q";
+    if (symbols_.variables.size() == 1 && variable_index(name, in_v ? 'p' : 'q'))
+      fail(token.column, "the variable " + name + " in " + (in_v ? "V(q)" : "T(p)"),
+           "only " + symbols_.variables + "0, " + symbols_.variables +
+               "1, ... here: " + (in_v ? "V depends on q alone" : "T depends on p alone"));
     else
       fail(token.column, "the unknown name " + name, term_text());
     return {};
@@ -312,16 +314,7 @@ class Parser {
 std::span<const Function> formula_functions() { return functions; }
 
 std::variant<Node, FormulaError> parse_formula(std::string_view text, const Symbols& symbols) {
-  auto result = Parser(text, symbols).run();
-  if (auto* tree = std::get_if<Node>(&result)) {
-    // Variables carry their letter in `name`, so that print() needs no context.
-    const auto mark = [&](auto& self, Node& node) -> void {
-      if (node.kind == Node::Kind::variable) node.name = std::string(1, symbols.variable);
-      for (Node& operand : node.operands) self(self, operand);
-    };
-    mark(mark, *tree);
-  }
-  return result;
+  return Parser(text, symbols).run();
 }
 
 std::size_t dimension_used(const Node& tree) {

@@ -20,18 +20,18 @@ bool is_primary(const Node& node) {
          node.kind == Node::Kind::pi || node.kind == Node::Kind::call;
 }
 
-std::string print_node(const Node& node, char letter);
+std::string print_node(const Node& node);
 
-std::string parenthesized(const Node& node, char letter, bool needed) {
-  return needed ? "(" + print_node(node, letter) + ")" : print_node(node, letter);
+std::string parenthesized(const Node& node, bool needed) {
+  return needed ? "(" + print_node(node) + ")" : print_node(node);
 }
 
-std::string print_node(const Node& node, char letter) {
+std::string print_node(const Node& node) {
   switch (node.kind) {
     case Node::Kind::number:
       return number_text(node.value);
     case Node::Kind::variable:
-      return letter + std::to_string(node.index);
+      return node.name + std::to_string(node.index);
     case Node::Kind::parameter:
       return node.name;
     case Node::Kind::pi:
@@ -39,30 +39,30 @@ std::string print_node(const Node& node, char letter) {
     case Node::Kind::call: {
       std::string text = node.name + "(";
       for (std::size_t i = 0; i < node.operands.size(); ++i)
-        text += (i == 0 ? "" : ", ") + print_node(node.operands[i], letter);
+        text += (i == 0 ? "" : ", ") + print_node(node.operands[i]);
       return text + ")";
     }
     case Node::Kind::negate:
-      return "-" + parenthesized(node.operands[0], letter,
-                                 !is_primary(node.operands[0]) && node.operands[0].kind != Node::Kind::power &&
-                                     node.operands[0].kind != Node::Kind::negate);
+      return "-" + parenthesized(node.operands[0], !is_primary(node.operands[0]) &&
+                                                       node.operands[0].kind != Node::Kind::power &&
+                                                       node.operands[0].kind != Node::Kind::negate);
     case Node::Kind::power: {
       const Node& exponent = node.operands[1];
-      return parenthesized(node.operands[0], letter, !is_primary(node.operands[0])) + "^" +
-             parenthesized(exponent, letter, exponent.kind == Node::Kind::sum || exponent.kind == Node::Kind::product);
+      return parenthesized(node.operands[0], !is_primary(node.operands[0])) + "^" +
+             parenthesized(exponent, exponent.kind == Node::Kind::sum || exponent.kind == Node::Kind::product);
     }
     case Node::Kind::sum: {
       std::string text;
       for (std::size_t i = 0; i < node.operands.size(); ++i)
         text += (i == 0 ? "" : std::string(" ") + node.signs[i] + " ") +
-                parenthesized(node.operands[i], letter, node.operands[i].kind == Node::Kind::sum);
+                parenthesized(node.operands[i], node.operands[i].kind == Node::Kind::sum);
       return text;
     }
     case Node::Kind::product: {
       std::string text;
       for (std::size_t i = 0; i < node.operands.size(); ++i)
         text += (i == 0 ? "" : std::string(1, node.signs[i])) +
-                parenthesized(node.operands[i], letter,
+                parenthesized(node.operands[i],
                               node.operands[i].kind == Node::Kind::sum || node.operands[i].kind == Node::Kind::product);
       return text;
     }
@@ -70,16 +70,8 @@ std::string print_node(const Node& node, char letter) {
   return {};
 }
 
-// The variable letter of a tree: the printer needs it, the tree stores indices only.
-char letter_of(const Node& node) {
-  if (node.kind == Node::Kind::variable) return node.name.empty() ? '\0' : node.name[0];
-  for (const Node& operand : node.operands)
-    if (const char letter = letter_of(operand)) return letter;
-  return '\0';
-}
-
 }  // namespace
 
-std::string print(const Node& tree) { return print_node(tree, letter_of(tree)); }
+std::string print(const Node& tree) { return print_node(tree); }
 
 }  // namespace nonsep::host::formula

@@ -16,7 +16,8 @@ using job_reader::Checker;
 using nlohmann::json;
 
 constexpr std::size_t max_model_file_bytes = std::size_t{1} << 20;
-const std::vector<std::string> formula_keys = {"name", "T", "V", "dT", "dV", "K", "U", "parameters", "dimension"};
+const std::vector<std::string> formula_keys = {"name", "H", "T", "V", "dT", "dV", "K", "U", "parameters", "dimension"};
+const std::vector<std::string> product_form_keys = {"T", "V", "dT", "dV", "K", "U"};
 
 bool is_plugin_name(const std::string& name) {
   if (name.empty() || name.size() > 64 || !(name[0] == '_' || (name[0] >= 'a' && name[0] <= 'z'))) return false;
@@ -25,8 +26,10 @@ bool is_plugin_name(const std::string& name) {
 }
 
 std::string formula_of(const Symbols& symbols) {
-  return std::string("a formula of ") + (symbols.variable == 'q' ? "q0, q1, ..." : "p0, p1, ...") +
-         " (the formula grammar: docs/formula-models.md)";
+  const std::string variables = symbols.variables == "q"   ? "q0, q1, ..."
+                                : symbols.variables == "p" ? "p0, p1, ..."
+                                                           : "q0, q1, ..., p0, p1, ...";
+  return "a formula of " + variables + " (the formula grammar: docs/formula-models.md)";
 }
 
 // The formula `value` at `path`, parsed against its variable letter and the parameters; an issue quoting it on
@@ -64,8 +67,8 @@ std::optional<std::vector<Node>> read_gradient(Checker& check, const json& objec
   if (!value) return std::nullopt;
   const std::string path = job_reader::child(pointer, key);
   const std::string what = std::string("an array of 1 to ") + std::to_string(max_formula_dimension) + " formulas of " +
-                           (symbols.variable == 'q' ? "q0, q1, ..." : "p0, p1, ...") +
-                           ", component i the derivative by " + symbols.variable + "i";
+                           symbols.variables + "0, " + symbols.variables + "1, ..., component i the derivative by " +
+                           symbols.variables + "i";
   if (!value->is_array() || value->empty() || value->size() > max_formula_dimension) {
     check.issue(path, job_reader::describe(*value), what);
     return std::nullopt;
@@ -109,11 +112,60 @@ bool read_function(Checker& check, const json& object, const std::string& pointe
   return true;
 }
 
+// H(q, p) of a model given by H; false after an issue (among them any key of the product form beside H).
+bool read_hamiltonian(Checker& check, const json& object, const std::string& pointer, Symbols symbols,
+                      FormulaModel& model) {
+  bool alone = true;
+  for (const auto& key : product_form_keys)
+    if (object.contains(key)) {
+      check.issue(job_reader::child(pointer, key), "both H and " + key,
+                  "either H alone (a Hamiltonian H(q, p) of any shape) or T and V, with K and U optional (H in "
+                  "product form, docs/formula-models.md)");
+      alone = false;
+    }
+  symbols.variables = "qp";
+  model.h_tree = read_term(check, object, pointer, "H", symbols);
+  if (!model.h_tree || !alone) return false;
+  model.H = print(*model.h_tree);
+  model.dimension = std::max(dimension_used(*model.h_tree), std::size_t{1});
+  return true;
+}
+
+// T (or dT), V (or dV), K and U of a model in product form; false after an issue.
+bool read_product_form(Checker& check, const json& object, const std::string& pointer, Symbols symbols,
+                       FormulaModel& model) {
+  const std::size_t before = check.issue_count();
+  symbols.variables = "p";
+  const bool has_t = read_function(check, object, pointer, "T", symbols, model.t_tree, model.t_gradient, model.T);
+  model.k_tree = read_term(check, object, pointer, "K", symbols, false);
+  symbols.variables = "q";
+  const bool has_v = read_function(check, object, pointer, "V", symbols, model.v_tree, model.v_gradient, model.V);
+  model.u_tree = read_term(check, object, pointer, "U", symbols, false);
+  if (!has_t || !has_v || check.issue_count() != before) return false;
+  std::size_t used = std::max({dimension_used(model.t_tree), dimension_used(model.v_tree), std::size_t{1}});
+  for (const auto* gradient : {&model.t_gradient, &model.v_gradient}) {
+    used = std::max(used, gradient->size());
+    for (const Node& component : *gradient) used = std::max(used, dimension_used(component));
+  }
+  if (model.k_tree) {
+    model.K = print(*model.k_tree);
+    used = std::max(used, dimension_used(*model.k_tree));
+  }
+  if (model.u_tree) {
+    model.U = print(*model.u_tree);
+    used = std::max(used, dimension_used(*model.u_tree));
+  }
+  model.dimension = used;
+  return true;
+}
+
 std::shared_ptr<const FormulaModel> read_object(const json& object, const std::string& pointer,
                                                 std::vector<JobIssue>& issues) {
   Checker check(issues);
   const std::size_t before = check.issue_count();
-  if (!check.object(object, pointer, "an object {\"T\": ..., \"V\": ..., \"parameters\": {...}}")) return nullptr;
+  if (!check.object(object, pointer,
+                    "an object {\"T\": ..., \"V\": ..., \"parameters\": {...}} or {\"H\": ..., \"parameters\": {...}}"))
+    return nullptr;
   check.known_keys(object, pointer, formula_keys);
   FormulaModel model;
   if (const json* name = check.member(object, pointer, "name", false, "")) {
@@ -142,27 +194,10 @@ std::shared_ptr<const FormulaModel> read_object(const json& object, const std::s
       }
     }
   }
-  symbols.variable = 'p';
-  const bool has_t = read_function(check, object, pointer, "T", symbols, model.t_tree, model.t_gradient, model.T);
-  model.k_tree = read_term(check, object, pointer, "K", symbols, false);
-  symbols.variable = 'q';
-  const bool has_v = read_function(check, object, pointer, "V", symbols, model.v_tree, model.v_gradient, model.V);
-  model.u_tree = read_term(check, object, pointer, "U", symbols, false);
-  if (!has_t || !has_v || check.issue_count() != before) return nullptr;
-  std::size_t used = std::max({dimension_used(model.t_tree), dimension_used(model.v_tree), std::size_t{1}});
-  for (const auto* gradient : {&model.t_gradient, &model.v_gradient}) {
-    used = std::max(used, gradient->size());
-    for (const Node& component : *gradient) used = std::max(used, dimension_used(component));
-  }
-  if (model.k_tree) {
-    model.K = print(*model.k_tree);
-    used = std::max(used, dimension_used(*model.k_tree));
-  }
-  if (model.u_tree) {
-    model.U = print(*model.u_tree);
-    used = std::max(used, dimension_used(*model.u_tree));
-  }
-  model.dimension = used;
+  const bool read = object.contains("H") ? read_hamiltonian(check, object, pointer, symbols, model)
+                                         : read_product_form(check, object, pointer, symbols, model);
+  if (!read || check.issue_count() != before) return nullptr;
+  const std::size_t used = model.dimension;
   if (const json* dimension = check.member(object, pointer, "dimension", false, ""))
     if (const auto n = check.integer(*dimension, job_reader::child(pointer, "dimension"),
                                      static_cast<std::int64_t>(used), static_cast<std::int64_t>(max_formula_dimension),
@@ -234,9 +269,11 @@ std::vector<PluginParameter> declared_parameters(const FormulaModel& model) {
 nlohmann::json formula_record(const FormulaModel& model, const std::string& cache_key) {
   json parameters = json::object();
   for (const auto& [name, value] : model.parameters) parameters[name] = value;
+  const bool product_form = !model.h_tree;
   return {{"name", model.name},
-          {"T", model.T},
-          {"V", model.V},
+          {"H", product_form ? json(nullptr) : json(model.H)},
+          {"T", product_form ? json(model.T) : json(nullptr)},
+          {"V", product_form ? json(model.V) : json(nullptr)},
           {"K", model.k_tree ? json(model.K) : json(nullptr)},
           {"U", model.u_tree ? json(model.U) : json(nullptr)},
           {"parameters", parameters},
@@ -247,15 +284,16 @@ nlohmann::json formula_record(const FormulaModel& model, const std::string& cach
 
 namespace {
 
-// Exactly one of T and dT (or of V and dV), as the job-file reference can put it in words.
+// Exactly one of T and dT (or of V and dV), or H alone, as the job-file reference can put it in words.
 nlohmann::ordered_json gradient_or_function(const std::string& function) {
   const std::string gradient = "d" + function;
-  return {
-      {"if", {{"required", {gradient}}}},
-      {"then",
-       {{"description", function + " given by its gradient " + gradient + ": " + function + " itself is absent."},
-        {"not", {{"required", {function}}}}}},
-      {"else", {{"description", "Without " + gradient + ", " + function + " is required."}, {"required", {function}}}}};
+  return {{"if", {{"required", {gradient}}}},
+          {"then",
+           {{"description", function + " given by its gradient " + gradient + ": " + function + " itself is absent."},
+            {"not", {{"required", {function}}}}}},
+          {"else",
+           {{"description", "Without " + gradient + ", " + function + " is required, or H alone (a model given by H)."},
+            {"oneOf", {{{"required", {function}}}, {{"required", {"H"}}}}}}}};
 }
 
 }  // namespace
@@ -265,16 +303,36 @@ nlohmann::ordered_json formula_schema() {
   nlohmann::ordered_json object = {
       {"type", "object"},
       {"description",
-       "A model written as formulas, compiled on first use into a cached plugin "
-       "(docs/formula-models.md)."},
+       "A model written as formulas, H(q, p) or T and V of the product form, compiled on first use into a cached "
+       "plugin (docs/formula-models.md)."},
       {"additionalProperties", false},
-      {"allOf", {gradient_or_function("T"), gradient_or_function("V")}},
+      {"allOf",
+       {{{"if", {{"required", {"H"}}}},
+         {"then",
+          {{"description", "A model given by H: none of T, V, dT, dV, K and U."},
+           {"not",
+            {{"anyOf",
+              {{{"required", {"T"}}},
+               {{"required", {"V"}}},
+               {{"required", {"dT"}}},
+               {{"required", {"dV"}}},
+               {{"required", {"K"}}},
+               {{"required", {"U"}}}}}}}}}},
+        gradient_or_function("T"),
+        gradient_or_function("V")}},
       {"properties",
        {{"name",
          {{"type", "string"},
           {"pattern", "^[a-z_][a-z0-9_]{0,63}$"},
           {"default", "formula"},
           {"description", "The plugin's name (summary.json, `nonsep model compile`'s NAME.so)."}}},
+        {"H",
+         {{"type", "string"},
+          {"minLength", 1},
+          {"maxLength", max_formula_length},
+          {"description",
+           "H(q, p), a Hamiltonian of any shape, instead of T and V: as T, with q0, q1, ... and p0, p1, .... "
+           "Served by gauss, implicit_midpoint and tao; Chin's schemes need the product form."}}},
         {"T",
          {{"type", "string"},
           {"minLength", 1},

@@ -86,8 +86,9 @@ void complete_entry(const CacheFolder& cache, const std::string& building, const
                           {"plugin", model.name + ".so"},
                           {"size", plugin->first},
                           {"content_hash", content_hash_hex(plugin->second)},
-                          {"T", model.T},
-                          {"V", model.V},
+                          {"H", model.h_tree ? json(model.H) : json(nullptr)},
+                          {"T", model.h_tree ? json(nullptr) : json(model.T)},
+                          {"V", model.h_tree ? json(nullptr) : json(model.V)},
                           {"compiler", toolchain.compiler},
                           {"compiler_identity", toolchain.identity},
                           {"nonsep_version", NONSEP_VERSION}}

@@ -33,6 +33,30 @@ std::string schemes_for_general_hamiltonian() {
   return "a scheme that integrates H itself: " + schemes_integrating_h() + ", or \"auto\"";
 }
 
+// The schemes (and the form) of `job` against a model given by H(q, p) itself, named `model`: Chin's schemes and the
+// form VVT need the product form. Each refusal is an issue at the scheme's (or /hamiltonian's) key.
+void check_schemes_for_general_hamiltonian(const Job& job, const std::string& model, std::vector<JobIssue>& issues) {
+  if ((job.is_study() ? job.study().form : job.run().integrator.form) == HamiltonianForm::VVT)
+    issues.push_back(
+        {"/hamiltonian",
+         "\"VVT\" with the plugin '" + model + "', a model given by H(q, p) itself, which has no T and V to exchange",
+         "no form (TTV, the default): the forms choose between the product-form Hamiltonians "
+         "T_i V_ij T_j and V_i T_ij V_j"});
+  const auto check = [&](const IntegratorSpec& spec, const std::string& path) {
+    if (!Integrator(spec).is_comparator())
+      issues.push_back(
+          {path, chin_scheme_with_general_hamiltonian(spec.scheme, model), schemes_for_general_hamiltonian()});
+  };
+  if (job.is_study()) {
+    const auto& integrators = job.study().integrators;
+    for (std::size_t i = 0; i < integrators.size(); ++i)
+      check(integrators[i].spec, "/study/integrators/" + std::to_string(i) + "/scheme");
+    if (const auto& reference = job.study().reference_run) check(reference->spec, "/study/reference_run/scheme");
+  } else if (!job.run().auto_scheme) {
+    check(job.run().integrator, "/integrator/scheme");
+  }
+}
+
 // The plugin of job.formula from the cache (compiling it first, saying so on standard error), its path into
 // job.plugin and its entry into job.formula_cache_key; nothing, with an issue at /model/formula, when it cannot be
 // had.
@@ -118,8 +142,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
   std::optional<formula::CachedPlugin> cached;
   if (job.formula) {
     // What `nonsep validate` checks without the compiler comes first: a job with any problem compiles nothing.
-    check_model_parameters(job.parameters, formula::declared_parameters(*job.formula), issues);
-    check_dimension(job.initial, job.formula->dimension, issues, true);
+    check_formula_job(job, issues);
     if (!issues.empty() || !(cached = attach_formula_plugin(job, issues))) return std::nullopt;
   }
   if (job.plugin.empty()) return std::nullopt;
@@ -158,12 +181,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
   if (issues.size() == before) check_gradients_at_initial_states(loaded, issues);
   // A model given by H (plugin ABI version 6) is served by the schemes that integrate H itself, in the form it has.
   const bool general = loaded.plugin.general_hamiltonian();
-  if (general && (checked.is_study() ? checked.study().form : checked.run().integrator.form) == HamiltonianForm::VVT)
-    issues.push_back({"/hamiltonian",
-                      "\"VVT\" with the plugin '" + loaded.plugin.name() +
-                          "', a model given by H(q, p) itself, which has no T and V to exchange",
-                      "no form (TTV, the default): the forms choose between the product-form Hamiltonians "
-                      "T_i V_ij T_j and V_i T_ij V_j"});
+  if (general) check_schemes_for_general_hamiltonian(checked, loaded.plugin.name(), issues);
   if (!checked.is_study())
     if (const Analysis& analysis = checked.run().analysis;
         analysis.tangent_vectors() > 0 && !general && !loaded.plugin.has_hessians())
@@ -181,11 +199,6 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
   // plugin's grad_H. Chin's schemes split H into T and V: a general plugin has neither.
   const bool has_gradient_of_h = general || (loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives());
   const auto check_comparator = [&](const IntegratorSpec& spec, const std::string& path) {
-    if (general && !Integrator(spec).is_comparator()) {
-      issues.push_back({path, chin_scheme_with_general_hamiltonian(spec.scheme, loaded.plugin.name()),
-                        schemes_for_general_hamiltonian()});
-      return;
-    }
     if (!Integrator(spec).is_comparator() || has_gradient_of_h) return;
     issues.push_back(
         {path,
@@ -221,6 +234,14 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
   }
   if (issues.size() != before) return std::nullopt;
   return loaded;
+}
+
+void check_formula_job(const Job& job, std::vector<JobIssue>& issues) {
+  const auto declared = formula::declared_parameters(*job.formula);
+  check_model_parameters(job.parameters, declared, issues);
+  check_swept_parameters(job, declared, issues);
+  check_dimension(job.initial, job.formula->dimension, issues, true);
+  if (job.formula->h_tree) check_schemes_for_general_hamiltonian(job, job.formula->name, issues);
 }
 
 LoadedJob load_job(const std::filesystem::path& job_file, std::size_t processes) {

@@ -341,6 +341,11 @@ std::optional<Job> read_job(const std::filesystem::path& job_file, std::vector<J
 // available memory (memory_issue) with its trajectories shared by `processes` (mpirun's ranks).
 std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std::size_t processes = 1);
 
+// What pass 3 checks of a formula job (job.formula) without compiling it, for `nonsep validate` and before the
+// compile: the parameters and swept values against the formula's, the states' dimension, and for a model given by
+// H(q, p) the schemes that apply to it (Chin's need the product form). Issues added; nothing else.
+void check_formula_job(const Job& job, std::vector<JobIssue>& issues);
+
 // All three passes on the file at `job_file`. Throws InvalidJob listing every issue (an unreadable file is an
 // issue at path ""). Exceptions other than InvalidJob mean a bug or an exhausted machine.
 LoadedJob load_job(const std::filesystem::path& job_file, std::size_t processes = 1);

@@ -1,7 +1,7 @@
 #pragma once
-// Formulas of T(p) and V(q): a strict grammar, parsed by recursive descent on a token stream into a tree. Nothing of
-// the text survives but the tree: the canonical text (print) and the C++ of a model (cpp_source.hpp) are both
-// written from it, so a formula cannot carry anything else to the compiler.
+// Formulas of T(p), V(q) and H(q, p): a strict grammar, parsed by recursive descent on a token stream into a tree.
+// Nothing of the text survives but the tree: the canonical text (print) and the C++ of a model (cpp_source.hpp) are
+// both written from it, so a formula cannot carry anything else to the compiler.
 //
 //   formula  := sum                                   (at most max_formula_length characters)
 //   sum      := product (("+" | "-") product)*
@@ -10,7 +10,8 @@
 //   power    := primary (("^" | "**") unary)?        right-associative: 2^3^2 = 2^(3^2); -q0^2 = -(q0^2)
 //   primary  := number | variable | parameter | "pi" | function "(" sum ("," sum)* ")" | "(" sum ")"
 //   number   := digits ["." digits] [("e" | "E") ["+" | "-"] digits], or "." digits [...]: a finite double
-//   variable := "q" index (in V) or "p" index (in T), index 0..max_formula_dimension-1 without leading zeros
+//   variable := "q" index (in V and H) or "p" index (in T and H), index 0..max_formula_dimension-1 without leading
+//               zeros
 // Names are only these: the variables, the parameters the model declares, the constant pi, and the functions of
 // formula_functions() (each with its number of arguments). Blanks (space, tab) separate tokens; any other
 // character is refused. Nesting (parentheses, signs, powers, calls) is at most max_formula_depth deep, so neither
@@ -44,16 +45,17 @@ struct Node {
   enum class Kind { number, variable, parameter, pi, call, negate, sum, product, power };
   Kind kind = Kind::number;
   double value = 0.0;               // number
-  std::string name = {};            // parameter, call (the function); variable: its letter
+  std::string name = {};            // parameter, call (the function); variable: its letter, "q" or "p"
   std::size_t index = 0;            // variable: q<index> or p<index>
   std::vector<Node> operands = {};  // negate: 1; power: base, exponent; call: its arguments; sum, product: 2 or more
   std::vector<char> signs = {};     // sum: '+' or '-' per operand (the first '+'); product: '*' or '/' (the first '*')
   friend bool operator==(const Node&, const Node&) = default;
 };
 
-// Which names a formula may use: its variable letter ('q' for V, 'p' for T) and the model's parameters.
+// Which names a formula may use: its variable letters ("q" for V, "p" for T, "qp" for H) and the model's
+// parameters.
 struct Symbols {
-  char variable = 'q';
+  std::string variables = "q";
   std::vector<std::string> parameters;
 };
 

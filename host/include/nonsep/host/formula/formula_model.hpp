@@ -11,6 +11,10 @@
 //                                                   (H = T_i V_ij T_j + K + U, nonsep/sdk/model_adapter.hpp)
 //    "parameters": {"alpha": 0.5},                  optional: names (is_parameter_name) and their default values
 //    "dimension": 2}                                optional: n (1..64); default the largest index used plus one
+// or, for a Hamiltonian of any shape, instead of T, V, dT, dV, K and U:
+//   {"H": "(p0 - q1)^2 / 2 + ...", ...}             H(q, p), a formula of q0, q1, ..., p0, p1, ...: a model given
+//                                                   by H (gauss, implicit_midpoint and tao integrate it; Chin's
+//                                                   schemes need the product form)
 // /model/formula is that object, or a string: the path of a JSON file holding it (relative to the job's folder).
 // The parameters are numbers; a job's /model/parameters overrides their defaults as for any plugin.
 // Every problem is a JobIssue at a JSON Pointer (in the job, or "<model file>#/V" in a model file); a formula's
@@ -32,7 +36,9 @@ namespace nonsep::host::formula {
 
 struct FormulaModel {
   std::string name = "formula";
-  std::string T, V;  // canonical text (print) of the trees: what the metadata and summary.json show
+  std::optional<Node> h_tree;  // a model given by H(q, p): its tree, and T, V, K, U and their trees unused
+  std::string H;               // its canonical text; empty for the product form
+  std::string T, V;            // canonical text (print) of the trees: what the metadata and summary.json show
   Node t_tree, v_tree;
   // When given by their gradients ("dT", "dV"): n trees each, and T (V) is "grad T = [..., ...]", t_tree (v_tree)
   // unused. Empty otherwise.
@@ -56,7 +62,8 @@ std::shared_ptr<const FormulaModel> read_formula_file(const std::filesystem::pat
 // The JSON Schema of /model/formula (the job schema's $defs/formula).
 nlohmann::ordered_json formula_schema();
 
-// What summary.json records of a formula model: {"T", "V" (canonical; "grad T = [...]" when given by "dT"),
+// What summary.json records of a formula model: {"H" (canonical, or null for the product form), "T", "V" (canonical;
+// "grad T = [...]" when given by "dT"; null for a model given by H),
 // "parameters" (defaults), "dimension", "file" (the model file, or null), "cache_key"}.
 nlohmann::json formula_record(const FormulaModel& model, const std::string& cache_key);
 
