@@ -1,4 +1,4 @@
-# nonsep_add_model(<target> [OUTPUT_DIRECTORY <dir>] [TANGENT_KERNELS] <sources>...)
+# nonsep_add_model(<target> [OUTPUT_DIRECTORY <dir>] [TANGENT_KERNELS] [KERNEL_SETS native|all|baseline] <sources>...)
 #
 # Builds a nonsep model plugin: a MODULE library named exactly <target>.so (no "lib" prefix) whose metadata name
 # must equal <target>. Only the symbol `nonsep_plugin` that NONSEP_EXPORT_MODEL (plugin_sdk.hpp) or
@@ -9,9 +9,15 @@
 # glibc refuse to ever unload the library; -fno-gnu-unique keeps a plugin unloadable (tests/plugins/
 # test_plugin_lifetime.cpp). A plugin's symbols are private to it, so uniqueness buys nothing.
 #
-# A one-file plugin that exports its model with NONSEP_EXPORT_MODEL, built with GCC on x86-64, is compiled as three
+# KERNEL_SETS chooses the stepping kernels compiled besides the baseline x86-64 one (nonsep/sdk/kernels.hpp), each a
+# large part of the compile time: `native` (the default, or NONSEP_KERNEL_SETS when set) the widest set the building
+# machine runs, x86-64-v4 or x86-64-v3 (none on another processor), found once per build folder by running a probe;
+# `all` both wider sets, for plugins that run on other machines than the one that builds them; `baseline` none.
+# The host picks the widest kernel the plugin has and the processor runs (NONSEP_INSTRUCTION_SET overrides).
+#
+# A one-file plugin that exports its model with NONSEP_EXPORT_MODEL, built with GCC on x86-64, is compiled as
 # translation units that make can run in parallel:
-# the plugin with its baseline kernels, and the x86-64-v3 and x86-64-v4 kernels each in a unit of its own
+# the plugin with its baseline kernels, and the x86-64-v3 and x86-64-v4 kernels it has each in a unit of its own
 # (${target}_kernel_unit_1.cpp and _2.cpp in the binary folder, which include the source; nonsep/sdk/kernels.hpp,
 # "Kernel units"). The plugin is the same; on two cores it builds in about two thirds of the wall time
 # (docs/writing-models.md, "How long a plugin takes to build"). Several sources are compiled as they are.
@@ -29,10 +35,58 @@
 # Used in the nonsep tree (shipped plugins land in NONSEP_BUILD_PLUGIN_DIR, the folder the host searches last) and
 # by installed users after find_package(nonsep) (the plugin lands in the current binary folder; point
 # NONSEP_PLUGIN_PATH at it, or load it by path).
+# The bits of NONSEP_SDK_WIDE_KERNEL_SETS (1: x86-64-v3, 2: x86-64-v4) of the widest set this machine runs, into
+# `out`; probed once per build folder (the same test as the host's kernel choice), and 3 (both) where the probe
+# cannot run (another compiler than GCC or clang, cross-compiling).
+function(_nonsep_native_kernel_sets out)
+  if(NOT DEFINED NONSEP_NATIVE_KERNEL_SETS)
+    set(probe "${CMAKE_BINARY_DIR}/CMakeFiles/nonsep_kernel_probe.cpp")
+    file(WRITE "${probe}" [=[
+#include <cstdio>
+int main() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  __builtin_cpu_init();
+  const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+                  __builtin_cpu_supports("bmi2");
+  const bool v4 = v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+                  __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
+                  __builtin_cpu_supports("avx512vl");
+  std::printf("%d", v4 ? 2 : v3 ? 1 : 0);
+#else
+  std::printf("0");
+#endif
+}
+]=])
+    try_run(probe_ran probe_compiled "${CMAKE_BINARY_DIR}/CMakeFiles/nonsep_kernel_probe" "${probe}"
+            RUN_OUTPUT_VARIABLE sets)
+    if(NOT probe_compiled OR NOT probe_ran EQUAL 0 OR NOT sets MATCHES "^[0-2]$")
+      set(sets 3)
+    endif()
+    set(NONSEP_NATIVE_KERNEL_SETS ${sets} CACHE INTERNAL "nonsep_add_model: the wider kernel sets this machine runs")
+  endif()
+  set(${out} ${NONSEP_NATIVE_KERNEL_SETS} PARENT_SCOPE)
+endfunction()
+
 function(nonsep_add_model target)
-  cmake_parse_arguments(PARSE_ARGV 1 arg "TANGENT_KERNELS" "OUTPUT_DIRECTORY" "")
+  cmake_parse_arguments(PARSE_ARGV 1 arg "TANGENT_KERNELS" "OUTPUT_DIRECTORY;KERNEL_SETS" "")
   if(NOT arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "nonsep_add_model(${target}): no source files given")
+  endif()
+  if(NOT arg_KERNEL_SETS)
+    set(arg_KERNEL_SETS native)
+    if(NONSEP_KERNEL_SETS)
+      set(arg_KERNEL_SETS ${NONSEP_KERNEL_SETS})
+    endif()
+  endif()
+  if(arg_KERNEL_SETS STREQUAL "native")
+    _nonsep_native_kernel_sets(wide_sets)
+  elseif(arg_KERNEL_SETS STREQUAL "all")
+    set(wide_sets 3)
+  elseif(arg_KERNEL_SETS STREQUAL "baseline")
+    set(wide_sets 0)
+  else()
+    message(FATAL_ERROR "nonsep_add_model(${target}): KERNEL_SETS \"${arg_KERNEL_SETS}\" (NONSEP_KERNEL_SETS?); "
+                        "allowed: native, all or baseline")
   endif()
   add_library(${target} MODULE ${arg_UNPARSED_ARGUMENTS})
   list(LENGTH arg_UNPARSED_ARGUMENTS source_count)
@@ -53,6 +107,10 @@ function(nonsep_add_model target)
     # (nonsep/sdk/kernels.hpp, "Kernel units"): each unit includes the one source with NONSEP_SDK_KERNEL_UNIT set.
     set(units "")
     foreach(unit 1 2)
+      math(EXPR wanted "${wide_sets} & ${unit}")
+      if(NOT wanted)
+        continue()
+      endif()
       set(unit_file "${CMAKE_CURRENT_BINARY_DIR}/${target}_kernel_unit_${unit}.cpp")
       math(EXPR level "${unit} + 2")
       file(CONFIGURE OUTPUT "${unit_file}"
@@ -62,8 +120,9 @@ function(nonsep_add_model target)
     endforeach()
     target_sources(${target} PRIVATE ${units})
     set_property(SOURCE "${source}" TARGET_DIRECTORY ${target} APPEND PROPERTY COMPILE_DEFINITIONS
-                 NONSEP_SDK_SEPARATE_KERNEL_UNITS=3)
+                 NONSEP_SDK_SEPARATE_KERNEL_UNITS=${wide_sets})
   endif()
+  target_compile_definitions(${target} PRIVATE NONSEP_SDK_WIDE_KERNEL_SETS=${wide_sets})
   set_target_properties(${target} PROPERTIES
     PREFIX ""
     SUFFIX ".so"

@@ -26,6 +26,11 @@ if(NONSEP_NATIVE)
   add_compile_options(-march=native)
 endif()
 
+# The stepping kernels of the plugins built here (nonsep_add_model's KERNEL_SETS): native (the widest set this machine
+# runs, besides the baseline), all (x86-64-v3 and x86-64-v4 too, for plugins that run elsewhere) or baseline.
+set(NONSEP_KERNEL_SETS "native" CACHE STRING "Plugin stepping kernels besides the baseline: native, all or baseline")
+set_property(CACHE NONSEP_KERNEL_SETS PROPERTY STRINGS native all baseline)
+
 option(NONSEP_WARNINGS_AS_ERRORS "Treat compiler warnings as errors" OFF)
 
 add_library(nonsep_warnings INTERFACE)
