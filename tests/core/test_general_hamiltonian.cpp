@@ -267,3 +267,33 @@ TEST_CASE("general H: the derivative checker compares grad_H and hvp_H with fini
   CHECK(bad.mismatches[0].component == 5);  // dH/dp_2, after the three of dH/dq
   CHECK(bad.summary().find("grad_H[5] at (q, p) = (") != std::string::npos);
 }
+
+namespace {
+// H = p^2/2 + sqrt(q): grad H is NaN for q < 0 and infinite at q = 0, where H is not differentiable.
+struct SquareRootWell {
+  static constexpr std::size_t dimension = 1;
+  template <class S>
+  S H(sdk::Vector<S> q, sdk::Vector<S> p) const {
+    return p[0] * p[0] / 2.0 + sdk::sqrt(q[0]);
+  }
+};
+}  // namespace
+
+TEST_CASE("general H: a Gauss step that reaches a point where grad H is not finite names that point, not dt") {
+  const sdk::HamiltonianAdapter<SquareRootWell> model;
+  GaussLegendre gauss(HamiltonianForm::TTV, 4);
+  // State 0 starts where H is not defined; state 1 is fine for this step.
+  PhaseSpaceBatch x(1, 2);
+  x.q()[0] = -0.5;
+  x.q()[1] = 1.0;
+  x.p()[1] = -0.1;
+  const auto failures = gauss.try_step(model, x, 0.01);
+  REQUIRE(failures.size() == 1);
+  CHECK(failures[0].state == 0);
+  INFO(failures[0].reason);
+  CHECK(failures[0].reason.find("grad H is not finite at stage 1 of iteration 1, q = (-0.5), p = (0)") == 0);
+  CHECK(failures[0].reason.find("not differentiable") != std::string::npos);
+  CHECK(failures[0].reason.find("smaller dt") == std::string::npos);
+  CHECK(x.q()[0] == -0.5);  // the failed state keeps its starting point
+  CHECK(x.q()[1] != 1.0);
+}

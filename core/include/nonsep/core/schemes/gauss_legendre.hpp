@@ -145,7 +145,7 @@ class GaussLegendre {
         message += (i ? "; " : "") + std::string("state ") + std::to_string(failures[i].state) + " of " +
                    std::to_string(x.count()) + " (" + failures[i].reason + ")";
     }
-    throw ModelError(message + "; a smaller dt makes the iteration contract");
+    throw ModelError(message);
   }
 
   // As step(), but returns the failed states instead of throwing ModelError; they keep their starting point.
@@ -201,7 +201,7 @@ class GaussLegendre {
           keep_stage_points(b, n, s, size);
           advance(x, b, s, size, dt);
         } else
-          failures.push_back({b, "an iterate is not finite after " + std::to_string(iterations_[b]) + " iterations"});
+          failures.push_back({b, not_finite_reason(b, n, s, size)});
       }
       active_.swap(still_);
       stage_q_.swap(next_q_);
@@ -210,14 +210,39 @@ class GaussLegendre {
     for (std::size_t b : active_) {
       char change[32];
       std::snprintf(change, sizeof change, "%.3g", last_change_[b]);
-      failures.push_back(
-          {b, "no convergence in " + std::to_string(max_iterations_) + " iterations, last relative change " + change});
+      failures.push_back({b, "no convergence in " + std::to_string(max_iterations_) +
+                                 " iterations, last relative change " + change +
+                                 ": a smaller dt makes the iteration contract, unless the orbit runs off where grad H "
+                                 "grows without bound (a non-compact energy shell)"});
     }
     std::sort(failures.begin(), failures.end(), [](const auto& l, const auto& r) { return l.state < r.state; });
     return failures;
   }
 
  private:
+  // Why state b's iterate is not finite: the first stage point of its last iteration where grad H is not finite
+  // (named, with the stage), or else the iterate itself overflowing.
+  std::string not_finite_reason(std::size_t b, std::size_t n, std::size_t s, std::size_t size) const {
+    const auto vector_text = [&](const std::vector<double>& start, const std::vector<double>& stage, std::size_t i) {
+      std::string text = "(";
+      char number[32];
+      for (std::size_t e = b * n; e < b * n + n; ++e) {
+        std::snprintf(number, sizeof number, "%.17g", start[e] + stage[i * size + e]);
+        text += (e == b * n ? "" : ", ") + std::string(number);
+      }
+      return text + ")";
+    };
+    for (std::size_t i = 0; i < s; ++i)
+      for (std::size_t e = b * n; e < b * n + n; ++e)
+        if (!std::isfinite(dH_dq_[i * size + e]) || !std::isfinite(dH_dp_[i * size + e]))
+          return "grad H is not finite at stage " + std::to_string(i + 1) + " of iteration " +
+                 std::to_string(iterations_[b]) + ", q = " + vector_text(start_q_, stage_q_, i) +
+                 ", p = " + vector_text(start_p_, stage_p_, i) +
+                 ": H is not defined or not differentiable there, or the orbit ran off to where it overflows";
+    return "an iterate is not finite after " + std::to_string(iterations_[b]) +
+           " iterations: the stages overflowed; a smaller dt makes the iteration contract";
+  }
+
   // The work arrays are stage-major, so that the loops over the batch run over contiguous memory: stage i, component
   // k of state b at i*size + b*n + k (size = count*n) in the stages Z^m (stage_q_, stage_p_), the next iterate
   // Z^{m+1} (next_q_, next_p_; the two swap after each iteration), the stage points z + Z^m (q_, p_; gathered: in
