@@ -551,3 +551,30 @@ TEST_CASE("killed after the first tenth and resumed: the runaway warnings of an 
   CHECK(runaway_warnings(resumed.err) == runaway_warnings(uninterrupted.err));
   CHECK(runaway_warnings(resumed.err).empty());
 }
+
+TEST_CASE("no runaway warning for an orbit whose cyclic coordinates grow: the time and azimuth around a black hole") {
+  // The shipped example's model and constants from r = 15 instead of 11 (a regular orbit, examples/given_by_h): r
+  // swings between about 10 and 165 with a radial period of about 5000 (so the first tenth of a run to 60000 shows
+  // that extent), while the coordinate time q0 and the azimuth q3, on which H does not depend (p0 and p3 kept to the
+  // bit), grow in proportion to the proper time.
+  json job = read_json(std::filesystem::path(NONSEP_SOURCE_DIR) / "examples/dynamics/schwarzschild_charged_orbit.json");
+  job.erase("$schema");
+  job.erase("analysis");
+  job["initial"]["q"][1] = 15.0;
+  job["initial"]["p"][2] = 3.4317409777285293;  // r sqrt(E^2/f - 1 - (L - beta r^2/2)^2/r^2): the mass shell
+  job["time"] = {{"dt", 2.0}, {"t_end", 60000}};
+  job["output"]["every"] = 15000;
+  TemporaryFolder folder;
+  const auto result = run_named(folder, "run", job);
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  const auto rows = table(folder / "run/trajectory.csv");
+  REQUIRE(rows.size() == 3);
+  // What the check saw when it counted every coordinate: the scale grew from the time at the end of the first tenth
+  // (t > tau = 6000) to ten times that.
+  CHECK(cell(rows[2], "q0") > 3.0 * std::max(170.0, 1.2 * 6000));
+  CHECK(cell(rows[2], "p0") == cell(rows[0], "p0"));
+  CHECK(cell(rows[2], "p3") == cell(rows[0], "p3"));
+  for (const auto& row : rows) CHECK(cell(row, "q1") < 200.0);
+  CHECK(runaway_warnings(result.err).empty());
+}

@@ -11,10 +11,15 @@ namespace nonsep::host {
 
 namespace {
 
-double scale_of(std::span<const double> q, std::span<const double> p) {
+// max(|q_i|, |p_i|) over the components, leaving out each q_i whose momentum p_i is still exactly its initial value
+// `p0_i`: a cyclic coordinate (H does not depend on it, so the schemes keep p_i to the bit), such as the time or an
+// angle, grows without the orbit running off.
+double scale_of(std::span<const double> q, std::span<const double> p, std::span<const double> p0) {
   double scale = 0.0;
-  for (const auto* x : {&q, &p})
-    for (double value : *x) scale = std::max(scale, std::abs(value));
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    if (p[i] != p0[i]) scale = std::max(scale, std::abs(q[i]));
+    scale = std::max(scale, std::abs(p[i]));
+  }
   return scale;
 }
 
@@ -28,15 +33,22 @@ RunawayObserver::RunawayObserver(std::span<const double> q, std::span<const doub
                                  const TimeGrid& time)
     : reference_until_(std::abs(time.t_end) / 10.0),
       stride_(std::max<std::uint64_t>(1, time.steps / watched_steps)),
+      n_(n),
+      initial_p_(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(count * n)),
       watches_(count) {
-  for (std::size_t b = 0; b < count; ++b)
-    watches_[b].reference_scale = scale_of(q.subspan(b * n, n), p.subspan(b * n, n));
+  for (std::size_t b = 0; b < count; ++b) {
+    // Every q_i counts at the start: a coordinate is taken for cyclic only once the steps have kept its momentum.
+    double scale = 0.0;
+    for (const auto x : {q.subspan(b * n, n), p.subspan(b * n, n)})
+      for (double value : x) scale = std::max(scale, std::abs(value));
+    watches_[b].reference_scale = scale;
+  }
 }
 
 // The scale at t: into the reference in the first tenth, else into the furthest point.
 void RunawayObserver::see_scale(std::size_t trajectory, double t, std::span<const double> q,
                                 std::span<const double> p) {
-  const double scale = scale_of(q, p);
+  const double scale = scale_of(q, p, std::span<const double>(initial_p_).subspan(trajectory * n_, n_));
   if (!std::isfinite(scale)) return;  // a chunk that will be redone step by step (block_stepper.hpp)
   Watch& watch = watches_[trajectory];
   if (std::abs(t) <= reference_until_)

@@ -1,16 +1,16 @@
 #pragma once
 // Orbits that run off with bounded energy: a trajectory whose scale, max(|q_i|, |p_i|), grew more than `growth`
-// times beyond its reference scale while its relative energy error |dH/H0| stayed at most `small_error`. The
-// reference scale is the largest in the first tenth of the run (|t| <= |t_end|/10, step 0 included): a bounded
-// orbit has shown its extent by then, one on a non-compact shell has not.
-// Such an orbit follows a non-compact energy shell (docs/method.md, "Non-compact energy shells"): the integrator
-// keeps H, and H does not keep the orbit. The scale is watched where the orbit is, not only where it is sampled: at
-// every stride()-th step of the run (about `watched_steps` steps, evenly spaced, through the plugin's kernel, which
-// the watching does not change), at the steps where H is evaluated and in the final state of a retired trajectory;
-// |dH/H0| where H is evaluated (step 0, samples, output.energy_every, the last step, final states): the furthest
-// point so far counts as a runaway where H is next evaluated, with the largest |dH/H0| up to there. Checkpointed,
-// so that a resumed run finds what an uninterrupted one finds. What it finds goes into the run's messages
-// (run_command), not into files.
+// times beyond its reference scale (leaving out each q_i whose momentum p_i is still exactly its initial value: a
+// cyclic coordinate such as the time or an angle, which grows while the orbit stays bounded) while its relative energy
+// error |dH/H0| stayed at most `small_error`. The reference scale is the largest in the first tenth of the run (|t| <=
+// |t_end|/10, step 0 included): a bounded orbit has shown its extent by then, one on a non-compact shell has not. Such
+// an orbit follows a non-compact energy shell (docs/method.md, "Non-compact energy shells"): the integrator keeps H,
+// and H does not keep the orbit. The scale is watched where the orbit is, not only where it is sampled: at every
+// stride()-th step of the run (about `watched_steps` steps, evenly spaced, through the plugin's kernel, which the
+// watching does not change), at the steps where H is evaluated and in the final state of a retired trajectory; |dH/H0|
+// where H is evaluated (step 0, samples, output.energy_every, the last step, final states): the furthest point so far
+// counts as a runaway where H is next evaluated, with the largest |dH/H0| up to there. Checkpointed, so that a resumed
+// run finds what an uninterrupted one finds. What it finds goes into the run's messages (run_command), not into files.
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -69,6 +69,8 @@ class RunawayObserver : public Observer, public ChunkObserver, public StepObserv
   };
   double reference_until_;
   std::uint64_t stride_;
+  std::size_t n_;
+  std::vector<double> initial_p_;          // per trajectory, its n initial momenta
   std::vector<Watch> watches_;             // per trajectory
   std::vector<std::vector<Watch>> saved_;  // per block: its trajectories' watches at the chunk's start
 
