@@ -25,5 +25,5 @@ from .process import (ExecutableNotFound, Problem, RunError, RunInterrupted, exe
                       validate)
 from .results import ChaoticFraction, Crossings, ErrorEstimates, LyapunovSeries, Orbit, Result, Samples, load
 
-__all__ = ["ChaoticFraction", "Crossings", "ErrorEstimates", "ExecutableNotFound", "LyapunovSeries", "Orbit", "Problem", "Result",
-           "RunError", "RunInterrupted", "Samples", "executable", "load", "parse_problems", "run", "validate"]
+__all__ = ["ChaoticFraction", "Crossings", "ErrorEstimates", "ExecutableNotFound", "LyapunovSeries", "Orbit", "Problem",
+           "Result", "RunError", "RunInterrupted", "Samples", "executable", "load", "parse_problems", "run", "validate"]

@@ -330,7 +330,7 @@ def chaotic_fraction(result, x=None, value="mean_megno", threshold=None, where=N
     left_out = int(counts.left_out.sum())
     note = f"; {left_out} left out (not completed, or no value)" if left_out else ""
     ax.set_title(f"Chaotic fraction ({criterion} at t = {_end_time(result):g}) of {int(counts.orbits.sum())} orbits, "
-                 f"bars {z:g} sigma{note}\n{describe_run(result, where)}", fontsize="medium")
+                 f"bars: Wilson interval, {z:g} sigma{note}\n{describe_run(result, where)}", fontsize="medium")
     return ax
 
 
@@ -526,7 +526,7 @@ def _end_time(result):
 def describe_run(result, where=None):
     """One line saying which run a picture shows, from summary.json: the model with its fixed parameters, the
     energy shell, the values chosen by `where`, the scheme, dt and t_end; e.g.
-    "paper2d, H = 8, coupling = 0.1; gauss 6, dt = 0.02, t = 100"."""
+    "paper2d, H = 8, coupling = 0.1; gauss order 6, dt = 0.02, t = 100"."""
     summary = result.summary
     model = summary.get("model") or {}
     parts = [model.get("plugin", "model")]
@@ -539,7 +539,7 @@ def describe_run(result, where=None):
     for name, wanted in (where or {}).items():
         parts.append(f"{name} = {', '.join(f'{v:g}' for v in np.atleast_1d(np.asarray(wanted, dtype=float)))}")
     integrator, time = summary.get("integrator") or {}, summary.get("time") or {}
-    run = [" ".join(str(part) for part in (integrator.get("scheme"), integrator.get("order")) if part is not None)]
+    run = [integrator.get("scheme", "") + (f" order {integrator['order']}" if "order" in integrator else "")]
     if "dt" in time:
         run.append(f"dt = {time['dt']:g}")
     if "t_end" in time:

@@ -125,14 +125,15 @@ class SweepPlotTest(unittest.TestCase):
         self.assertEqual([list(line.get_ydata()) for line in bar.lines], [[2.0, 2.0]], "2 marked on the colour bar")
         self.assertIn("2: quasi-periodic", bar.get_ylabel())
         self.assertEqual(ax.get_title(), f"MEGNO $\\langle Y \\rangle$ at t = 2 of {len(self.result.trajectories)} "
-                         "orbits\npaper2d, H = 7; mpe 4, dt = 0.005, t = 2")
+                         "orbits\npaper2d, H = 7; mpe order 4, dt = 0.005, t = 2")
         self.save(ax, "megno_scale")
         ax = nonsep.plot.stability_map(self.result, vmin=0.0, vmax=3.0)
         self.assertEqual((ax.images[0].norm.vmin, ax.images[0].norm.vmax), (0.0, 3.0))
         ax = nonsep.plot.stability_map(self.two, value="H0", reduce="max")
         mesh = ax.collections[0]
         cells = np.ma.getdata(mesh.get_array())
-        self.assertEqual((mesh.norm.vmin, mesh.norm.vmax), (cells.min(), cells.max()), "other columns: the data's range")
+        self.assertEqual((mesh.norm.vmin, mesh.norm.vmax), (cells.min(), cells.max()),
+                         "other columns: the data's range")
         self.assertEqual(cells.max(), self.two.trajectories["H0"].max())
         self.assertEqual(len(ax.figure.axes[-1].lines), 0)
 
@@ -154,7 +155,7 @@ class SweepPlotTest(unittest.TestCase):
             expected[np.argmin(abs(ps - p[i, 0])), np.argmin(abs(qs - q[i, 0]))] = table["mean_megno"][i]
         np.testing.assert_array_equal(shown, expected)
         self.assertEqual(np.count_nonzero(np.isfinite(shown)), len(chosen))
-        self.assertIn("paper2d, H = 8, coupling = 0.15; gauss 6, dt = 0.02, t = 40", ax.get_title())
+        self.assertIn("paper2d, H = 8, coupling = 0.15; gauss order 6, dt = 0.02, t = 40", ax.get_title())
         self.save(ax, "chaos_map_where")
         self.assertEqual(len(self.grid.select({"coupling": [0.0, 0.3]})), np.isin(table["coupling"], [0.0, 0.3]).sum())
         with self.assertRaisesRegex(ValueError, r"no trajectory has coupling = 0.2 \(its values: 0, 0.15, 0.3\)"):
