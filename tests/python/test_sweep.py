@@ -17,6 +17,7 @@ from matplotlib.colors import LogNorm  # noqa: E402
 
 import nonsep  # noqa: E402
 import nonsep.plot  # noqa: E402
+from support import blowup_job, state  # noqa: E402
 
 COUPLINGS = [0.0, 0.1, 0.2]
 
@@ -238,6 +239,24 @@ class SweepPlotTest(unittest.TestCase):
         np.testing.assert_array_equal(
             counts.chaotic, [np.sum((table["lambda"] == 0.5) & (table["alpha"] == a) & (table["H0"] > 0.5))
                              for a in (0.5, 1.0, 2.0)])
+
+    def test_chaotic_fraction_leaves_out_the_orbits_that_did_not_complete(self):
+        # tests/host/plugins/blowup.cpp: q = 1e103 overflows grad V in the first step (diverged); H_TTV = 3 q^2 p^2
+        # gives H0 = 0.0075 and 0.12 to the other two, so one of two counted orbits per set has H0 > 0.1.
+        job = blowup_job([state(1e103, 0.0), state(0.5, 0.1), state(1.0, 0.2)], steps=5, fail_above=[1e299, 1e300])
+        with self.assertRaises(nonsep.RunError) as caught:
+            nonsep.run(job, output=f"{self._folder.name}/blowup")
+        result = caught.exception.result
+        self.assertEqual(list(result.trajectories["status"]), ["diverged", "completed", "completed"] * 2)
+        counts = result.chaotic_fraction(value="H0", threshold=0.1)
+        np.testing.assert_array_equal(counts.values, [1e299, 1e300])
+        np.testing.assert_array_equal(counts.orbits, [2, 2])
+        np.testing.assert_array_equal(counts.chaotic, [1, 1])
+        np.testing.assert_array_equal(counts.left_out, [1, 1])
+        self.assertEqual(list(counts.fraction), [0.5, 0.5])
+        ax = nonsep.plot.chaotic_fraction(result, value="H0", threshold=0.1)
+        self.assertIn("2 left out (not completed, or no value)", ax.get_title())
+        self.save(ax, "chaotic_fraction_left_out")
 
     def test_poincare_of_one_parameter_set(self):
         ax = nonsep.plot.poincare(self.grid, where={"coupling": 0.0}, color_by="mean_megno")
