@@ -293,6 +293,8 @@ class Result:
                                      f"{', '.join(f'{x:g}' for x in values)})")
                 chosen |= match
             mask &= chosen
+        if where and not mask.any():
+            raise ValueError(f"where: no trajectory has all of {where}")
         return np.flatnonzero(mask)
 
     def chaotic_fraction(self, x=None, value="mean_megno", threshold=None, where=None, z=1.0):

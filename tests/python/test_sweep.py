@@ -232,6 +232,8 @@ class SweepPlotTest(unittest.TestCase):
     def test_chaotic_fraction_needs_the_other_parameters_fixed(self):
         with self.assertRaisesRegex(ValueError, r"lambda varies too: fix it with where=\{'lambda': ...\}"):
             self.two.chaotic_fraction("alpha", value="H0", threshold=0.5)
+        with self.assertRaisesRegex(ValueError, r"where: no trajectory has alpha = 3 \(its values: 0.5, 1, 2\)"):
+            self.two.select({"lambda": 0.5, "alpha": 3.0})
         counts = self.two.chaotic_fraction("alpha", value="H0", threshold=0.5, where={"lambda": 0.5})
         np.testing.assert_array_equal(counts.values, [0.5, 1.0, 2.0])
         np.testing.assert_array_equal(counts.orbits, [2, 2, 2])
