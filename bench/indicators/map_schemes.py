@@ -6,7 +6,7 @@ system of the nonsep process), the orbits that diverged (in all, and at coupling
 the completed orbits at couplings <= 0.2 and above, and how many completed orbits it classifies (<Y> > 2.5 or not)
 as Gauss-Legendre 3 stages at dt = 0.02, the first run, does; then the chaotic fraction per coupling of each run.
 
-    /usr/bin/python3 bench/indicators/map_schemes.py build/bin/nonsep /tmp/map_schemes   (about 5 minutes of CPU)
+    /usr/bin/python3 bench/indicators/map_schemes.py build/bin/nonsep /tmp/map_schemes   (about 6 minutes of CPU)
 """
 import json
 import resource
@@ -23,7 +23,9 @@ SCHEMES = [("gauss 3 stages", {"scheme": "gauss", "stages": 3}, 0.02),
            ("gauss 2 stages", {"scheme": "gauss", "stages": 2}, 0.02),
            ("gauss 3 stages", {"scheme": "gauss", "stages": 3}, 0.04),
            ("mpe 4", {"scheme": "mpe", "order": 4}, 0.005),
-           ("mpe 4", {"scheme": "mpe", "order": 4}, 0.0025)]
+           ("mpe 4", {"scheme": "mpe", "order": 4}, 0.0025),
+           ("auto, tolerance 1e-6 on |dH/H0| (dt: the output grid)",
+            {"scheme": "auto", "tolerance": 1e-6, "measure": "energy"}, 0.04)]
 THRESHOLD = 2.5
 
 
@@ -57,7 +59,7 @@ def main():
     work.mkdir(parents=True, exist_ok=True)
     runs = []
     for label, integrator, dt in SCHEMES:
-        name = f"{integrator['scheme']}{integrator.get('stages', integrator.get('order'))}_{dt:g}"
+        name = f"{integrator['scheme']}{integrator.get('stages', integrator.get('order', ''))}_{dt:g}"
         result, cpu = run(sys.argv[1], work, name, integrator, dt)
         runs.append((f"{label}, dt = {dt:g}", result, cpu))
     reference = runs[0][1].trajectories
@@ -72,6 +74,10 @@ def main():
         print(f"{label} | {cpu:.1f} | {np.sum(~done)} of {len(table)} ({np.sum(~done & (table['coupling'] >= 0.24))}) | "
               f"{np.max(error[done & ~strong]):.1e} / {np.max(error[done & strong]):.1e} | "
               f"{np.sum(agree)} of {np.sum(done)}")
+    choice = runs[-1][1].summary["scheme_choice"]
+    print(f"auto chose {choice['chosen']} with {choice['subdivision']} steps per dt = 0.04 (pilots: "
+          f"{choice['pilot_cost']['wall_seconds']:.1f} s); measured largest |dH/H0| {choice['measured_error']:.1e}; "
+          + "; ".join(f"{c['scheme']} {c['order']}: {c['excluded']}" for c in choice["candidates"] if c.get("excluded")))
     for label, result, _ in runs:
         counts = result.chaotic_fraction(threshold=THRESHOLD)
         print(f"{label}: chaotic of completed per coupling: "
