@@ -329,8 +329,8 @@ def chaotic_fraction(result, x=None, value="mean_megno", threshold=None, where=N
     ax.set_ylim(-0.02, 1.02)
     left_out = int(counts.left_out.sum())
     note = f"; {left_out} left out (not completed, or no value)" if left_out else ""
-    ax.set_title(f"Chaotic fraction ({criterion} at t = {_end_time(result):g}) of {int(counts.orbits.sum())} orbits, "
-                 f"bars: Wilson interval, {z:g} sigma{note}\n{describe_run(result, where)}", fontsize="medium")
+    ax.set_title(f"Chaotic fraction: {criterion} at t = {_end_time(result):g}\n{int(counts.orbits.sum())} orbits, "
+                 f"bars: Wilson interval of {z:g} sigma{note}\n{describe_run(result, where)}", fontsize="medium")
     return ax
 
 

@@ -216,7 +216,7 @@ class SweepPlotTest(unittest.TestCase):
         counts = self.grid.chaotic_fraction()
         self.assertEqual(counts.orbits.sum() + counts.left_out.sum(), len(table))
         self.assertTrue(0 < counts.fraction[-1], "some orbits at coupling 0.3 are chaotic")
-        self.assertIn("Chaotic fraction (MEGNO", ax.get_title())
+        self.assertIn("Chaotic fraction: MEGNO", ax.get_title())
         self.assertIn("> 2.5 at t = 40", ax.get_title())
         self.assertEqual(ax.get_xlabel(), "coupling")
         self.save(ax, "chaotic_fraction")
