@@ -32,8 +32,8 @@ job["$schema"] = sys.argv[3]
 grid = job["initial"]["grid"]
 # Per job: the swept couplings, the grid's counts (q0, then p0 where it is a range) and t_end of the small run.
 small = {"poincare_portrait": (None, (9, 9), 100), "chaos_map": (None, (15, 15), 40),
-         "stability_map": (9, (15,), 40), "stability_map_shell8": (7, (11,), 40),
-         "chaotic_fraction": (4, (7, 7), 40)}
+         "stability_map": (9, (15,), 40), "stability_map_shell8": (5, (9,), 40),
+         "chaotic_fraction": (4, (6, 6), 30)}
 couplings, counts, t_end = small[sys.argv[4]]
 if couplings:
     job["model"]["parameters"]["coupling"]["count"] = couplings
