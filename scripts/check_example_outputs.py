@@ -44,6 +44,18 @@ SHORTENED = {
                                                "p": [{"from": -1.8, "to": 1.8, "count": 5}, 0.0]},
                                       "energy": 7.0, "solve_for": "p1"},
                           "time": {"dt": 0.005, "t_end": 200}},
+    # the shell H = 8 over 31 and 11 couplings to t = 100: 4 couplings, 5 starting points (5 x 5) to t = 10
+    "stability_map_shell8": {"model": {"plugin": "paper2d",
+                                       "parameters": {"coupling": {"from": 0.0, "to": 0.3, "count": 4}}},
+                             "initial": {"grid": {"q": [{"from": -2.2, "to": 2.2, "count": 5}, 0.0], "p": [0.0, 0.0]},
+                                         "energy": 8.0, "solve_for": "p1"},
+                             "time": {"dt": 0.02, "t_end": 10}, "output": {"every": 500}},
+    "chaotic_fraction": {"model": {"plugin": "paper2d",
+                                   "parameters": {"coupling": {"from": 0.0, "to": 0.3, "count": 4}}},
+                         "initial": {"grid": {"q": [{"from": -2.1, "to": 2.1, "count": 5}, 0.0],
+                                              "p": [{"from": -1.8, "to": 1.8, "count": 5}, 0.0]},
+                                     "energy": 8.0, "solve_for": "p1"},
+                         "time": {"dt": 0.02, "t_end": 10}, "output": {"every": 500}},
     # models given by H itself: a 16 x 16 grid to t = 500, tau = 10000: shorter
     "magnetic_bottle_chaos_map": {"initial": {"grid": {"q": [{"from": 0.2, "to": 2.0, "count": 4}, 0.0, 0.0],
                                                        "p": [0.0, {"from": -1.0, "to": 1.0, "count": 4}, 0.5]}},

@@ -1,6 +1,6 @@
 """Render the dynamics pictures of paper2d from the outputs the nonsep runs wrote, with nonsep.load and
-nonsep.plot.poincare / chaos_map / stability_map / indicator_series (python/nonsep, found from this file when not on
-PYTHONPATH).
+nonsep.plot.poincare / chaos_map / stability_map / chaotic_fraction / indicator_series (python/nonsep, found from
+this file when not on PYTHONPATH), on their default colour scales (MEGNO <Y> from 1.25 to 8, 2 marked).
 
     /usr/bin/python3 examples/dynamics/plot_dynamics.py OUT_DIR
 
@@ -12,9 +12,12 @@ OUT_DIR is the folder `examples/dynamics/run_dynamics.sh` fills:
     stability_map/trajectories.csv       each trajectory's coupling (a column of the sweep) and <Y>
     stability_map/trajectory.csv         each trajectory's first state (its q0 on the map)
     stability_map/lyapunov.csv           the running <Y> of every trajectory, for the time series beside the map
+    stability_map_shell8/                the same on the shell H = 8 over the couplings 0 to 0.3 (no lyapunov.csv)
+    chaotic_fraction/                    <Y> of a (q0, p0) grid on the shell H = 8 for each coupling
     */summary.json                       the energy shell, the integrator and the time, for the titles
-Writes dynamics_poincare, dynamics_chaos_map and dynamics_stability_map into OUT_DIR, each as a PNG at DPI dots per
-inch and as a PDF.
+Writes dynamics_poincare, dynamics_chaos_map, dynamics_stability_map, dynamics_stability_map_shell8 and
+dynamics_chaotic_fraction into OUT_DIR, each as a PNG at DPI dots per inch and as a PDF, and prints the chaotic
+fractions.
 """
 import sys
 from pathlib import Path
@@ -24,7 +27,6 @@ import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.colors import LinearSegmentedColormap  # noqa: E402
 
 try:
     import nonsep.plot
@@ -34,9 +36,6 @@ except ImportError:  # run from the source tree without PYTHONPATH=python
 
 DPI = 200
 PALETTE = 64
-MEGNO_TOP = 8.0  # <Y> at or above this is drawn as the most chaotic colour
-# <Y> = 2 (quasi-periodic) blue, rising to red for chaotic orbits.
-CHAOS = LinearSegmentedColormap.from_list("chaos", ["#2166ac", "#67a9cf", "#fddbc7", "#ef8a62", "#b2182b"])
 
 
 def save(fig, out, name):
@@ -55,61 +54,66 @@ def save(fig, out, name):
     small.save(png, optimize=True, dpi=(DPI, DPI))
 
 
-def subtitle(summary):
-    integrator = summary["integrator"]
-    shell = summary["energy_shell"]
-    return (f"paper2d, H = {shell['energy']:g}; {integrator['scheme']} {integrator['order']}, "
-            f"dt = {summary['time']['dt']:g}, t = {summary['time']['t_end']:g}")
-
-
-# <Y> from just below 2 to MEGNO_TOP; larger values take the top colour.
-COLOURS = {"cmap": CHAOS, "vmin": 2.0 - (MEGNO_TOP - 2.0) / 8, "vmax": MEGNO_TOP}
-BAR = f"(2: regular; >= {MEGNO_TOP:g} shown alike)"
-
-
 def portrait(out):
     result = nonsep.load(out / "poincare_portrait")
     if result.poincare is None or len(result.poincare) == 0:
         raise SystemExit(f"{result.directory / 'poincare.csv'} has no crossings")
     fig, ax = plt.subplots(figsize=(6.4, 5.6))
-    nonsep.plot.poincare(result, ax=ax, color_by="mean_megno", colorbar=False, s=0.4, **COLOURS)
-    ax.set_title(f"Poincaré section q1 = 0 (upwards), {len(result.trajectories)} orbits\n"
-                 f"{subtitle(result.summary)}", fontsize=10)
-    fig.colorbar(ax.collections[0], ax=ax).set_label(f"orbit's MEGNO <Y> {BAR}")
+    nonsep.plot.poincare(result, ax=ax, color_by="mean_megno", s=0.4)
+    ax.set_title(f"Poincaré section q1 = 0 (upwards) of {len(result.trajectories)} orbits, coloured by their "
+                 f"MEGNO\n{nonsep.plot.describe_run(result)}", fontsize=10)
     save(fig, out, "dynamics_poincare")
 
 
 def chaos_map(out):
     result = nonsep.load(out / "chaos_map")
     fig, ax = plt.subplots(figsize=(6.4, 5.6))
-    nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q0", y="p0", colorbar=False, **COLOURS)
+    nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q0", y="p0")
     ax.set_xlabel("q0 (initial; q1 = 0)")
     ax.set_ylabel("p0 (initial; p1 >= 0 on the shell)")
-    ax.set_title(f"Chaos map: MEGNO <Y> of {len(result.trajectories)} orbits (grey: off the shell)\n"
-                 f"{subtitle(result.summary)}", fontsize=10)
-    fig.colorbar(ax.images[0], ax=ax).set_label(f"<Y> {BAR}")
     save(fig, out, "dynamics_chaos_map")
 
 
 def stability_map(out):
     result = nonsep.load(out / "stability_map")
     fig, (ax, series) = plt.subplots(1, 2, figsize=(12.0, 5.2), gridspec_kw={"width_ratios": [1.15, 1]})
-    nonsep.plot.stability_map(result, ax=ax, value="mean_megno", x="coupling", y="q0", colorbar=False, **COLOURS)
+    nonsep.plot.stability_map(result, ax=ax, value="mean_megno", x="coupling", y="q0")
     ax.set_ylabel("q0 (initial; q1 = p0 = 0, p1 >= 0 on the shell)")
-    ax.set_title(f"Stability map: MEGNO <Y> of {len(result.trajectories)} orbits (grey: off the shell)\n"
-                 f"{subtitle(result.summary)}", fontsize=10)
-    fig.colorbar(ax.images[0], ax=ax).set_label(f"<Y> {BAR}")
     # Beside it, <Y>(t) of the most chaotic orbit and of the most regular one with its coupling.
     table = result.trajectories
     chaotic = int(np.nanargmax(table["mean_megno"]))
     same = np.flatnonzero(table["coupling"] == table["coupling"][chaotic])
     regular = int(same[np.nanargmin(np.abs(table["mean_megno"][same] - 2.0))])
     nonsep.plot.indicator_series(result, i=[regular, chaotic], value="mean_megno", ax=series)
-    series.axhline(2.0, color="grey", linewidth=0.8, linestyle="--")
-    series.set_title(f"<Y>(t) of the most chaotic orbit and the most regular one at its coupling\n"
-                     f"(lyapunov.csv; dashed: 2, the quasi-periodic limit)", fontsize=10)
+    series.set_title("<Y>(t) of the most chaotic orbit and the most regular one at its coupling\n"
+                     "(lyapunov.csv; dashed: 2, the quasi-periodic limit)", fontsize=10)
     fig.tight_layout()
     save(fig, out, "dynamics_stability_map")
+
+
+def stability_map_shell8(out):
+    result = nonsep.load(out / "stability_map_shell8")
+    fig, ax = plt.subplots(figsize=(7.2, 5.4))
+    nonsep.plot.stability_map(result, ax=ax, value="mean_megno", x="coupling", y="q0")
+    ax.set_ylabel("q0 (initial; q1 = p0 = 0, p1 >= 0 on the shell)")
+    save(fig, out, "dynamics_stability_map_shell8")
+
+
+def chaotic_fraction(out):
+    """The fraction against the coupling, between the chaos maps of the smallest and the largest coupling."""
+    result = nonsep.load(out / "chaotic_fraction")
+    couplings = np.unique(result.trajectories["coupling"])
+    fig, (first, fraction, last) = plt.subplots(1, 3, figsize=(17.0, 5.0), gridspec_kw={"width_ratios": [1, 1.1, 1]})
+    for ax, coupling in ((first, couplings[0]), (last, couplings[-1])):
+        nonsep.plot.chaos_map(result, ax=ax, x="q0", y="p0", where={"coupling": coupling})
+    nonsep.plot.chaotic_fraction(result, ax=fraction)
+    fig.tight_layout()
+    save(fig, out, "dynamics_chaotic_fraction")
+    counts = result.chaotic_fraction()
+    for value, chaotic, orbits, lower, upper in zip(counts.values, counts.chaotic, counts.orbits, counts.lower,
+                                                     counts.upper):
+        print(f"coupling {value:g}: {chaotic} of {orbits} orbits with {counts.criterion} "
+              f"({chaotic / orbits:.3f}, interval {lower:.3f} to {upper:.3f})")
 
 
 def main():
@@ -119,6 +123,8 @@ def main():
     portrait(out)
     chaos_map(out)
     stability_map(out)
+    stability_map_shell8(out)
+    chaotic_fraction(out)
 
 
 if __name__ == "__main__":

@@ -23,7 +23,7 @@ except ImportError as missing:
 
 from .process import (ExecutableNotFound, Problem, RunError, RunInterrupted, executable, parse_problems, run,
                       validate)
-from .results import Crossings, ErrorEstimates, LyapunovSeries, Orbit, Result, Samples, load
+from .results import ChaoticFraction, Crossings, ErrorEstimates, LyapunovSeries, Orbit, Result, Samples, load
 
-__all__ = ["Crossings", "ErrorEstimates", "ExecutableNotFound", "LyapunovSeries", "Orbit", "Problem", "Result",
-           "RunError", "RunInterrupted", "Samples", "executable", "load", "parse_problems", "run", "validate"]
+__all__ = ["ChaoticFraction", "Crossings", "ErrorEstimates", "ExecutableNotFound", "LyapunovSeries", "Orbit", "Problem",
+           "Result", "RunError", "RunInterrupted", "Samples", "executable", "load", "parse_problems", "run", "validate"]

@@ -16,6 +16,9 @@ Files read (docs/outputs.md); each is optional except summary.json:
   error_estimate.csv Result.error_estimate (analysis.error_estimate: the estimated errors at every comparison step,
                      rows in (step, trajectory) order; None without the file) and Result.error_estimates(i);
                      trajectories.csv has each trajectory's last estimate and its horizon
+  (trajectories.csv) Result.select(where): the trajectories of some values of swept parameters; and
+                     Result.chaotic_fraction(...): the fraction of orbits past an indicator's threshold against a
+                     swept parameter, with binomial (Wilson score) intervals
   other *.csv        Result.dynamics[name] (poincare.csv and lyapunov.csv too, the same arrays): read by header on
                      first use, as tables.read_table types columns
   results.h5         also Result.dynamics["results.h5/<dataset path>"]: every dataset, read with h5py on first use
@@ -79,6 +82,57 @@ class LyapunovSeries(NamedTuple):
     mean_megno: object
     sali: object = None
     gali: object = None
+
+
+class ChaoticFraction(NamedTuple):
+    """The fraction of chaotic orbits per value of a swept parameter (Result.chaotic_fraction): `values` are the
+    parameter's values in increasing order; `orbits` the completed trajectories of each with a finite indicator,
+    `chaotic` those past the threshold, `left_out` the others (diverged, failed, inaccurate, or without a value);
+    `fraction` = chaotic / orbits and [lower, upper] its Wilson score interval of z standard deviations (NaN where
+    no orbit counts). `criterion` says what counts as chaotic, e.g. "mean_megno > 2.5"."""
+    parameter: str
+    values: np.ndarray
+    chaotic: np.ndarray
+    orbits: np.ndarray
+    left_out: np.ndarray
+    fraction: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    criterion: str
+
+
+# What counts as chaotic, per column of trajectories.csv: (">" or "<", threshold). MEGNO's <Y> tends to 2 on a
+# quasi-periodic orbit and grows like l_1 t / 2 on a chaotic one; SALI and GALI_2 fall exponentially on a chaotic
+# orbit (docs/dynamics.md, "Chaotic fraction", measures where regular and chaotic orbits part on paper2d).
+CHAOS_THRESHOLDS = {"mean_megno": (">", 2.5), "megno": (">", 2.5), "sali": ("<", 1e-8), "gali2": ("<", 1e-8)}
+
+
+def chaos_threshold(value, threshold=None):
+    """(direction, threshold) for column `value`: the given threshold (a number, or a (direction, number) pair with
+    direction ">" or "<"), else CHAOS_THRESHOLDS' default. Raises ValueError for a column without a default."""
+    if threshold is None:
+        if value not in CHAOS_THRESHOLDS:
+            raise ValueError(f"no default threshold for {value!r} (defaults: {', '.join(CHAOS_THRESHOLDS)}): give "
+                             "threshold, a number, or (\">\" or \"<\", number)")
+        return CHAOS_THRESHOLDS[value]
+    if isinstance(threshold, tuple):
+        direction, number = threshold
+        if direction not in (">", "<"):
+            raise ValueError(f"threshold's direction must be \">\" or \"<\", found {direction!r}")
+        return direction, float(number)
+    return CHAOS_THRESHOLDS.get(value, (">", None))[0], float(threshold)
+
+
+def wilson_interval(successes, trials, z=1.0):
+    """The Wilson score interval of a binomial proportion successes / trials, z standard deviations wide on each
+    side: (lower, upper), NaN where trials is 0. Unlike f +- z sqrt(f (1 - f) / n) it stays inside [0, 1] and does
+    not shrink to nothing at f = 0 or 1."""
+    k, n = np.asarray(successes, dtype=float), np.asarray(trials, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = k / n
+        centre = (f + z * z / (2 * n)) / (1 + z * z / n)
+        half = z / (1 + z * z / n) * np.sqrt(f * (1 - f) / n + z * z / (4 * n * n))
+    return np.maximum(centre - half, 0.0), np.minimum(centre + half, 1.0)
 
 
 class ErrorEstimates(NamedTuple):
@@ -212,6 +266,72 @@ class Result:
         k_gali = sum(1 for name in names if re.fullmatch(r"gali\d+", name)) + 1
         gali = np.column_stack([rows[f"gali{j}"] for j in range(2, k_gali + 1)]) if k_gali > 1 else None
         return LyapunovSeries(rows["step"], rows["t"], exponents, megno, mean_megno, sali, gali)
+
+    @property
+    def swept(self):
+        """The swept parameters' names (summary.json's sweep), in its order; [] for a run without a sweep."""
+        return list((self.summary.get("sweep") or {}).get("parameters", {}))
+
+    def select(self, where=None):
+        """The indices of the trajectories whose swept parameters have the given values: `where` maps a swept
+        parameter's name to a value or a list of values, e.g. {"coupling": 0.1} (compared to 1e-9 relative, so the
+        decimal written in the job matches); None selects every trajectory. Raises ValueError naming the parameter
+        for a name that is not swept, or a value that no trajectory has (with the values there are)."""
+        count = len(self.trajectories) if self.trajectories is not None else 0
+        mask = np.ones(count, dtype=bool)
+        for name, wanted in (where or {}).items():
+            if name not in self.swept:
+                raise ValueError(f"where: {name!r} is not a swept parameter of {self.directory} (swept: "
+                                 f"{', '.join(self.swept) or 'none, not a parameter sweep'})")
+            column = np.asarray(self.trajectories[name], dtype=float)
+            values = np.unique(column)
+            chosen = np.zeros(count, dtype=bool)
+            for v in np.atleast_1d(np.asarray(wanted, dtype=float)):
+                match = np.isclose(column, v, rtol=1e-9, atol=1e-12)
+                if not match.any():
+                    raise ValueError(f"where: no trajectory has {name} = {v:g} (its values: "
+                                     f"{', '.join(f'{x:g}' for x in values)})")
+                chosen |= match
+            mask &= chosen
+        if where and not mask.any():
+            raise ValueError(f"where: no trajectory has all of {where}")
+        return np.flatnonzero(mask)
+
+    def chaotic_fraction(self, x=None, value="mean_megno", threshold=None, where=None, z=1.0):
+        """The fraction of orbits past `threshold` in column `value` of trajectories.csv, for each value of the swept
+        parameter `x` (default: the one swept parameter), as a ChaoticFraction. `threshold`: a number (the direction
+        of the column's default: chaotic above for MEGNO, below for SALI), a pair (">" or "<", number), or None for
+        CHAOS_THRESHOLDS' default (mean_megno > 2.5, sali < 1e-8, ...). Counted: the trajectories selected by
+        `where` (see select) that completed with a finite value; the others are `left_out`. Another swept
+        parameter must be fixed by `where` (ValueError otherwise: pooling its values would mix maps). The intervals
+        are Wilson score intervals of z standard deviations (wilson_interval)."""
+        chosen = self.select(where)
+        if x is None:
+            varying = [n for n in self.swept if len(np.unique(self.trajectories[n][chosen])) > 1]
+            if len(self.swept) == 0:
+                raise ValueError(f"{self.directory} is not a parameter sweep (summary.json has no \"sweep\")")
+            x = varying[0] if len(varying) == 1 else self.swept[0]
+        if x not in self.swept:
+            raise ValueError(f"{x!r} is not a swept parameter (swept: {', '.join(self.swept) or 'none'})")
+        for other in self.swept:
+            if other != x and len(np.unique(self.trajectories[other][chosen])) > 1:
+                raise ValueError(f"{other} varies too: fix it with where={{{other!r}: ...}}")
+        table = self.trajectories
+        if value not in table.dtype.names:
+            raise ValueError(f"trajectories.csv has no column {value!r} (its columns: {', '.join(table.dtype.names)})")
+        direction, limit = chaos_threshold(value, threshold)
+        indicator = np.asarray(table[value], dtype=float)[chosen]
+        counted = (table["status"][chosen] == "completed") & np.isfinite(indicator)
+        past = (indicator > limit) if direction == ">" else (indicator < limit)
+        values, group = np.unique(np.asarray(table[x], dtype=float)[chosen], return_inverse=True)
+        orbits = np.bincount(group, weights=counted, minlength=len(values)).astype(int)
+        chaotic = np.bincount(group, weights=counted & past, minlength=len(values)).astype(int)
+        left_out = np.bincount(group, minlength=len(values)) - orbits
+        lower, upper = wilson_interval(chaotic, orbits, z)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            fraction = chaotic / orbits
+        return ChaoticFraction(x, values, chaotic, orbits, left_out, fraction, lower, upper,
+                               f"{value} {direction} {limit:g}")
 
     def initial_states(self):
         """(q, p), each [trajectories, dimension]: every trajectory's state at step 0, from trajectory.csv (the host

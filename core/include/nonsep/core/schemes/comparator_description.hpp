@@ -1,9 +1,9 @@
 #pragma once
-// How the comparator schemes (Tao's extended phase space, Gauss-Legendre collocation) describe themselves.
-// IntegratorDescription (integrator_description.hpp) is shaped for Chin's family: a fractional order, a count of
-// basic steps and t2. The comparators differ in kind: they need the full gradient of H (hamiltonian_gradient.hpp),
-// one of them iterates, the other is symplectic only on a doubled phase space. So they describe themselves here,
-// and integrator_description() gives the common part for a run's summary.
+// How the schemes of the family "comparator" (Tao's extended phase space, Gauss-Legendre collocation) describe
+// themselves. IntegratorDescription (integrator_description.hpp) is shaped for Chin's family: a fractional order, a
+// count of basic steps and t2. These schemes differ in kind: they need the full gradient of H
+// (hamiltonian_gradient.hpp), one of them iterates, the other is symplectic only on a doubled phase space. So they
+// describe themselves here, and integrator_description() gives the common part for a run's summary.
 #include <cstdint>
 #include <string>
 #include <utility>

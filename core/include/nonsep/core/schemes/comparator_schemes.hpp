@@ -1,7 +1,8 @@
 #pragma once
-// The comparators as the runtime-chosen integrators offer them (stepper.hpp): Tao's extended phase space
-// (tao_extended_phase_space.hpp) and Gauss-Legendre collocation (gauss_legendre.hpp), the implicit midpoint rule
-// being its one-stage case. They integrate H itself from its gradient (hamiltonian_gradient.hpp): their steppers step
+// The schemes of the family "comparator" as the runtime-chosen integrators offer them (stepper.hpp): Tao's extended
+// phase space (tao_extended_phase_space.hpp) and Gauss-Legendre collocation (gauss_legendre.hpp), the implicit
+// midpoint rule being its one-stage case. Unlike Chin's splittings of T(p) + V(q), they integrate H itself from its
+// gradient (hamiltonian_gradient.hpp): their steppers step
 // only a model with Hessians and third derivatives, and their tangent maps need the directional derivative of
 // grad H.
 #include <string>
@@ -38,7 +39,7 @@ struct TaoScheme {
   using Stepper = TaoExtendedPhaseSpace;
   static SchemeDescription description() {
     return {"tao",
-            "Tao's explicit symplectic integrator in extended phase space (comparator)",
+            "Tao's explicit symplectic integrator in extended phase space, for any H",
             "M. Tao, Phys. Rev. E 94, 043303 (2016)",
             "Two copies (q, p), (x, y) bound by omega |(q, p) - (x, y)|^2 / 2; Strang splitting of the three "
             "exactly solvable parts (order 2), triple jumps for 4 and 6. Explicit; symplectic and symmetric on "
@@ -77,7 +78,7 @@ struct ImplicitMidpointScheme {
   using Stepper = GaussLegendre;
   static SchemeDescription description() {
     return {"implicit_midpoint",
-            "Implicit midpoint rule (comparator)",
+            "Implicit midpoint rule, for any H",
             "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VIII.6",
             "z' = z + dt f((z + z')/2), Gauss-Legendre with 1 stage; order 2, symplectic and symmetric. Solved by "
             "fixed-point iteration from Z = 0 (no Newton), 1 grad H per state per iteration. Stopping rule per "
@@ -108,11 +109,13 @@ struct GaussScheme {
   using Stepper = GaussLegendre;
   static SchemeDescription description() {
     return {"gauss",
-            "Gauss-Legendre collocation (comparator)",
+            "Gauss-Legendre collocation, for any H",
             "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6",
             "s-stage Gauss-Legendre Runge-Kutta method on Hamilton's equations of H, order 2s; symplectic and "
             "symmetric. Fixed-point iteration from Z = 0 (no Newton), s grad H per state per iteration, with the "
-            "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed)." +
+            "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed). Implicit: a step "
+            "costs more than an explicit one of the same order, but stays accurate at larger steps on strongly "
+            "coupled or chaotic orbits, which makes it the safer choice for chaos maps (docs/dynamics.md)." +
                 comparator_scheme::cost_note,
             "comparator",
             true,

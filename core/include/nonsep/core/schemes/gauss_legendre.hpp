@@ -1,6 +1,6 @@
 #pragma once
-// Gauss-Legendre collocation with s = 1, 2, 3 stages (orders 2, 4, 6), a comparator for Chin's explicit schemes:
-// the implicit Runge-Kutta method applied to Hamilton's equations of the solved Hamiltonian itself,
+// Gauss-Legendre collocation with s = 1, 2, 3 stages (orders 2, 4, 6), the implicit alternative to Chin's explicit
+// schemes for any H: the implicit Runge-Kutta method applied to Hamilton's equations of the solved Hamiltonian itself,
 //   z = (q, p),   dz/dt = f(z) = (dH/dp, -dH/dq)   (H_TTV or H_VVT, hamiltonian_gradient.hpp),
 //   Z_i = dt sum_j a_ij f(z + Z_j),   z' = z + dt sum_i b_i f(z + Z_i),   i, j = 1..s.
 // s = 1 is the implicit midpoint rule, z' = z + dt f((z + z')/2); there is no separate implicit_midpoint header.

@@ -26,8 +26,9 @@ struct SchemeDescription {
   std::string method;     // human name: "Chin basic 9-stage splitting"
   std::string equations;  // where in the paper: "eq. (expalg)"
   std::string summary;    // one paragraph
-  // "chin" (the paper's schemes) or "comparator" (Tao, Gauss-Legendre: need the gradient of H, i.e. the plugin's
-  // Hessians and third derivatives; their tangent maps the directional derivative of grad H).
+  // "chin" (the paper's splittings) or "comparator" (Tao, Gauss-Legendre: they integrate H itself, so they need the
+  // gradient of H, i.e. the plugin's Hessians and third derivatives; their tangent maps the directional derivative
+  // of grad H). The family says how a scheme works and what it needs of the plugin, not which to prefer.
   std::string family = "chin";
   bool symplectic = true;
   bool time_reversible = true;

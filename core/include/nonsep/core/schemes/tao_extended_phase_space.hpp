@@ -1,5 +1,5 @@
 #pragma once
-// Tao's explicit symplectic integrator in an extended phase space, a comparator for Chin's schemes:
+// Tao's explicit symplectic integrator in an extended phase space, for any H (not only Chin's T_i V_ij T_j forms):
 // M. Tao, "Explicit symplectic approximation of nonseparable Hamiltonians: algorithm and long time performance",
 // Phys. Rev. E 94, 043303 (2016). Two copies (q, p) and (x, y) of phase space are bound together by
 //
