@@ -35,6 +35,7 @@ long_runs=(
   '^host.sweep$'
   '^formula commands: formulas at the length limit compile'
   '^killed after the first tenth and resumed: the runaway warnings'
+  '^a model given by H: killed and resumed'
 )
 # Left out as well: host.run_memory, which runs nonsep under an RLIMIT_AS (ulimit -v) of 8 GiB, less than the
 # address space AddressSanitizer reserves for its shadow memory at start.

@@ -2,7 +2,7 @@
 """MPI ranks with the comparators' tangent maps (tao: private state per trajectory, its copies and their tangents;
 gauss): `mpirun -n 2` with one and two threads a rank writes trajectory.csv, trajectories.csv and lyapunov.csv byte
 for byte as one process with one thread, on an ensemble cut into several work units where an energy bound retires
-some orbits mid-run (a bound per scheme, set here).
+some orbits mid-run (a bound per scheme, set here); and gauss on a model given by H(q, p) itself (henon_heiles).
 
 Usage: check_distributed_tangents.py NONSEP MPIEXEC JOB.json WORKDIR
 """
@@ -55,6 +55,28 @@ for scheme, bound in (({"scheme": "tao", "order": 4}, 2e-4), ({"scheme": "gauss"
         for file in ("trajectory.csv", "trajectories.csv", "lyapunov.csv"):
             check((out / file).read_bytes() == (one / file).read_bytes(),
                   f"{name}, 2 ranks x {threads} threads: {file} byte for byte")
+
+# A model given by H(q, p) itself (henon_heiles) with gauss on its shell H = 1/8: the same files byte for byte.
+job = json.loads(job_file.read_text())
+job["model"] = {"plugin": "henon_heiles"}
+job["integrator"] = {"scheme": "gauss", "stages": 3}
+job["initial"] = {"grid": {"q": [0.0, {"from": -0.4, "to": 0.6, "count": 12}],
+                           "p": [0.0, {"from": -0.4, "to": 0.4, "count": 12}]},
+                  "energy": 0.125, "solve_for": "p0"}
+del job["analysis"]["max_relative_energy_error"]
+path = work / "general.json"
+path.write_text(json.dumps(job, indent=2))
+one = work / "general_one"
+r = run([nonsep, "run", "-q", "--threads", "1", "--output", str(one), str(path)])
+check(r.returncode == 0, f"model given by H, one process: exit 0 ({r.returncode} {r.stderr[-300:]})")
+summary = json.loads((one / "summary.json").read_text())
+check(summary["hamiltonian"] == "general" and summary["trajectories"] > 64,
+      f"model given by H: several work units ({summary['trajectories']})")
+out = work / "general_ranks"
+r = run([mpiexec, "-n", "2", nonsep, "run", "-q", "--threads", "1", "--output", str(out), str(path)])
+check(r.returncode == 0, f"model given by H, 2 ranks: exit 0 ({r.returncode} {r.stderr[-300:]})")
+for file in ("trajectory.csv", "trajectories.csv", "lyapunov.csv"):
+    check((out / file).read_bytes() == (one / file).read_bytes(), f"model given by H, 2 ranks: {file} byte for byte")
 
 print(f"{len(failures)} failed" if failures else "all passed")
 sys.exit(1 if failures else 0)

@@ -120,3 +120,51 @@ TEST_CASE("a model given by H: initial states on an energy shell, solved for p1 
   for (const json& trajectory : summary["trajectories"])
     CHECK(std::abs(trajectory["energy"]["initial"].get<double>() - 0.125) < 1e-15);
 }
+
+TEST_CASE("a model given by H: killed and resumed bit for bit, with threads, a sweep, MEGNO and results.h5") {
+  // A magnetic bottle swept over its mirror, gauss 3 stages with MEGNO and a Lyapunov exponent: the files of one
+  // thread, of two, and of a run killed after a checkpoint and resumed are the same bytes; HDF5 output completes.
+  const json job = {
+      {"model", {{"plugin", "magnetic_bottle"}, {"parameters", {{"omega", 0.2}, {"mirror", json::array({0.3, 0.6})}}}}},
+      {"integrator", {{"scheme", "gauss"}, {"stages", 3}}},
+      {"initial",
+       {{"grid",
+         {{"q", {{{"from", 0.5}, {"to", 1.5}, {"count", 2}}, 0.0, 0.0}},
+          {"p", {0.0, {{"from", -0.5}, {"to", 0.5}, {"count", 2}}, 0.5}}}}}},
+      {"time", {{"dt", 0.02}, {"steps", 20000}}},
+      {"output", {{"every", 5000}}},
+      {"analysis", {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 1000}}}, {"megno", true}}},
+      {"checkpoint", {{"every_steps", 1000}, {"every_seconds", 0}}}};
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "job.json", job);
+  const auto one = run_nonsep(
+      {"run", "--quiet", "--threads", "1", "--output", (folder / "one").string(), file.string()}, folder.path());
+  INFO("stderr: " << one.err);
+  REQUIRE(one.status == 0);
+  const auto two = run_nonsep(
+      {"run", "--quiet", "--threads", "2", "--output", (folder / "two").string(), file.string()}, folder.path());
+  REQUIRE(two.status == 0);
+  const std::uint64_t step = kill_after_checkpoint(file, folder / "killed", 2000, folder.path());
+  INFO("killed after the checkpoint at step " << step);
+  REQUIRE(step < 20000);
+  const auto resumed = run_nonsep(
+      {"run", "--quiet", "--resume", "--output", (folder / "killed").string(), file.string()}, folder.path());
+  INFO("resumed stderr: " << resumed.err);
+  REQUIRE(resumed.status == 0);
+  for (const char* name : {"trajectory.csv", "trajectories.csv", "lyapunov.csv"}) {
+    CAPTURE(name);
+    const std::string reference = read_text(folder / "one" / name);
+    CHECK(!reference.empty());
+    CHECK(read_text(folder / "two" / name) == reference);
+    CHECK(read_text(folder / "killed" / name) == reference);
+  }
+  const json summary = read_json(folder / "one" / "summary.json");
+  CHECK(summary["hamiltonian"] == "general");
+  CHECK(summary["counts"]["completed"] == 8);
+  json hdf5 = job;
+  hdf5["output"]["format"] = "hdf5";
+  hdf5.erase("checkpoint");
+  const json h5 = run_job(folder, "h5", hdf5);
+  CHECK(h5["counts"]["completed"] == 8);
+  CHECK(std::filesystem::file_size(folder / "h5" / "results.h5") > 0);
+}

@@ -39,6 +39,18 @@ class RunTest(FolderTestCase):
                          (self.folder / "two" / "trajectory.csv").read_bytes())
         self.assertSameTable(one.trajectories, two.trajectories)
 
+    def test_a_model_given_by_h_runs_and_loads_with_its_indicators(self):
+        job = {"model": {"plugin": "henon_heiles"}, "integrator": {"scheme": "gauss", "stages": 3},
+               "initial": [{"q": [0.0, 0.1], "p": [0.45, 0.0]},
+                           {"q": [0.0, -0.2], "p": [0.4, 0.1]}],
+               "time": {"dt": 0.02, "steps": 500}, "output": {"every": 50}, "analysis": {"megno": True}}
+        result = nonsep.run(job, output="h")
+        self.assertEqual(result.status, "completed")
+        self.assertEqual(result.summary["hamiltonian"], "general")
+        self.assertEqual(result.orbit(1).q.shape, (11, 2))
+        self.assertTrue(np.all(np.abs(result.trajectories["max_abs_relative_energy_error"]) < 1e-10))
+        self.assertTrue(np.all(np.isfinite(result.trajectories["mean_megno"])))
+
     def test_a_dict_resolves_relative_paths_against_the_current_directory(self):
         os.mkdir("plugins")
         shutil.copy(os.path.join(os.environ["NONSEP_PLUGIN_PATH"], "blowup.so"), "plugins/blowup.so")
