@@ -318,7 +318,7 @@ TEST_CASE("formula parser: H takes q and p, prints each variable with its letter
   CHECK(unknown.allowed.find("q0, q1, ..., p0, p1, ...") != std::string::npos);
 }
 
-TEST_CASE("formula models: H alone or T and V, never both; H's dimension counts q and p; its C++ is a Hamiltonian") {
+TEST_CASE("formula models: H alone or T and V, never both, its dimension counting q and p, its C++ a Hamiltonian") {
   std::vector<nonsep::host::JobIssue> issues;
   CHECK(!read_formula_model(nlohmann::json{{"H", "p0^2/2 + q0^2/2"}, {"T", "p0^2/2"}, {"U", "q0"}}, "/f", ".", issues));
   std::vector<std::string> paths;
