@@ -3,10 +3,11 @@ nonsep.plot (python/nonsep, found from this file when not on PYTHONPATH).
 
     /usr/bin/python3 examples/given_by_h/plot_pictures.py OUT_DIR
 
-OUT_DIR holds henon_heiles_portrait/, schwarzschild_section/ (poincare.csv: the crossings; trajectories.csv: each
-orbit's MEGNO <Y>, which colours its points) and magnetic_bottle_chaos_map/ (trajectory.csv: each orbit's first
-state, its place on the map; trajectories.csv: its <Y>). Writes given_by_h_henon_heiles, given_by_h_schwarzschild and
-given_by_h_magnetic_bottle into OUT_DIR as PNG (150 dots per inch).
+OUT_DIR holds henon_heiles_portrait/, schwarzschild_section/, magnetic_bottle_section/ (poincare.csv: the crossings;
+trajectories.csv: each orbit's MEGNO <Y>, which colours its points) and magnetic_bottle_chaos_map/ (trajectory.csv:
+each orbit's first state, its place on the map; trajectories.csv: its <Y>; the Henon-Heiles run makes a map of its
+starting grid too). Writes given_by_h_henon_heiles, given_by_h_henon_heiles_map, given_by_h_schwarzschild,
+given_by_h_magnetic_bottle and given_by_h_magnetic_bottle_section into OUT_DIR as PNG (150 dots per inch).
 """
 import sys
 from pathlib import Path
@@ -15,6 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 
 try:
     import nonsep.plot
@@ -51,6 +53,26 @@ def save(fig, out, name):
     plt.close(fig)
 
 
+def bottle_section(out):
+    """The magnetic bottle's crossings of z = 0 in the cylindrical radius and its momentum, (rho, p_rho)."""
+    result = nonsep.load(out / "magnetic_bottle_section")
+    crossings = result.poincare
+    if crossings is None or len(crossings) == 0:
+        raise SystemExit(f"{result.directory / 'poincare.csv'} has no crossings")
+    x, y, px, py = (np.asarray(crossings[c], dtype=float) for c in ("q0", "q1", "p0", "p1"))
+    rho = np.hypot(x, y)
+    megno = dict(zip(result.trajectories["trajectory"], result.trajectories["mean_megno"]))
+    colour = [megno[t] for t in crossings["trajectory"]]
+    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    points = ax.scatter(rho, (x * px + y * py) / rho, c=colour, s=0.8, linewidths=0, **MEGNO)
+    ax.set_xlabel("rho = |(x, y)| at z = 0")
+    ax.set_ylabel("p_rho = (x p_x + y p_y)/rho")
+    ax.set_title(f"Magnetic bottle, section z = 0 at H = 0.5, x p_y - y p_x = 0.5: {len(result.trajectories)} orbits\n"
+                 f"{subtitle(result.summary)}", fontsize=10)
+    fig.colorbar(points, ax=ax).set_label("orbit's MEGNO <Y> (2: regular)")
+    save(fig, out, "given_by_h_magnetic_bottle_section")
+
+
 def main():
     if len(sys.argv) != 2:
         raise SystemExit(__doc__)
@@ -60,6 +82,16 @@ def main():
     save(portrait(out, "schwarzschild_section", "q1", "p1",
                   "Charged particle, Schwarzschild + uniform field: section θ = π/2",
                   "q1 (r)", "p1 (p_r)", 2.0), out, "given_by_h_schwarzschild")
+    result = nonsep.load(out / "henon_heiles_portrait")
+    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q1", y="p1", colorbar=False, **MEGNO)
+    ax.set_xlabel("q1 (y at start; x = 0)")
+    ax.set_ylabel("p1 (p_y at start; p_x >= 0 on the shell)")
+    ax.set_title(f"Hénon-Heiles as one H: MEGNO <Y> of {len(result.trajectories)} orbits at H = 1/8 (grey: off the "
+                 f"shell)\n{subtitle(result.summary)}", fontsize=10)
+    fig.colorbar(ax.images[0], ax=ax).set_label("<Y> (2: regular)")
+    save(fig, out, "given_by_h_henon_heiles_map")
+    bottle_section(out)
     result = nonsep.load(out / "magnetic_bottle_chaos_map")
     fig, ax = plt.subplots(figsize=(6.4, 5.4))
     nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q0", y="p1", colorbar=False, **MEGNO)

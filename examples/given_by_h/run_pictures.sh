@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs the examples of models given by H(q, p) and draws them: the Henon-Heiles Poincare portrait at H = 1/8, the
 # Poincare section theta = pi/2 of a charged particle around a Schwarzschild black hole in a uniform magnetic field,
-# and the MEGNO chaos map of a charged particle in a magnetic bottle (examples/dynamics/magnetic_bottle_chaos_map.json).
+# and a charged particle in a magnetic bottle: its Poincare section z = 0 and its MEGNO chaos map
+# (examples/dynamics/magnetic_bottle_chaos_map.json).
 #
 #   bash examples/given_by_h/run_pictures.sh [OUT_DIR] [BUILD_DIR] [--small]
 #
@@ -19,7 +20,8 @@ python="${PYTHON:-/usr/bin/python3}"  # the system interpreter, which has python
 
 mkdir -p "$out/jobs"
 : >"$out/messages.txt"
-for job in given_by_h/henon_heiles_portrait given_by_h/schwarzschild_section dynamics/magnetic_bottle_chaos_map; do
+for job in given_by_h/henon_heiles_portrait given_by_h/schwarzschild_section given_by_h/magnetic_bottle_section \
+  dynamics/magnetic_bottle_chaos_map; do
   name=$(basename "$job")
   file="$root/examples/$job.json"
   if [ "$small" = "--small" ]; then
@@ -27,9 +29,12 @@ for job in given_by_h/henon_heiles_portrait given_by_h/schwarzschild_section dyn
 import json, sys
 job = json.load(open(sys.argv[1]))
 job["$schema"] = sys.argv[3]
-for axis in job["initial"]["grid"]["q"] + job["initial"]["grid"]["p"]:
-    if isinstance(axis, dict):
-        axis["count"] = min(axis["count"], 4)
+if "grid" in job["initial"]:
+    for axis in job["initial"]["grid"]["q"] + job["initial"]["grid"]["p"]:
+        if isinstance(axis, dict):
+            axis["count"] = min(axis["count"], 4)
+else:
+    job["initial"] = job["initial"][::6]
 job["time"]["t_end"] = job["time"]["t_end"] / 20
 if job["output"]["every"]:  # step 0 and the last step, as the full job
     job["output"]["every"] = round(job["time"]["t_end"] / job["time"]["dt"])

@@ -26,15 +26,16 @@ def rows(path):
         return list(csv.DictReader(file))
 
 
-for name in ("henon_heiles", "schwarzschild", "magnetic_bottle"):
+for name in ("henon_heiles", "henon_heiles_map", "schwarzschild", "magnetic_bottle", "magnetic_bottle_section"):
     png = out / f"given_by_h_{name}.png"
     check(png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", f"{png.name} is a PNG")
-for job in ("henon_heiles_portrait", "schwarzschild_section", "magnetic_bottle_chaos_map"):
+for job in ("henon_heiles_portrait", "schwarzschild_section", "magnetic_bottle_section", "magnetic_bottle_chaos_map"):
     summary = json.loads((out / job / "summary.json").read_text())
     counts = summary["counts"]
     check(counts["completed"] > 0 and counts["completed"] == sum(counts.values()), f"{job}: every run completed {counts}")
     check(summary["hamiltonian"] == "general", f"{job}: a model given by H")
-for job, column, value in (("henon_heiles_portrait", "q0", 0.0), ("schwarzschild_section", "q2", 1.5707963267948966)):
+for job, column, value in (("henon_heiles_portrait", "q0", 0.0), ("schwarzschild_section", "q2", 1.5707963267948966),
+                           ("magnetic_bottle_section", "q2", 0.0)):
     crossings = rows(out / job / "poincare.csv")
     worst = max(abs(float(row[column]) - value) for row in crossings)
     check(len(crossings) > 0 and worst <= 1e-12, f"{job}: {len(crossings)} crossings on {column} = {value} ({worst:.2g})")
