@@ -3,11 +3,12 @@ nonsep.plot (python/nonsep, found from this file when not on PYTHONPATH).
 
     /usr/bin/python3 examples/given_by_h/plot_pictures.py OUT_DIR
 
-OUT_DIR holds henon_heiles_portrait/, schwarzschild_section/, magnetic_bottle_section/ (poincare.csv: the crossings;
+OUT_DIR holds henon_heiles_portrait/, schwarzschild_section/, schwarzschild_stability_map/ (a sweep of beta),
+magnetic_bottle_section/ (poincare.csv: the crossings;
 trajectories.csv: each orbit's MEGNO <Y>, which colours its points) and magnetic_bottle_chaos_map/ (trajectory.csv:
 each orbit's first state, its place on the map; trajectories.csv: its <Y>; the Henon-Heiles run makes a map of its
 starting grid too). Writes given_by_h_henon_heiles, given_by_h_henon_heiles_map, given_by_h_schwarzschild,
-given_by_h_magnetic_bottle and given_by_h_magnetic_bottle_section into OUT_DIR as PNG (150 dots per inch).
+given_by_h_schwarzschild_map, given_by_h_magnetic_bottle and given_by_h_magnetic_bottle_section into OUT_DIR as PNG (150 dots per inch).
 """
 import sys
 from pathlib import Path
@@ -92,6 +93,15 @@ def main():
     fig.colorbar(ax.images[0], ax=ax).set_label("<Y> (2: regular)")
     save(fig, out, "given_by_h_henon_heiles_map")
     bottle_section(out)
+    result = nonsep.load(out / "schwarzschild_stability_map")
+    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    nonsep.plot.stability_map(result, ax=ax, value="mean_megno", x="beta", y="q1", colorbar=False, **MEGNO)
+    ax.set_xlabel("beta (field strength)")
+    ax.set_ylabel("q1 (r at start; theta = pi/2, p_r = 0)")
+    ax.set_title(f"Charged particle, Schwarzschild + uniform field: MEGNO <Y> of {len(result.trajectories)} orbits "
+                 f"(grey: off the shell)\n{subtitle(result.summary)}", fontsize=10)
+    fig.colorbar(ax.images[0], ax=ax).set_label("<Y> (2: regular)")
+    save(fig, out, "given_by_h_schwarzschild_map")
     result = nonsep.load(out / "magnetic_bottle_chaos_map")
     fig, ax = plt.subplots(figsize=(6.4, 5.4))
     nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q0", y="p1", colorbar=False, **MEGNO)

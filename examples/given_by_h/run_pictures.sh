@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs the examples of models given by H(q, p) and draws them: the Henon-Heiles Poincare portrait at H = 1/8, the
-# Poincare section theta = pi/2 of a charged particle around a Schwarzschild black hole in a uniform magnetic field,
+# Poincare section theta = pi/2 and the stability map over the field strength of a charged particle around a
+# Schwarzschild black hole in a uniform magnetic field,
 # and a charged particle in a magnetic bottle: its Poincare section z = 0 and its MEGNO chaos map
 # (examples/dynamics/magnetic_bottle_chaos_map.json).
 #
@@ -20,8 +21,8 @@ python="${PYTHON:-/usr/bin/python3}"  # the system interpreter, which has python
 
 mkdir -p "$out/jobs"
 : >"$out/messages.txt"
-for job in given_by_h/henon_heiles_portrait given_by_h/schwarzschild_section given_by_h/magnetic_bottle_section \
-  dynamics/magnetic_bottle_chaos_map; do
+for job in given_by_h/henon_heiles_portrait given_by_h/schwarzschild_section given_by_h/schwarzschild_stability_map \
+  given_by_h/magnetic_bottle_section dynamics/magnetic_bottle_chaos_map; do
   name=$(basename "$job")
   file="$root/examples/$job.json"
   if [ "$small" = "--small" ]; then
@@ -36,6 +37,9 @@ if "grid" in job["initial"]:
 else:
     job["initial"] = job["initial"][::6]
 job["time"]["t_end"] = job["time"]["t_end"] / 20
+for parameter in job["model"].get("parameters", {}).values():
+    if isinstance(parameter, dict):
+        parameter["count"] = min(parameter["count"], 3)
 if job["output"]["every"]:  # step 0 and the last step, as the full job
     job["output"]["every"] = round(job["time"]["t_end"] / job["time"]["dt"])
 json.dump(job, open(sys.argv[2], "w"), indent=2)

@@ -26,10 +26,12 @@ def rows(path):
         return list(csv.DictReader(file))
 
 
-for name in ("henon_heiles", "henon_heiles_map", "schwarzschild", "magnetic_bottle", "magnetic_bottle_section"):
+for name in ("henon_heiles", "henon_heiles_map", "schwarzschild", "schwarzschild_map", "magnetic_bottle",
+             "magnetic_bottle_section"):
     png = out / f"given_by_h_{name}.png"
     check(png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", f"{png.name} is a PNG")
-for job in ("henon_heiles_portrait", "schwarzschild_section", "magnetic_bottle_section", "magnetic_bottle_chaos_map"):
+for job in ("henon_heiles_portrait", "schwarzschild_section", "schwarzschild_stability_map", "magnetic_bottle_section",
+            "magnetic_bottle_chaos_map"):
     summary = json.loads((out / job / "summary.json").read_text())
     counts = summary["counts"]
     check(counts["completed"] > 0 and counts["completed"] == sum(counts.values()), f"{job}: every run completed {counts}")
