@@ -3,6 +3,7 @@
 // Lyapunov exponents and the energy from H; scheme auto choosing among the schemes that apply.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -167,4 +168,36 @@ TEST_CASE("a model given by H: killed and resumed bit for bit, with threads, a s
   const json h5 = run_job(folder, "h5", hdf5);
   CHECK(h5["counts"]["completed"] == 8);
   CHECK(std::filesystem::file_size(folder / "h5" / "results.h5") > 0);
+}
+
+TEST_CASE("a model given by H: a convergence study finds each scheme's order against a reference run") {
+  const json job = {{"model", {{"plugin", "henon_heiles"}}},
+                    {"initial", {{"q", {0.0, 0.1}}, {"p", {0.45, 0.0}}}},
+                    {"time", {{"t_end", 10}}},
+                    {"study",
+                     {{"reference_run", {{"scheme", "gauss"}, {"stages", 3}, {"steps", {4000}}}},
+                      {"integrators",
+                       {{{"scheme", "gauss"}, {"stages", 2}, {"steps", {100, 200, 400}}},
+                        {{"scheme", "implicit_midpoint"}, {"steps", {100, 200, 400}}},
+                        {{"scheme", "tao"}, {"order", "4"}, {"steps", {400, 800, 1600}}}}}}}};
+  TemporaryFolder folder;
+  const auto file = write_job(folder / "study.json", job);
+  const auto result =
+      run_nonsep({"run", "--quiet", "--output", (folder / "study").string(), file.string()}, folder.path());
+  INFO("stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  CHECK(read_json(folder / "study" / "summary.json")["hamiltonian"] == "general");
+  const auto rows = parse_csv(read_text(folder / "study" / "convergence.csv"));
+  REQUIRE(rows.size() == 10);
+  const auto& header = rows[0];
+  const auto column = static_cast<std::size_t>(std::find(header.begin(), header.end(), "phase_error") - header.begin());
+  REQUIRE(column < header.size());
+  // The observed order between the last two step counts: log2 of the error ratio, 4, 2 and 4 (Tao's scheme reaches
+  // its order at smaller steps).
+  const double expected[] = {4.0, 2.0, 4.0};
+  for (std::size_t scheme = 0; scheme < 3; ++scheme) {
+    const double coarse = std::stod(rows[2 + 3 * scheme][column]), fine = std::stod(rows[3 + 3 * scheme][column]);
+    CAPTURE(scheme);
+    CHECK(std::log2(coarse / fine) == doctest::Approx(expected[scheme]).epsilon(0.05));
+  }
 }
