@@ -14,7 +14,6 @@ The machine's load average is printed with the numbers: other work on the machin
 Usage: python3 bench/given_by_h.py --nonsep build/bin/nonsep [--repeats 5] [--steps 2000]
 """
 import argparse
-import json
 import os
 import resource
 import statistics
@@ -22,6 +21,8 @@ import subprocess
 import sys
 import tempfile
 import time
+
+from formula_model import spread, write  # the same bench folder
 
 FORMULA = {"name": "paper1d_as_h", "H": "(1 + p0^2/2)^2*(1 + q0^2)"}
 
@@ -43,17 +44,6 @@ def timed_run(nonsep, job_file, environment):
     if result.returncode != 0:
         sys.exit(f"nonsep run {job_file} failed ({result.returncode}):\n{result.stderr}")
     return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime, wall
-
-
-def write(folder, name, content):
-    path = os.path.join(folder, name)
-    with open(path, "w", encoding="utf-8") as file:
-        json.dump(content, file)
-    return path
-
-
-def spread(values):
-    return f"median {statistics.median(values):.4g}, min {min(values):.4g}, max {max(values):.4g}"
 
 
 def main():

@@ -54,6 +54,19 @@ def save(fig, out, name):
     plt.close(fig)
 
 
+def grid_map(out, name, draw, x, y, title, xlabel, ylabel, picture):
+    """Each orbit's MEGNO <Y> at its starting point (draw: nonsep.plot.chaos_map or stability_map); {n} in the title
+    is the number of orbits."""
+    result = nonsep.load(out / name)
+    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    draw(result, ax=ax, value="mean_megno", x=x, y=y, colorbar=False, **MEGNO)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(f"{title.format(n=len(result.trajectories))}\n{subtitle(result.summary)}", fontsize=10)
+    fig.colorbar(ax.images[0], ax=ax).set_label("<Y> (2: regular)")
+    save(fig, out, picture)
+
+
 def bottle_section(out):
     """The magnetic bottle's crossings of z = 0 in the cylindrical radius and its momentum, (rho, p_rho)."""
     result = nonsep.load(out / "magnetic_bottle_section")
@@ -83,34 +96,15 @@ def main():
     save(portrait(out, "schwarzschild_section", "q1", "p1",
                   "Charged particle, Schwarzschild + uniform field: section θ = π/2",
                   "q1 (r)", "p1 (p_r)", 2.0), out, "given_by_h_schwarzschild")
-    result = nonsep.load(out / "henon_heiles_portrait")
-    fig, ax = plt.subplots(figsize=(6.4, 5.4))
-    nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q1", y="p1", colorbar=False, **MEGNO)
-    ax.set_xlabel("q1 (y at start; x = 0)")
-    ax.set_ylabel("p1 (p_y at start; p_x >= 0 on the shell)")
-    ax.set_title(f"Hénon-Heiles as one H: MEGNO <Y> of {len(result.trajectories)} orbits at H = 1/8 (grey: off the "
-                 f"shell)\n{subtitle(result.summary)}", fontsize=10)
-    fig.colorbar(ax.images[0], ax=ax).set_label("<Y> (2: regular)")
-    save(fig, out, "given_by_h_henon_heiles_map")
+    grid_map(out, "henon_heiles_portrait", nonsep.plot.chaos_map, "q1", "p1",
+             "Hénon-Heiles as one H: MEGNO <Y> of {n} orbits at H = 1/8 (grey: off the shell)",
+             "q1 (y at start; x = 0)", "p1 (p_y at start; p_x >= 0 on the shell)", "given_by_h_henon_heiles_map")
     bottle_section(out)
-    result = nonsep.load(out / "schwarzschild_stability_map")
-    fig, ax = plt.subplots(figsize=(6.4, 5.4))
-    nonsep.plot.stability_map(result, ax=ax, value="mean_megno", x="beta", y="q1", colorbar=False, **MEGNO)
-    ax.set_xlabel("beta (field strength)")
-    ax.set_ylabel("q1 (r at start; theta = pi/2, p_r = 0)")
-    ax.set_title(f"Charged particle, Schwarzschild + uniform field: MEGNO <Y> of {len(result.trajectories)} orbits "
-                 f"(grey: off the shell)\n{subtitle(result.summary)}", fontsize=10)
-    fig.colorbar(ax.images[0], ax=ax).set_label("<Y> (2: regular)")
-    save(fig, out, "given_by_h_schwarzschild_map")
-    result = nonsep.load(out / "magnetic_bottle_chaos_map")
-    fig, ax = plt.subplots(figsize=(6.4, 5.4))
-    nonsep.plot.chaos_map(result, ax=ax, value="mean_megno", x="q0", y="p1", colorbar=False, **MEGNO)
-    ax.set_xlabel("q0 (x at start; y = z = 0)")
-    ax.set_ylabel("p1 (p_y at start; p_x = 0, p_z = 0.5)")
-    ax.set_title(f"Magnetic bottle: MEGNO <Y> of {len(result.trajectories)} orbits\n"
-                 f"{subtitle(result.summary)}", fontsize=10)
-    fig.colorbar(ax.images[0], ax=ax).set_label("<Y> (2: regular)")
-    save(fig, out, "given_by_h_magnetic_bottle")
+    grid_map(out, "schwarzschild_stability_map", nonsep.plot.stability_map, "beta", "q1",
+             "Charged particle, Schwarzschild + uniform field: MEGNO <Y> of {n} orbits (grey: off the shell)",
+             "beta (field strength)", "q1 (r at start; theta = pi/2, p_r = 0)", "given_by_h_schwarzschild_map")
+    grid_map(out, "magnetic_bottle_chaos_map", nonsep.plot.chaos_map, "q0", "p1", "Magnetic bottle: MEGNO <Y> of {n} orbits",
+             "q0 (x at start; y = z = 0)", "p1 (p_y at start; p_x = 0, p_z = 0.5)", "given_by_h_magnetic_bottle")
 
 
 if __name__ == "__main__":
