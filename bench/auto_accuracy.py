@@ -10,7 +10,7 @@ every step ("energy"): 24 cases. For each case:
   auto   `nonsep run` of the job with "scheme": "auto" (time.dt = t_end: the output grid is the end point); its
          actual error against the answer, its choice, and its wall time: the whole process (median of --repeats
          runs), and inside the process the pilots plus the run (summary.json);
-  best   every candidate of a hand-picked ladder (gauss 6 and 4, mpe 4, triplet 8/3 and 2, tao 4 and 6; steps
+  best   every candidate of a hand-picked ladder (gauss 16, 8, 6 and 4, mpe 4, triplet 8/3 and 2, tao 4 and 6; steps
          doubling, from a study with study.repeats 1) at the fewest steps that meet the tolerance, each timed by
          `nonsep run` like auto; the fastest of them.
 Prints the markdown table, and writes WORK_FOLDER/auto_accuracy.json with every number.
@@ -36,7 +36,8 @@ PROBLEMS = {
     "paper2d": {"model": {"plugin": "paper2d"}, "initial": {"q": [0.0, 0.0], "p": [0.5, 2.0]}, "t_end": 2.0,
                 "answer": None},
 }
-LADDER = [("gauss 6", {"scheme": "gauss", "stages": 3}, 1), ("gauss 4", {"scheme": "gauss", "stages": 2}, 1),
+LADDER = [("gauss 16", {"scheme": "gauss", "stages": 8}, 1), ("gauss 8", {"scheme": "gauss", "stages": 4}, 1),
+          ("gauss 6", {"scheme": "gauss", "stages": 3}, 1), ("gauss 4", {"scheme": "gauss", "stages": 2}, 1),
           ("mpe 4", {"scheme": "mpe", "order": "4"}, 2), ("triplet 8/3", {"scheme": "triplet", "order": "8/3"}, 8),
           ("triplet 2", {"scheme": "triplet", "order": "2"}, 8), ("tao 4", {"scheme": "tao", "order": "4"}, 8),
           ("tao 6", {"scheme": "tao", "order": "6"}, 8)]

@@ -15,7 +15,9 @@
 //
 // It then prints the cost per step in full gradients of H (EvaluationCounts::grad_H) of Tao and Gauss of orders 2,
 // 4, 6 over the quarter period of paper1d from (2, 0) at dt = T/16 .. T/1024, with the phase error at the end
-// against the exact end point (docs/work-precision.md, "Methods and their cost").
+// against the exact end point (docs/work-precision.md, "Methods and their cost"), and, for Gauss with 2 to 8 stages,
+// the fewest grad H that meet a phase tolerance (1e-6 .. 1e-13) over one period of paper1d from (1, 0) and (2, 0)
+// (the steps on a ladder of ratio 2^(1/4)): where each order wins.
 //
 // Usage: nonsep_bench_comparators [--smoke]   (--smoke: short runs, a few seconds; the ctest bench.comparators.smoke)
 // Times are medians of 5 repetitions on a shared machine: reported, not enforced.
@@ -95,30 +97,45 @@ struct HandTao {
   }
 };
 
-// The implicit midpoint rule by the fixed-point iteration and stopping rule of gauss_legendre.hpp (s = 1).
-// Returns false when the iteration fails.
-bool hand_midpoint(double& q, double& p) {
-  const double eps = std::numeric_limits<double>::epsilon();
-  double zq = 0.0, zp = 0.0, fq = 0.0, fp = 0.0, last = std::numeric_limits<double>::infinity();
-  for (int m = 0; m < nonsep::GaussLegendre::default_max_iterations; ++m) {
-    double dq, dp;
-    grad_H(q + zq, p + zp, dq, dp);
-    fq = dp, fp = -dq;
-    const double nq = 0.5 * fq * dt, np = 0.5 * fp * dt;
-    if (!std::isfinite(nq) || !std::isfinite(np)) return false;
-    const double change = std::max(std::abs(nq - zq), std::abs(np - zp));
-    const double scale = std::max({std::abs(q), std::abs(p), std::abs(nq), std::abs(np)});
-    zq = nq, zp = np;
-    const double relative = scale > 0.0 ? change / scale : 0.0;
-    if (relative <= eps || (relative >= last && relative <= 64 * eps)) {
-      q += dt * (1.0 * fq);
-      p += dt * (1.0 * fp);
-      return true;
-    }
-    last = relative;
+// The implicit midpoint rule by the fixed-point iteration, starting values and stopping rule of gauss_legendre.hpp
+// (s = 1: hb = dt, mu = nu = 1/2, so that L = dt f, Z = L / 2, z' = z + L compensated, and the next step starts from
+// Z = L / 2 of this one's L when it continues it). Returns false when the iteration fails.
+struct HandMidpoint {
+  double q, p, last_q = 0.0, last_p = 0.0, Lq = 0.0, Lp = 0.0, error_q = 0.0, error_p = 0.0;
+  bool have_last = false;
+  static void add(double& z, double increment, double& error) {
+    increment += error;
+    const double sum = z + increment, increment_part = sum - z;
+    error = (z - (sum - increment_part)) + (increment - increment_part);
+    z = sum;
   }
-  return false;
-}
+  bool step() {
+    const double eps = std::numeric_limits<double>::epsilon();
+    const bool continues = have_last && last_q == q && last_p == p;
+    if (!continues) error_q = error_p = 0.0;
+    double zq = continues ? 0.5 * Lq : 0.0, zp = continues ? 0.5 * Lp : 0.0;
+    double last = std::numeric_limits<double>::infinity();
+    for (int m = 0; m < nonsep::GaussLegendre::default_max_iterations; ++m) {
+      double dq, dp;
+      grad_H(q + zq, p + zp, dq, dp);
+      const double lq = dt * dp, lp = dt * -dq;
+      const double nq = 0.5 * lq, np = 0.5 * lp;
+      if (!std::isfinite(nq) || !std::isfinite(np)) return false;
+      const double change = std::max(std::abs(nq - zq), std::abs(np - zp));
+      const double scale = std::max({std::abs(q), std::abs(p), std::abs(nq), std::abs(np)});
+      zq = nq, zp = np;
+      const double relative = scale > 0.0 ? change / scale : 0.0;
+      if (relative <= eps || (relative >= last && relative <= 64 * eps)) {
+        add(q, lq, error_q);
+        add(p, lp, error_p);
+        last_q = q, last_p = p, Lq = lq, Lp = lp, have_last = true;
+        return true;
+      }
+      last = relative;
+    }
+    return false;
+  }
+};
 
 double median_seconds(const std::function<void()>& run) {
   std::vector<double> times;
@@ -183,9 +200,12 @@ int main(int argc, char** argv) {
     });
     const double gauss_hand = median_seconds([&] {
       hand = initial(count);
+      std::vector<HandMidpoint> states(count);
+      for (std::size_t b = 0; b < count; ++b) states[b] = {hand.q()[b], hand.p()[b]};
       for (int s = 0; s < steps; ++s)
-        for (std::size_t b = 0; b < count; ++b)
-          if (!hand_midpoint(hand.q()[b], hand.p()[b])) std::abort();
+        for (auto& state : states)
+          if (!state.step()) std::abort();
+      for (std::size_t b = 0; b < count; ++b) hand.q()[b] = states[b].q, hand.p()[b] = states[b].p;
     });
     agree &= same(generic, hand, "gauss 2");
     std::printf("%-8s %9zu %8d %16.1f %16.1f %7.2f\n", "gauss 2", count, steps, gauss_generic * per, gauss_hand * per,
@@ -210,6 +230,38 @@ int main(int argc, char** argv) {
       std::printf("gauss %d  %9d %13.2f %13.2f %12.3g\n", order, steps, gauss_cost, gauss_cost / (order / 2),
                   std::hypot(y.q()[0], y.p()[0] - exact.p_final));
     }
+  std::printf("\nfewest grad H (steps) of Gauss over one period of paper1d to meet a phase tolerance\n%-4s %-7s", "q0",
+              "tol");
+  const int stage_counts[] = {2, 3, 4, 5, 6, 8};
+  for (const int stages : stage_counts) std::printf(" %14s", ("gauss " + std::to_string(2 * stages)).c_str());
+  std::printf("\n");
+  for (const double q0 : {1.0, 2.0}) {
+    const double period = 4 * nonsep::reference::paper1d_quarter(q0).period;
+    for (const double tolerance : {1e-6, 1e-8, 1e-10, 1e-12, 1e-13}) {
+      std::printf("%-4g %-7g", q0, tolerance);
+      for (const int stages : stage_counts) {
+        std::string cell = "-";
+        for (int k = 0; k < (smoke ? 40 : 80); ++k) {
+          const int steps = static_cast<int>(std::ceil(std::pow(2.0, k / 4.0)));
+          nonsep::GaussLegendre gauss(nonsep::HamiltonianForm::TTV, 2 * stages);
+          auto x = nonsep::PhaseSpaceBatch::single(std::vector<double>{q0}, std::vector<double>{0.0});
+          double error = std::numeric_limits<double>::infinity();
+          try {
+            for (int s = 0; s < steps; ++s) gauss.step(Paper1D{}, x, period / steps);
+            error = std::hypot(x.q()[0] - q0, x.p()[0]);
+          } catch (const nonsep::ModelError&) {
+            // too large a step for the iteration: the next rung
+          }
+          if (error <= tolerance) {
+            cell = std::to_string(gauss.evaluations().grad_H) + " (" + std::to_string(steps) + ")";
+            break;
+          }
+        }
+        std::printf(" %14s", cell.c_str());
+      }
+      std::printf("\n");
+    }
+  }
   if (!agree) {
     std::printf("the generic steppers and the hand-written loops disagree\n");
     return 1;

@@ -36,7 +36,7 @@ std::vector<IntegratorSpec> comparator_specs(HamiltonianForm form) {
   IntegratorSpec midpoint{"implicit_midpoint"};
   midpoint.form = form;
   specs.push_back(midpoint);
-  for (int stages = 1; stages <= 3; ++stages) {
+  for (int stages : {1, 2, 3, 4, 8}) {
     IntegratorSpec gauss{"gauss", GaussOptions{stages}};
     gauss.form = form;
     specs.push_back(gauss);

@@ -97,6 +97,8 @@ const std::vector<Study>& order_cases() {
       {gauss(2), 4.0, 2.0, 1, 16, 4},
       // gauss 3 stages: slopes 6.12, 6.02, 6.007 for T/8 .. T/64, then round-off near 1e-14.
       {gauss(3), 6.0, 2.0, 1, 8, 3},
+      // gauss 4 stages: slopes 8.97, 8.39, 8.08 for T/2 .. T/16 from q0 = 1, then round-off near 1e-15.
+      {gauss(4), 8.0, 1.0, 1, 8, 1},
   };
   return cases;
 }
@@ -139,10 +141,32 @@ TEST_CASE("triplet composition converges with orders 4/3, 2 and 8/3") { check_ca
 
 TEST_CASE("multi-product expansion converges with orders 4/3, 2, 8/3 and 4") { check_cases_of("mpe"); }
 
-TEST_CASE("comparators from the catalogue: tao 2, 4, 6, implicit midpoint, gauss with 1, 2, 3 stages") {
+TEST_CASE("comparators from the catalogue: tao 2, 4, 6, implicit midpoint, gauss with 1, 2, 3, 4 stages") {
   for (const char* scheme : {"tao", "implicit_midpoint", "gauss"}) {
     CAPTURE(scheme);
     check_cases_of(scheme);
+  }
+}
+
+// Gauss with 5 to 8 stages (orders 10 to 16): from q0 = 1 the error reaches round-off (~1e-15) within two halvings
+// of dt = T (slopes 8.0, 10.9 for 5 stages; 10.5, 11.8; 11.5, 13.2; 12.7, 11.7 for 8 stages), before the asymptotic
+// regime: double precision does not resolve these orders on this problem. Their order rests on the order conditions
+// B(2s) and C(s) of the tableau (test_comparators_properties.cpp; Butcher's theorem, GNI III.1); here the error must
+// fall faster than order 8 does over the same steps (gauss 4: 6.9, 9.0) and reach 1e-10 by T/4.
+TEST_CASE("gauss with 5 to 8 stages: the error falls faster than order 8 until round-off") {
+  const auto exact = nonsep::reference::paper1d_quarter(1.0);
+  for (int stages = 5; stages <= 8; ++stages) {
+    CAPTURE(stages);
+    std::vector<double> errors;
+    for (int steps = 1; steps <= 4; steps *= 2) {
+      Integrator integrator(gauss(stages));
+      const double q[] = {1.0}, p[] = {0.0};
+      auto x = PhaseSpaceBatch::single(q, p);
+      for (int s = 0; s < steps; ++s) integrator.step(Paper1D{}, x, exact.period / steps);
+      errors.push_back(std::hypot(x.q()[0], x.p()[0] - exact.p_final));
+    }
+    CHECK(std::log2(errors[1] / errors[2]) > 10.0);
+    CHECK(errors[2] < 1e-10);
   }
 }
 
@@ -155,6 +179,7 @@ TEST_CASE("every scheme of the catalogue, every order of a comparator, has an or
     CHECK_MESSAGE(!covered.empty(), "no order case for the catalogue scheme " << scheme.name);
     if (scheme.family == "comparator")
       for (const Fraction& order : scheme.orders()) {
+        if (scheme.name == "gauss" && order.value() > 8) continue;  // the test case above
         CAPTURE(order.to_string());
         CHECK(std::find(covered.begin(), covered.end(), order) != covered.end());
       }

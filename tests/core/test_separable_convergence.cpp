@@ -125,6 +125,8 @@ const std::vector<Study>& order_cases() {
       {gauss(2), 4.0, 16, 3},
       // gauss 3: slopes 6.118, 6.027, 6.006 for T/8 .. T/64.
       {gauss(3), 6.0, 8, 3},
+      // gauss 4: slopes 8.92, 8.23, 8.09 for T/4 .. T/32, then round-off near 5e-15.
+      {gauss(4), 8.0, 16, 1},
   };
   return cases;
 }
@@ -229,7 +231,7 @@ TEST_CASE("separable part: multi-product expansion converges with orders 4/3, 2,
   check_cases_of("mpe");
 }
 
-TEST_CASE("separable part: comparators tao 2, 4, 6, implicit midpoint, gauss with 1, 2, 3 stages") {
+TEST_CASE("separable part: comparators tao 2, 4, 6, implicit midpoint, gauss with 1, 2, 3, 4 stages") {
   for (const char* scheme : {"tao", "implicit_midpoint", "gauss"}) {
     CAPTURE(scheme);
     check_cases_of(scheme);
@@ -245,6 +247,8 @@ TEST_CASE("separable part: every scheme of the catalogue, every order of a compa
     CHECK_MESSAGE(!covered.empty(), "no order case for the catalogue scheme " << scheme.name);
     if (scheme.family == "comparator")
       for (const Fraction& order : scheme.orders()) {
+        // Gauss with 5 to 8 stages reaches round-off before its asymptotic regime (test_core_convergence.cpp).
+        if (scheme.name == "gauss" && order.value() > 8) continue;
         CAPTURE(order.to_string());
         CHECK(std::find(covered.begin(), covered.end(), order) != covered.end());
       }

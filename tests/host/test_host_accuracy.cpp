@@ -253,7 +253,7 @@ TEST_CASE("scheme auto meets its tolerance against the exact solution and record
     const json summary = read_json(ran.folder / "summary.json");
     const json& choice = summary["scheme_choice"];
     CHECK(choice["tolerance"] == 1e-8);
-    CHECK(choice["candidates"].size() == 5);
+    CHECK(choice["candidates"].size() == 7);
     CHECK(choice["estimated_error"].get<double>() <= 1e-8);
     CHECK(choice["tolerance_met"] == true);
     CHECK(choice["pilot_cost"]["state_steps"].get<std::uint64_t>() > 0);
@@ -319,7 +319,8 @@ TEST_CASE("scheme auto: validate says what would be tried, and bad tolerances an
   const auto valid = run_nonsep({"validate", file.string()}, folder.path());
   CHECK(valid.status == 0);
   CHECK(valid.out.find("scheme auto: tolerance 1e-06") != std::string::npos);
-  CHECK(valid.out.find("would try gauss 6, gauss 4, mpe 4, triplet 8/3, triplet 2") != std::string::npos);
+  CHECK(valid.out.find("would try gauss 16, gauss 8, gauss 6, gauss 4, mpe 4, triplet 8/3, triplet 2") !=
+        std::string::npos);
   for (const json& bad : {json{{"scheme", "auto"}}, json{{"scheme", "auto"}, {"tolerance", 0.5}},
                           json{{"scheme", "auto"}, {"tolerance", 1e-6}, {"measure", "both"}},
                           json{{"scheme", "auto"}, {"tolerance", 1e-6}, {"order", "2"}}}) {

@@ -69,21 +69,30 @@ TEST_CASE("magnetic_bottle at mirror 0: gauss 3 stages at 1e-12 of the exact sta
 TEST_CASE("magnetic_bottle: gauss conserves the canonical angular momentum (a quadratic invariant) and H") {
   const PluginModel model = shipped("magnetic_bottle", {{"mirror", 0.5}});
   const std::vector<double> q{0.8, 0.0, 0.3}, p{0.0, 0.9, 0.7};
-  auto x = nonsep::PhaseSpaceBatch::single(q, p);
-  const auto momentum = [&] { return x.q()[0] * x.p()[1] - x.q()[1] * x.p()[0]; };
-  nonsep::EnergyEvaluator energy(nonsep::HamiltonianForm::TTV);
-  const double l0 = momentum(), h0 = energy.evaluate_one(model, x);
-  nonsep::GaussLegendre gauss(nonsep::HamiltonianForm::TTV, 6);
-  double largest_l = 0.0, largest_h = 0.0;
-  for (int s = 0; s < 20000; ++s) {
-    gauss.step(model, x, 0.01);
-    largest_l = std::max(largest_l, std::abs(momentum() - l0));
-    largest_h = std::max(largest_h, std::abs(energy.evaluate_one(model, x) - h0) / h0);
+  // To t = 20, with the starting values and from Z = 0 (the same map up to round-off). Further on this orbit's close
+  // approaches to the axis, where p_phi^2 / rho^2 stiffens the flow, amplify round-off: to t = 200 the largest error
+  // of H was 1.2e-8 with the starting values and 1.6e-7 from Z = 0, with different end states: no bound to test.
+  std::vector<std::vector<double>> ends;
+  for (const bool extrapolate : {true, false}) {
+    CAPTURE(extrapolate);
+    auto x = nonsep::PhaseSpaceBatch::single(q, p);
+    const auto momentum = [&] { return x.q()[0] * x.p()[1] - x.q()[1] * x.p()[0]; };
+    nonsep::EnergyEvaluator energy(nonsep::HamiltonianForm::TTV);
+    const double l0 = momentum(), h0 = energy.evaluate_one(model, x);
+    nonsep::GaussLegendre gauss(nonsep::HamiltonianForm::TTV, 6, 100, extrapolate);
+    double largest_l = 0.0, largest_h = 0.0;
+    for (int s = 0; s < 2000; ++s) {
+      gauss.step(model, x, 0.01);
+      largest_l = std::max(largest_l, std::abs(momentum() - l0));
+      largest_h = std::max(largest_h, std::abs(energy.evaluate_one(model, x) - h0) / h0);
+    }
+    MESSAGE("magnetic bottle, gauss 3 stages, dt 0.01 to t = 20: largest change of x p_y - y p_x "
+            << largest_l << ", of H (relative) " << largest_h);
+    CHECK(largest_l < 1e-14);
+    CHECK(largest_h < 1e-12);  // 1.3e-14 measured: the scheme's accuracy at dt 0.01 (H is not quadratic)
+    ends.push_back({x.q()[0], x.q()[1], x.q()[2], x.p()[0], x.p()[1], x.p()[2]});
   }
-  MESSAGE("magnetic bottle, gauss 3 stages, dt 0.01 to t = 200: largest change of x p_y - y p_x "
-          << largest_l << ", of H (relative) " << largest_h);
-  CHECK(largest_l < 1e-12);
-  CHECK(largest_h < 1e-8);  // the scheme's accuracy at dt 0.01: H is not quadratic
+  for (std::size_t k = 0; k < 6; ++k) CHECK(std::abs(ends[0][k] - ends[1][k]) < 1e-10);
 }
 
 TEST_CASE("the shipped models given by H: grad_H and hvp_H agree with finite differences of their values") {

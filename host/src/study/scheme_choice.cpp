@@ -297,8 +297,11 @@ json number_or_null(double x, bool known) { return known && std::isfinite(x) ? j
 std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
   const SingleRun& run = loaded.job.run();
   const HamiltonianForm form = run.integrator.form;
-  // In the order of docs/work-precision.md's fastest first, so that the pilots of slower ones are cut short.
+  // Fastest first, so that the pilots of slower ones are cut short: Gauss by falling order (on paper1d order 16
+  // needs the fewest grad H of all stage counts to meet 1e-8 or tighter: bench/comparators.cpp), then Chin's.
   std::vector<AutoCandidate> all{
+      {"gauss 16", spec_of("gauss", Fraction(2, 3), 8, form)},
+      {"gauss 8", spec_of("gauss", Fraction(2, 3), 4, form)},
       {"gauss 6", spec_of("gauss", Fraction(2, 3), 3, form)},
       {"gauss 4", spec_of("gauss", Fraction(2, 3), 2, form)},
       {"mpe 4", spec_of("mpe", Fraction(4), 2, form)},

@@ -81,8 +81,9 @@ struct ImplicitMidpointScheme {
             "Implicit midpoint rule, for any H",
             "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VIII.6",
             "z' = z + dt f((z + z')/2), Gauss-Legendre with 1 stage; order 2, symplectic and symmetric. Solved by "
-            "fixed-point iteration from Z = 0 (no Newton), 1 grad H per state per iteration. Stopping rule per "
-            "state: converged when the relative change of the stages is <= 1 ulp, or stops decreasing while "
+            "fixed-point iteration (no Newton) from the last step's stage extrapolated, 1 grad H per state per "
+            "iteration. Stopping rule per state: converged when the relative change of the stages is <= 1 ulp, or "
+            "stops decreasing while "
             "<= 64 ulp; failed when an iterate is not finite or after max_iterations: the trajectory then "
             "retires with status failed and the reason, never with an inaccurate step." +
                 comparator_scheme::cost_note,
@@ -108,26 +109,29 @@ struct GaussScheme {
   using Options = GaussOptions;
   using Stepper = GaussLegendre;
   static SchemeDescription description() {
-    return {"gauss",
-            "Gauss-Legendre collocation, for any H",
-            "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6",
-            "s-stage Gauss-Legendre Runge-Kutta method on Hamilton's equations of H, order 2s; symplectic and "
-            "symmetric. Fixed-point iteration from Z = 0 (no Newton), s grad H per state per iteration, with the "
-            "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed). Implicit: a step "
-            "costs more than an explicit one of the same order, but stays accurate at larger steps on strongly "
-            "coupled or chaotic orbits, which makes it the safer choice for chaos maps (docs/dynamics.md)." +
-                comparator_scheme::cost_note,
-            "comparator",
-            true,
-            true,
-            {number_parameter("stages", "2", "number of stages s: 1, 2 or 3 (orders 2, 4, 6)"),
-             comparator_scheme::max_iterations_parameter()},
-            1,
-            {Fraction(2), Fraction(4), Fraction(6)}};
+    return {
+        "gauss",
+        "Gauss-Legendre collocation, for any H",
+        "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6",
+        "s-stage Gauss-Legendre Runge-Kutta method on Hamilton's equations of H, order 2s; symplectic and "
+        "symmetric, its coefficients arranged so that it stays symplectic in floating point (round-off in H grows "
+        "like the square root of the steps). Fixed-point iteration (no Newton) from the last step's stages "
+        "extrapolated, s grad H per state per iteration, with the "
+        "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed). Implicit: a step "
+        "costs more than an explicit one of the same order, but stays accurate at larger steps on strongly "
+        "coupled or chaotic orbits, which makes it the safer choice for chaos maps (docs/dynamics.md)." +
+            comparator_scheme::cost_note,
+        "comparator",
+        true,
+        true,
+        {number_parameter("stages", "2", "number of stages s, 1 to 8 (orders 2 to 16)"),
+         comparator_scheme::max_iterations_parameter()},
+        1,
+        {Fraction(2), Fraction(4), Fraction(6), Fraction(8), Fraction(10), Fraction(12), Fraction(14), Fraction(16)}};
   }
   static Stepper make(const Options& options, HamiltonianForm form) {
-    if (options.stages < 1 || options.stages > 3)
-      throw InvalidArgument("Gauss-Legendre collocation has 1, 2 or 3 stages (orders 2, 4, 6); found " +
+    if (options.stages < 1 || options.stages > GaussLegendreTableau::max_stages)
+      throw InvalidArgument("Gauss-Legendre collocation has 1 to 8 stages (orders 2 to 16); found " +
                             std::to_string(options.stages));
     return Stepper(form, 2 * options.stages, options.max_iterations);
   }

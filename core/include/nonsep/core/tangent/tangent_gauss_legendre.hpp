@@ -64,6 +64,21 @@ class TangentGaussLegendre {
     map_tangents(model, x, tangents, k, dt);
   }
 
+  // The private state is the plain stepper's (its starting values, gauss_legendre.hpp); the vectors keep none.
+  template <class M>
+  requires ModelWithHamiltonianHessian<M>
+  void step_part(const M& model, PhaseSpaceBatch& part, PhaseSpaceBatch& part_tangents,
+                 const TangentGaussLegendre& before, std::size_t first, std::size_t total, double dt) {
+    const std::size_t k = check_tangents_fit(part, part_tangents);
+    require_hamiltonian_hessian(model, base_.stages() == 1 ? "implicit_midpoint" : "gauss");
+    base_.step_part(model, part, before.base_, first, total, dt);
+    map_tangents(model, part, part_tangents, k, dt);
+  }
+  void compact(const std::vector<bool>& retire) { base_.compact(retire); }
+  SchemeState save_state(const PhaseSpaceBatch& states) const { return base_.save_state(states); }
+  void restore_state(const SchemeState& state) { base_.restore_state(state); }
+  std::vector<SchemeFigure> report() const { return base_.report(); }
+
  private:
   // Work arrays of the rows (tangent vectors) still iterating, stage-major: stage i, row a of active_, component c
   // at (i*A + a)*n + c (A = active_.size()); dZ per row and stage at (i*R + r)*n + c (R = all rows).
