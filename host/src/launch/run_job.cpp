@@ -118,20 +118,19 @@ nlohmann::ordered_json checked_choice(nlohmann::ordered_json choice, const RunOu
   }
   // No prediction when the pilots' phase error grew exponentially (scheme_choice.hpp): then only a measurement
   // judges the tolerance.
-  const std::optional<double> predicted =
-      choice["estimated_error"].is_number() ? std::optional(choice["estimated_error"].get<double>()) : std::nullopt;
-  const std::optional<double> judged = measured && predicted ? std::max(*measured, *predicted)
-                                       : measured            ? measured
-                                                             : predicted;
+  const bool has_prediction = choice["estimated_error"].is_number();
+  const double predicted = has_prediction ? choice["estimated_error"].get<double>() : 0.0;
+  const bool judged = measured || has_prediction;
+  const double error = measured && has_prediction ? std::max(*measured, predicted) : measured ? *measured : predicted;
   choice["measured_error"] = measured ? nlohmann::ordered_json(*measured) : nullptr;
-  choice["measured_by"] = measured ? how : predicted ? "nothing (the pilots' prediction alone)" : "nothing";
-  choice["tolerance_met"] = judged ? nlohmann::ordered_json(*judged <= tolerance) : nullptr;
-  if (judged && !(*judged <= tolerance))
+  choice["measured_by"] = measured ? how : has_prediction ? "nothing (the pilots' prediction alone)" : "nothing";
+  choice["tolerance_met"] = judged ? nlohmann::ordered_json(error <= tolerance) : nullptr;
+  if (judged && !(error <= tolerance))
     notes.push_back("warning: scheme auto did not meet the tolerance " + format_number(tolerance) + ": " +
                     (measured ? how + " is " + format_number(*measured) : std::string()) +
-                    (measured && predicted ? ", " : "") +
-                    (predicted ? "the prediction " + std::string(measured ? "" : "is ") + format_number(*predicted)
-                               : std::string()));
+                    (measured && has_prediction ? ", " : "") +
+                    (has_prediction ? "the prediction " + std::string(measured ? "" : "is ") + format_number(predicted)
+                                    : std::string()));
   return choice;
 }
 
