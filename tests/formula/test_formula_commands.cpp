@@ -62,6 +62,68 @@ TEST_CASE("formula commands: validate checks a formula job's parameters and dime
   CHECK(contains(run.err, "apt-get install g++"));
 }
 
+TEST_CASE("formula commands: a parameter's range is declared by its plugin and refuses values and sweeps outside it") {
+  TemporaryFolder folder;
+  Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");
+  // paper2d written as formulas, its coupling kept where the energy shells are compact as the plugin keeps it.
+  const json range = {{"value", 0.2}, {"min", -0.1}, {"max", 0.3}};
+  const json formula = {{"name", "coupled_2d"},
+                        {"T", "p0 + p1 + (p0^3 + p1^3)/6"},
+                        {"V", "(q0^2 + q1^2)/2 + (q0^2 + q1^2)^2/12 + coupling*q0^2*q1^2"},
+                        {"parameters", {{"coupling", range}}}};
+  const auto validate = [&](const json& model, const std::string& name) {
+    json job = job_with(model);
+    job["initial"] = {{"q", {0.25, 0.3}}, {"p", {-1.5, 0.2}}};
+    return run_nonsep({"validate", write_job(folder / (name + ".json"), job).string()}, folder.path());
+  };
+  const std::string refused = "found 0.6; allowed: a value >= -0.1 and <= 0.3: ";
+  SUBCASE("inside the range, a value and a sweep are accepted; outside, refused as the plugin refuses them") {
+    CHECK(validate({{"formula", formula}, {"parameters", {{"coupling", 0.25}}}}, "inside").status == 0);
+    CHECK(validate({{"formula", formula}, {"parameters", {{"coupling", {-0.1, 0.3}}}}}, "sweep_inside").status == 0);
+    const auto value = validate({{"formula", formula}, {"parameters", {{"coupling", 0.6}}}}, "outside");
+    CHECK(value.status == 2);
+    CHECK(contains(value.err, "/model/parameters/coupling: " + refused + "a parameter of the formulas"));
+    const auto plugin = validate({{"plugin", "paper2d"}, {"parameters", {{"coupling", 0.6}}}}, "plugin");
+    CHECK(plugin.status == 2);
+    CHECK(contains(plugin.err, "/model/parameters/coupling: " + refused));
+    const auto sweep = validate({{"formula", formula}, {"parameters", {{"coupling", {0.1, 0.2, 0.6}}}}}, "sweep");
+    CHECK(sweep.status == 2);
+    CHECK(
+        contains(sweep.err, "/model/parameters/coupling/2: found the value 0.6; allowed: a value >= -0.1 and <= 0.3"));
+  }
+  SUBCASE("the plugin's source declares the range; a plain number has none") {
+    json model = formula;
+    model["parameters"]["other"] = 1.5;
+    model["V"] = "(q0^2 + q1^2)/2 + (q0^2 + q1^2)^2/12 + coupling*q0^2*q1^2 + other*q0";
+    write_text(folder / "model.json", model.dump());
+    const auto source =
+        run_nonsep({"model", "compile", (folder / "model.json").string(), "--print-source"}, folder.path());
+    CHECK(source.status == 0);
+    CHECK(contains(source.out,
+                   "{.name = \"coupling\", .type = nonsep::sdk::ParameterType::number, .default_value = "
+                   "0.2, .minimum = -0.1, .maximum = 0.3,"));
+    CHECK(contains(source.out,
+                   "{.name = \"other\", .type = nonsep::sdk::ParameterType::number, .default_value = "
+                   "1.5, .description"));
+  }
+  SUBCASE("a bad range is refused at its key path, exit 2") {
+    for (const auto& [bad, path] : std::vector<std::pair<json, std::string>>{
+             {{{"value", 0.2}, {"min", 0.3}, {"max", -0.1}}, "/coupling/min: found min 0.3 above max -0.1"},
+             {{{"value", 0.6}, {"min", -0.1}, {"max", 0.3}}, "/coupling/value: found the default 0.6"},
+             {{{"value", 0.2}, {"max", "0.3"}}, "/coupling/max"},
+             {{{"value", 0.2}, {"max", 1e999}}, "/coupling/max"},
+             {{{"min", -0.1}}, "/coupling/value"},
+             {{{"value", 0.2}, {"minimum", -0.1}}, "/coupling/minimum"}}) {
+      json model = formula;
+      model["parameters"]["coupling"] = bad;
+      const auto result = validate({{"formula", model}}, "bad");
+      CAPTURE(bad.dump());
+      CHECK(result.status == 2);
+      CHECK(contains(result.err, "/model/formula/parameters" + path));
+    }
+  }
+}
+
 TEST_CASE("formula commands: a model written with q1 and q2 for two coordinates is told that components count from 0") {
   TemporaryFolder folder;
   Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");
