@@ -111,7 +111,7 @@ TEST_CASE("formula commands: a parameter's range is declared by its plugin and r
              {{{"value", 0.2}, {"min", 0.3}, {"max", -0.1}}, "/coupling/min: found min 0.3 above max -0.1"},
              {{{"value", 0.6}, {"min", -0.1}, {"max", 0.3}}, "/coupling/value: found the default 0.6"},
              {{{"value", 0.2}, {"max", "0.3"}}, "/coupling/max"},
-             {{{"value", 0.2}, {"max", 1e999}}, "/coupling/max"},
+             {{{"value", 0.2}, {"max", nullptr}}, "/coupling/max"},
              {{{"min", -0.1}}, "/coupling/value"},
              {{{"value", 0.2}, {"minimum", -0.1}}, "/coupling/minimum"}}) {
       json model = formula;
