@@ -124,6 +124,43 @@ TEST_CASE("formula commands: a parameter's range is declared by its plugin and r
   }
 }
 
+TEST_CASE(
+    "formula commands: validate says what scheme auto would try for a formula job, as for the plugin of its model") {
+  TemporaryFolder folder;
+  Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");  // nothing is compiled
+  const json automatic = {{"scheme", "auto"}, {"tolerance", 1e-6}};
+  // The line after "integrator:" of `nonsep validate` for `model` with the states `initial`.
+  const auto auto_line = [&](const json& model, const json& initial, const std::string& name) {
+    json job = job_with(model, automatic);
+    job["initial"] = initial;
+    const auto result = run_nonsep({"validate", write_job(folder / (name + ".json"), job).string()}, folder.path());
+    INFO(name << ": " << result.err);
+    CHECK(result.status == 0);
+    const auto at = result.out.find("integrator:  ");
+    return at == std::string::npos ? std::string() : result.out.substr(at, result.out.find('\n', at) - at);
+  };
+  const json two = {{{"q", {0.25, 0.3}}, {"p", {-1.5, 0.2}}}, {{"q", {-0.75, 0.3}}, {"p", {-1.5, 0.2}}}};
+  const json paper2d_formula = {{"T", "p0 + p1 + (p0^3 + p1^3)/6"},
+                                {"V", "(q0^2 + q1^2)/2 + (q0^2 + q1^2)^2/12 + coupling*q0^2*q1^2"},
+                                {"parameters", {{"coupling", 0.2}}}};
+  const std::string product = auto_line({{"formula", paper2d_formula}}, two, "product");
+  CHECK(contains(product, "scheme auto: tolerance 1e-06"));
+  CHECK(contains(product, "would try gauss 6, gauss 4, mpe 4, triplet 8/3, triplet 2 with pilot runs of 2 state(s)"));
+  CHECK(product == auto_line({{"plugin", "paper2d"}}, two, "paper2d"));
+  // On an energy shell, before the compiled model places the states, the pilot states are an upper bound.
+  const json shell = {{"grid", {{"q", {{{"from", -2.0}, {"to", 2.0}, {"count", 11}}, 0.0}}, {"p", {0.0, 0.0}}}},
+                      {"energy", 7.0},
+                      {"solve_for", "p1"}};
+  CHECK(contains(auto_line({{"formula", paper2d_formula}}, shell, "shell"), "pilot runs of at most 8 state(s)"));
+  // Given by H: the schemes that integrate H, as for the Henon-Heiles plugin (also given by H).
+  const json henon_heiles = {{"H", "(p0^2 + p1^2)/2 + (q0^2 + q1^2)/2 + lambda*(q0^2*q1 - q1^3/3)"},
+                             {"parameters", {{"lambda", 1}}}};
+  const json one = {{{"q", {0.0, 0.1}}, {"p", {0.3, 0.0}}}};
+  const std::string general = auto_line({{"formula", henon_heiles}}, one, "general");
+  CHECK(contains(general, "would try gauss 6, gauss 4 with"));
+  CHECK(general == auto_line({{"plugin", "henon_heiles"}}, one, "henon_heiles"));
+}
+
 TEST_CASE("formula commands: a model written with q1 and q2 for two coordinates is told that components count from 0") {
   TemporaryFolder folder;
   Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");

@@ -9,6 +9,7 @@
 #include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
+#include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
@@ -321,8 +322,22 @@ json number_or_null(double x, bool known) { return known && std::isfinite(x) ? j
 
 }  // namespace
 
+AutoModel auto_model(const Plugin& plugin) {
+  return {plugin.general_hamiltonian(), plugin.has_hessians() && plugin.has_third_derivatives(),
+          plugin.has_hamiltonian_hessian_products()};
+}
+
+AutoModel auto_model(const formula::FormulaModel& model) {
+  // Its plugin's functions are templates of the number type: the SDK differentiates them to every order.
+  return {model.h_tree.has_value(), true, true};
+}
+
 std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
-  const SingleRun& run = loaded.job.run();
+  return auto_candidates(loaded.job, auto_model(loaded.plugin));
+}
+
+std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& model) {
+  const SingleRun& run = job.run();
   const HamiltonianForm form = run.integrator.form;
   // In the order of docs/work-precision.md's fastest first, so that the pilots of slower ones are cut short.
   std::vector<AutoCandidate> all{
@@ -333,15 +348,14 @@ std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
       {"triplet 2", spec_of("triplet", Fraction(2), 2, form)},
   };
   // A model given by H (general_hamiltonian) has the gradient of H and no product form for Chin's schemes.
-  const bool general = loaded.plugin.general_hamiltonian();
-  const bool gradient_of_h = general || (loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives());
+  const bool general = model.general;
+  const bool gradient_of_h = general || model.hessians_and_third_derivatives;
   std::vector<AutoCandidate> usable;
   for (auto& candidate : all) {
     if (Integrator(candidate.spec).is_comparator() ? !gradient_of_h : general) continue;
     // A comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
     if (run.analysis.tangent_vectors() > 0 &&
-        (!has_tangent_map(candidate.spec) ||
-         (Integrator(candidate.spec).is_comparator() && !loaded.plugin.has_hamiltonian_hessian_products())))
+        (!has_tangent_map(candidate.spec) || (Integrator(candidate.spec).is_comparator() && !model.hessian_products)))
       continue;
     usable.push_back(std::move(candidate));
   }
@@ -556,14 +570,21 @@ json to_json(const SchemeChoice& choice) {
 }
 
 std::string describe_auto(const LoadedJob& loaded) {
-  const AutoScheme& asked = *loaded.job.run().auto_scheme;
+  return describe_auto(loaded.job, auto_model(loaded.plugin), true);
+}
+
+std::string describe_auto(const Job& job, const AutoModel& model, bool loaded) {
+  const AutoScheme& asked = *job.run().auto_scheme;
   std::string names;
-  for (const AutoCandidate& candidate : auto_candidates(loaded)) names += (names.empty() ? "" : ", ") + candidate.label;
-  const std::size_t states = pilot_indices(loaded.job.initial).size();
+  for (const AutoCandidate& candidate : auto_candidates(job, model))
+    names += (names.empty() ? "" : ", ") + candidate.label;
+  const std::size_t states = pilot_indices(job.initial).size();
+  // Before the states are placed on an energy shell, some may be left out: the pilots are at most these.
+  const bool at_most = !loaded && job.initial.shell;
   return "scheme auto: tolerance " + format_number(asked.tolerance) + " on the " +
          (asked.measure == AutoScheme::Measure::phase ? "phase-space error at t_end" : "largest |dH/H0|") +
-         "; would try " + names + " with pilot runs of " + std::to_string(states) +
-         " state(s) to t = " + format_number(loaded.job.run().time.t_end) + " (at most " +
+         "; would try " + names + " with pilot runs of " + (at_most ? "at most " : "") + std::to_string(states) +
+         " state(s) to t = " + format_number(job.run().time.t_end) + " (at most " +
          std::to_string(auto_pilot_max_steps) +
          " steps each; to t_end / 8, then t_end / 64, when none is usable), then run the cheapest that meets it";
 }

@@ -53,8 +53,19 @@ struct AutoCandidate {
   IntegratorSpec spec;
 };
 
+// What of a model decides the candidates.
+struct AutoModel {
+  bool general = false;                         // given by H (PluginModel::general_hamiltonian)
+  bool hessians_and_third_derivatives = false;  // the comparators need them of a product-form model
+  bool hessian_products = false;                // hvp_H: the comparators' tangent maps need it
+};
+AutoModel auto_model(const Plugin& plugin);
+// A formula model's, without compiling it: its plugin has every derivative (formula-models.md).
+AutoModel auto_model(const formula::FormulaModel& model);
+
 // The candidates of `loaded` (a single run with /integrator "auto"), in the order they are tried.
 std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded);
+std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& model);
 
 // What the pilots measured of one candidate.
 struct PilotResult {
@@ -136,7 +147,9 @@ void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& reco
 // left out), the choice, its predicted error and the pilots' cost.
 nlohmann::ordered_json to_json(const SchemeChoice& choice);
 
-// What `nonsep validate` says auto would try, one line.
+// What `nonsep validate` says auto would try, one line; of a job not loaded (a formula job, not compiled), with
+// the count of pilot states an upper bound when an energy shell will leave some out.
 std::string describe_auto(const LoadedJob& loaded);
+std::string describe_auto(const Job& job, const AutoModel& model, bool loaded);
 
 }  // namespace nonsep::host
