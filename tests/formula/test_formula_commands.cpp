@@ -62,6 +62,105 @@ TEST_CASE("formula commands: validate checks a formula job's parameters and dime
   CHECK(contains(run.err, "apt-get install g++"));
 }
 
+TEST_CASE("formula commands: a parameter's range is declared by its plugin and refuses values and sweeps outside it") {
+  TemporaryFolder folder;
+  Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");
+  // paper2d written as formulas, its coupling kept where the energy shells are compact as the plugin keeps it.
+  const json range = {{"value", 0.2}, {"min", -0.1}, {"max", 0.3}};
+  const json formula = {{"name", "coupled_2d"},
+                        {"T", "p0 + p1 + (p0^3 + p1^3)/6"},
+                        {"V", "(q0^2 + q1^2)/2 + (q0^2 + q1^2)^2/12 + coupling*q0^2*q1^2"},
+                        {"parameters", {{"coupling", range}}}};
+  const auto validate = [&](const json& model, const std::string& name) {
+    json job = job_with(model);
+    job["initial"] = {{"q", {0.25, 0.3}}, {"p", {-1.5, 0.2}}};
+    return run_nonsep({"validate", write_job(folder / (name + ".json"), job).string()}, folder.path());
+  };
+  const std::string refused = "found 0.6; allowed: a value >= -0.1 and <= 0.3: ";
+  SUBCASE("inside the range, a value and a sweep are accepted; outside, refused as the plugin refuses them") {
+    CHECK(validate({{"formula", formula}, {"parameters", {{"coupling", 0.25}}}}, "inside").status == 0);
+    CHECK(validate({{"formula", formula}, {"parameters", {{"coupling", {-0.1, 0.3}}}}}, "sweep_inside").status == 0);
+    const auto value = validate({{"formula", formula}, {"parameters", {{"coupling", 0.6}}}}, "outside");
+    CHECK(value.status == 2);
+    CHECK(contains(value.err, "/model/parameters/coupling: " + refused + "a parameter of the formulas"));
+    const auto plugin = validate({{"plugin", "paper2d"}, {"parameters", {{"coupling", 0.6}}}}, "plugin");
+    CHECK(plugin.status == 2);
+    CHECK(contains(plugin.err, "/model/parameters/coupling: " + refused));
+    const auto sweep = validate({{"formula", formula}, {"parameters", {{"coupling", {0.1, 0.2, 0.6}}}}}, "sweep");
+    CHECK(sweep.status == 2);
+    CHECK(
+        contains(sweep.err, "/model/parameters/coupling/2: found the value 0.6; allowed: a value >= -0.1 and <= 0.3"));
+  }
+  SUBCASE("the plugin's source declares the range; a plain number has none") {
+    json model = formula;
+    model["parameters"]["other"] = 1.5;
+    model["V"] = "(q0^2 + q1^2)/2 + (q0^2 + q1^2)^2/12 + coupling*q0^2*q1^2 + other*q0";
+    write_text(folder / "model.json", model.dump());
+    const auto source =
+        run_nonsep({"model", "compile", (folder / "model.json").string(), "--print-source"}, folder.path());
+    CHECK(source.status == 0);
+    CHECK(contains(source.out,
+                   "{.name = \"coupling\", .type = nonsep::sdk::ParameterType::number, .default_value = "
+                   "0.2, .minimum = -0.1, .maximum = 0.3,"));
+    CHECK(contains(source.out,
+                   "{.name = \"other\", .type = nonsep::sdk::ParameterType::number, .default_value = "
+                   "1.5, .description"));
+  }
+  SUBCASE("a bad range is refused at its key path, exit 2") {
+    for (const auto& [bad, path] : std::vector<std::pair<json, std::string>>{
+             {{{"value", 0.2}, {"min", 0.3}, {"max", -0.1}}, "/coupling/min: found min 0.3 above max -0.1"},
+             {{{"value", 0.6}, {"min", -0.1}, {"max", 0.3}}, "/coupling/value: found the default 0.6"},
+             {{{"value", 0.2}, {"max", "0.3"}}, "/coupling/max"},
+             {{{"value", 0.2}, {"max", nullptr}}, "/coupling/max"},
+             {{{"min", -0.1}}, "/coupling/value"},
+             {{{"value", 0.2}, {"minimum", -0.1}}, "/coupling/minimum"}}) {
+      json model = formula;
+      model["parameters"]["coupling"] = bad;
+      const auto result = validate({{"formula", model}}, "bad");
+      CAPTURE(bad.dump());
+      CHECK(result.status == 2);
+      CHECK(contains(result.err, "/model/formula/parameters" + path));
+    }
+  }
+}
+
+TEST_CASE(
+    "formula commands: validate says what scheme auto would try for a formula job, as for the plugin of its model") {
+  TemporaryFolder folder;
+  Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");  // nothing is compiled
+  const json automatic = {{"scheme", "auto"}, {"tolerance", 1e-6}};
+  // The line after "integrator:" of `nonsep validate` for `model` with the states `initial`.
+  const auto auto_line = [&](const json& model, const json& initial, const std::string& name) {
+    json job = job_with(model, automatic);
+    job["initial"] = initial;
+    const auto result = run_nonsep({"validate", write_job(folder / (name + ".json"), job).string()}, folder.path());
+    INFO(name << ": " << result.err);
+    CHECK(result.status == 0);
+    const auto at = result.out.find("integrator:  ");
+    return at == std::string::npos ? std::string() : result.out.substr(at, result.out.find('\n', at) - at);
+  };
+  const json two = {{{"q", {0.25, 0.3}}, {"p", {-1.5, 0.2}}}, {{"q", {-0.75, 0.3}}, {"p", {-1.5, 0.2}}}};
+  const json paper2d_formula = {{"T", "p0 + p1 + (p0^3 + p1^3)/6"},
+                                {"V", "(q0^2 + q1^2)/2 + (q0^2 + q1^2)^2/12 + coupling*q0^2*q1^2"},
+                                {"parameters", {{"coupling", 0.2}}}};
+  const std::string product = auto_line({{"formula", paper2d_formula}}, two, "product");
+  CHECK(contains(product, "scheme auto: tolerance 1e-06"));
+  CHECK(contains(product, "would try gauss 6, gauss 4, mpe 4, triplet 8/3, triplet 2 with pilot runs of 2 state(s)"));
+  CHECK(product == auto_line({{"plugin", "paper2d"}}, two, "paper2d"));
+  // On an energy shell, before the compiled model places the states, the pilot states are an upper bound.
+  const json shell = {{"grid", {{"q", {{{"from", -2.0}, {"to", 2.0}, {"count", 11}}, 0.0}}, {"p", {0.0, 0.0}}}},
+                      {"energy", 7.0},
+                      {"solve_for", "p1"}};
+  CHECK(contains(auto_line({{"formula", paper2d_formula}}, shell, "shell"), "pilot runs of at most 8 state(s)"));
+  // Given by H: the schemes that integrate H, as for the Henon-Heiles plugin (also given by H).
+  const json henon_heiles = {{"H", "(p0^2 + p1^2)/2 + (q0^2 + q1^2)/2 + lambda*(q0^2*q1 - q1^3/3)"},
+                             {"parameters", {{"lambda", 1}}}};
+  const json one = {{{"q", {0.0, 0.1}}, {"p", {0.3, 0.0}}}};
+  const std::string general = auto_line({{"formula", henon_heiles}}, one, "general");
+  CHECK(contains(general, "would try gauss 6, gauss 4 with"));
+  CHECK(general == auto_line({{"plugin", "henon_heiles"}}, one, "henon_heiles"));
+}
+
 TEST_CASE("formula commands: a model written with q1 and q2 for two coordinates is told that components count from 0") {
   TemporaryFolder folder;
   Environment no_compiler("NONSEP_CXX", "/nonexistent/c++");

@@ -289,6 +289,55 @@ TEST_CASE("scheme auto meets its tolerance against the exact solution and record
   }
 }
 
+TEST_CASE("scheme auto: a phase tolerance on a chaotic orbit is not promised, the step is chosen by the energy") {
+  const TemporaryFolder folder;
+  // paper2d at coupling 0.2 (docs/dynamics.md): at t = 100 the pilots reach their asymptotic range only to t_end / 8,
+  // and a polynomial extrapolation from there predicted 3e-7 where the chaotic orbit's phase error is of order 1.
+  const auto run_orbit = [&](const std::string& name, double q0) {
+    json job = run_of({{"plugin", "paper2d"}}, {{"scheme", "auto"}, {"tolerance", 1e-6}},
+                      {{"q", {q0, 0.3}}, {"p", {-1.5, 0.2}}}, 100.0, 100.0, 0);
+    job["output"]["energy_every"] = 1;
+    return run_job(folder, name, job, {});
+  };
+  SUBCASE("chaotic: q = (-0.75, 0.3), p = (-1.5, 0.2)") {
+    const auto ran = run_orbit("chaotic", -0.75);
+    REQUIRE(ran.status == 0);
+    CHECK(ran.err.find("phase error grows exponentially") != std::string::npos);
+    CHECK(ran.err.find("is not promised") != std::string::npos);
+    CHECK(ran.err.find("error_estimate") != std::string::npos);
+    CHECK(ran.out.find("chosen by the energy") != std::string::npos);
+    const json choice = read_json(ran.folder / "summary.json")["scheme_choice"];
+    CHECK(choice["measure"] == "phase");
+    CHECK(choice["phase_error_growth"] == "exponential");
+    CHECK(choice["chosen_by"] == "energy");
+    CHECK(choice["estimated_error"].is_null());
+    CHECK(choice["estimated_error_meets_tolerance"].is_null());
+    CHECK(choice["tolerance_met"].is_null());
+    CHECK(choice["estimated_energy_error"].get<double>() <= 1e-6);
+    bool exponential = false;
+    for (const auto& candidate : choice["phase_candidates"])
+      exponential = exponential || (candidate["envelope_growth_exponent"].is_number() &&
+                                    candidate["envelope_growth_exponent"].get<double>() > 3.0);
+    CHECK(exponential);
+    // What was chosen by holds: the run's largest |dH/H0| with H at every step.
+    CHECK(number(table(ran.folder / "trajectories.csv").at(0), "max_abs_relative_energy_error") <= 1e-6);
+  }
+  SUBCASE("regular: q = (0.25, 0.3), p = (-1.5, 0.2)") {
+    const auto ran = run_orbit("regular", 0.25);
+    REQUIRE(ran.status == 0);
+    CHECK(ran.err.find("exponentially") == std::string::npos);
+    const json choice = read_json(ran.folder / "summary.json")["scheme_choice"];
+    CHECK(choice["phase_error_growth"] == "polynomial");
+    CHECK(choice["chosen_by"] == "phase");
+    CHECK(choice["phase_candidates"].is_null());
+    CHECK(choice["estimated_error"].get<double>() <= 1e-6);
+    CHECK(choice["tolerance_met"] == true);
+    for (const auto& candidate : choice["candidates"])
+      if (candidate["envelope_growth_exponent"].is_number())
+        CHECK(candidate["envelope_growth_exponent"].get<double>() <= 3.0);
+  }
+}
+
 TEST_CASE("scheme auto with a sweep meets its tolerance on every set, whose steps differ, against the exact solution") {
   const TemporaryFolder folder;
   // alpha sets the frequency: alpha = 3 or 20 needs a much smaller step than alpha = 1, whichever set comes first.

@@ -56,6 +56,9 @@ std::string sweep_text(const Job& job, bool loaded);
 // The "  parameters: ..." of `nonsep validate`: `parameters` with job's swept ones as their values (a list of up to
 // 8, else "N values: a, b, ..., z").
 std::string parameters_text(nlohmann::json parameters, const Job& job);
+// The "  integrator: ..." line of `nonsep validate`: the scheme and its options, or with scheme auto `auto_text`
+// (describe_auto's), and the form.
+std::string integrator_line(const SingleRun& run, const std::string& auto_text);
 int command_schema();
 
 // Texts of --help, generated from the scheme catalogue and the exit statuses.

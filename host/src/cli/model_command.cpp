@@ -10,6 +10,7 @@
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/formula/cpp_source.hpp"
 #include "nonsep/host/formula/plugin_cache.hpp"
+#include "nonsep/host/study/scheme_choice.hpp"
 
 namespace nonsep::host::cli {
 
@@ -89,6 +90,10 @@ int report_formula_job(const std::string& job_file, const Job& job) {
                              : "    " + std::string(model.t_gradient.empty() ? "T = " : "") + model.T + "\n" + "    " +
                                    (model.v_gradient.empty() ? "V = " : "") + model.V + "\n")
             << "  parameters:  " << parameters_with_defaults(job, formula::declared_parameters(model)) << "\n"
+            << (job.is_study()
+                    ? ""
+                    : integrator_line(job.run(),
+                                      job.run().auto_scheme ? describe_auto(job, auto_model(model), false) : ""))
             << sweep_text(job, false)
             << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "
                "(initial states on an energy shell, the gradient check) is checked then\n";

@@ -351,11 +351,16 @@ std::optional<int> choose(LoadedJob& loaded, RunOptions& options, const RunArgum
     options.scheme_choice = to_json(choice);
     if (!arguments.quiet) {
       const PilotResult& chosen = choice.pilots[choice.chosen];
+      const std::string predicted = choice.chosen_by == AutoScheme::Measure::energy
+                                        ? "chosen by the energy, predicted largest |dH/H0| "
+                                        : "predicted error ";
       std::cout << "auto: " << chosen.candidate.label << " with dt = " << format_number(loaded.job.run().time.dt)
-                << " (" << loaded.job.run().time.steps << " steps), predicted error "
+                << " (" << loaded.job.run().time.steps << " steps), " << predicted
                 << format_number(chosen.predicted_error) << " for tolerance " << format_number(choice.tolerance)
                 << "; pilots " << format_number(choice.pilot_seconds) << " s\n";
     }
+    if (const std::string warning = choice_warning(choice); !warning.empty())
+      std::cerr << "nonsep: " << warning << "\n";
     return std::nullopt;
   } catch (const PilotsInterrupted&) {
     const int signal = stop_signal.load();

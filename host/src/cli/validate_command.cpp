@@ -34,6 +34,11 @@ std::string integrator_text(const IntegratorSpec& spec) {
   return text;
 }
 
+std::string integrator_line(const SingleRun& run, const std::string& auto_text) {
+  return "  integrator:  " + (run.auto_scheme ? auto_text : integrator_text(run.integrator)) + ", H_" +
+         (run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT") + "\n";
+}
+
 std::string parameters_text(nlohmann::json parameters, const Job& job) {
   for (const SweptParameter& swept : job.sweep) {
     const auto& values = swept.values;
@@ -89,13 +94,11 @@ int command_validate(const std::string& job_file) {
       return to_int(ExitStatus::success);
     }
     const SingleRun& run = job.run();
-    const IntegratorSpec& spec = run.integrator;
     std::cout << "valid: " << job_file << "\n"
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
               << "  parameters:  " << parameters_text(loaded.model.parameters(), job) << "\n"
-              << "  integrator:  " << (run.auto_scheme ? describe_auto(loaded) : integrator_text(spec)) << ", H_"
-              << (spec.form == HamiltonianForm::TTV ? "TTV" : "VVT") << "\n"
+              << integrator_line(run, run.auto_scheme ? describe_auto(loaded) : "")
               << "  initial:     " << job.initial.count
               << (job.sweep.empty() ? (job.initial.count == 1 ? " state" : " states")
                                     : (job.initial.count == 1 ? " trajectory" : " trajectories"))

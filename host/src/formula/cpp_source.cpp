@@ -247,16 +247,18 @@ std::string cpp_source(const FormulaModel& model) {
       std::to_string(model.dimension) + ";\n";
   if (!model.parameters.empty()) {
     source += "  static constexpr nonsep::sdk::Parameter parameters[] = {\n";
-    for (const auto& [name, value] : model.parameters)
-      source += "      {.name = \"" + name +
-                "\", .type = nonsep::sdk::ParameterType::number, .default_value = " + literal(value) +
-                ", .description = \"a parameter of the formulas\"},\n";
+    for (const FormulaParameter& parameter : model.parameters)
+      source += "      {.name = \"" + parameter.name +
+                "\", .type = nonsep::sdk::ParameterType::number, .default_value = " + literal(parameter.value) +
+                (parameter.minimum ? ", .minimum = " + literal(*parameter.minimum) : std::string()) +
+                (parameter.maximum ? ", .maximum = " + literal(*parameter.maximum) : std::string()) +
+                ", .description = \"" + formula_parameter_description + "\"},\n";
     source += "  };\n  explicit Formula(const nonsep::sdk::ParameterValues& values)\n      : ";
     for (std::size_t i = 0; i < model.parameters.size(); ++i)
-      source += (i == 0 ? "" : ", ") + std::string("parameter_") + model.parameters[i].first + "(values.number(\"" +
-                model.parameters[i].first + "\"))";
+      source += (i == 0 ? "" : ", ") + std::string("parameter_") + model.parameters[i].name + "(values.number(\"" +
+                model.parameters[i].name + "\"))";
     source += " {}\n";
-    for (const auto& parameter : model.parameters) source += "  double parameter_" + parameter.first + ";\n";
+    for (const auto& parameter : model.parameters) source += "  double parameter_" + parameter.name + ";\n";
   }
   std::string parts;
   std::size_t part_count = 0;

@@ -5,8 +5,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "job/sections.hpp"
 #include "nonsep/host/json/checker.hpp"
 #include "nonsep/host/json/strict_json.hpp"
+#include "nonsep/host/number_format.hpp"
 
 namespace nonsep::host::formula {
 
@@ -159,6 +161,56 @@ bool read_product_form(Checker& check, const json& object, const std::string& po
   return true;
 }
 
+// A formula's parameter as its plugin declares it.
+PluginParameter as_declared(const FormulaParameter& parameter) {
+  return {parameter.name,
+          "number",
+          parameter.value,
+          parameter.minimum,
+          parameter.maximum,
+          "",
+          formula_parameter_description};
+}
+
+// One parameter: its default, a number, or {"value": default, "min": ..., "max": ...} (either bound optional; the
+// default within them). Nothing, with issues added, when anything is wrong.
+std::optional<FormulaParameter> read_parameter(Checker& check, const std::string& name, const json& value,
+                                               const std::string& path) {
+  const std::string what =
+      "the parameter's default, a finite number, or {\"value\": default, \"min\": ..., \"max\": ...} with its "
+      "allowed range";
+  FormulaParameter parameter;
+  parameter.name = name;
+  if (!value.is_object()) {
+    const auto number = check.finite_number(value, path, what);
+    if (!number) return std::nullopt;
+    parameter.value = *number;
+    return parameter;
+  }
+  const std::size_t before = check.issue_count();
+  check.known_keys(value, path, {"value", "min", "max"});
+  const auto number = [&](const char* key, bool required, const std::string& allowed) -> std::optional<double> {
+    const json* member = check.member(value, path, key, required, allowed);
+    return member ? check.finite_number(*member, job_reader::child(path, key), allowed) : std::nullopt;
+  };
+  const auto given = number("value", true, "the parameter's default, a finite number");
+  parameter.minimum = number("min", false, "the smallest value allowed, a finite number");
+  parameter.maximum = number("max", false, "the largest value allowed, a finite number");
+  if (check.issue_count() != before || !given) return std::nullopt;
+  parameter.value = *given;
+  if (parameter.minimum && parameter.maximum && *parameter.minimum > *parameter.maximum) {
+    check.issue(job_reader::child(path, "min"),
+                "min " + format_number(*parameter.minimum) + " above max " + format_number(*parameter.maximum),
+                "a range with min <= max");
+    return std::nullopt;
+  }
+  // The default against its range by the rule every parameter value meets (job_reader::check_parameter_value).
+  job_reader::check_parameter_value(check, as_declared(parameter), value["value"], job_reader::child(path, "value"),
+                                    "the default " + format_number(parameter.value));
+  if (check.issue_count() != before) return std::nullopt;
+  return parameter;
+}
+
 std::shared_ptr<const FormulaModel> read_object(const json& object, const std::string& pointer,
                                                 std::vector<JobIssue>& issues) {
   Checker check(issues);
@@ -187,10 +239,10 @@ std::shared_ptr<const FormulaModel> read_object(const json& object, const std::s
                       "variable (q0, p1, ...), a function or pi");
           continue;
         }
-        if (const auto number = check.finite_number(value, member, "the parameter's default, a finite number")) {
-          model.parameters.emplace_back(name, *number);
-          symbols.parameters.push_back(name);
-        }
+        // A name the formulas may use even when its default or range is refused (one issue, not one per use).
+        symbols.parameters.push_back(name);
+        if (auto parameter = read_parameter(check, name, value, member))
+          model.parameters.push_back(std::move(*parameter));
       }
     }
   }
@@ -261,14 +313,13 @@ std::shared_ptr<const FormulaModel> read_formula_model(const nlohmann::json& val
 
 std::vector<PluginParameter> declared_parameters(const FormulaModel& model) {
   std::vector<PluginParameter> declared;
-  for (const auto& [name, value] : model.parameters)
-    declared.push_back({name, "number", value, std::nullopt, std::nullopt, "", "a parameter of the formulas"});
+  for (const FormulaParameter& parameter : model.parameters) declared.push_back(as_declared(parameter));
   return declared;
 }
 
 nlohmann::json formula_record(const FormulaModel& model, const std::string& cache_key) {
   json parameters = json::object();
-  for (const auto& [name, value] : model.parameters) parameters[name] = value;
+  for (const FormulaParameter& parameter : model.parameters) parameters[parameter.name] = parameter.value;
   const bool product_form = !model.h_tree;
   return {{"name", model.name},
           {"H", product_form ? json(nullptr) : json(model.H)},
@@ -374,9 +425,21 @@ nlohmann::ordered_json formula_schema() {
         {"parameters",
          {{"type", "object"},
           {"propertyNames", parameter_names},
-          {"additionalProperties", {{"type", "number"}}},
+          {"additionalProperties",
+           {{"oneOf",
+             {{{"type", "number"}},
+              {{"type", "object"},
+               {"additionalProperties", false},
+               {"required", {"value"}},
+               {"properties",
+                {{"value", {{"type", "number"}, {"description", "The default value."}}},
+                 {"min", {{"type", "number"}, {"description", "The smallest value allowed (inclusive)."}}},
+                 {"max", {{"type", "number"}, {"description", "The largest value allowed (inclusive)."}}}}}}}}}},
           {"default", nlohmann::ordered_json::object()},
-          {"description", "The formulas' parameters and their default values; /model/parameters overrides them."}}},
+          {"description",
+           "The formulas' parameters and their default values, each a number or {\"value\": default, \"min\": ..., "
+           "\"max\": ...} with the range allowed (either bound optional); /model/parameters overrides the defaults, "
+           "and a value or sweep outside a range is refused as for a plugin's parameter."}}},
         {"dimension",
          {{"type", "integer"},
           {"minimum", 1},

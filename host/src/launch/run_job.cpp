@@ -101,7 +101,8 @@ nlohmann::ordered_json error_estimate_facts(const ErrorEstimateObserver& estimat
 
 // Scheme "auto": the choice, and what the run itself shows against the tolerance: the largest |dH/H0| where it
 // evaluated H (measure "energy"), the largest estimated phase error of /analysis/error_estimate (measure "phase",
-// when asked for); without them the pilots' prediction alone. A note for the user when it is not met.
+// when asked for); without them the pilots' prediction alone (none when the phase error grew exponentially: then
+// tolerance_met is null). A note for the user when it is not met.
 nlohmann::ordered_json checked_choice(nlohmann::ordered_json choice, const RunOutcome& outcome,
                                       const ErrorEstimateObserver* estimate, std::vector<std::string>& notes) {
   const double tolerance = choice["tolerance"].get<double>();
@@ -115,15 +116,21 @@ nlohmann::ordered_json checked_choice(nlohmann::ordered_json choice, const RunOu
     measured = estimate->totals().largest_phase_error;
     how = "the run's error estimate (analysis.error_estimate)";
   }
-  const double predicted = choice["estimated_error"].get<double>();
-  const double judged = measured ? std::max(*measured, predicted) : predicted;
+  // No prediction when the pilots' phase error grew exponentially (scheme_choice.hpp): then only a measurement
+  // judges the tolerance.
+  const bool has_prediction = choice["estimated_error"].is_number();
+  const double predicted = has_prediction ? choice["estimated_error"].get<double>() : 0.0;
+  const bool judged = measured || has_prediction;
+  const double error = measured && has_prediction ? std::max(*measured, predicted) : measured ? *measured : predicted;
   choice["measured_error"] = measured ? nlohmann::ordered_json(*measured) : nullptr;
-  choice["measured_by"] = measured ? how : "nothing (the pilots' prediction alone)";
-  choice["tolerance_met"] = judged <= tolerance;
-  if (!(judged <= tolerance))
+  choice["measured_by"] = measured ? how : has_prediction ? "nothing (the pilots' prediction alone)" : "nothing";
+  choice["tolerance_met"] = judged ? nlohmann::ordered_json(error <= tolerance) : nullptr;
+  if (judged && !(error <= tolerance))
     notes.push_back("warning: scheme auto did not meet the tolerance " + format_number(tolerance) + ": " +
-                    (measured ? how + " is " + format_number(*measured) + ", the prediction " : "the prediction is ") +
-                    format_number(predicted));
+                    (measured ? how + " is " + format_number(*measured) : std::string()) +
+                    (measured && has_prediction ? ", " : "") +
+                    (has_prediction ? "the prediction " + std::string(measured ? "" : "is ") + format_number(predicted)
+                                    : std::string()));
   return choice;
 }
 

@@ -9,6 +9,7 @@
 #include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
+#include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
@@ -24,6 +25,8 @@ using Clock = std::chrono::steady_clock;
 constexpr double pilot_round_off = 1e-13;
 // The asymptotic range: the error falls by 2^order per halving of the step, within this factor.
 constexpr double asymptotic_within = 2.5;
+// The pilots' states are kept at t_p k / pilot_marks (k = 1 .. pilot_marks), for the growth of the phase error.
+constexpr std::uint64_t pilot_marks = 8;
 
 // The catalogue's scheme `name` with its defaults, and `order` or `stages` for the option of that name.
 IntegratorSpec spec_of(const std::string& name, Fraction order, double stages, HamiltonianForm form) {
@@ -38,16 +41,18 @@ IntegratorSpec spec_of(const std::string& name, Fraction order, double stages, H
   return spec;
 }
 
-// One pilot run: its states at t_p / 2 and t_p and its largest |dH/H0| up to each (energy evaluated at every step
-// when the measure is the energy).
+// One pilot run: its states at t_p k / pilot_marks (k = 1 .. pilot_marks; those that fall on a step) and its largest
+// |dH/H0| up to t_p / 2 and t_p (energy evaluated at every step when the measure is the energy).
 class PilotObserver : public Observer {
  public:
   PilotObserver(std::size_t count, std::size_t dimension, std::uint64_t steps, bool energy)
-      : dimension_(dimension), steps_(steps), energy_(energy), half_(count * 2 * dimension), end_(half_) {}
+      : dimension_(dimension), steps_(steps), energy_(energy), width_(count * 2 * dimension), marks_(pilot_marks) {}
 
   std::uint64_t next_event(std::uint64_t step) const override {
     if (energy_) return step < steps_ ? step + 1 : no_event;
-    return step < steps_ / 2 ? steps_ / 2 : step < steps_ ? steps_ : no_event;
+    for (std::uint64_t k = 1; k <= pilot_marks; ++k)
+      if (const auto mark = mark_step(k); mark && *mark > step) return *mark;
+    return no_event;
   }
   bool needs_energy(std::uint64_t) const override { return energy_; }
   void on_event(const Event& event) override {
@@ -57,8 +62,10 @@ class PilotObserver : public Observer {
         max_end_ = std::max(max_end_, e);
         if (event.step <= steps_ / 2) max_half_ = std::max(max_half_, e);
       }
-      if (event.step != steps_ / 2 && event.step != steps_) continue;
-      std::vector<double>& into = event.step == steps_ ? end_ : half_;
+      const std::uint64_t k = event.step * pilot_marks / steps_;
+      if (k == 0 || mark_step(k) != event.step) continue;
+      std::vector<double>& into = marks_[k - 1];
+      into.resize(width_);
       std::copy(state.q.begin(), state.q.end(),
                 into.begin() + static_cast<std::ptrdiff_t>(state.trajectory * 2 * dimension_));
       std::copy(state.p.begin(), state.p.end(),
@@ -71,17 +78,24 @@ class PilotObserver : public Observer {
                  " (pilot state " + std::to_string(trajectory) + ")";
   }
 
+  // The step of mark k, when t_p k / pilot_marks falls on one.
+  std::optional<std::uint64_t> mark_step(std::uint64_t k) const {
+    if (k * steps_ % pilot_marks != 0) return std::nullopt;
+    return k * steps_ / pilot_marks;
+  }
+
   std::size_t dimension_;
   std::uint64_t steps_;
   bool energy_;
-  std::vector<double> half_, end_;
+  std::size_t width_;
+  std::vector<std::vector<double>> marks_;  // the states at mark k = 1 .. pilot_marks; empty where none falls
   double max_half_ = 0.0, max_end_ = 0.0;
   std::string problem_;
 };
 
 struct PilotRun {
-  std::string problem;  // "" when every pilot state completed
-  std::vector<double> half, end;
+  std::string problem;                     // "" when every pilot state completed
+  std::vector<std::vector<double>> marks;  // PilotObserver::marks_
   double max_half = 0.0, max_end = 0.0;
   double seconds = 0.0;
 };
@@ -121,6 +135,19 @@ std::vector<std::size_t> pilot_indices(const InitialStates& initial) {
     for (std::size_t k = 0; k < count; ++k) indices.push_back(first + k * size / count);
   }
   return indices;
+}
+
+// How the phase error of the pilot pair (2n, 4n steps) grew over the second half of the pilot: log2 of the largest
+// distance between their states at the marks up to t_p over the largest up to t_p / 2. Nothing when that at t_p / 2
+// is within a factor 10 of round-off (`floor`): the ratio of two round-offs says nothing about the orbit.
+std::optional<double> envelope_growth(const PilotRun& coarse, const PilotRun& fine, std::size_t width, double floor) {
+  double largest = 0.0, at_half = 0.0;
+  for (std::size_t k = 0; k < pilot_marks; ++k) {
+    largest = std::max(largest, largest_distance(coarse.marks[k], fine.marks[k], width));
+    if (k + 1 == pilot_marks / 2) at_half = largest;
+  }
+  if (!(at_half > 10.0 * floor)) return std::nullopt;
+  return std::log2(largest / at_half);
 }
 
 class Pilots {
@@ -188,9 +215,9 @@ class Pilots {
                                       : r4.problem);
         continue;
       }
-      const double coarse = energy ? r2.max_end : largest_distance(r1.end, r2.end, width);
-      const double fine = energy ? r4.max_end : largest_distance(r2.end, r4.end, width);
-      const double floor = pilot_round_off * (energy ? 1.0 : std::max(1.0, largest_length(r4.end, width)));
+      const double coarse = energy ? r2.max_end : largest_distance(r1.marks.back(), r2.marks.back(), width);
+      const double fine = energy ? r4.max_end : largest_distance(r2.marks.back(), r4.marks.back(), width);
+      const double floor = pilot_round_off * (energy ? 1.0 : std::max(1.0, largest_length(r4.marks.back(), width)));
       const double ratio = coarse / fine, expected = std::pow(2.0, order);
       const bool round_off = fine <= floor;
       if (!round_off && !(ratio >= expected / asymptotic_within && ratio <= expected * asymptotic_within)) {
@@ -203,9 +230,11 @@ class Pilots {
       result.ratio = ratio;
       // At round-off the difference bounds the error; in the asymptotic range Richardson gives it.
       result.pilot_error = energy || round_off ? std::max(fine, floor) : fine / (expected - 1.0);
-      const double half = energy ? r4.max_half : largest_distance(r2.half, r4.half, width);
+      const double half =
+          energy ? r4.max_half : largest_distance(r2.marks[pilot_marks / 2 - 1], r4.marks[pilot_marks / 2 - 1], width);
       const double raw = half > 0.0 && fine > 0.0 ? std::log2(fine / half) : 1.0;
-      result.growth = std::clamp(std::isfinite(raw) ? raw : 1.0, energy ? 0.0 : 1.0, 3.0);
+      result.growth = std::clamp(std::isfinite(raw) ? raw : 1.0, energy ? 0.0 : 1.0, max_growth_exponent);
+      if (!energy) result.envelope_growth = envelope_growth(r2, r4, width, floor);
       result.seconds_per_step = r4.seconds > r1.seconds ? (r4.seconds - r1.seconds) / static_cast<double>(3 * n)
                                                         : r4.seconds / static_cast<double>(4 * n);
       predict(result, order);
@@ -275,8 +304,7 @@ class Pilots {
     if (end == DriverEnd::interrupted) throw PilotsInterrupted("interrupted during the pilot runs of scheme auto");
     if (end == DriverEnd::failed) result.problem = "failed: " + driver.error();
     if (result.problem.empty()) result.problem = observer.problem_;
-    result.half = std::move(observer.half_);
-    result.end = std::move(observer.end_);
+    result.marks = std::move(observer.marks_);
     result.max_half = observer.max_half_;
     result.max_end = observer.max_end_;
     return result;
@@ -294,8 +322,22 @@ json number_or_null(double x, bool known) { return known && std::isfinite(x) ? j
 
 }  // namespace
 
+AutoModel auto_model(const Plugin& plugin) {
+  return {plugin.general_hamiltonian(), plugin.has_hessians() && plugin.has_third_derivatives(),
+          plugin.has_hamiltonian_hessian_products()};
+}
+
+AutoModel auto_model(const formula::FormulaModel& model) {
+  // Its plugin's functions are templates of the number type: the SDK differentiates them to every order.
+  return {model.h_tree.has_value(), true, true};
+}
+
 std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
-  const SingleRun& run = loaded.job.run();
+  return auto_candidates(loaded.job, auto_model(loaded.plugin));
+}
+
+std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& model) {
+  const SingleRun& run = job.run();
   const HamiltonianForm form = run.integrator.form;
   // Fastest first, so that the pilots of slower ones are cut short: Gauss by falling order (on paper1d order 16
   // needs the fewest grad H of all stage counts to meet 1e-8 or tighter: bench/comparators.cpp), then Chin's.
@@ -309,26 +351,28 @@ std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
       {"triplet 2", spec_of("triplet", Fraction(2), 2, form)},
   };
   // A model given by H (general_hamiltonian) has the gradient of H and no product form for Chin's schemes.
-  const bool general = loaded.plugin.general_hamiltonian();
-  const bool gradient_of_h = general || (loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives());
+  const bool general = model.general;
+  const bool gradient_of_h = general || model.hessians_and_third_derivatives;
   std::vector<AutoCandidate> usable;
   for (auto& candidate : all) {
     if (Integrator(candidate.spec).is_comparator() ? !gradient_of_h : general) continue;
     // A comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
     if (run.analysis.tangent_vectors() > 0 &&
-        (!has_tangent_map(candidate.spec) ||
-         (Integrator(candidate.spec).is_comparator() && !loaded.plugin.has_hamiltonian_hessian_products())))
+        (!has_tangent_map(candidate.spec) || (Integrator(candidate.spec).is_comparator() && !model.hessian_products)))
       continue;
     usable.push_back(std::move(candidate));
   }
   return usable;
 }
 
-SchemeChoice choose_scheme(const LoadedJob& loaded, const RunOptions& options) {
-  const AutoScheme& asked = *loaded.job.run().auto_scheme;
+namespace {
+
+// The choice by `measure`: the pilots at each fraction of t_end in turn until some candidate is usable.
+SchemeChoice choose_by(const LoadedJob& loaded, const RunOptions& options, AutoScheme::Measure measure) {
   SchemeChoice choice;
-  choice.tolerance = asked.tolerance;
-  choice.measure = asked.measure;
+  choice.tolerance = loaded.job.run().auto_scheme->tolerance;
+  choice.measure = measure;
+  choice.chosen_by = measure;
   std::optional<std::size_t> best;
   std::string reasons;
   for (const double fraction : auto_pilot_fractions) {
@@ -356,6 +400,66 @@ SchemeChoice choose_scheme(const LoadedJob& loaded, const RunOptions& options) {
   choice.chosen = *best;
   choice.subdivision = choice.pilots[*best].steps / loaded.job.run().time.steps;
   return choice;
+}
+
+// Whether a usable candidate's pilots saw the phase error grow faster than t^max_growth_exponent over their second
+// half: exponentially, as on a chaotic orbit, where no power of t extrapolates it.
+bool grows_exponentially(const SchemeChoice& choice) {
+  return std::any_of(choice.pilots.begin(), choice.pilots.end(), [](const PilotResult& pilot) {
+    return pilot.excluded.empty() && pilot.envelope_growth && *pilot.envelope_growth > max_growth_exponent;
+  });
+}
+
+}  // namespace
+
+SchemeChoice choose_scheme(const LoadedJob& loaded, const RunOptions& options) {
+  SchemeChoice choice = choose_by(loaded, options, loaded.job.run().auto_scheme->measure);
+  if (choice.measure == AutoScheme::Measure::energy) return choice;
+  // One degree of freedom is integrable, never chaotic: there a fast growth within a period is not judged.
+  const bool judged = loaded.job.initial.dimension >= 2;
+  choice.phase_growth = judged && grows_exponentially(choice) ? PhaseGrowth::exponential : PhaseGrowth::polynomial;
+  // The phase error at t_end cannot be predicted: the step is chosen by the energy, which a chaotic orbit does not
+  // amplify, when the model has it (else the phase pilots' choice stands, unpromised).
+  if (choice.phase_growth == PhaseGrowth::polynomial || !loaded.plugin.has_energy()) return choice;
+  try {
+    SchemeChoice by_energy = choose_by(loaded, options, AutoScheme::Measure::energy);
+    by_energy.measure = AutoScheme::Measure::phase;
+    by_energy.phase_growth = choice.phase_growth;
+    by_energy.phase_pilots = std::move(choice.pilots);
+    by_energy.phase_pilot_horizon = choice.pilot_horizon;
+    by_energy.pilot_seconds += choice.pilot_seconds;
+    by_energy.pilot_state_steps += choice.pilot_state_steps;
+    EvaluationCounts& total = by_energy.pilot_evaluations;
+    const EvaluationCounts& phase = choice.pilot_evaluations;
+    total.grad_T += phase.grad_T;
+    total.grad_V += phase.grad_V;
+    total.grad_H += phase.grad_H;
+    total.grad_K += phase.grad_K;
+    total.grad_U += phase.grad_U;
+    return by_energy;
+  } catch (const PilotsInterrupted&) {
+    throw;
+  } catch (const ChoiceFailed&) {
+    return choice;  // no candidate meets the tolerance on the energy either: the phase pilots' choice stands
+  }
+}
+
+std::string choice_warning(const SchemeChoice& choice) {
+  if (choice.phase_growth != PhaseGrowth::exponential) return "";
+  const PilotResult& chosen = choice.pilots[choice.chosen];
+  return "warning: scheme auto: the pilots' phase error grows exponentially (faster than t^" +
+         format_number(max_growth_exponent) + " from t = " +
+         format_number(
+             (choice.chosen_by == AutoScheme::Measure::energy ? choice.phase_pilot_horizon : choice.pilot_horizon) /
+             2) +
+         " on), as on a chaotic orbit: the phase error at t_end cannot be predicted, and the tolerance " +
+         format_number(choice.tolerance) + " on it is not promised; " +
+         (choice.chosen_by == AutoScheme::Measure::energy
+              ? "the step was chosen by the energy instead (largest |dH/H0| predicted " +
+                    format_number(chosen.predicted_error) + ")"
+              : "the step is the phase pilots' choice (the model has no energy to choose by)") +
+         ". Measure the phase error with \"analysis\": {\"error_estimate\": true} (it says when the runs separate), "
+         "or ask for \"measure\": \"energy\"";
 }
 
 void apply_choice(Job& job, const SchemeChoice& choice) {
@@ -396,9 +500,11 @@ void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& reco
   apply_choice(loaded.job, choice);
 }
 
-json to_json(const SchemeChoice& choice) {
+namespace {
+
+json candidates_json(const std::vector<PilotResult>& pilots) {
   json candidates = json::array();
-  for (const PilotResult& pilot : choice.pilots) {
+  for (const PilotResult& pilot : pilots) {
     const bool usable = pilot.excluded.empty();
     const double order = Integrator(pilot.candidate.spec).describe().order.value();
     candidates.push_back({{"label", pilot.candidate.label},
@@ -411,46 +517,77 @@ json to_json(const SchemeChoice& choice) {
                           {"error_ratio_per_halving", number_or_null(pilot.ratio, pilot.pilot_steps > 0)},
                           {"expected_ratio", std::pow(2.0, order)},
                           {"growth_exponent", number_or_null(pilot.growth, pilot.pilot_steps > 0)},
+                          {"envelope_growth_exponent",
+                           number_or_null(pilot.envelope_growth.value_or(0.0), pilot.envelope_growth.has_value())},
                           {"seconds_per_step", number_or_null(pilot.seconds_per_step, pilot.pilot_steps > 0)},
                           {"steps", usable ? json(pilot.steps) : json(nullptr)},
                           {"predicted_error", number_or_null(pilot.predicted_error, usable)},
                           {"predicted_seconds", number_or_null(pilot.predicted_seconds, usable)}});
   }
+  return candidates;
+}
+
+const char* measure_name(AutoScheme::Measure measure) {
+  return measure == AutoScheme::Measure::phase ? "phase" : "energy";
+}
+
+}  // namespace
+
+json to_json(const SchemeChoice& choice) {
   const PilotResult& chosen = choice.pilots[choice.chosen];
   const EvaluationCounts& e = choice.pilot_evaluations;
-  return {{"tolerance", choice.tolerance},
-          {"measure", choice.measure == AutoScheme::Measure::phase ? "phase" : "energy"},
-          {"method",
-           "pilots at n, 2n, 4n steps to the pilot horizon; error at t_end predicted as e_p (h / h_p)^order "
-           "(t_end / t_p)^growth_exponent, aimed at tolerance / " +
-               format_number(auto_safety)},
-          {"pilot_horizon", choice.pilot_horizon},
-          {"pilot_states", choice.pilot_states},
-          {"candidates", std::move(candidates)},
-          {"chosen", chosen.candidate.label},
-          {"subdivision", choice.subdivision},
-          {"estimated_error", chosen.predicted_error},
-          {"estimated_error_meets_tolerance", chosen.predicted_error <= choice.tolerance},
-          {"pilot_cost",
-           {{"wall_seconds", choice.pilot_seconds},
-            {"state_steps", choice.pilot_state_steps},
-            {"evaluations",
-             {{"grad_T", e.grad_T},
-              {"grad_V", e.grad_V},
-              {"grad_H", e.grad_H},
-              {"grad_K", e.grad_K},
-              {"grad_U", e.grad_U}}}}}};
+  const bool asked = choice.chosen_by == choice.measure;  // false: chosen by the energy for a phase tolerance
+  // The phase error at t_end of an exponentially growing one is not predicted (its pilots' extrapolation stays in
+  // "candidates" or "phase_candidates").
+  const bool predicted = choice.phase_growth != PhaseGrowth::exponential;
+  return {
+      {"tolerance", choice.tolerance},
+      {"measure", measure_name(choice.measure)},
+      {"phase_error_growth", choice.phase_growth == PhaseGrowth::not_measured  ? json(nullptr)
+                             : choice.phase_growth == PhaseGrowth::exponential ? json("exponential")
+                                                                               : json("polynomial")},
+      {"chosen_by", measure_name(choice.chosen_by)},
+      {"method",
+       "pilots at n, 2n, 4n steps to the pilot horizon; error at t_end predicted as e_p (h / h_p)^order "
+       "(t_end / t_p)^growth_exponent, aimed at tolerance / " +
+           format_number(auto_safety)},
+      {"pilot_horizon", choice.pilot_horizon},
+      {"pilot_states", choice.pilot_states},
+      {"candidates", candidates_json(choice.pilots)},
+      {"phase_candidates", asked ? json(nullptr) : candidates_json(choice.phase_pilots)},
+      {"phase_pilot_horizon", asked ? json(nullptr) : json(choice.phase_pilot_horizon)},
+      {"chosen", chosen.candidate.label},
+      {"subdivision", choice.subdivision},
+      {"estimated_error", predicted ? json(chosen.predicted_error) : json(nullptr)},
+      {"estimated_error_meets_tolerance", predicted ? json(chosen.predicted_error <= choice.tolerance) : json(nullptr)},
+      {"estimated_energy_error", asked ? json(nullptr) : json(chosen.predicted_error)},
+      {"pilot_cost",
+       {{"wall_seconds", choice.pilot_seconds},
+        {"state_steps", choice.pilot_state_steps},
+        {"evaluations",
+         {{"grad_T", e.grad_T},
+          {"grad_V", e.grad_V},
+          {"grad_H", e.grad_H},
+          {"grad_K", e.grad_K},
+          {"grad_U", e.grad_U}}}}}};
 }
 
 std::string describe_auto(const LoadedJob& loaded) {
-  const AutoScheme& asked = *loaded.job.run().auto_scheme;
+  return describe_auto(loaded.job, auto_model(loaded.plugin), true);
+}
+
+std::string describe_auto(const Job& job, const AutoModel& model, bool loaded) {
+  const AutoScheme& asked = *job.run().auto_scheme;
   std::string names;
-  for (const AutoCandidate& candidate : auto_candidates(loaded)) names += (names.empty() ? "" : ", ") + candidate.label;
-  const std::size_t states = pilot_indices(loaded.job.initial).size();
+  for (const AutoCandidate& candidate : auto_candidates(job, model))
+    names += (names.empty() ? "" : ", ") + candidate.label;
+  const std::size_t states = pilot_indices(job.initial).size();
+  // Before the states are placed on an energy shell, some may be left out: the pilots are at most these.
+  const bool at_most = !loaded && job.initial.shell;
   return "scheme auto: tolerance " + format_number(asked.tolerance) + " on the " +
          (asked.measure == AutoScheme::Measure::phase ? "phase-space error at t_end" : "largest |dH/H0|") +
-         "; would try " + names + " with pilot runs of " + std::to_string(states) +
-         " state(s) to t = " + format_number(loaded.job.run().time.t_end) + " (at most " +
+         "; would try " + names + " with pilot runs of " + (at_most ? "at most " : "") + std::to_string(states) +
+         " state(s) to t = " + format_number(job.run().time.t_end) + " (at most " +
          std::to_string(auto_pilot_max_steps) +
          " steps each; to t_end / 8, then t_end / 64, when none is usable), then run the cheapest that meets it";
 }

@@ -9,14 +9,19 @@
 //                                                   never their values; the plugin's value_T, value_V then throw)
 //    "K": "...", "U": "alpha^2 * q0^2 / 2",         optional: a separable part K(p) + U(q) of H
 //                                                   (H = T_i V_ij T_j + K + U, nonsep/sdk/model_adapter.hpp)
-//    "parameters": {"alpha": 0.5},                  optional: names (is_parameter_name) and their default values
+//    "parameters": {"alpha": 0.5},                  optional: names (is_parameter_name) and their default values;
+//                                                   or {"c": {"value": 0.2, "min": -0.1, "max": 0.3}}: a default
+//                                                   and its allowed range (inclusive, either bound optional),
+//                                                   which the compiled plugin declares as a plugin's table does, so
+//                                                   that values and sweeps outside it are refused
 //    "dimension": 2}                                optional: n (1..64); default the largest index used plus one
 // or, for a Hamiltonian of any shape, instead of T, V, dT, dV, K and U:
 //   {"H": "(p0 - q1)^2 / 2 + ...", ...}             H(q, p), a formula of q0, q1, ..., p0, p1, ...: a model given
 //                                                   by H (gauss, implicit_midpoint and tao integrate it; Chin's
 //                                                   schemes need the product form)
 // /model/formula is that object, or a string: the path of a JSON file holding it (relative to the job's folder).
-// The parameters are numbers; a job's /model/parameters overrides their defaults as for any plugin.
+// The parameters are numbers; a job's /model/parameters overrides their defaults as for any plugin, within their
+// ranges.
 // Every problem is a JobIssue at a JSON Pointer (in the job, or "<model file>#/V" in a model file); a formula's
 // issue quotes it and points at the column (expression.hpp). Nothing is compiled here.
 #include <cstddef>
@@ -34,6 +39,15 @@
 
 namespace nonsep::host::formula {
 
+// What the plugin of a formula model says of each parameter.
+inline constexpr const char* formula_parameter_description = "a parameter of the formulas";
+
+struct FormulaParameter {
+  std::string name;
+  double value = 0.0;                      // the default
+  std::optional<double> minimum, maximum;  // the allowed range, inclusive; absent: unbounded
+};
+
 struct FormulaModel {
   std::string name = "formula";
   std::optional<Node> h_tree;  // a model given by H(q, p): its tree, and T, V, K, U and their trees unused
@@ -45,7 +59,7 @@ struct FormulaModel {
   std::vector<Node> t_gradient, v_gradient;
   std::string K, U;  // the separable part's canonical text; empty when absent
   std::optional<Node> k_tree, u_tree;
-  std::vector<std::pair<std::string, double>> parameters;  // in the order of the JSON object (by name)
+  std::vector<FormulaParameter> parameters;  // in the order of the JSON object (by name)
   std::size_t dimension = 1;
   std::filesystem::path file;  // the model file it came from; empty when written in the job
 };

@@ -46,14 +46,26 @@ inline constexpr double auto_pilot_fractions[] = {1.0, 8.0, 64.0};
 inline constexpr std::size_t auto_pilot_states = 8;
 inline constexpr std::uint64_t auto_pilot_max_steps = 1 << 14;  // the finest pilot of one candidate at most
 inline constexpr double auto_safety = 3.0;                      // the prediction aims at tolerance / this
+inline constexpr double max_growth_exponent = 3.0;              // the largest a the prediction extrapolates with
 
 struct AutoCandidate {
   std::string label;  // "gauss 6", "triplet 8/3"
   IntegratorSpec spec;
 };
 
+// What of a model decides the candidates.
+struct AutoModel {
+  bool general = false;                         // given by H (PluginModel::general_hamiltonian)
+  bool hessians_and_third_derivatives = false;  // the comparators need them of a product-form model
+  bool hessian_products = false;                // hvp_H: the comparators' tangent maps need it
+};
+AutoModel auto_model(const Plugin& plugin);
+// A formula model's, without compiling it: its plugin has every derivative (formula-models.md).
+AutoModel auto_model(const formula::FormulaModel& model);
+
 // The candidates of `loaded` (a single run with /integrator "auto"), in the order they are tried.
 std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded);
+std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& model);
 
 // What the pilots measured of one candidate.
 struct PilotResult {
@@ -64,15 +76,28 @@ struct PilotResult {
   double pilot_error = 0.0;       // e_p: the 4n run's error at t_p
   double ratio = 0.0;             // how much the error fell from 2n to 4n (2^order in the asymptotic range)
   double growth = 0.0;            // a
+  // Phase: log2 of the growth of the pilot pair's largest distance from t_p / 2 to t_p (largest over the marks up to
+  // each); nothing for the energy, or when the distance is at round-off.
+  std::optional<double> envelope_growth;
   double seconds_per_step = 0.0;  // of the pilot states together
   std::uint64_t steps = 0;        // of the final run, predicted
   double predicted_error = 0.0;   // e(h) at t_end
   double predicted_seconds = 0.0;
 };
 
+// How the phase error of the pilots grew over their second half (measure "phase"): by at most a power
+// t^max_growth_exponent, or faster (exponentially, as on a chaotic orbit, where no prediction of the phase error at
+// t_end holds).
+enum class PhaseGrowth { not_measured, polynomial, exponential };
+
 struct SchemeChoice {
   double tolerance = 0.0;
-  AutoScheme::Measure measure = AutoScheme::Measure::phase;
+  AutoScheme::Measure measure = AutoScheme::Measure::phase;  // the one asked for
+  // The measure whose pilots chose: the energy when the phase error grows exponentially and the model has it.
+  AutoScheme::Measure chosen_by = AutoScheme::Measure::phase;
+  PhaseGrowth phase_growth = PhaseGrowth::not_measured;
+  std::vector<PilotResult> phase_pilots;  // the phase pilots, when chosen by the energy
+  double phase_pilot_horizon = 0.0;       // and their horizon
   double pilot_horizon = 0.0;
   std::size_t pilot_states = 0;
   std::vector<PilotResult> pilots;  // one per candidate
@@ -94,8 +119,17 @@ class PilotsInterrupted : public ChoiceFailed {
 };
 
 // Runs the pilots of `loaded` and returns the choice. Throws ChoiceFailed when no candidate is left (with every
-// candidate's reason), PilotsInterrupted when interrupted (options.stop_requested).
+// candidate's reason), PilotsInterrupted when interrupted (options.stop_requested). With measure "phase" and two or
+// more degrees of freedom (one is integrable, and within a period its error may grow fast), when a usable
+// candidate's phase error grew by more than 2^max_growth_exponent from t_p / 2 to t_p (the largest distance
+// of its pilot pair at t_p k / 8 up to each), it grows exponentially: no prediction of the phase error at t_end
+// holds, and the choice is made again by the energy (same tolerance) when the model has it (has_energy) and some
+// candidate meets it there; else the phase pilots' choice stands.
 SchemeChoice choose_scheme(const LoadedJob& loaded, const RunOptions& options);
+
+// The warning to print before the run when the phase error grows exponentially: the tolerance is not promised, what
+// chose the step, and what to use instead; "" otherwise.
+std::string choice_warning(const SchemeChoice& choice);
 
 // The run `loaded` would make with `choice`: the chosen integrator, the time grid divided by the subdivision m, and
 // the strides counted in steps (output.every, checkpoint.every_steps, the Lyapunov strides) times m, so that every
@@ -113,7 +147,9 @@ void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& reco
 // left out), the choice, its predicted error and the pilots' cost.
 nlohmann::ordered_json to_json(const SchemeChoice& choice);
 
-// What `nonsep validate` says auto would try, one line.
+// What `nonsep validate` says auto would try, one line; of a job not loaded (a formula job, not compiled), with
+// the count of pilot states an upper bound when an energy shell will leave some out.
 std::string describe_auto(const LoadedJob& loaded);
+std::string describe_auto(const Job& job, const AutoModel& model, bool loaded);
 
 }  // namespace nonsep::host
