@@ -145,7 +145,9 @@ TEST_CASE(
                                 {"parameters", {{"coupling", 0.2}}}};
   const std::string product = auto_line({{"formula", paper2d_formula}}, two, "product");
   CHECK(contains(product, "scheme auto: tolerance 1e-06"));
-  CHECK(contains(product, "would try gauss 6, gauss 4, mpe 4, triplet 8/3, triplet 2 with pilot runs of 2 state(s)"));
+  CHECK(contains(
+      product,
+      "would try gauss 16, gauss 8, gauss 6, gauss 4, mpe 4, triplet 8/3, triplet 2 with pilot runs of 2 state(s)"));
   CHECK(product == auto_line({{"plugin", "paper2d"}}, two, "paper2d"));
   // On an energy shell, before the compiled model places the states, the pilot states are an upper bound.
   const json shell = {{"grid", {{"q", {{{"from", -2.0}, {"to", 2.0}, {"count", 11}}, 0.0}}, {"p", {0.0, 0.0}}}},
@@ -157,7 +159,7 @@ TEST_CASE(
                              {"parameters", {{"lambda", 1}}}};
   const json one = {{{"q", {0.0, 0.1}}, {"p", {0.3, 0.0}}}};
   const std::string general = auto_line({{"formula", henon_heiles}}, one, "general");
-  CHECK(contains(general, "would try gauss 6, gauss 4 with"));
+  CHECK(contains(general, "would try gauss 16, gauss 8, gauss 6, gauss 4 with"));
   CHECK(general == auto_line({{"plugin", "henon_heiles"}}, one, "henon_heiles"));
 }
 

@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "job/sections.hpp"
 #include "nonsep/host/json/checker.hpp"
+#include "nonsep/host/json/parameter_check.hpp"
 #include "nonsep/host/json/strict_json.hpp"
 #include "nonsep/host/number_format.hpp"
 

@@ -27,6 +27,11 @@ std::size_t array_size(const json& value, const char* key) {
 
 namespace {
 
+// GCC's and Clang's 128-bit integers (exact sums of two 20-digit decimals times a count), named once: __extension__
+// tells -Wpedantic that the extension is meant.
+__extension__ using Signed128 = __int128;
+__extension__ using Unsigned128 = unsigned __int128;
+
 // A double as its shortest round-trip decimal (std::to_chars): sign * digits * 10^exponent.
 struct Decimal {
   bool negative = false;
@@ -70,13 +75,13 @@ double range_value(double from, double to, std::size_t count, std::size_t k) {
   const std::uint64_t d = count - 1;
   if (a.length + (a.exponent - e) <= 20 && b.length + (b.exponent - e) <= 20 && d <= 1'000'000'000) {
     const auto scaled = [e](const Decimal& x) {
-      __int128 value = static_cast<__int128>(x.digits);
+      Signed128 value = static_cast<Signed128>(x.digits);
       for (int i = e; i < x.exponent; ++i) value *= 10;
       return x.negative ? -value : value;
     };
-    const __int128 n = scaled(a) * static_cast<__int128>(d - k) + scaled(b) * static_cast<__int128>(k);
-    unsigned __int128 magnitude = static_cast<unsigned __int128>(n < 0 ? -n : n);
-    unsigned __int128 quotient = magnitude / d, remainder = magnitude % d;
+    const Signed128 n = scaled(a) * static_cast<Signed128>(d - k) + scaled(b) * static_cast<Signed128>(k);
+    Unsigned128 magnitude = static_cast<Unsigned128>(n < 0 ? -n : n);
+    Unsigned128 quotient = magnitude / d, remainder = magnitude % d;
     char integer[48], *i = integer + sizeof integer;
     do {
       *--i = static_cast<char>('0' + static_cast<int>(quotient % 10));

@@ -13,6 +13,7 @@
 #include "job_keys.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/json/checker.hpp"
+#include "nonsep/host/json/parameter_check.hpp"
 
 namespace nonsep::host::job_reader {
 
@@ -21,9 +22,6 @@ void read_model(Checker& check, const json& document, Job& job);
 // The declared parameter `name` (model.cpp), or nothing and an issue at `path` naming the plugin's parameters.
 const PluginParameter* find_parameter(Checker& check, const std::vector<PluginParameter>& declared,
                                       const std::string& name, const std::string& path);
-// One value of `parameter` at `path` (model.cpp), by the rule of nonsep::sdk::parameter_fault; `found` describes it.
-void check_parameter_value(Checker& check, const PluginParameter& parameter, const json& value, const std::string& path,
-                           const std::string& found);
 // /model/parameters/<name> given as an array, {"values": [...]} or {"from", "to", "count"} (sweep.cpp): a swept
 // parameter, or nothing and an issue.
 std::optional<SweptParameter> read_swept_parameter(Checker& check, const std::string& name, const json& value,

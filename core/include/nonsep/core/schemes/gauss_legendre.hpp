@@ -427,7 +427,8 @@ class GaussLegendre {
           return "grad H is not finite at stage " + std::to_string(i + 1) + " of iteration " +
                  std::to_string(iterations_[b]) + ", q = " + vector_text(start_q_, stage_q_, i) +
                  ", p = " + vector_text(start_p_, stage_p_, i) +
-                 ": H is not defined or not differentiable there, or the orbit ran off to where it overflows";
+                 ": H is not defined or not differentiable there, or the orbit ran off to where it overflows (on a "
+                 "non-compact energy shell it can run off without bound)";
     return "an iterate is not finite after " + std::to_string(iterations_[b]) +
            " iterations: the stages overflowed; a smaller dt makes the iteration contract";
   }
