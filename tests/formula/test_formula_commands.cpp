@@ -107,13 +107,17 @@ TEST_CASE("formula commands: a parameter's range is declared by its plugin and r
                    "1.5, .description"));
   }
   SUBCASE("a bad range is refused at its key path, exit 2") {
-    for (const auto& [bad, path] : std::vector<std::pair<json, std::string>>{
+    // The pair is named, not bound: clang 14 (the sanitized build) refuses a lambda's (CAPTURE's) reference to a
+    // structured binding.
+    for (const auto& bad_and_path : std::vector<std::pair<json, std::string>>{
              {{{"value", 0.2}, {"min", 0.3}, {"max", -0.1}}, "/coupling/min: found min 0.3 above max -0.1"},
              {{{"value", 0.6}, {"min", -0.1}, {"max", 0.3}}, "/coupling/value: found the default 0.6"},
              {{{"value", 0.2}, {"max", "0.3"}}, "/coupling/max"},
              {{{"value", 0.2}, {"max", nullptr}}, "/coupling/max"},
              {{{"min", -0.1}}, "/coupling/value"},
              {{{"value", 0.2}, {"minimum", -0.1}}, "/coupling/minimum"}}) {
+      const json& bad = bad_and_path.first;
+      const std::string& path = bad_and_path.second;
       json model = formula;
       model["parameters"]["coupling"] = bad;
       const auto result = validate({{"formula", model}}, "bad");
