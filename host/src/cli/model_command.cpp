@@ -58,10 +58,14 @@ std::string parameters_with_defaults(const Job& job, const std::vector<PluginPar
   nlohmann::json used = nlohmann::json::object();
   std::string defaults;
   for (const PluginParameter& parameter : declared) {
-    const bool set = given.contains(parameter.name) ||
-                     std::any_of(job.sweep.begin(), job.sweep.end(),
-                                 [&](const SweptParameter& swept) { return swept.name == parameter.name; });
-    used[parameter.name] = set ? given[parameter.name] : parameter.default_value;
+    const bool swept = std::any_of(job.sweep.begin(), job.sweep.end(),
+                                   [&](const SweptParameter& sweep) { return sweep.name == parameter.name; });
+    const bool set = given.contains(parameter.name) || swept;
+    // A swept parameter is not in job.parameters (const operator[] of a missing key is undefined): parameters_text
+    // writes its values over the placeholder.
+    used[parameter.name] = given.contains(parameter.name) ? given.at(parameter.name)
+                           : swept                        ? nlohmann::json()
+                                                          : nlohmann::json(parameter.default_value);
     if (!set) defaults += (defaults.empty() ? "" : ", ") + parameter.name;
   }
   if (defaults.empty()) return parameters_text(used, job);
