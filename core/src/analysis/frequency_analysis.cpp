@@ -118,12 +118,14 @@ struct FrequencyAnalysis::Workspace {
   void prepare(std::span<const std::complex<double>> z) {
     const std::size_t n = z.size();
     if (window.size() != n) {
+      // chi_k = 1 - cos(2 pi k / (N-1)) = 1 + cos(u x_k) with u = 2 pi / (N-1).
       window.resize(n);
       window_sum = 0.0;
-      for (std::size_t k = 0; k < n; ++k) {
-        window[k] = 1.0 - std::cos(two_pi * static_cast<double>(k) / static_cast<double>(n - 1));
+      exponentials.set(two_pi / static_cast<double>(n - 1), n);
+      exponentials.for_each([&](std::size_t k, double er, double) {
+        window[k] = 1.0 + er;
         window_sum += window[k];
-      }
+      });
     }
     signal_re.resize(n);
     signal_im.resize(n);
@@ -135,8 +137,14 @@ struct FrequencyAnalysis::Workspace {
     residual_im = signal_im;
   }
 
-  // The strongest frequency u of the residual, by the FFT's peak and Newton's method on d|phi|^2/du.
-  double strongest_frequency() {
+  // The strongest frequency u of the residual (not wrapped into [-pi, pi): exp(-i u x_k) changes with u by 2 pi when
+  // N is even), by the FFT's peak and Newton's method on d|phi|^2/du, and the residual's transform there,
+  // sum_k chi_k r_k exp(-i u x_k).
+  struct Peak {
+    double u;
+    std::complex<double> transform;
+  };
+  Peak strongest_frequency() {
     const std::size_t n = residual_re.size(), m = std::bit_ceil(n);
     padded.assign(m, {0.0, 0.0});
     for (std::size_t k = 0; k < n; ++k) padded[k] = {residual_re[k], residual_im[k]};
@@ -161,27 +169,36 @@ struct FrequencyAnalysis::Workspace {
     }
     const double peak_u = grid * static_cast<double>(peak);
     double lo = peak_u - grid, hi = peak_u + grid, u = peak_u + offset * grid;
-    const double tolerance = 1e-8 * grid;
+    // Newton's error after a step d is about K d^2 with K ~ 0.01 / grid on a Hann lobe: a step below 1e-6 of the
+    // grid leaves an error below 1e-12 of it, round-off. From the parabola's start (within some 5e-3 of the grid)
+    // that is two passes.
+    const double tolerance = 1e-6 * grid;
+    Moments s{};
+    double step = 0.0;
     for (int iteration = 0; iteration < 100; ++iteration) {
       exponentials.set(u, n);
-      const Moments s = moments(exponentials, residual_re, residual_im);
+      s = moments(exponentials, residual_re, residual_im);
       // |phi|^2 up to a positive factor is |s0|^2; its first and second derivatives in u:
       const double slope = 2.0 * (std::conj(s.s0) * s.s1).imag();
       const double curvature = 2.0 * (std::norm(s.s1) - (std::conj(s.s0) * s.s2).real());
+      step = 0.0;
       if (slope == 0.0) break;
       (slope > 0.0 ? lo : hi) = u;
-      double next = u - slope / curvature;
-      // A Newton step below 1e-8 of the grid leaves an error of order its square: done (it may land on the
-      // bracket's end, which is u itself to the last bit).
-      if (curvature < 0.0 && std::abs(next - u) <= tolerance) {
-        u = next;
+      step = -slope / curvature;
+      // The last step may land on the bracket's end, which is u itself to the last bit.
+      if (curvature < 0.0 && std::abs(step) <= tolerance) break;
+      if (!(curvature < 0.0) || !(u + step > lo && u + step < hi)) step = 0.5 * (lo + hi) - u;
+      u += step;
+      if (hi - lo <= 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(u), grid)) {
+        step = 0.0;
+        exponentials.set(u, n);
+        s = moments(exponentials, residual_re, residual_im);
         break;
       }
-      if (!(curvature < 0.0) || !(next > lo && next < hi)) next = 0.5 * (lo + hi);
-      u = next;
-      if (hi - lo <= 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(u), grid)) break;
     }
-    return wrap(u);
+    // The transform at u + step from the moments at u (Taylor; the next term, (step N/2)^3 / 6, is below 1e-18).
+    const std::complex<double> i_step{0.0, step};
+    return {u + step, s.s0 - i_step * s.s1 + 0.5 * i_step * i_step * s.s2};
   }
 };
 
@@ -212,10 +229,11 @@ std::vector<FrequencyTerm> FrequencyAnalysis::terms(std::span<const std::complex
   count = std::min(count, n);
   std::vector<double> u;                          // the frequencies found, in radians per sample
   std::vector<std::complex<double>> projections;  // <e_j, z>
-  std::vector<double> gram, cholesky;             // G_ij = <e_i, e_j> (real: the window is symmetric), row-major; L
+  std::vector<double> cholesky;  // L, row-major, of the Gram matrix G_ij = <e_i, e_j> = L L^T (real: chi is symmetric)
   std::vector<std::complex<double>> amplitude;
   for (std::size_t found = 0; found < count; ++found) {
-    const double next = w.strongest_frequency();
+    const Workspace::Peak peak = w.strongest_frequency();
+    const double next = peak.u;
     // The new row of G and of its Cholesky factor L (G = L L^T); a pivot below 1e-20 (the new exponential's
     // component orthogonal to the earlier ones below 1e-10 of its norm) ends the search.
     const std::size_t size = found + 1;
@@ -238,8 +256,12 @@ std::vector<FrequencyTerm> FrequencyAnalysis::terms(std::span<const std::complex
     cholesky.resize(size * count);
     std::copy(l_row.begin(), l_row.end(), cholesky.begin() + static_cast<std::ptrdiff_t>(found * count));
     u.push_back(next);
-    w.exponentials.set(next, n);
-    projections.push_back(transform(w.exponentials, w.signal_re, w.signal_im) / w.window_sum);
+    if (found == 0) {  // the residual is still the signal
+      projections.push_back(peak.transform / w.window_sum);
+    } else {
+      w.exponentials.set(next, n);
+      projections.push_back(transform(w.exponentials, w.signal_re, w.signal_im) / w.window_sum);
+    }
     // Solve L L^T a = b.
     amplitude.assign(size, {0.0, 0.0});
     for (std::size_t i = 0; i < size; ++i) {
@@ -267,7 +289,8 @@ std::vector<FrequencyTerm> FrequencyAnalysis::terms(std::span<const std::complex
     }
   }
   std::vector<FrequencyTerm> result(u.size());
-  for (std::size_t j = 0; j < u.size(); ++j) result[j] = {u[j] / tau, amplitude[j] * std::polar(1.0, -u[j] * centre)};
+  for (std::size_t j = 0; j < u.size(); ++j)
+    result[j] = {wrap(u[j]) / tau, amplitude[j] * std::polar(1.0, -u[j] * centre)};
   std::stable_sort(result.begin(), result.end(), [](const FrequencyTerm& a, const FrequencyTerm& b) {
     return std::abs(a.amplitude) > std::abs(b.amplitude);
   });
