@@ -7,9 +7,9 @@
 // second half of a run: on a torus nu is the same in both up to the method's error, in a chaotic zone it drifts;
 // diffusion_index() turns the two into one number.
 //
-// Method. With the window chi_k = 1 - cos(2 pi k / (N-1)) (Laskar's window of order 1, 1 + cos(pi t / (T/2)) over
-// the centred time t in [-T/2, T/2]; the symmetric Hann window times 2, which the normalisation removes), and the
-// centred times s_k = (k - (N-1)/2) tau, the windowed transform is
+// Method. With the window chi_k = 1 - cos(2 pi k / (N-1)) (Laskar's window of order 1, 1 + cos(2 pi t / T) at the
+// centred times t = s_k = (k - (N-1)/2) tau in [-T/2, T/2], mean 1; the symmetric Hann window times 2, a factor the
+// normalisation removes anyway), the windowed transform is
 //   phi(omega) = sum_k chi_k z_k exp(-i omega s_k) / sum_k chi_k,
 // normalised so that a pure term a exp(i nu t) gives |phi(nu)| = |a|. Each term is found in the residual r of the
 // signal after the earlier ones (r = z at first):
@@ -29,17 +29,20 @@
 //
 // Accuracy. For a quasi-periodic signal the error of a frequency with this window falls like T^-4 (Laskar 1993:
 // T^-(2p+2) for the window of order p; without a window, T^-1), the leakage of the other terms through the window's
-// side lobes, until round-off: the tests measure the law and the floor (tests/core/test_frequency_analysis.cpp).
+// side lobes, until round-off. Measured (tests/core/test_frequency_analysis.cpp): nu = 1 beside a term 0.3 at 1.05,
+// errors from 1.05e-5 at T = 100 periods to 1.5e-10 at 1600, fitted exponent -4.01, one ulp of nu at 51200 periods;
+// three terms over 1000 periods, frequencies within 2.5e-14 relative and amplitudes within 8e-11.
 // A frequency is known modulo the sampling frequency 2 pi / tau: the result lies in [-pi/tau, pi/tau).
 //
 // Conventions. Frequencies are angular, in radians per unit time, signed: nu > 0 turns counter-clockwise in the
 // complex plane (q + i p of a harmonic oscillator with H = (q^2 + p^2)/2 turns clockwise: nu = -1). Amplitudes refer
 // to the first sample, z_k ~ sum_j a_j exp(i nu_j k tau). Terms come strongest first (by |a_j|).
 //
-// Cost. One FFT of the padded length M (5 M log2 M flops) and some 3 to 5 passes of 20 flops per sample per term,
-// plus the projection, O(N m^2) for m terms. The FFT's tables are kept by the FrequencyAnalysis object between
-// calls of the same length: keep one object per thread and reuse it. One fundamental frequency of 2^14 samples
-// takes some 0.3 ms on one core (bench/frequency_analysis.cpp gives the figure of the machine at hand).
+// Cost. Per term one FFT of the padded length M (about half the time of a fundamental frequency) and two or three
+// passes of some 20 flops per sample, plus the projection, O(N m^2) for m terms. The FrequencyAnalysis object keeps
+// the FFT's tables for each length it has seen and its buffers: keep one object per thread and reuse it. One
+// fundamental frequency of 2^14 samples takes some 0.4 ms on one core (bench/frequency_analysis.cpp measures it;
+// docs/dynamics.md has the figures).
 //
 // Errors: InvalidArgument for fewer than minimum_samples samples, a non-finite sample, tau not finite and
 // positive, and a request for zero terms.
