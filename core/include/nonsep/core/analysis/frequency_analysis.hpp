@@ -25,10 +25,11 @@
 //      window: the projection is Gram-Schmidt's, done on the Gram matrix G_ij = <e_i, e_j> (its Cholesky
 //      factorisation), and the new residual is r = z - sum_j a_j e_j.
 // A term whose exponential is already (to 1e-10 of its norm) in the span of the earlier ones cannot be separated
-// from them and ends the search: fewer than the asked number of terms come back.
+// from them and ends the search: fewer than the asked number of terms come back (a zero signal gives one term,
+// frequency 0 and amplitude 0).
 //
 // Accuracy. For a quasi-periodic signal the error of a frequency with this window falls like T^-4 (Laskar 1993:
-// T^-(2p+2) for the window of order p; without a window, T^-1), the leakage of the other terms through the window's
+// T^-(2p+2) for the window of order p; without a window, T^-2), the leakage of the other terms through the window's
 // side lobes, until round-off. Measured (tests/core/test_frequency_analysis.cpp): nu = 1 beside a term 0.3 at 1.05,
 // errors from 1.05e-5 at T = 100 periods to 1.5e-10 at 1600, fitted exponent -4.01, one ulp of nu at 51200 periods;
 // three terms over 1000 periods, frequencies within 2.5e-14 relative and amplitudes within 8e-11.
