@@ -18,4 +18,21 @@ std::vector<double> hamiltonian_flow(Rhs rhs, std::vector<double> x, double t_en
   return x;
 }
 
+// The same flow sampled: x at t = k tau for k = 0 .. count-1 (the first is x itself), the stepper landing on each
+// sample time (Odeint's integrate_times), so no interpolation error enters.
+template <class Rhs>
+std::vector<std::vector<double>> hamiltonian_flow_samples(Rhs rhs, std::vector<double> x, double tau, std::size_t count,
+                                                          double tolerance = 1e-14) {
+  namespace odeint = boost::numeric::odeint;
+  auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<std::vector<double>>());
+  std::vector<double> times(count);
+  for (std::size_t k = 0; k < count; ++k) times[k] = static_cast<double>(k) * tau;
+  std::vector<std::vector<double>> samples;
+  samples.reserve(count);
+  odeint::integrate_times(
+      stepper, [&](const std::vector<double>& s, std::vector<double>& d, double) { rhs(s, d); }, x, times.begin(),
+      times.end(), tau / 10, [&](const std::vector<double>& s, double) { samples.push_back(s); });
+  return samples;
+}
+
 }  // namespace nonsep::reference
