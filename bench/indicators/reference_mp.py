@@ -1,16 +1,17 @@
 #!/usr/bin/env python3
-"""The truth for docs/dynamics.md's accuracy table of Lyapunov exponents and MEGNO: paper2d (coupling 0.2) on the
+"""The truth for docs/dynamics.md's accuracy tables of Lyapunov exponents and MEGNO: paper2d (coupling COUPLING, 0.2 by
+default) on the
 chaotic orbit q = (0.5, 0), p = (0, 2.5), its variational equations derived by hand (independent of nonsep's
 plugins and automatic differentiation), integrated
 by an s-stage Gauss-Legendre method (order 2s) in mpmath at `dps` digits, stage equations solved by fixed-point
 iteration to 10^-(dps-3). Prints lambda_1(10), lambda_1(20), continuous Y and <Y> at 10, 20, and the discrete MEGNO of
 nonsep's definition (megno.hpp) on the grid dt_grid (= h * integer).
-usage: reference_mp.py H STAGES DPS"""
+usage: reference_mp.py H STAGES DPS [COUPLING]"""
 import sys, mpmath as mp
 h_s, s, dps = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 mp.mp.dps = dps
 h = mp.mpf(h_s)
-c = mp.mpf('0.2'); k = mp.mpf(2)/3 + 4*c; two3 = mp.mpf(2)/3
+c = mp.mpf(sys.argv[4] if len(sys.argv) > 4 else '0.2'); k = mp.mpf(2)/3 + 4*c; two3 = mp.mpf(2)/3
 P = lambda x: mp.legendre(s, 2*x - 1)
 coef = mp.taylor(lambda x: mp.legendre(s, x), 0, s)[::-1]
 cs = sorted((1 + mp.re(r))/2 for r in mp.polyroots(coef, maxsteps=200, extraprec=2*dps))

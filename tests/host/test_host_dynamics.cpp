@@ -133,9 +133,10 @@ TEST_CASE("a general normal, direction both, and max_crossings stopping a trajec
   }
 }
 
-TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaotic one, and lyapunov.csv") {
+TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaotic one, FLI, and lyapunov.csv") {
   TemporaryFolder folder;
-  const json analysis = {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 10000}}}, {"megno", true}};
+  const json analysis = {
+      {"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 10000}}}, {"megno", true}, {"fli", true}};
   const auto result = run_named(folder, "run",
                                 paper2d_job(json::array({state2(regular_q, regular_p), state2(chaotic_q, chaotic_p)}),
                                             {{"dt", 0.005}, {"steps", 80000}}, analysis));
@@ -148,6 +149,15 @@ TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaoti
   CHECK(cell(rows[0], "mean_megno") == doctest::Approx(2.0).epsilon(0.05));
   CHECK(cell(rows[0], "lyapunov0") < 0.05);
   CHECK(cell(rows[1], "lyapunov0") > 0.1);
+  // FLI: the supremum of ln |w| is at least ln |w(400)| = 400 lambda_1(400) (the last step is an orthonormalisation),
+  // which it exceeds on the chaotic orbit by the fluctuations of the growth only; on the regular orbit |w| grows
+  // like t, so FLI stays near ln t.
+  MESSAGE("FLI(400): regular " << rows[0].at("fli") << ", chaotic " << rows[1].at("fli")
+                               << ", ln 400 = " << std::log(400.0));
+  for (const auto& row : rows) CHECK(cell(row, "fli") >= 400.0 * cell(row, "lyapunov0") - 1e-9);
+  CHECK(cell(rows[1], "fli") < 400.0 * cell(rows[1], "lyapunov0") + 5.0);
+  CHECK(cell(rows[0], "fli") < 2.0 * std::log(400.0));
+  CHECK(cell(rows[1], "fli") > 5.0 * cell(rows[0], "fli"));
   // The series: the chaotic <Y> grows (like lambda t / 2), the regular one stays near 2.
   const auto series = table(folder / "run/lyapunov.csv");
   REQUIRE(series.size() == 16);  // 2 trajectories at steps 10000, 20000, ..., 80000
@@ -267,7 +277,8 @@ json ensemble_job(std::uint64_t steps, std::uint64_t max_crossings) {
                           {"lyapunov", {{"vectors", 2}, {"renormalize_every", 5}, {"every", 500}}},
                           {"megno", true},
                           {"sali", true},
-                          {"gali", 3}});
+                          {"gali", 3},
+                          {"fli", true}});
   job["output"]["every"] = 250;
   job["integrator"] = {{"scheme", "basic"}, {"t2", -3.0}};
   return job;

@@ -1,6 +1,10 @@
 #pragma once
 // Everything of nonsep::core in one include.
+#include "nonsep/core/analysis/alignment_indices.hpp"
 #include "nonsep/core/analysis/energy.hpp"
+#include "nonsep/core/analysis/fast_lyapunov_indicator.hpp"
+#include "nonsep/core/analysis/frequency_analysis.hpp"
+#include "nonsep/core/analysis/indicator.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
 #include "nonsep/core/analysis/poincare_crossing.hpp"

@@ -10,7 +10,6 @@
 #include <variant>
 #include <vector>
 
-#include "nonsep/core/analysis/alignment_indices.hpp"
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
@@ -139,6 +138,7 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   if (run.analysis.megno) analysis += "|megno";
   if (run.analysis.sali) analysis += "|sali";
   if (run.analysis.gali > 0) analysis += "|gali " + std::to_string(run.analysis.gali);
+  if (run.analysis.fli) analysis += "|fli";
   if (run.analysis.error_estimate) analysis += "|error_estimate";
   parts.emplace_back("analysis", std::move(analysis));
   std::string fingerprint;
@@ -299,13 +299,10 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   for (SchemeState::Largest& number : state.scheme.largest)
     number.value = read.number(read.member(document, number.name), number.name);
   const json& lyapunov = read.member(active, "lyapunov");
-  const json& megno = read.member(active, "megno");
-  if (!lyapunov.is_array() || !megno.is_array() || lyapunov.size() != (k > 0 ? state.active.size() : 0) ||
-      megno.size() != lyapunov.size())
-    read.damaged("active.lyapunov and active.megno do not have one entry per active trajectory");
-  for (std::size_t i = 0; i < lyapunov.size(); ++i) {
-    const auto l = read.numbers(lyapunov[i], 5 + k, "active.lyapunov");
-    const auto m = read.numbers(megno[i], 3, "active.megno");
+  if (!lyapunov.is_array() || lyapunov.size() != (k > 0 ? state.active.size() : 0))
+    read.damaged("active.lyapunov does not have one entry per active trajectory");
+  for (const json& entry : lyapunov) {
+    const auto l = read.numbers(entry, 5 + k, "active.lyapunov");
     LyapunovRecord record;
     record.steps = static_cast<std::uint64_t>(l[0]);
     record.steps_since_renormalization = static_cast<std::uint64_t>(l[1]);
@@ -314,16 +311,23 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     record.log_norm_first = l[4];
     std::copy(l.begin() + 5, l.end(), record.log_stretch.begin());
     state.lyapunov.push_back(record);
-    state.megno.push_back(MegnoRecord{m[0], m[1], m[2]});
   }
-  const std::size_t factor_size = job.run().analysis.alignment_indices() ? AlignmentIndices(k).factor_size() : 0;
-  if (factor_size > 0 || active.contains("alignment"))
-    state.alignment =
-        read.numbers(read.member(active, "alignment"), state.active.size() * factor_size, "active.alignment");
+  // Each indicator's state under its name, as the run's indicators size it.
+  const IndicatorList indicators = k > 0 ? job.run().analysis.indicators() : IndicatorList();
+  const json& saved_indicators = read.member(active, "indicators");
+  if (!saved_indicators.is_object() || saved_indicators.size() != indicators.size())
+    read.damaged("active.indicators does not have the states of the job's indicators");
+  std::size_t columns = 0;
+  for (const auto& indicator : indicators) {
+    const std::string what = "active.indicators." + indicator->name();
+    state.indicators.push_back(
+        {indicator->name(), read.numbers(read.member(saved_indicators, indicator->name()),
+                                         state.active.size() * indicator->needs().state_size, what)});
+    columns += indicator->columns().size();
+  }
   const json& records = read.member(document, "records");
   if (!records.is_array() || records.size() != job.initial.count)
     read.damaged("it does not have one record per trajectory");
-  const std::size_t gali_size = factor_size > 0 ? k - 1 : 0;  // GALI_2 .. GALI_k
   for (const auto& entry : records) {
     TrajectoryRecord record;
     const auto status = trajectory_status_from_string(read.string(read.member(entry, "status"), "status"));
@@ -341,13 +345,8 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     record.stop_t = read.number(read.member(entry, "stop_t"), "stop_t");
     record.stop_variable = read.string(read.member(entry, "stop_variable"), "stop_variable");
     record.message = read.string(read.member(entry, "message"), "message");
-    const json& exponents = read.member(entry, "lyapunov");
-    record.lyapunov = read.numbers(exponents, exponents.is_array() && exponents.empty() ? 0 : k, "lyapunov");
-    record.megno = read.optional_number(read.member(entry, "megno"), "megno");
-    record.mean_megno = read.optional_number(read.member(entry, "mean_megno"), "mean_megno");
-    // Written only when known (checkpoints of runs without SALI and GALI have neither).
-    if (entry.contains("sali")) record.sali = read.number(entry["sali"], "sali");
-    if (entry.contains("gali")) record.gali = read.numbers(entry["gali"], gali_size, "gali");
+    const json& values = read.member(entry, "indicators");
+    record.indicators = read.numbers(values, values.is_array() && values.empty() ? 0 : columns, "indicators");
     state.records.push_back(std::move(record));
   }
   check_consistency(read, state, n);

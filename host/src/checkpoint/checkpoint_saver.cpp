@@ -31,10 +31,6 @@ json encode(const LyapunovRecord& record, std::size_t k) {
                  record.log_stretch.begin() + static_cast<std::ptrdiff_t>(k));
   return encode(numbers);
 }
-json encode(const MegnoRecord& record) {
-  return encode(std::vector<double>{record.time, record.weighted_growth, record.integrated_y});
-}
-
 // Writes checkpoint.json (checkpoint_file.hpp describes it) atomically. Throws OutputError.
 void save_checkpoint(const std::filesystem::path& path, const DriverState& state, const json& observers,
                      const CheckpointIdentity& identity) {
@@ -51,18 +47,13 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
                        {"stop_t", encode(record.stop_t)},
                        {"stop_variable", record.stop_variable},
                        {"message", record.message},
-                       {"lyapunov", encode(record.lyapunov)},
-                       {"megno", encode(record.megno)},
-                       {"mean_megno", encode(record.mean_megno)}});
-  // SALI and GALI only where known, so that the records of other runs keep their form.
-  for (std::size_t i = 0; i < state.records.size(); ++i) {
-    if (state.records[i].sali) records[i]["sali"] = encode(*state.records[i].sali);
-    if (!state.records[i].gali.empty()) records[i]["gali"] = encode(state.records[i].gali);
-  }
-  json lyapunov = json::array(), megno = json::array();
+                       {"indicators", encode(record.indicators)}});
+  json lyapunov = json::array();
   const std::size_t k = state.active.empty() ? 0 : state.tangent_q.size() / std::max<std::size_t>(1, state.q.size());
   for (const LyapunovRecord& record : state.lyapunov) lyapunov.push_back(encode(record, k));
-  for (const MegnoRecord& record : state.megno) megno.push_back(encode(record));
+  json indicator_states = json::object();
+  for (const DriverState::IndicatorState& indicator : state.indicators)
+    indicator_states[indicator.name] = encode(indicator.values);
   json evaluations = {
       {"grad_T", state.evaluations.grad_T}, {"grad_V", state.evaluations.grad_V}, {"grad_H", state.evaluations.grad_H}};
   // The separable part's counts, only for a model that has one (the checkpoints of other models are unchanged).
@@ -83,12 +74,11 @@ void save_checkpoint(const std::filesystem::path& path, const DriverState& state
                      {"tangent_q", encode(state.tangent_q)},
                      {"tangent_p", encode(state.tangent_p)},
                      {"lyapunov", std::move(lyapunov)},
-                     {"megno", std::move(megno)}}},
+                     {"indicators", std::move(indicator_states)}}},
                    {"records", std::move(records)},
                    {"observers", observers}};
   // The scheme's private state, under the names it gives: its columns with the active trajectories', its numbers
   // about the run at the top.
-  if (!state.alignment.empty()) document["active"]["alignment"] = encode(state.alignment);
   for (const SchemeState::Column& column : state.scheme.columns)
     document["active"][column.name] = encode(column.values);
   for (const SchemeState::Largest& number : state.scheme.largest) document[number.name] = encode(number.value);

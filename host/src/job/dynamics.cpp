@@ -1,7 +1,6 @@
-// /analysis/poincare, /analysis/lyapunov, /analysis/megno, /analysis/sali and /analysis/gali: the dynamics
-// diagnostics of a run
-// (docs/dynamics.md). Whether the plugin has the Hessians the tangent map
-// needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
+// /analysis/poincare, /analysis/lyapunov, /analysis/megno, /analysis/sali, /analysis/gali and /analysis/fli: the
+// dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the Hessians the tangent map needs is
+// checked when the job is loaded (load_job.cpp), where the plugin is known.
 #include <limits>
 
 #include "job_keys.hpp"
@@ -136,6 +135,13 @@ void read_dynamics(Checker& check, const json& value, std::size_t dimension, Ana
     else
       check.issue(child(path, "megno"), describe(*megno),
                   "true or false: MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)");
+  }
+  if (const json* fli = check.member(value, path, "fli", false, "")) {
+    if (fli->is_boolean())
+      analysis.fli = fli->get<bool>();
+    else
+      check.issue(child(path, "fli"), describe(*fli),
+                  "true or false: the fast Lyapunov indicator of the first tangent vector (trajectories.csv fli)");
   }
   if (const json* sali = check.member(value, path, "sali", false, "")) {
     if (sali->is_boolean())

@@ -51,6 +51,12 @@ const KeyTable& analysis_keys() {
                       "by the unit vectors of the first j tangent vectors: trajectories.csv columns gali2 .. gali<k> "
                       "(exponential decay on chaotic orbits; constant for j <= N, ~ t^(-2(j-N)) on an N-torus). Shares "
                       "the vectors of lyapunov. The plugin must have Hessians."},
+      {.name = "fli",
+       .type = ValueType::boolean,
+       .default_value = false,
+       .description = "The fast Lyapunov indicator of the first tangent vector (Froeschle, Lega and Gonczi 1997): "
+                      "trajectories.csv column fli, the supremum over the steps of ln |w(t)| with |w(0)| = 1 (~ lambda "
+                      "t on chaotic orbits, ~ ln t on regular ones). The plugin must have Hessians."},
       {.name = "error_estimate",
        .type = ValueType::boolean,
        .default_value = false,

@@ -56,20 +56,23 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
        "component j (run/tangent_block.hpp)"},
       {"method",
        "the exact tangent map of the run's integrator (core/include/nonsep/core/runtime/tangent_integrator.hpp)"}};
-  if (const auto& l = analysis.lyapunov)
-    facts["lyapunov"] = {{"exponents", l->vectors},
-                         {"renormalize_every", l->renormalize_every},
-                         {"columns", "trajectories.csv lyapunov0 .. lyapunov" + std::to_string(l->vectors - 1)},
-                         {"series", l->every > 0 ? nlohmann::ordered_json(LyapunovMegnoObserver::file_name) : nullptr},
-                         {"every", l->every}};
-  if (analysis.megno)
-    facts["megno"] = {{"columns", "trajectories.csv megno (Y), mean_megno (<Y>, -> 2 on quasi-periodic orbits)"}};
-  if (analysis.sali) facts["sali"] = {{"columns", "trajectories.csv sali, of the first two vectors"}};
-  if (analysis.gali > 0)
-    facts["gali"] = {{"vectors", analysis.gali},
-                     {"columns", "trajectories.csv gali2 .. gali" + std::to_string(analysis.gali) +
-                                     ", GALI_j of the first j vectors"}};
-  if (analysis.alignment_indices())
+  for (const auto& indicator : analysis.indicators()) {
+    if (indicator->name() == "lyapunov") {
+      const LyapunovAnalysis& l = *analysis.lyapunov;
+      facts["lyapunov"] = {{"exponents", l.vectors},
+                           {"renormalize_every", l.renormalize_every},
+                           {"columns", indicator->description()},
+                           {"series", l.every > 0 ? nlohmann::ordered_json(IndicatorColumns::file_name) : nullptr},
+                           {"every", l.every}};
+      continue;
+    }
+    nlohmann::ordered_json entry = nlohmann::ordered_json::object();
+    for (const auto& [name, value] : indicator->settings()) entry[name] = value;
+    entry["columns"] = indicator->description();
+    facts[indicator->name()] = std::move(entry);
+  }
+  const auto with_factors = [](const auto& indicator) { return indicator->needs().orthonormalization_factors; };
+  if (std::ranges::any_of(analysis.indicators(), with_factors))
     facts["alignment_indices"] =
         "the vectors of the Lyapunov exponents, with the triangular factors of their orthonormalisations "
         "(core/include/nonsep/core/analysis/alignment_indices.hpp), at the last orthonormalisation";

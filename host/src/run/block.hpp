@@ -158,20 +158,11 @@ struct alignas(64) Block {  // a cache line of its own: threads count evaluation
     return tangents ? tangents->integrator.report() : integrator.report();
   }
 
-  // The final Lyapunov, MEGNO, SALI and GALI estimates of `slot` into `record` (each when computed).
+  // The final values of the run's chaos indicators of `slot` into `record` (when computed).
   void final_estimates(std::size_t slot, TrajectoryRecord& record) const {
     if (!tangents) return;
-    record.lyapunov.clear();
-    for (std::size_t j = 0; j < tangents->k; ++j) record.lyapunov.push_back(tangents->lyapunov[slot].exponent(j));
-    if (tangents->with_megno) {
-      record.megno = tangents->megno[slot].y();
-      record.mean_megno = tangents->megno[slot].mean_y();
-    }
-    if (tangents->factor_size == 0) return;
-    const auto factor = tangents->factor(slot);
-    record.sali = AlignmentIndices::sali(factor);
-    record.gali.clear();
-    for (std::size_t j = 2; j <= tangents->k; ++j) record.gali.push_back(AlignmentIndices::gali(factor, j));
+    record.indicators.clear();
+    tangents->values(slot, record.indicators);
   }
   void clear() { trajectories.clear(); }
 

@@ -164,14 +164,21 @@ struct EnsembleDriver::Impl {
   void notify_event(std::uint64_t step, bool energy_evaluated) {
     std::vector<StateView> states;
     states.reserve(active_count());
+    // The indicators' values of every active state, one after the other (their columns per state).
+    std::vector<double> values;
+    std::size_t columns = 0;
+    for (const auto& indicator : setup.indicators) columns += indicator->columns().size();
+    if (columns > 0) values.reserve(active_count() * columns);
     for (const Block& block : blocks)
-      for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot)
+      for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {
+        if (block.tangents) block.tangents->values(slot, values);
         states.push_back({block.trajectories[slot], block.batch.q(slot), block.batch.p(slot),
                           block.energy_step == step ? block.energy(slot) : std::nullopt,
-                          &records[block.trajectories[slot]],
-                          block.tangents ? &block.tangents->lyapunov[slot] : nullptr,
-                          block.tangents ? &block.tangents->megno[slot] : nullptr,
-                          block.tangents ? block.tangents->factor(slot) : std::span<const double>()});
+                          &records[block.trajectories[slot]]});
+      }
+    if (!values.empty())
+      for (std::size_t s = 0; s < states.size(); ++s)
+        states[s].indicators = std::span<const double>(values).subspan(s * columns, columns);
     std::vector<StoppedTrajectory> requests;
     const Event event{step, setup.time.time_at(step), states, energy_evaluated, &requests};
     for (Observer* observer : observers) observer->on_event(event);
@@ -339,6 +346,8 @@ DriverState EnsembleDriver::state() const {
   DriverState state;
   state.step = d.completed;
   state.scheme = scheme_state_layout(d.setup.integrator, d.setup.tangent_vectors, d.setup.dimension);
+  if (d.setup.tangent_vectors > 0)
+    for (const auto& indicator : d.setup.indicators) state.indicators.push_back({indicator->name(), {}});
   for (const Block& block : d.blocks) {
     state.active.insert(state.active.end(), block.trajectories.begin(), block.trajectories.end());
     state.q.insert(state.q.end(), block.batch.q().begin(), block.batch.q().end());

@@ -1,11 +1,11 @@
 #pragma once
-// Internal to the ensemble driver: the tangent vectors of one block's trajectories, for /analysis/lyapunov and
-// /analysis/megno, /analysis/sali and /analysis/gali. When a run asks for them, the block steps with
-// nonsep::TangentIntegrator instead of nonsep::Integrator: the states get the same numbers bit for bit
-// (tangent_integrator.hpp), and k vectors per state follow the exact tangent map of each step. After every step
-// LyapunovExponents::after_step takes the growth of the first vector (only for MEGNO) and re-orthonormalises every
-// `renormalize_every` steps (lyapunov_exponents.hpp); MegnoRecord::add_step sums Y and <Y> (megno.hpp); with SALI or
-// GALI each slot keeps the triangular factor of alignment_indices.hpp, updated at the orthonormalisations.
+// Internal to the ensemble driver: the tangent vectors of one block's trajectories and the states of the run's chaos
+// indicators (nonsep/core/analysis/indicator.hpp: Lyapunov exponents, MEGNO, SALI and GALI, FLI). When a run asks for
+// them, the block steps with nonsep::TangentIntegrator instead of nonsep::Integrator: the states get the same numbers
+// bit for bit (tangent_integrator.hpp), and k vectors per state follow the exact tangent map of each step. After every
+// step LyapunovExponents::after_step takes the growth of the first vector (when an indicator needs it) and
+// re-orthonormalises every `renormalize_every` steps (lyapunov_exponents.hpp); each indicator then updates its state
+// of each slot (after_step, and after_orthonormalization at the orthonormalisations).
 //
 // Initial vectors (the same for every trajectory, fixed so that results are reproducible): vector 0 is
 // w = (1, 1/2, 1/3, ..., 1/(2n)) over (dq_0 .. dq_(n-1), dp_0 .. dp_(n-1)), a generic direction (not along the flow
@@ -17,8 +17,8 @@
 #include <span>
 #include <vector>
 
+#include "nonsep/core/analysis/indicator.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
-#include "nonsep/core/analysis/megno.hpp"
 #include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
@@ -36,38 +36,56 @@ struct BlockTangents {
   TangentIntegrator integrator;
   LyapunovExponents exponents;
   std::size_t k;
-  bool with_megno;                       // EnsembleSetup::megno
-  PhaseSpaceBatch vectors;               // k per slot: vector j of slot s at entry s*k + j
-  std::vector<LyapunovRecord> lyapunov;  // per slot
-  std::vector<MegnoRecord> megno;        // per slot (zeros unless MEGNO is asked)
-  std::vector<double> growth;            // scratch: ln-growth of vector 0 over the last step, per slot (MEGNO)
-  std::size_t factor_size;               // numbers per slot in `alignment`; 0 without SALI and GALI
-  std::vector<double> alignment;         // per slot: the factor of alignment_indices.hpp
+  const IndicatorList* indicators;          // EnsembleSetup::indicators
+  bool with_growth;                         // an indicator needs the first vector's growth at every step
+  bool with_factors;                        // an indicator needs the orthonormalisations' triangular factors
+  PhaseSpaceBatch vectors;                  // k per slot: vector j of slot s at entry s*k + j
+  std::vector<LyapunovRecord> lyapunov;     // per slot
+  std::vector<std::vector<double>> states;  // per indicator: its state_size numbers per slot
+  std::vector<double> growth;               // scratch: ln-growth of vector 0 over the last step, per slot
+  std::vector<std::size_t> column_counts;   // per indicator: its number of columns
 
   // setup.tangent_vectors per state, `slots` states.
   BlockTangents(const EnsembleSetup& setup, std::size_t slots)
       : integrator(setup.integrator, setup.tangent_vectors),
         exponents(setup.tangent_vectors, setup.renormalize_every),
         k(setup.tangent_vectors),
-        with_megno(setup.megno),
+        indicators(&setup.indicators),
+        with_growth(std::any_of(setup.indicators.begin(), setup.indicators.end(),
+                                [](const auto& i) { return i->needs().first_growth; })),
+        with_factors(std::any_of(setup.indicators.begin(), setup.indicators.end(),
+                                 [](const auto& i) { return i->needs().orthonormalization_factors; })),
         vectors(setup.dimension, slots * setup.tangent_vectors),
         lyapunov(slots),
-        megno(slots),
-        growth(setup.megno ? slots : 0),
-        factor_size(setup.alignment_indices ? AlignmentIndices(k).factor_size() : 0),
-        alignment(slots * factor_size) {}
+        growth(with_growth ? slots : 0) {
+    for (const auto& indicator : setup.indicators) {
+      states.emplace_back(slots * indicator->needs().state_size);
+      column_counts.push_back(indicator->columns().size());
+    }
+  }
 
-  // Every slot at time 0: the initial vectors, orthonormalised, and zeroed sums.
+  std::size_t slots() const { return lyapunov.size(); }
+  // Indicator i's state of `slot`.
+  std::span<double> state(std::size_t i, std::size_t slot) {
+    const std::size_t size = (*indicators)[i]->needs().state_size;
+    return std::span<double>(states[i]).subspan(slot * size, size);
+  }
+  std::span<const double> state(std::size_t i, std::size_t slot) const {
+    const std::size_t size = (*indicators)[i]->needs().state_size;
+    return std::span<const double>(states[i]).subspan(slot * size, size);
+  }
+
+  // Every slot at time 0: the initial vectors, orthonormalised, and every indicator's start.
   void start() {
     const std::size_t n = vectors.dimension();
     const PhaseSpaceBatch one = initial_tangent_vectors(n, k);
-    for (std::size_t s = 0; s < lyapunov.size(); ++s) {
+    for (std::size_t s = 0; s < slots(); ++s) {
       std::copy(one.q().begin(), one.q().end(), vectors.q().begin() + static_cast<std::ptrdiff_t>(s * k * n));
       std::copy(one.p().begin(), one.p().end(), vectors.p().begin() + static_cast<std::ptrdiff_t>(s * k * n));
     }
     exponents.start(vectors, lyapunov);
-    std::fill(megno.begin(), megno.end(), MegnoRecord{});
-    if (factor_size > 0) AlignmentIndices(k).start(alignment);
+    for (std::size_t i = 0; i < indicators->size(); ++i)
+      for (std::size_t s = 0; s < slots(); ++s) (*indicators)[i]->start(state(i, s));
   }
 
   // Steps the states of `x`, which are slots first .. first + x.count() - 1 of the block, with their vectors and the
@@ -89,58 +107,61 @@ struct BlockTangents {
   template <class M>
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
     integrator.step(model, x, vectors, dt);
-    after_step(dt);
+    after_steps(dt, 1);
   }
 
   // `n` steps of every slot, n calls of step(). A Chin scheme with a plugin's tangent kernel takes them in runs that
-  // end at the orthonormalisations (one step a run with MEGNO, whose growth is taken at every step), each run one
+  // end at the orthonormalisations (one step a run when an indicator takes the growth at every step), each run one
   // kernel call (bit for bit step()'s numbers with the baseline instruction set; the wider sets round as their kernels
   // do); otherwise step by step through the evaluation path.
   template <class M>
   void step_n(const M& model, PhaseSpaceBatch& x, double dt, std::uint64_t n) {
     while (n > 0) {
-      const std::uint64_t run = with_megno ? 1 : std::min(n, exponents.steps_to_renormalization(lyapunov));
+      const std::uint64_t run = with_growth ? 1 : std::min(n, exponents.steps_to_renormalization(lyapunov));
       if (!integrator.step_kernel_n(model, x, vectors, dt, run)) break;
-      exponents.after_steps(vectors, lyapunov, dt, run, growth, alignment);
-      if (with_megno) add_megno_step(megno, growth, dt);
+      after_steps(dt, run);
       n -= run;
     }
     for (; n > 0; --n) step(model, x, dt);
   }
 
-  // The Lyapunov and MEGNO sums and the SALI/GALI factors after a step of dt of every slot.
-  void after_step(double dt) {
-    exponents.after_step(vectors, lyapunov, dt, growth, alignment);
-    if (with_megno) add_megno_step(megno, growth, dt);
-  }
-  // The factor of alignment_indices.hpp of `slot` (empty without SALI and GALI).
-  std::span<const double> factor(std::size_t slot) const {
-    return std::span<const double>(alignment).subspan(slot * factor_size, factor_size);
+  // The Lyapunov sums and every indicator's state after a step of dt of every slot.
+  void after_step(double dt) { after_steps(dt, 1); }
+
+  // The values of every indicator's columns of `slot`, in the list's order, appended to `values`.
+  void values(std::size_t slot, std::vector<double>& values) const {
+    for (std::size_t i = 0; i < indicators->size(); ++i) {
+      const Indicator& indicator = *(*indicators)[i];
+      const std::size_t first = values.size();
+      values.resize(first + column_counts[i]);
+      indicator.values(state(i, slot), lyapunov[slot], std::span<double>(values).subspan(first));
+    }
   }
 
-  // Checkpoints (DriverState): appends every slot's vectors, sums and factors; restore() takes slot s from entry
-  // entries[s] of such lists (the block's members among the active trajectories of a checkpoint).
+  // Checkpoints (DriverState, whose `indicators` are those of the run, named): appends every slot's vectors, sums and
+  // indicator states; restore() takes slot s from
+  // entry entries[s] of such lists (the block's members among the active trajectories of a checkpoint).
   void save(DriverState& state) const {
     state.tangent_q.insert(state.tangent_q.end(), vectors.q().begin(), vectors.q().end());
     state.tangent_p.insert(state.tangent_p.end(), vectors.p().begin(), vectors.p().end());
     state.lyapunov.insert(state.lyapunov.end(), lyapunov.begin(), lyapunov.end());
-    state.megno.insert(state.megno.end(), megno.begin(), megno.end());
-    state.alignment.insert(state.alignment.end(), alignment.begin(), alignment.end());
+    for (std::size_t i = 0; i < states.size(); ++i)
+      state.indicators[i].values.insert(state.indicators[i].values.end(), states[i].begin(), states[i].end());
   }
-  void restore(std::span<const std::size_t> entries, const DriverState& state) {
-    const std::span<const double> q = state.tangent_q, p = state.tangent_p;
-    const std::span<const LyapunovRecord> l = state.lyapunov;
-    const std::span<const MegnoRecord> m = state.megno;
+  void restore(std::span<const std::size_t> entries, const DriverState& saved) {
+    const std::span<const double> q = saved.tangent_q, p = saved.tangent_p;
     const std::size_t size = k * vectors.dimension();
     for (std::size_t slot = 0; slot < entries.size(); ++slot) {
       std::copy_n(q.begin() + static_cast<std::ptrdiff_t>(entries[slot] * size), size,
                   vectors.q().begin() + static_cast<std::ptrdiff_t>(slot * size));
       std::copy_n(p.begin() + static_cast<std::ptrdiff_t>(entries[slot] * size), size,
                   vectors.p().begin() + static_cast<std::ptrdiff_t>(slot * size));
-      lyapunov[slot] = l[entries[slot]];
-      megno[slot] = m[entries[slot]];
-      std::copy_n(state.alignment.begin() + static_cast<std::ptrdiff_t>(entries[slot] * factor_size), factor_size,
-                  alignment.begin() + static_cast<std::ptrdiff_t>(slot * factor_size));
+      lyapunov[slot] = saved.lyapunov[entries[slot]];
+      for (std::size_t i = 0; i < states.size(); ++i) {
+        const std::size_t n = (*indicators)[i]->needs().state_size;
+        std::copy_n(saved.indicators[i].values.begin() + static_cast<std::ptrdiff_t>(entries[slot] * n), n,
+                    state(i, slot).begin());
+      }
     }
   }
 
@@ -157,9 +178,10 @@ struct BlockTangents {
         std::copy_n(vectors.p().begin() + static_cast<std::ptrdiff_t>(s * k * n), k * n,
                     vectors.p().begin() + static_cast<std::ptrdiff_t>(kept * k * n));
         lyapunov[kept] = lyapunov[s];
-        megno[kept] = megno[s];
-        std::copy_n(alignment.begin() + static_cast<std::ptrdiff_t>(s * factor_size), factor_size,
-                    alignment.begin() + static_cast<std::ptrdiff_t>(kept * factor_size));
+        for (std::size_t i = 0; i < states.size(); ++i) {
+          const auto from = state(i, s);
+          std::copy(from.begin(), from.end(), state(i, kept).begin());
+        }
       }
       ++kept;
     }
@@ -169,9 +191,27 @@ struct BlockTangents {
     std::copy_n(vectors.p().begin(), kept * k * n, next.p().begin());
     vectors = std::move(next);
     lyapunov.resize(kept);
-    megno.resize(kept);
-    growth.resize(with_megno ? kept : 0);
-    alignment.resize(kept * factor_size);
+    for (std::size_t i = 0; i < states.size(); ++i) states[i].resize(kept * (*indicators)[i]->needs().state_size);
+    growth.resize(with_growth ? kept : 0);
+  }
+
+ private:
+  void after_steps(double dt, std::uint64_t steps) {
+    LyapunovExponents::OrthonormalizationHook hook;
+    if (with_factors)
+      hook = [this](std::size_t slot, std::span<const double> r) {
+        for (std::size_t i = 0; i < indicators->size(); ++i)
+          if ((*indicators)[i]->needs().orthonormalization_factors)
+            (*indicators)[i]->after_orthonormalization(state(i, slot), r, k);
+      };
+    exponents.after_steps(vectors, lyapunov, dt, steps, growth, hook);
+    for (std::size_t i = 0; i < indicators->size(); ++i) {
+      const Indicator& indicator = *(*indicators)[i];
+      const bool needs_growth = indicator.needs().first_growth;
+      for (std::size_t s = 0; s < slots(); ++s)
+        for (std::uint64_t step = 0; step < steps; ++step)
+          indicator.after_step(state(i, s), needs_growth ? growth[s] : 0.0, dt);
+    }
   }
 };
 

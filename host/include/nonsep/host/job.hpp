@@ -25,6 +25,7 @@
 #include <variant>
 #include <vector>
 
+#include "nonsep/core/analysis/indicator.hpp"
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/json/issues.hpp"
 #include "nonsep/host/plugin_loader.hpp"
@@ -129,21 +130,14 @@ struct Analysis {
   bool megno = false;                        // /analysis/megno: MEGNO of the first tangent vector
   bool sali = false;                         // /analysis/sali: SALI of the first two tangent vectors
   std::size_t gali = 0;                      // /analysis/gali: GALI_2 .. GALI_gali of the first vectors; 0: none
-  // Tangent vectors per trajectory the run must follow, shared by every analysis: the most any of them needs
-  // (lyapunov's k, 1 for MEGNO, 2 for SALI, gali's k); 0 for none.
-  std::size_t tangent_vectors() const {
-    return std::max({lyapunov ? lyapunov->vectors : 0, megno ? std::size_t{1} : 0, sali ? std::size_t{2} : 0, gali});
-  }
-  // Whether the run keeps the factors of SALI and GALI (nonsep/core/analysis/alignment_indices.hpp).
-  bool alignment_indices() const { return sali || gali > 0; }
-  // The job file's key of the first analysis that needs tangent vectors, for messages ("" for none).
-  std::string tangent_key() const {
-    return lyapunov ? "/analysis/lyapunov"
-           : megno  ? "/analysis/megno"
-           : sali   ? "/analysis/sali"
-           : gali   ? "/analysis/gali"
-                    : "";
-  }
+  bool fli = false;                          // /analysis/fli: the fast Lyapunov indicator of the first vector
+  // The chaos indicators these ask for, in the order of their columns (host/src/job/indicators.cpp: the one list).
+  IndicatorList indicators() const;
+  // Tangent vectors per trajectory the run must follow, shared by every indicator: the most any of them needs; 0
+  // for none.
+  std::size_t tangent_vectors() const;
+  // The job file's key of the first indicator, for messages ("" for none).
+  std::string tangent_key() const;
   // /analysis/closest_return_after: from this time on, the smallest Euclidean phase-space distance
   // |(q, p) - (q0, p0)| to the trajectory's initial state is tracked at every step (summary: closest_return).
   std::optional<double> closest_return_after;

@@ -28,11 +28,14 @@
 //
 // LyapunovExponents::after_step calls update() when it is given the factors. Errors: InvalidArgument for k < 2
 // or spans of the wrong size.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <span>
 #include <string>
 
+#include "nonsep/core/analysis/indicator.hpp"
 #include "nonsep/core/base/error.hpp"
 
 namespace nonsep {
@@ -99,6 +102,58 @@ class AlignmentIndices {
   }
 
   std::size_t k_;
+};
+
+// SALI and GALI as indicators (indicator.hpp): SALI (columns: sali) from the factor of the first 2 vectors, GALI
+// (columns gali2 .. gali<k>) from that of the first k; state: the factor. A factor of the first j vectors is the
+// leading part of that of more vectors, bit for bit (column j of C needs rows 0 .. j of R only), so each keeps its own.
+class AlignmentIndicator final : public Indicator {
+ public:
+  static AlignmentIndicator sali() { return AlignmentIndicator(0); }
+  static AlignmentIndicator gali(std::size_t k) { return AlignmentIndicator(k); }
+
+  std::string name() const override { return gali_ == 0 ? "sali" : "gali"; }
+  IndicatorNeeds needs() const override {
+    return {.tangent_vectors = indices_.vectors(),
+            .orthonormalization_factors = true,
+            .state_size = indices_.factor_size()};
+  }
+  std::vector<std::string> columns() const override {
+    if (gali_ == 0) return {"sali"};
+    std::vector<std::string> names;
+    for (std::size_t j = 2; j <= gali_; ++j) names.push_back("gali" + std::to_string(j));
+    return names;
+  }
+  std::string description() const override {
+    return gali_ == 0 ? "trajectories.csv sali, of the first two vectors"
+                      : "trajectories.csv gali2 .. gali" + std::to_string(gali_) + ", GALI_j of the first j vectors";
+  }
+  std::vector<std::pair<std::string, std::size_t>> settings() const override {
+    if (gali_ == 0) return {};
+    return {{"vectors", gali_}};
+  }
+
+  void start(std::span<double> state) const override { indices_.start(state); }
+  // R's leading block of this indicator's vectors.
+  void after_orthonormalization(std::span<double> state, std::span<const double> r, std::size_t k) const override {
+    const std::size_t own = indices_.vectors();
+    std::array<double, LyapunovRecord::max_exponents * LyapunovRecord::max_exponents> leading;  // written before read
+    for (std::size_t i = 0; i < own; ++i)
+      for (std::size_t j = 0; j < own; ++j) leading[i * own + j] = r[i * k + j];
+    indices_.update(state, std::span<const double>(leading.data(), own * own));
+  }
+  void values(std::span<const double> state, const LyapunovRecord&, std::span<double> out) const override {
+    if (gali_ == 0) {
+      out[0] = AlignmentIndices::sali(state);
+      return;
+    }
+    for (std::size_t j = 2; j <= gali_; ++j) out[j - 2] = AlignmentIndices::gali(state, j);
+  }
+
+ private:
+  explicit AlignmentIndicator(std::size_t gali) : gali_(gali), indices_(std::max<std::size_t>(2, gali)) {}
+  std::size_t gali_;  // 0: SALI
+  AlignmentIndices indices_;
 };
 
 }  // namespace nonsep

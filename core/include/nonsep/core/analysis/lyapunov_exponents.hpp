@@ -25,30 +25,16 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <optional>
+#include <functional>
 #include <span>
 #include <string>
 
 #include "nonsep/core/analysis/alignment_indices.hpp"
+#include "nonsep/core/analysis/lyapunov_record.hpp"
 #include "nonsep/core/base/error.hpp"
 #include "nonsep/core/base/phase_space_batch.hpp"
 
 namespace nonsep {
-
-struct LyapunovRecord {
-  static constexpr std::size_t max_exponents = 32;  // 2n for n = 16, the largest dimension the shipped models have
-
-  std::uint64_t steps = 0;  // steps since start()
-  std::uint64_t steps_since_renormalization = 0;
-  double time = 0.0;  // time at the last orthonormalisation (the exponents' denominator)
-  double time_since_renormalization = 0.0;
-  double log_norm_first = 0.0;                      // ln |v_1| now; 0 right after an orthonormalisation
-  std::array<double, max_exponents> log_stretch{};  // sum of ln R_jj, vector j at index j
-
-  // lambda_j at the last orthonormalisation; 0 before the first.
-  double exponent(std::size_t j) const { return time == 0.0 ? 0.0 : log_stretch[j] / time; }
-  friend bool operator==(const LyapunovRecord&, const LyapunovRecord&) = default;
-};
 
 // Modified Gram-Schmidt of the k vectors of state b of `tangents` (layout above), in place: afterwards they are
 // orthonormal, and log_norms[j] = ln R_jj (the length of vector j after the projections onto vectors 0 .. j-1
@@ -89,6 +75,9 @@ inline void orthonormalize_state(PhaseSpaceBatch& tangents, std::size_t k, std::
 
 class LyapunovExponents {
  public:
+  // Called at each orthonormalisation of state b with its triangular factor R (k x k, row-major).
+  using OrthonormalizationHook = std::function<void(std::size_t b, std::span<const double> r)>;
+
   // k vectors per state (1 for the largest exponent), re-orthonormalised every `renormalize_every` steps.
   LyapunovExponents(std::size_t k, std::size_t renormalize_every) : k_(k), renormalize_every_(renormalize_every) {
     if (k == 0 || k > LyapunovRecord::max_exponents)
@@ -125,7 +114,7 @@ class LyapunovExponents {
   }
   // Without first_growth and alignment.
   void after_step(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt) {
-    after_steps(tangents, records, dt, 1, {}, {});
+    after_steps(tangents, records, dt, 1, {}, OrthonormalizationHook());
   }
 
   // The steps every state can take before one reaches its next orthonormalisation (at least 1; renormalize_every
@@ -143,6 +132,20 @@ class LyapunovExponents {
   // steps == 1.
   void after_steps(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt, std::uint64_t steps,
                    std::span<double> first_growth, std::span<double> alignment = {}) {
+    if (alignment.empty()) return after_steps(tangents, records, dt, steps, first_growth, OrthonormalizationHook());
+    const AlignmentIndices indices(k_);
+    if (alignment.size() != records.size() * indices.factor_size())
+      throw InvalidArgument("SALI/GALI: " + std::to_string(alignment.size()) + " numbers of factors for " +
+                            std::to_string(records.size()) + " states of " + std::to_string(k_) +
+                            " vectors (expected " + std::to_string(records.size() * indices.factor_size()) + ")");
+    after_steps(tangents, records, dt, steps, first_growth, [&](std::size_t b, std::span<const double> r) {
+      indices.update(alignment.subspan(b * indices.factor_size(), indices.factor_size()), r);
+    });
+  }
+
+  // after_steps with a hook in place of the SALI/GALI factors (an empty hook: R is not kept).
+  void after_steps(PhaseSpaceBatch& tangents, std::span<LyapunovRecord> records, double dt, std::uint64_t steps,
+                   std::span<double> first_growth, const OrthonormalizationHook& hook) {
     check(tangents, records);
     if (steps == 0 || steps > steps_to_renormalization(records) || (steps > 1 && !first_growth.empty()))
       throw InvalidArgument("after_steps: " + std::to_string(steps) +
@@ -151,18 +154,10 @@ class LyapunovExponents {
     if (!first_growth.empty() && first_growth.size() != records.size())
       throw InvalidArgument("first_growth has " + std::to_string(first_growth.size()) + " entries for " +
                             std::to_string(records.size()) + " states");
-    std::optional<AlignmentIndices> indices;
-    if (!alignment.empty()) {
-      indices.emplace(k_);
-      if (alignment.size() != records.size() * indices->factor_size())
-        throw InvalidArgument("SALI/GALI: " + std::to_string(alignment.size()) + " numbers of factors for " +
-                              std::to_string(records.size()) + " states of " + std::to_string(k_) +
-                              " vectors (expected " + std::to_string(records.size() * indices->factor_size()) + ")");
-    }
     const std::size_t n = tangents.dimension();
     std::array<double, LyapunovRecord::max_exponents> log_norms{};
     std::array<double, LyapunovRecord::max_exponents * LyapunovRecord::max_exponents> r;  // written before read
-    const std::span<double> triangle = indices ? std::span<double>(r.data(), k_ * k_) : std::span<double>();
+    const std::span<double> triangle = hook ? std::span<double>(r.data(), k_ * k_) : std::span<double>();
     for (std::size_t b = 0; b < records.size(); ++b) {
       LyapunovRecord& record = records[b];
       if (!first_growth.empty()) {
@@ -181,7 +176,7 @@ class LyapunovExponents {
       if (record.steps_since_renormalization < renormalize_every_) continue;
       orthonormalize_state(tangents, k_, b, log_norms, triangle);
       for (std::size_t j = 0; j < k_; ++j) record.log_stretch[j] += log_norms[j];
-      if (indices) indices->update(alignment.subspan(b * indices->factor_size(), indices->factor_size()), triangle);
+      if (hook) hook(b, triangle);
       record.time += record.time_since_renormalization;
       record.time_since_renormalization = 0.0;
       record.steps_since_renormalization = 0;

@@ -23,6 +23,7 @@
 #include <span>
 #include <string>
 
+#include "nonsep/core/analysis/indicator.hpp"
 #include "nonsep/core/base/error.hpp"
 
 namespace nonsep {
@@ -51,5 +52,36 @@ inline void add_megno_step(std::span<MegnoRecord> records, std::span<const doubl
                           " growth values");
   for (std::size_t b = 0; b < records.size(); ++b) records[b].add_step(growth[b], dt);
 }
+
+// MEGNO as an indicator (indicator.hpp): columns megno (Y) and mean_megno (<Y>); state: a MegnoRecord's three
+// numbers (time, weighted_growth, integrated_y).
+class MegnoIndicator final : public Indicator {
+ public:
+  std::string name() const override { return "megno"; }
+  IndicatorNeeds needs() const override { return {.tangent_vectors = 1, .first_growth = true, .state_size = 3}; }
+  std::vector<std::string> columns() const override { return {"megno", "mean_megno"}; }
+  std::string description() const override {
+    return "trajectories.csv megno (Y), mean_megno (<Y>, -> 2 on quasi-periodic orbits)";
+  }
+  void start(std::span<double> state) const override { store(MegnoRecord{}, state); }
+  void after_step(std::span<double> state, double growth, double dt) const override {
+    MegnoRecord record = load(state);
+    record.add_step(growth, dt);
+    store(record, state);
+  }
+  void values(std::span<const double> state, const LyapunovRecord&, std::span<double> out) const override {
+    const MegnoRecord record = load(state);
+    out[0] = record.y();
+    out[1] = record.mean_y();
+  }
+
+ private:
+  static MegnoRecord load(std::span<const double> state) { return {state[0], state[1], state[2]}; }
+  static void store(const MegnoRecord& record, std::span<double> state) {
+    state[0] = record.time;
+    state[1] = record.weighted_growth;
+    state[2] = record.integrated_y;
+  }
+};
 
 }  // namespace nonsep

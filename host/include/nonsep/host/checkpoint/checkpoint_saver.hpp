@@ -22,8 +22,9 @@ inline constexpr const char* checkpoint_file_name = "checkpoint.json";
 
 // The value of the file's "format" key; a checkpoint with another is refused.
 // 4: the scheme's private state, grad H; 5: "stepping" (stepping_identity); 6: the runaway check's extents and
-// whether H was evaluated after step 0 (energy_error).
-inline constexpr const char* checkpoint_format = "nonsep checkpoint 6";
+// whether H was evaluated after step 0 (energy_error); 7: the chaos indicators' states under their names
+// (active.indicators) and their final values as one list per record (records[].indicators).
+inline constexpr const char* checkpoint_format = "nonsep checkpoint 7";
 // The value of the file's "checksum" key: the content hash of everything else, as dumped (keys sorted, numbers as
 // strings), so that an edited or damaged checkpoint is refused instead of changing the results.
 inline std::string checkpoint_checksum(const nlohmann::json& document) {

@@ -3,7 +3,7 @@
 // rank: distributed_run.hpp) into the files one process would have written, byte for byte.
 //
 // This works because every streamed file names each row by its (step, trajectory) or (trajectory) and is written in
-// that order by one process (sample_writer.hpp, poincare_section.hpp, lyapunov_megno.hpp, trajectories.csv): the
+// that order by one process (sample_writer.hpp, poincare_section.hpp, indicator_columns.hpp, trajectories.csv): the
 // merged file is the unit files' rows in key order, with each unit's trajectory numbers shifted by its first
 // trajectory. Rows with equal keys (two Poincare crossings in one step) come from one unit and keep their order.
 #include <cstddef>

@@ -39,8 +39,7 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/analysis/lyapunov_exponents.hpp"
-#include "nonsep/core/analysis/megno.hpp"
+#include "nonsep/core/analysis/indicator.hpp"
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/observer.hpp"
@@ -87,10 +86,9 @@ struct EnsembleSetup {
   // block_size), and each thread creates its own instance of a set's parameters when it first steps one of its
   // blocks: one instance per set and thread (`model` is then not stepped).
   std::vector<ParameterSet> parameter_sets = {};
-  // With tangent vectors: whether the run computes MEGNO (the first vector's log-growth at every step), and whether
-  // it keeps the factors of SALI and GALI (nonsep/core/analysis/alignment_indices.hpp; tangent_vectors >= 2).
-  bool megno = false;
-  bool alignment_indices = false;
+  // With tangent vectors: the chaos indicators computed from them (nonsep/core/analysis/indicator.hpp), in the order
+  // of their columns; tangent_vectors is at least the most any of them needs.
+  IndicatorList indicators = {};
   // The wall time each chunk aims at, from the speed of the chunk before (run/chunk_sizer.hpp); 0: one step each.
   // No number depends on it.
   double chunk_seconds = run_chunk_seconds;
@@ -105,12 +103,15 @@ struct DriverState {
   std::vector<TrajectoryRecord> records;  // every trajectory, by index
   EvaluationCounts evaluations;
   // With tangent vectors (k per trajectory): the active trajectories' vectors (k * dimension numbers each, in
-  // tangent_basic_step.hpp's layout) and their Lyapunov and MEGNO sums; empty without.
+  // tangent_basic_step.hpp's layout), their Lyapunov sums, and per indicator of EnsembleSetup::indicators its state
+  // of each (state_size numbers each); empty without.
   std::vector<double> tangent_q, tangent_p;
   std::vector<LyapunovRecord> lyapunov;
-  std::vector<MegnoRecord> megno;
-  // With SALI or GALI: the active trajectories' factors (AlignmentIndices::factor_size(k) numbers each); else empty.
-  std::vector<double> alignment;
+  struct IndicatorState {
+    std::string name;            // Indicator::name()
+    std::vector<double> values;  // state_size numbers per active trajectory, in the order of `active`
+  };
+  std::vector<IndicatorState> indicators;
   // The scheme's private state of the active trajectories (its columns in the order of `active`) and its numbers
   // about the run (nonsep::SchemeState): stored and handed back, never read; empty for most schemes.
   SchemeState scheme;

@@ -44,8 +44,6 @@
 #include <string>
 #include <vector>
 
-#include "nonsep/core/analysis/lyapunov_exponents.hpp"
-#include "nonsep/core/analysis/megno.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
 namespace nonsep::host {
@@ -60,11 +58,8 @@ struct StateView {
   std::span<const double> q, p;
   std::optional<double> energy;              // H at this step, when it was evaluated and finite
   const TrajectoryRecord* record = nullptr;  // energy_initial etc.
-  // The running Lyapunov and MEGNO sums, when the run follows tangent vectors (EnsembleSetup::tangent_vectors).
-  const LyapunovRecord* lyapunov = nullptr;
-  const MegnoRecord* megno = nullptr;
-  // With SALI or GALI: the state's factor of nonsep/core/analysis/alignment_indices.hpp; else empty.
-  std::span<const double> alignment = {};
+  // When the run computes chaos indicators (EnsembleSetup::indicators): their columns' running values, in order.
+  std::span<const double> indicators = {};
 };
 
 struct Event {

@@ -44,13 +44,9 @@ struct TrajectoryRecord {
   double stop_t = 0.0;
   std::string stop_variable;
   std::string message;
-  // The final estimates of /analysis/lyapunov (k exponents) and /analysis/megno (Y and <Y>), set when a run that
-  // follows tangent vectors retires the trajectory; empty for one that diverged or failed, and when not computed.
-  std::vector<double> lyapunov;
-  std::optional<double> megno, mean_megno;
-  // SALI and GALI_2 .. GALI_k (gali[j - 2] = GALI_j) at the last orthonormalisation, likewise, when asked for.
-  std::optional<double> sali;
-  std::vector<double> gali;
+  // The final values of the run's chaos indicators' columns (EnsembleSetup::indicators, in order), set when a run
+  // that computes them retires the trajectory; empty for one that diverged or failed, and when not computed.
+  std::vector<double> indicators;
 };
 
 // A trajectory that stops before the end of the run, and its record: the one record of a stopped trajectory, from

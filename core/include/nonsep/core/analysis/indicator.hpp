@@ -1,0 +1,83 @@
+#pragma once
+// The seam for chaos indicators: what an indicator needs from a run, how it keeps its state, what it reports.
+//
+// The tangent machinery is shared: k tangent vectors per trajectory follow the exact tangent map of the run's
+// integrator, LyapunovExponents re-orthonormalises them every m steps and keeps one LyapunovRecord per trajectory
+// (lyapunov_exponents.hpp). An indicator is a small stateless object (its settings only) that says what it needs of
+// that machinery (IndicatorNeeds) and turns it into its numbers; every trajectory's own state is state_size numbers
+// that the caller owns, hands to the indicator at each step, and stores in checkpoints as numbers (restoring them bit
+// for bit continues a run bit for bit). Its columns go to trajectories.csv and the series file, in order.
+//
+// The calls, for each trajectory (the caller's loop; the host's driver is one, run/tangent_block.hpp):
+//   start(state)                     time 0, before the first step;
+//   after_step(state, growth, dt)    after each step of dt, with growth = ln(|v_1(t_k)| / |v_1(t_{k-1})|), the
+//                                    first vector's log-growth over the step (needs().first_growth; else 0);
+//   after_orthonormalization(state, r, k)  at each re-orthonormalisation of the run's k vectors (k at least what the
+//                                    indicator needs), with its triangular factor R (k x k, row-major:
+//                                    orthonormalize_state; needs().orthonormalization_factors);
+//   values(state, lyapunov, out)     its columns' values now (out.size() == columns().size()).
+// The lists of indicators, which the host reads from the job file, is host/src/job/indicators.cpp.
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nonsep/core/analysis/lyapunov_record.hpp"
+
+namespace nonsep {
+
+struct IndicatorNeeds {
+  std::size_t tangent_vectors = 0;          // the first k vectors of the shared ones (the run follows the most asked)
+  bool first_growth = false;                // the first vector's log-growth at every step
+  bool orthonormalization_factors = false;  // the triangular factor of every re-orthonormalisation
+  std::size_t state_size = 0;               // numbers per trajectory
+};
+
+class Indicator {
+ public:
+  virtual ~Indicator() = default;
+
+  // Its key under /analysis in job files, in summary.json and in checkpoints: "megno", "fli", ...
+  virtual std::string name() const = 0;
+  virtual IndicatorNeeds needs() const = 0;
+  // Its columns in trajectories.csv and the series, in order.
+  virtual std::vector<std::string> columns() const = 0;
+  // What the columns hold, for summary.json ("trajectories.csv megno (Y), ...").
+  virtual std::string description() const = 0;
+  // Its settings as named integers, for summary.json (e.g. {"vectors", 3}); none by default.
+  virtual std::vector<std::pair<std::string, std::size_t>> settings() const { return {}; }
+
+  virtual void start(std::span<double> /*state*/) const {}
+  virtual void after_step(std::span<double> /*state*/, double /*growth*/, double /*dt*/) const {}
+  virtual void after_orthonormalization(std::span<double> /*state*/, std::span<const double> /*r*/,
+                                        std::size_t /*k*/) const {}
+  virtual void values(std::span<const double> state, const LyapunovRecord& lyapunov, std::span<double> out) const = 0;
+};
+
+// The indicators of a run, in the order of their columns.
+using IndicatorList = std::vector<std::shared_ptr<const Indicator>>;
+
+// Finite-time Lyapunov exponents lambda_0 .. lambda_(k-1) at the last orthonormalisation (LyapunovRecord::exponent),
+// columns lyapunov0 .. lyapunov<k-1>; no state of its own.
+class LyapunovIndicator final : public Indicator {
+ public:
+  explicit LyapunovIndicator(std::size_t k) : k_(k) {}
+  std::string name() const override { return "lyapunov"; }
+  IndicatorNeeds needs() const override { return {.tangent_vectors = k_}; }
+  std::vector<std::string> columns() const override {
+    std::vector<std::string> names;
+    for (std::size_t j = 0; j < k_; ++j) names.push_back("lyapunov" + std::to_string(j));
+    return names;
+  }
+  std::string description() const override { return "trajectories.csv lyapunov0 .. lyapunov" + std::to_string(k_ - 1); }
+  void values(std::span<const double>, const LyapunovRecord& lyapunov, std::span<double> out) const override {
+    for (std::size_t j = 0; j < k_; ++j) out[j] = lyapunov.exponent(j);
+  }
+
+ private:
+  std::size_t k_;
+};
+
+}  // namespace nonsep
