@@ -41,18 +41,22 @@ Orbit follow(const M& model, const IntegratorSpec& spec, std::vector<double> q, 
   std::copy_n(delta.begin(), n, tangents.q().begin());
   std::copy_n(delta.begin() + static_cast<std::ptrdiff_t>(n), n, tangents.p().begin());
   std::array<LyapunovRecord, 1> record{};
-  std::array<MegnoRecord, 1> megno{};
+  const MegnoIndicator megno;
+  std::vector<double> megno_state(MegnoIndicator::state_numbers);
   std::array<double, 1> growth{};
+  std::array<double, 2> y{};
   lyapunov.start(tangents, record);
+  megno.start(megno_state);
   Orbit orbit;
   for (int s = 1; s <= steps; ++s) {
     integrator.step(model, x, tangents, dt);
     lyapunov.after_step(tangents, record, dt, growth);
-    add_megno_step(megno, growth, dt);
+    megno.after_step(megno_state, growth[0], dt);
     if (record[0].steps_since_renormalization == 0) {
       orbit.times.push_back(record[0].time);
       orbit.exponents.push_back(record[0].exponent(0));
-      orbit.mean_y.push_back(megno[0].mean_y());
+      megno.values(megno_state, record[0], y);
+      orbit.mean_y.push_back(y[1]);
     }
   }
   return orbit;

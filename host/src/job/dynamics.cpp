@@ -129,27 +129,11 @@ void read_dynamics(Checker& check, const json& value, std::size_t dimension, Ana
     analysis.poincare = read_poincare(check, *poincare, dimension);
   if (const json* lyapunov = check.member(value, path, "lyapunov", false, ""))
     analysis.lyapunov = read_lyapunov(check, *lyapunov, dimension);
-  if (const json* megno = check.member(value, path, "megno", false, "")) {
-    if (megno->is_boolean())
-      analysis.megno = megno->get<bool>();
-    else
-      check.issue(child(path, "megno"), describe(*megno),
-                  "true or false: MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)");
-  }
-  if (const json* fli = check.member(value, path, "fli", false, "")) {
-    if (fli->is_boolean())
-      analysis.fli = fli->get<bool>();
-    else
-      check.issue(child(path, "fli"), describe(*fli),
-                  "true or false: the fast Lyapunov indicator of the first tangent vector (trajectories.csv fli)");
-  }
-  if (const json* sali = check.member(value, path, "sali", false, "")) {
-    if (sali->is_boolean())
-      analysis.sali = sali->get<bool>();
-    else
-      check.issue(child(path, "sali"), describe(*sali),
-                  "true or false: SALI of the first two tangent vectors (trajectories.csv sali)");
-  }
+  read_flag(check, value, path, "megno", "MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)",
+            analysis.megno);
+  read_flag(check, value, path, "fli", "the fast Lyapunov indicator of the first tangent vector (trajectories.csv fli)",
+            analysis.fli);
+  read_flag(check, value, path, "sali", "SALI of the first two tangent vectors (trajectories.csv sali)", analysis.sali);
   if (const json* gali = check.member(value, path, "gali", false, "")) {
     const std::size_t most = most_tangent_vectors(dimension);
     if (auto k = check.integer(*gali, child(path, "gali"), 2, static_cast<std::int64_t>(most),

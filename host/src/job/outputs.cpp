@@ -26,6 +26,16 @@ OutputFormat read_format(Checker& check, const json& value, bool study) {
 
 }  // namespace
 
+void read_flag(Checker& check, const json& value, const std::string& path, const std::string& key,
+               const std::string& meaning, bool& flag) {
+  const json* member = check.member(value, path, key, false, "");
+  if (!member) return;
+  if (member->is_boolean())
+    flag = member->get<bool>();
+  else
+    check.issue(child(path, key), describe(*member), "true or false: " + meaning);
+}
+
 void read_output(Checker& check, const json& document, Job& job) {
   SingleRun study_strides;  // a study's /output/every and /output/energy_every are checked but not used
   SingleRun& run = job.is_study() ? study_strides : std::get<SingleRun>(job.plan);
@@ -72,13 +82,8 @@ Analysis read_analysis(Checker& check, const json& value, std::size_t dimension)
         check.positive_number(*bound, child(path, "max_relative_energy_error"),
                               "a finite number > 0: a trajectory whose |H - H0| / |H0| exceeds it stops with status "
                               "\"inaccurate\"");
-  if (const json* estimate = check.member(value, path, "error_estimate", false, "")) {
-    if (estimate->is_boolean())
-      analysis.error_estimate = estimate->get<bool>();
-    else
-      check.issue(child(path, "error_estimate"), describe(*estimate),
-                  "true or false: estimate each trajectory's global error by a second run with half the step");
-  }
+  read_flag(check, value, path, "error_estimate",
+            "estimate each trajectory's global error by a second run with half the step", analysis.error_estimate);
   return analysis;
 }
 
