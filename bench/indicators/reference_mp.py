@@ -5,7 +5,7 @@ chaotic orbit q = (0.5, 0), p = (0, 2.5), its variational equations derived by h
 plugins and automatic differentiation), integrated
 by an s-stage Gauss-Legendre method (order 2s) in mpmath at `dps` digits, stage equations solved by fixed-point
 iteration to 10^-(dps-3). Prints lambda_1(10), lambda_1(20), continuous Y and <Y> at 10, 20, and the discrete MEGNO of
-nonsep's definition (megno.hpp) on the grid dt_grid (= h * integer).
+REBOUND's right-endpoint sums (first order in dt) on the grid dt_grid (= h * integer).
 usage: reference_mp.py H STAGES DPS [COUPLING]"""
 import sys, mpmath as mp
 h_s, s, dps = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
