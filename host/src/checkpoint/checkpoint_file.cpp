@@ -135,10 +135,11 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   if (const auto& lyapunov = run.analysis.lyapunov)
     analysis += "|lyapunov " + std::to_string(lyapunov->vectors) + ' ' + std::to_string(lyapunov->renormalize_every) +
                 ' ' + std::to_string(lyapunov->every);
-  if (run.analysis.megno) analysis += "|megno";
-  if (run.analysis.sali) analysis += "|sali";
-  if (run.analysis.gali > 0) analysis += "|gali " + std::to_string(run.analysis.gali);
-  if (run.analysis.fli) analysis += "|fli";
+  for (const auto& indicator : run.analysis.indicators) {
+    if (indicator->name() == "lyapunov") continue;  // above
+    analysis += "|" + indicator->name();
+    for (const auto& [name, value] : indicator->settings()) analysis += " " + std::to_string(value);
+  }
   if (run.analysis.error_estimate) analysis += "|error_estimate";
   parts.emplace_back("analysis", std::move(analysis));
   std::string fingerprint;
@@ -313,7 +314,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     state.lyapunov.push_back(record);
   }
   // Each indicator's state under its name, as the run's indicators size it.
-  const IndicatorList indicators = k > 0 ? job.run().analysis.indicators() : IndicatorList();
+  const IndicatorList indicators = k > 0 ? job.run().analysis.indicators : IndicatorList();
   const json& saved_indicators = read.member(active, "indicators");
   if (!saved_indicators.is_object() || saved_indicators.size() != indicators.size())
     read.damaged("active.indicators does not have the states of the job's indicators");

@@ -1,10 +1,10 @@
-// /analysis/poincare, /analysis/lyapunov, /analysis/megno, /analysis/sali, /analysis/gali and /analysis/fli: the
-// dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the Hessians the tangent map needs is
-// checked when the job is loaded (load_job.cpp), where the plugin is known.
+// /analysis/poincare and the chaos indicators (/analysis/lyapunov, /megno, /sali, /gali, /fli: the list of
+// indicators.cpp): the dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the Hessians the
+// tangent map needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
 #include <limits>
 
+#include "indicators.hpp"
 #include "job_keys.hpp"
-#include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -22,11 +22,6 @@ std::optional<std::size_t> component_index(const std::string& name, std::size_t 
   }
   if (index >= dimension) return std::nullopt;
   return (name[0] == 'q' ? 0 : dimension) + index;
-}
-
-// The most tangent vectors a trajectory can have: 2n, at most LyapunovRecord::max_exponents (2 when n is unknown).
-std::size_t most_tangent_vectors(std::size_t dimension) {
-  return std::min<std::size_t>(LyapunovRecord::max_exponents, dimension > 0 ? 2 * dimension : 2);
 }
 
 std::optional<PoincareSection> read_poincare(Checker& check, const json& value, std::size_t dimension) {
@@ -94,54 +89,16 @@ std::optional<PoincareSection> read_poincare(Checker& check, const json& value, 
   return section;
 }
 
-std::optional<LyapunovAnalysis> read_lyapunov(Checker& check, const json& value, std::size_t dimension) {
-  const std::string path = "/analysis/lyapunov";
-  if (!check.object(value, path, "an object {\"vectors\": k, \"renormalize_every\": m, \"every\": s}"))
-    return std::nullopt;
-  check.known_keys(value, path, lyapunov_keys().names());
-  const std::size_t issues = check.issue_count();
-  LyapunovAnalysis lyapunov;
-  const std::size_t most = most_tangent_vectors(dimension);
-  if (const json* k = check.member(value, path, "vectors", false, ""))
-    if (auto n = check.integer(*k, child(path, "vectors"), 1, static_cast<std::int64_t>(most),
-                               "an integer from 1 to " + std::to_string(most) +
-                                   " (2n, at most 32): the number of largest exponents (default 1)"))
-      lyapunov.vectors = static_cast<std::size_t>(*n);
-  if (const json* m = check.member(value, path, "renormalize_every", false, ""))
-    if (auto n = check.integer(*m, child(path, "renormalize_every"), 1, static_cast<std::int64_t>(max_steps),
-                               "an integer >= 1: steps between re-orthonormalisations of the tangent vectors "
-                               "(default 1)"))
-      lyapunov.renormalize_every = static_cast<std::uint64_t>(*n);
-  if (const json* every = check.member(value, path, "every", false, ""))
-    if (auto n = check.integer(*every, child(path, "every"), 0, static_cast<std::int64_t>(max_steps),
-                               "an integer >= 0: write lyapunov.csv every n-th step (0: no time series; the "
-                               "default)"))
-      lyapunov.every = static_cast<std::uint64_t>(*n);
-  if (check.issue_count() != issues) return std::nullopt;
-  return lyapunov;
-}
-
 }  // namespace
 
 void read_dynamics(Checker& check, const json& value, std::size_t dimension, Analysis& analysis) {
   const std::string path = "/analysis";
   if (const json* poincare = check.member(value, path, "poincare", false, ""))
     analysis.poincare = read_poincare(check, *poincare, dimension);
-  if (const json* lyapunov = check.member(value, path, "lyapunov", false, ""))
-    analysis.lyapunov = read_lyapunov(check, *lyapunov, dimension);
-  read_flag(check, value, path, "megno", "MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)",
-            analysis.megno);
-  read_flag(check, value, path, "fli", "the fast Lyapunov indicator of the first tangent vector (trajectories.csv fli)",
-            analysis.fli);
-  read_flag(check, value, path, "sali", "SALI of the first two tangent vectors (trajectories.csv sali)", analysis.sali);
-  if (const json* gali = check.member(value, path, "gali", false, "")) {
-    const std::size_t most = most_tangent_vectors(dimension);
-    if (auto k = check.integer(*gali, child(path, "gali"), 2, static_cast<std::int64_t>(most),
-                               "an integer from 2 to " + std::to_string(most) +
-                                   " (2n, at most 32): GALI_2 .. GALI_k of the first k tangent vectors "
-                                   "(trajectories.csv gali2 .. gali<k>)"))
-      analysis.gali = static_cast<std::size_t>(*k);
-  }
+  for (const IndicatorEntry& entry : indicator_entries())
+    if (const json* member = check.member(value, path, entry.rule.name, false, ""))
+      if (auto indicator = entry.read(check, *member, child(path, entry.rule.name), dimension, analysis))
+        analysis.indicators.push_back(std::move(indicator));
 }
 
 }  // namespace nonsep::host::job_reader

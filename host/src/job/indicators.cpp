@@ -1,32 +1,131 @@
-// The one list of chaos indicators: which of nonsep/core/analysis's indicators a job's /analysis asks for, in the
-// order of their columns in trajectories.csv and lyapunov.csv. The driver, the columns and series, the checkpoint and
-// summary.json iterate over it.
+// The one list of a job's chaos indicators (indicators.hpp): each key's rule and reading.
+#include "indicators.hpp"
+
+#include <algorithm>
+
 #include "nonsep/core/analysis/alignment_indices.hpp"
 #include "nonsep/core/analysis/fast_lyapunov_indicator.hpp"
+#include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
-#include "nonsep/host/job.hpp"
+#include "sections.hpp"
 
-namespace nonsep::host {
+namespace nonsep::host::job_reader {
 
-IndicatorList Analysis::indicators() const {
-  IndicatorList list;
-  if (lyapunov) list.push_back(std::make_shared<LyapunovIndicator>(lyapunov->vectors));
-  if (megno) list.push_back(std::make_shared<MegnoIndicator>());
-  if (sali) list.push_back(std::make_shared<AlignmentIndicator>(AlignmentIndicator::sali()));
-  if (gali > 0) list.push_back(std::make_shared<AlignmentIndicator>(AlignmentIndicator::gali(gali)));
-  if (fli) list.push_back(std::make_shared<FastLyapunovIndicator>());
-  return list;
+namespace {
+
+using json = nlohmann::json;
+
+// The most tangent vectors a trajectory can have: 2n, at most LyapunovRecord::max_exponents (2 when n is unknown).
+std::size_t most_tangent_vectors(std::size_t dimension) {
+  return std::min<std::size_t>(LyapunovRecord::max_exponents, dimension > 0 ? 2 * dimension : 2);
 }
 
-std::size_t Analysis::tangent_vectors() const {
-  std::size_t k = 0;
-  for (const auto& indicator : indicators()) k = std::max(k, indicator->needs().tangent_vectors);
-  return k;
+std::shared_ptr<const Indicator> read_lyapunov(Checker& check, const json& value, const std::string& path,
+                                               std::size_t dimension, Analysis& analysis) {
+  if (!check.object(value, path, "an object {\"vectors\": k, \"renormalize_every\": m, \"every\": s}")) return nullptr;
+  check.known_keys(value, path, lyapunov_keys().names());
+  const std::size_t issues = check.issue_count();
+  LyapunovAnalysis lyapunov;
+  const std::size_t most = most_tangent_vectors(dimension);
+  if (const json* k = check.member(value, path, "vectors", false, ""))
+    if (auto n = check.integer(*k, child(path, "vectors"), 1, static_cast<std::int64_t>(most),
+                               "an integer from 1 to " + std::to_string(most) +
+                                   " (2n, at most 32): the number of largest exponents (default 1)"))
+      lyapunov.vectors = static_cast<std::size_t>(*n);
+  if (const json* m = check.member(value, path, "renormalize_every", false, ""))
+    if (auto n = check.integer(*m, child(path, "renormalize_every"), 1, static_cast<std::int64_t>(max_steps),
+                               "an integer >= 1: steps between re-orthonormalisations of the tangent vectors "
+                               "(default 1)"))
+      lyapunov.renormalize_every = static_cast<std::uint64_t>(*n);
+  if (const json* every = check.member(value, path, "every", false, ""))
+    if (auto n = check.integer(*every, child(path, "every"), 0, static_cast<std::int64_t>(max_steps),
+                               "an integer >= 0: write lyapunov.csv every n-th step (0: no time series; the "
+                               "default)"))
+      lyapunov.every = static_cast<std::uint64_t>(*n);
+  if (check.issue_count() != issues) return nullptr;
+  analysis.lyapunov = lyapunov;
+  return std::make_shared<LyapunovIndicator>(lyapunov.vectors);
 }
 
-std::string Analysis::tangent_key() const {
-  const IndicatorList list = indicators();
-  return list.empty() ? "" : "/analysis/" + list.front()->name();
+// A boolean key: `meaning` completes "true or false: " in its message; `make` the indicator it asks for.
+template <class Made>
+std::shared_ptr<const Indicator> read_boolean(Checker& check, const json& value, const std::string& path,
+                                              const std::string& meaning, Made&& make) {
+  if (!value.is_boolean()) {
+    check.issue(path, describe(value), "true or false: " + meaning);
+    return nullptr;
+  }
+  return value.get<bool>() ? make() : nullptr;
 }
 
-}  // namespace nonsep::host
+}  // namespace
+
+const std::vector<IndicatorEntry>& indicator_entries() {
+  static const std::vector<IndicatorEntry> entries{
+      {KeyRule{.name = "lyapunov",
+               .type = ValueType::object,
+               .description =
+                   "Finite-time Lyapunov exponents (Benettin et al.) from the exact tangent map of the run's "
+                   "integrator: trajectories.csv columns lyapunov0 .. lyapunov<k-1>. The plugin must have "
+                   "Hessians. The first tangent vector is (1, 1/2, ..., 1/(2n)) over (dq, dp), normalised.",
+               .keys = lyapunov_keys},
+       read_lyapunov},
+      {KeyRule{.name = "megno",
+               .type = ValueType::boolean,
+               .default_value = false,
+               .description =
+                   "MEGNO of the first tangent vector (Cincotta and Simo): trajectories.csv columns megno (Y) and "
+                   "mean_megno (<Y>: -> 2 on quasi-periodic orbits, ~ lambda t / 2 on chaotic ones). The plugin "
+                   "must have Hessians."},
+       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
+         return read_boolean(check, value, path,
+                             "MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)",
+                             [] { return std::make_shared<const MegnoIndicator>(); });
+       }},
+      {KeyRule{.name = "sali",
+               .type = ValueType::boolean,
+               .default_value = false,
+               .description =
+                   "SALI of the first two tangent vectors (Skokos 2001), min(|u1 + u2|, |u1 - u2|) of their unit "
+                   "vectors: trajectories.csv column sali (-> 0 exponentially on chaotic orbits, stays away from 0 "
+                   "on regular ones). Shares the vectors of lyapunov (at least 2). The plugin must have Hessians."},
+       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
+         return read_boolean(check, value, path, "SALI of the first two tangent vectors (trajectories.csv sali)",
+                             [] { return std::make_shared<const AlignmentIndicator>(AlignmentIndicator::sali()); });
+       }},
+      {KeyRule{.name = "gali",
+               .type = ValueType::integer,
+               .minimum = 2,
+               .maximum = static_cast<std::int64_t>(LyapunovRecord::max_exponents),
+               .description =
+                   "k (at most 2n): GALI_2 .. GALI_k (Skokos, Bountis and Antonopoulos 2007), the volume spanned "
+                   "by the unit vectors of the first j tangent vectors: trajectories.csv columns gali2 .. gali<k> "
+                   "(exponential decay on chaotic orbits; constant for j <= N, ~ t^(-2(j-N)) on an N-torus). Shares "
+                   "the vectors of lyapunov. The plugin must have Hessians."},
+       [](Checker& check, const json& value, const std::string& path, std::size_t dimension,
+          Analysis&) -> std::shared_ptr<const Indicator> {
+         const std::size_t most = most_tangent_vectors(dimension);
+         const auto k = check.integer(value, path, 2, static_cast<std::int64_t>(most),
+                                      "an integer from 2 to " + std::to_string(most) +
+                                          " (2n, at most 32): GALI_2 .. GALI_k of the first k tangent vectors "
+                                          "(trajectories.csv gali2 .. gali<k>)");
+         if (!k) return nullptr;
+         return std::make_shared<const AlignmentIndicator>(AlignmentIndicator::gali(static_cast<std::size_t>(*k)));
+       }},
+      {KeyRule{.name = "fli",
+               .type = ValueType::boolean,
+               .default_value = false,
+               .description =
+                   "The fast Lyapunov indicator of the first tangent vector (Froeschle, Lega and Gonczi 1997): "
+                   "trajectories.csv column fli, the supremum over the steps of ln |w(t)| with |w(0)| = 1 (~ lambda "
+                   "t on chaotic orbits, ~ ln t on regular ones). The plugin must have Hessians."},
+       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
+         return read_boolean(check, value, path,
+                             "the fast Lyapunov indicator of the first tangent vector (trajectories.csv fli)",
+                             [] { return std::make_shared<const FastLyapunovIndicator>(); });
+       }},
+  };
+  return entries;
+}
+
+}  // namespace nonsep::host::job_reader

@@ -2,72 +2,47 @@
 // (job_keys.hpp). Descriptions are the schema's; the limits are the analyses' own constants.
 #include <limits>
 
+#include "indicators.hpp"
 #include "job_keys.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 
 namespace nonsep::host::job_reader {
 
 const KeyTable& analysis_keys() {
-  static const KeyTable table{{
-      {.name = "closest_return_after",
-       .type = ValueType::finite,
-       .description = "From |t| >= this time on, the smallest Euclidean phase-space distance |(q, p) - (q0, p0)| "
-                      "of each trajectory to its initial state is tracked at every step (trajectories.csv: "
-                      "closest_return_distance, _t, _step)."},
-      {.name = "max_relative_energy_error",
-       .type = ValueType::positive,
-       .description = "A bound on the relative energy error |H(t) - H0| / |H0|: a trajectory that exceeds it is "
-                      "retired with status \"inaccurate\". Absent: no bound."},
-      {.name = "poincare",
-       .type = ValueType::object,
-       .description = "A surface of section normal . (q, p) = value: every crossing of every trajectory goes to "
-                      "poincare.csv (trajectory, crossing, step, t, q, p, H), located on the numerical trajectory by "
-                      "a fractional step of the run's integrator (|normal . (q, p) - value| at round-off). Exactly "
-                      "one of component and normal.",
-       .keys = poincare_keys},
-      {.name = "lyapunov",
-       .type = ValueType::object,
-       .description = "Finite-time Lyapunov exponents (Benettin et al.) from the exact tangent map of the run's "
-                      "integrator: trajectories.csv columns lyapunov0 .. lyapunov<k-1>. The plugin must have "
-                      "Hessians. The first tangent vector is (1, 1/2, ..., 1/(2n)) over (dq, dp), normalised.",
-       .keys = lyapunov_keys},
-      {.name = "megno",
-       .type = ValueType::boolean,
-       .default_value = false,
-       .description = "MEGNO of the first tangent vector (Cincotta and Simo): trajectories.csv columns megno (Y) and "
-                      "mean_megno (<Y>: -> 2 on quasi-periodic orbits, ~ lambda t / 2 on chaotic ones). The plugin "
-                      "must have Hessians."},
-      {.name = "sali",
-       .type = ValueType::boolean,
-       .default_value = false,
-       .description = "SALI of the first two tangent vectors (Skokos 2001), min(|u1 + u2|, |u1 - u2|) of their unit "
-                      "vectors: trajectories.csv column sali (-> 0 exponentially on chaotic orbits, stays away from 0 "
-                      "on regular ones). Shares the vectors of lyapunov (at least 2). The plugin must have Hessians."},
-      {.name = "gali",
-       .type = ValueType::integer,
-       .minimum = 2,
-       .maximum = static_cast<std::int64_t>(LyapunovRecord::max_exponents),
-       .description = "k (at most 2n): GALI_2 .. GALI_k (Skokos, Bountis and Antonopoulos 2007), the volume spanned "
-                      "by the unit vectors of the first j tangent vectors: trajectories.csv columns gali2 .. gali<k> "
-                      "(exponential decay on chaotic orbits; constant for j <= N, ~ t^(-2(j-N)) on an N-torus). Shares "
-                      "the vectors of lyapunov. The plugin must have Hessians."},
-      {.name = "fli",
-       .type = ValueType::boolean,
-       .default_value = false,
-       .description = "The fast Lyapunov indicator of the first tangent vector (Froeschle, Lega and Gonczi 1997): "
-                      "trajectories.csv column fli, the supremum over the steps of ln |w(t)| with |w(0)| = 1 (~ lambda "
-                      "t on chaotic orbits, ~ ln t on regular ones). The plugin must have Hessians."},
-      {.name = "error_estimate",
-       .type = ValueType::boolean,
-       .default_value = false,
-       .description = "Integrates every trajectory a second time with half the step and estimates the run's global "
-                      "error by Richardson extrapolation with the scheme's order, at the samples (or 100 evenly "
-                      "spaced steps without samples) and at the end: error_estimate.csv, trajectories.csv columns "
-                      "estimated_phase_error, estimated_relative_energy_error, error_estimate_t, "
-                      "error_estimate_horizon, error_estimate. Where the two runs separate (their difference above "
-                      "0.1 of |(q, p)|: a chaotic orbit) the estimate ends: error_estimate_horizon is that time. "
-                      "Costs twice the run."},
-  }};
+  // The chaos indicators' keys (indicators.cpp) come before error_estimate.
+  static const KeyTable table = [] {
+    KeyTable t{{
+        {.name = "closest_return_after",
+         .type = ValueType::finite,
+         .description = "From |t| >= this time on, the smallest Euclidean phase-space distance |(q, p) - (q0, p0)| "
+                        "of each trajectory to its initial state is tracked at every step (trajectories.csv: "
+                        "closest_return_distance, _t, _step)."},
+        {.name = "max_relative_energy_error",
+         .type = ValueType::positive,
+         .description = "A bound on the relative energy error |H(t) - H0| / |H0|: a trajectory that exceeds it is "
+                        "retired with status \"inaccurate\". Absent: no bound."},
+        {.name = "poincare",
+         .type = ValueType::object,
+         .description = "A surface of section normal . (q, p) = value: every crossing of every trajectory goes to "
+                        "poincare.csv (trajectory, crossing, step, t, q, p, H), located on the numerical trajectory by "
+                        "a fractional step of the run's integrator (|normal . (q, p) - value| at round-off). Exactly "
+                        "one of component and normal.",
+         .keys = poincare_keys},
+    }};
+    for (const IndicatorEntry& entry : indicator_entries()) t.rules.push_back(entry.rule);
+    t.rules.push_back(
+        {.name = "error_estimate",
+         .type = ValueType::boolean,
+         .default_value = false,
+         .description = "Integrates every trajectory a second time with half the step and estimates the run's global "
+                        "error by Richardson extrapolation with the scheme's order, at the samples (or 100 evenly "
+                        "spaced steps without samples) and at the end: error_estimate.csv, trajectories.csv columns "
+                        "estimated_phase_error, estimated_relative_energy_error, error_estimate_t, "
+                        "error_estimate_horizon, error_estimate. Where the two runs separate (their difference above "
+                        "0.1 of |(q, p)|: a chaotic orbit) the estimate ends: error_estimate_horizon is that time. "
+                        "Costs twice the run."});
+    return t;
+  }();
   return table;
 }
 

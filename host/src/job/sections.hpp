@@ -81,7 +81,7 @@ Study read_study(Checker& check, const json& study, HamiltonianForm form, double
 void read_output(Checker& check, const json& document, Job& job);
 // read_analysis needs the dimension of the initial states (0 when unknown) for /analysis/poincare and /lyapunov.
 Analysis read_analysis(Checker& check, const json& value, std::size_t dimension);
-// /analysis/poincare, /lyapunov, /megno, /sali, /gali and /fli (dynamics.cpp), into `analysis`.
+// /analysis/poincare and the chaos indicators (dynamics.cpp, indicators.hpp), into `analysis`.
 void read_dynamics(Checker& check, const json& value, std::size_t dimension, Analysis& analysis);
 // The boolean `key` of the object `value` at `path` into `flag`, when present; otherwise an issue saying "true or
 // false: " and `meaning` (outputs.cpp).

@@ -56,7 +56,7 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
        "component j (run/tangent_block.hpp)"},
       {"method",
        "the exact tangent map of the run's integrator (core/include/nonsep/core/runtime/tangent_integrator.hpp)"}};
-  for (const auto& indicator : analysis.indicators()) {
+  for (const auto& indicator : analysis.indicators) {
     if (indicator->name() == "lyapunov") {
       const LyapunovAnalysis& l = *analysis.lyapunov;
       facts["lyapunov"] = {{"exponents", l.vectors},
@@ -72,7 +72,7 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
     facts[indicator->name()] = std::move(entry);
   }
   const auto with_factors = [](const auto& indicator) { return indicator->needs().orthonormalization_factors; };
-  if (std::ranges::any_of(analysis.indicators(), with_factors))
+  if (std::ranges::any_of(analysis.indicators, with_factors))
     facts["alignment_indices"] =
         "the vectors of the Lyapunov exponents, with the triangular factors of their orthonormalisations "
         "(core/include/nonsep/core/analysis/alignment_indices.hpp), at the last orthonormalisation";

@@ -33,7 +33,7 @@ EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
           run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1,
           run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count),
           parameter_sets(job, job.initial.parameter_set),
-          run.analysis.indicators(),
+          run.analysis.indicators,
           options.chunk_seconds};
 }
 
@@ -100,7 +100,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
     remove_stale(directory / PoincareSectionObserver::file_name);
   const std::uint64_t series_every = run.analysis.lyapunov ? run.analysis.lyapunov->every : 0;
   if (run.analysis.tangent_vectors() > 0)
-    chaos.emplace(directory / IndicatorColumns::file_name, run.analysis.indicators(), series_every, driver.records(),
+    chaos.emplace(directory / IndicatorColumns::file_name, run.analysis.indicators, series_every, driver.records(),
                   options.resume);
   if (!chaos || series_every == 0) remove_stale(directory / IndicatorColumns::file_name);
   if (run.analysis.error_estimate)

@@ -127,17 +127,18 @@ struct LyapunovAnalysis {
 struct Analysis {
   std::optional<PoincareSection> poincare;   // /analysis/poincare
   std::optional<LyapunovAnalysis> lyapunov;  // /analysis/lyapunov
-  bool megno = false;                        // /analysis/megno: MEGNO of the first tangent vector
-  bool sali = false;                         // /analysis/sali: SALI of the first two tangent vectors
-  std::size_t gali = 0;                      // /analysis/gali: GALI_2 .. GALI_gali of the first vectors; 0: none
-  bool fli = false;                          // /analysis/fli: the fast Lyapunov indicator of the first vector
-  // The chaos indicators these ask for, in the order of their columns (host/src/job/indicators.cpp: the one list).
-  IndicatorList indicators() const;
+  // The chaos indicators asked for (/analysis/lyapunov, /megno, /sali, /gali, /fli), in the order of their columns
+  // (host/src/job/indicators.cpp: the one list).
+  IndicatorList indicators;
   // Tangent vectors per trajectory the run must follow, shared by every indicator: the most any of them needs; 0
   // for none.
-  std::size_t tangent_vectors() const;
+  std::size_t tangent_vectors() const {
+    std::size_t k = 0;
+    for (const auto& indicator : indicators) k = std::max(k, indicator->needs().tangent_vectors);
+    return k;
+  }
   // The job file's key of the first indicator, for messages ("" for none).
-  std::string tangent_key() const;
+  std::string tangent_key() const { return indicators.empty() ? "" : "/analysis/" + indicators.front()->name(); }
   // /analysis/closest_return_after: from this time on, the smallest Euclidean phase-space distance
   // |(q, p) - (q0, p0)| to the trajectory's initial state is tracked at every step (summary: closest_return).
   std::optional<double> closest_return_after;

@@ -16,7 +16,7 @@
 //                                    indicator needs), with its triangular factor R (k x k, row-major:
 //                                    orthonormalize_state; needs().orthonormalization_factors);
 //   values(state, lyapunov, out)     its columns' values now (out.size() == columns().size()).
-// The lists of indicators, which the host reads from the job file, is host/src/job/indicators.cpp.
+// The list of the indicators a job file can ask for is host/src/job/indicators.cpp.
 #include <cstddef>
 #include <memory>
 #include <span>
