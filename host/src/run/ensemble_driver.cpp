@@ -45,6 +45,7 @@ struct EnsembleDriver::Impl {
   bool resumed = false;
   EvaluationCounts evaluations_before;
   std::string error;
+  std::size_t indicator_columns = 0;  // the columns of setup.indicators, together
 
   Impl(const Plugin& p, const PluginModel& model, EnsembleSetup s)
       : plugin(p), setup(std::move(s)), energy_available(p.has_energy()), records(setup.q.size() / setup.dimension) {
@@ -54,6 +55,7 @@ struct EnsembleDriver::Impl {
                                : setup.threads > 0   ? setup.threads
                                                      : static_cast<unsigned>(omp_get_max_threads());
     block_size = setup.block_size > 0 ? setup.block_size : run_block_size_for(count);
+    for (const auto& indicator : setup.indicators) indicator_columns += indicator->columns().size();
     const bool own_sets = !setup.parameter_sets.empty();
     if (!own_sets) setup.parameter_sets.push_back({0, model.parameters()});
     for (const ParameterSet& set : setup.parameter_sets) set_parameters.push_back(set.parameters);
@@ -166,8 +168,7 @@ struct EnsembleDriver::Impl {
     states.reserve(active_count());
     // The indicators' values of every active state, one after the other (their columns per state).
     std::vector<double> values;
-    std::size_t columns = 0;
-    for (const auto& indicator : setup.indicators) columns += indicator->columns().size();
+    const std::size_t columns = indicator_columns;
     if (columns > 0) values.reserve(active_count() * columns);
     for (const Block& block : blocks)
       for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {

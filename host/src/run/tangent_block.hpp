@@ -43,6 +43,7 @@ struct BlockTangents {
   std::vector<LyapunovRecord> lyapunov;     // per slot
   std::vector<std::vector<double>> states;  // per indicator: its state_size numbers per slot
   std::vector<double> growth;               // scratch: ln-growth of vector 0 over the last step, per slot
+  std::vector<IndicatorNeeds> needs;        // per indicator: Indicator::needs()
   std::vector<std::size_t> column_counts;   // per indicator: its number of columns
 
   // setup.tangent_vectors per state, `slots` states.
@@ -59,7 +60,8 @@ struct BlockTangents {
         lyapunov(slots),
         growth(with_growth ? slots : 0) {
     for (const auto& indicator : setup.indicators) {
-      states.emplace_back(slots * indicator->needs().state_size);
+      needs.push_back(indicator->needs());
+      states.emplace_back(slots * needs.back().state_size);
       column_counts.push_back(indicator->columns().size());
     }
   }
@@ -67,11 +69,11 @@ struct BlockTangents {
   std::size_t slots() const { return lyapunov.size(); }
   // Indicator i's state of `slot`.
   std::span<double> state(std::size_t i, std::size_t slot) {
-    const std::size_t size = (*indicators)[i]->needs().state_size;
+    const std::size_t size = needs[i].state_size;
     return std::span<double>(states[i]).subspan(slot * size, size);
   }
   std::span<const double> state(std::size_t i, std::size_t slot) const {
-    const std::size_t size = (*indicators)[i]->needs().state_size;
+    const std::size_t size = needs[i].state_size;
     return std::span<const double>(states[i]).subspan(slot * size, size);
   }
 
@@ -139,8 +141,8 @@ struct BlockTangents {
   }
 
   // Checkpoints (DriverState, whose `indicators` are those of the run, named): appends every slot's vectors, sums and
-  // indicator states; restore() takes slot s from
-  // entry entries[s] of such lists (the block's members among the active trajectories of a checkpoint).
+  // indicator states; restore() takes slot s from entry entries[s] of such lists (the block's members among the
+  // active trajectories of a checkpoint).
   void save(DriverState& state) const {
     state.tangent_q.insert(state.tangent_q.end(), vectors.q().begin(), vectors.q().end());
     state.tangent_p.insert(state.tangent_p.end(), vectors.p().begin(), vectors.p().end());
@@ -158,7 +160,7 @@ struct BlockTangents {
                   vectors.p().begin() + static_cast<std::ptrdiff_t>(slot * size));
       lyapunov[slot] = saved.lyapunov[entries[slot]];
       for (std::size_t i = 0; i < states.size(); ++i) {
-        const std::size_t n = (*indicators)[i]->needs().state_size;
+        const std::size_t n = needs[i].state_size;
         std::copy_n(saved.indicators[i].values.begin() + static_cast<std::ptrdiff_t>(entries[slot] * n), n,
                     state(i, slot).begin());
       }
@@ -191,7 +193,7 @@ struct BlockTangents {
     std::copy_n(vectors.p().begin(), kept * k * n, next.p().begin());
     vectors = std::move(next);
     lyapunov.resize(kept);
-    for (std::size_t i = 0; i < states.size(); ++i) states[i].resize(kept * (*indicators)[i]->needs().state_size);
+    for (std::size_t i = 0; i < states.size(); ++i) states[i].resize(kept * needs[i].state_size);
     growth.resize(with_growth ? kept : 0);
   }
 
@@ -201,17 +203,13 @@ struct BlockTangents {
     if (with_factors)
       hook = [this](std::size_t slot, std::span<const double> r) {
         for (std::size_t i = 0; i < indicators->size(); ++i)
-          if ((*indicators)[i]->needs().orthonormalization_factors)
-            (*indicators)[i]->after_orthonormalization(state(i, slot), r, k);
+          if (needs[i].orthonormalization_factors) (*indicators)[i]->after_orthonormalization(state(i, slot), r, k);
       };
     exponents.after_steps(vectors, lyapunov, dt, steps, growth, hook);
-    for (std::size_t i = 0; i < indicators->size(); ++i) {
-      const Indicator& indicator = *(*indicators)[i];
-      const bool needs_growth = indicator.needs().first_growth;
-      for (std::size_t s = 0; s < slots(); ++s)
-        for (std::uint64_t step = 0; step < steps; ++step)
-          indicator.after_step(state(i, s), needs_growth ? growth[s] : 0.0, dt);
-    }
+    // Only indicators that take the growth have a per-step update; their runs are one step each (step_n).
+    for (std::size_t i = 0; i < indicators->size(); ++i)
+      if (needs[i].first_growth)
+        for (std::size_t s = 0; s < slots(); ++s) (*indicators)[i]->after_step(state(i, s), growth[s], dt);
   }
 };
 

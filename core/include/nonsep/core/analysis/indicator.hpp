@@ -10,8 +10,9 @@
 //
 // The calls, for each trajectory (the caller's loop; the host's driver is one, run/tangent_block.hpp):
 //   start(state)                     time 0, before the first step;
-//   after_step(state, growth, dt)    after each step of dt, with growth = ln(|v_1(t_k)| / |v_1(t_{k-1})|), the
-//                                    first vector's log-growth over the step (needs().first_growth; else 0);
+//   after_step(state, growth, dt)    after each step of dt, for an indicator that needs().first_growth, with
+//                                    growth = ln(|v_1(t_k)| / |v_1(t_{k-1})|), the first vector's log-growth over
+//                                    the step;
 //   after_orthonormalization(state, r, k)  at each re-orthonormalisation of the run's k vectors (k at least what the
 //                                    indicator needs), with its triangular factor R (k x k, row-major:
 //                                    orthonormalize_state; needs().orthonormalization_factors);
