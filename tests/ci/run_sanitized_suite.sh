@@ -36,6 +36,9 @@ long_runs=(
   '^formula commands: formulas at the length limit compile'
   '^killed after the first tenth and resumed: the runaway warnings'
   '^a model given by H: killed and resumed'
+  '^no output depends on where chunks end'
+  '^no runaway warning for paper2d.s bounded orbits on the compact shell'
+  '^comparators with tangent vectors: --threads 1 and 2 write the same files'
 )
 # Left out as well: host.run_memory, which runs nonsep under an RLIMIT_AS (ulimit -v) of 8 GiB, less than the
 # address space AddressSanitizer reserves for its shadow memory at start.

@@ -88,8 +88,8 @@ for threads in ("1", "2"):
 # 2. interrupted on two ranks, resumed by one process
 long_job = work / "long.json"
 document = json.loads(job.read_text())
-document["time"]["steps"] = 4000
-document["output"]["every"] = 1000
+document["time"]["steps"] = 2000
+document["output"]["every"] = 500
 document["analysis"].pop("max_relative_energy_error")
 document["analysis"]["poincare"].pop("max_crossings")  # which would stop the orbits early
 # SALI and GALI (a third vector, and their series) are compared above; here they would only make every run of this
