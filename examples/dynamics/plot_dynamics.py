@@ -1,6 +1,6 @@
 """Render the dynamics pictures of paper2d from the outputs the nonsep runs wrote, with nonsep.load and
-nonsep.plot.poincare / chaos_map / stability_map / chaotic_fraction / indicator_series (python/nonsep, found from
-this file when not on PYTHONPATH), on their default colour scales (MEGNO <Y> from 1.25 to 8, 2 marked).
+nonsep.plot.poincare / chaos_map / stability_map / chaotic_fraction / indicator_series / frequency_map (python/nonsep,
+found from this file when not on PYTHONPATH), on their default colour scales (MEGNO <Y> from 1.25 to 8, 2 marked).
 
     /usr/bin/python3 examples/dynamics/plot_dynamics.py OUT_DIR
 
@@ -14,10 +14,11 @@ OUT_DIR is the folder `examples/dynamics/run_dynamics.sh` fills:
     stability_map/lyapunov.csv           the running <Y> of every trajectory, for the time series beside the map
     stability_map_shell8/                the same on the shell H = 8 over the couplings 0 to 0.3 (no lyapunov.csv)
     chaotic_fraction/                    <Y> of a (q0, p0) grid on the shell H = 8 for each coupling
+    frequency_map/                       the frequencies and the diffusion index of Henon-Heiles on H = 1/8
     */summary.json                       the energy shell, the integrator and the time, for the titles
-Writes dynamics_poincare, dynamics_chaos_map, dynamics_stability_map, dynamics_stability_map_shell8 and
-dynamics_chaotic_fraction into OUT_DIR, each as a PNG at DPI dots per inch and as a PDF, and prints the chaotic
-fractions.
+Writes dynamics_poincare, dynamics_chaos_map, dynamics_stability_map, dynamics_stability_map_shell8,
+dynamics_chaotic_fraction and dynamics_frequency_map into OUT_DIR, each as a PNG at DPI dots per inch and as a PDF,
+and prints the chaotic fractions and the range of the diffusion index.
 """
 import sys
 from pathlib import Path
@@ -116,6 +117,26 @@ def chaotic_fraction(out):
               f"({chaotic / orbits:.3f}, interval {lower:.3f} to {upper:.3f})")
 
 
+def frequency_map(out):
+    """The frequency map of Henon-Heiles (nu_1 against nu_0, coloured by the diffusion index) beside the diffusion
+    index over the starting points."""
+    result = nonsep.load(out / "frequency_map")
+    fig, (frequencies, diffusion) = plt.subplots(1, 2, figsize=(13.0, 5.4), gridspec_kw={"width_ratios": [1.1, 1]})
+    nonsep.plot.frequency_map(result, ax=frequencies)
+    # The starting point q = p0 = 0 moves in q1 alone: its z_0 = 0 has the frequency 0, far off the others.
+    table = result.trajectories
+    bulk = table["frequency0"][np.abs(table["frequency0"]) > 0.5]
+    frequencies.set_xlim(bulk.min() - 0.01, bulk.max() + 0.01)
+    nonsep.plot.chaos_map(result, ax=diffusion, value="diffusion", x="q1", y="p1")
+    diffusion.set_xlabel("q1 (initial; q0 = 0)")
+    diffusion.set_ylabel("p1 (initial; p0 >= 0 on the shell)")
+    fig.tight_layout()
+    save(fig, out, "dynamics_frequency_map")
+    index = table["diffusion"][np.isfinite(table["diffusion"])]
+    print(f"frequency map: {len(index)} orbits analysed, diffusion index from {index.min():.2f} to "
+          f"{index.max():.2f}, {int((index > -3).sum())} above -3, {int((index < -6).sum())} below -6")
+
+
 def main():
     if len(sys.argv) != 2:
         raise SystemExit(__doc__)
@@ -125,6 +146,7 @@ def main():
     stability_map(out)
     stability_map_shell8(out)
     chaotic_fraction(out)
+    frequency_map(out)
 
 
 if __name__ == "__main__":

@@ -207,7 +207,20 @@ def _indicator_name(column):
         return "SALI"
     if column.startswith("gali") and column[4:].isdigit():
         return f"GALI$_{{{column[4:]}}}$"
-    return column
+    if column == "diffusion":
+        return "diffusion index"
+    frequency = _frequency_symbol(column)
+    return f"frequency {frequency}" if frequency else column
+
+
+def _frequency_symbol(column):
+    """"frequency1" -> "$\\nu_1$", "frequency1_first" -> "$\\nu_1$ (first half)"; None for other columns."""
+    if not column.startswith("frequency"):
+        return None
+    degree, _, part = column[len("frequency"):].partition("_")
+    if not degree.isdigit() or part not in ("", "first", "second"):
+        return None
+    return f"$\\nu_{{{degree}}}$" + (f" ({part} half)" if part else "")
 
 
 def _value_label(column):
@@ -221,7 +234,10 @@ def _value_label(column):
         return "SALI (-> 0: chaotic)"
     if column.startswith("gali") and column[4:].isdigit():
         return f"GALI$_{{{column[4:]}}}$"
-    return column
+    if column == "diffusion":
+        return "diffusion index $\\log_{10} |\\nu_2 - \\nu_1| / |\\nu|$ (small: a torus)"
+    frequency = _frequency_symbol(column)
+    return f"{frequency}, rad per unit time" if frequency else column
 
 
 def _grid_axes(columns, count):
@@ -331,6 +347,34 @@ def chaotic_fraction(result, x=None, value="mean_megno", threshold=None, where=N
     note = f"; {left_out} left out (not completed, or no value)" if left_out else ""
     ax.set_title(f"Chaotic fraction: {criterion} at t = {_end_time(result):g}\n{int(counts.orbits.sum())} orbits, "
                  f"bars: Wilson interval of {z:g} sigma{note}\n{describe_run(result, where)}", fontsize="medium")
+    return ax
+
+
+def frequency_map(result, ax=None, x="frequency0", y="frequency1", value="diffusion", where=None, cmap=None,
+                  colorbar=True, **style):
+    """Laskar's frequency map: each analysed trajectory as a point at its fundamental frequencies (x, y: columns of
+    trajectories.csv from /analysis/frequencies, by default nu_0 and nu_1 over the whole run), coloured by `value`
+    (the diffusion index by default: blue where the frequencies stay put between the halves of the run, a torus; red
+    where they drift, a chaotic zone). On a family of tori the points lie on smooth curves; resonances show as lines
+    the points gather on, chaotic zones as scattered red points. Trajectories without an analysis (not completed)
+    are left out, and counted in the title. `where` chooses trajectories (Result.select); `style` goes to
+    ax.scatter. Returns the axes."""
+    chosen = result.select(where)
+    xs, ys = (_per_trajectory(result, name)[chosen] for name in (x, y))
+    values = _per_trajectory(result, value)[chosen]
+    shown = np.isfinite(xs) & np.isfinite(ys) & np.isfinite(values)
+    ax = _axes(ax)
+    norm, colours, marks = _colours(value, cmap, style)
+    style = {"s": 6, "linewidths": 0, **style}
+    points = ax.scatter(xs[shown], ys[shown], c=_shown(values[shown], norm), cmap=colours, norm=norm, **style)
+    if colorbar:
+        _colour_bar(ax, points, value, values[shown], marks)
+    ax.set_xlabel(_value_label(x))
+    ax.set_ylabel(_value_label(y))
+    left_out = int((~shown).sum())
+    note = f", {left_out} without an analysis left out" if left_out else ""
+    ax.set_title(f"Frequency map: {_indicator_name(y)} against {_indicator_name(x)}, {int(shown.sum())} orbits"
+                 f"{note}\n{describe_run(result, where)}", fontsize="medium")
     return ax
 
 
@@ -455,13 +499,15 @@ class ColourScale(NamedTuple):
 
 MEGNO_RANGE = (1.25, 8.0)  # <Y> from just below 2 (regular) to 8 (clearly chaotic); beyond, the end colours
 ALIGNMENT_RANGE = (1e-16, 1.0)  # SALI and GALI: from round-off to unaligned, logarithmic
+DIFFUSION_RANGE = (-10.0, 0.0)  # the diffusion index: from a torus's frequencies kept to 1e-10 to a drift of order 1
 
 
 def colour_scale(value):
     """The default ColourScale of a column of trajectories.csv: MEGNO (mean_megno, megno) from 1.25 to 8, blue to
     red, 2 (regular) marked; SALI and GALI_k on a log scale from 1e-16 to 1, red (small: chaotic) to blue, with
     the chaos threshold marked where there is a default one (CHAOS_THRESHOLDS: SALI and GALI_2, 1e-8); Lyapunov
-    exponents from 0 to the data's largest; anything else viridis over the data's range."""
+    exponents from 0 to the data's largest; the diffusion index from -10 to 0; anything else viridis over the data's
+    range."""
     threshold = CHAOS_THRESHOLDS.get(value)
     if value in ("mean_megno", "megno"):
         return ColourScale("chaos", *MEGNO_RANGE, False, ((2.0, "regular"),))
@@ -469,6 +515,8 @@ def colour_scale(value):
         return ColourScale("chaos_r", *ALIGNMENT_RANGE, True, ((threshold[1], "chaotic below"),) if threshold else ())
     if value.startswith("lyapunov") and value[8:].isdigit():
         return ColourScale("chaos", 0.0, None, False, ())
+    if value == "diffusion":
+        return ColourScale("chaos", *DIFFUSION_RANGE, False, ())
     return ColourScale("viridis", None, None, False, ())
 
 

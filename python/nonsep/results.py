@@ -16,6 +16,11 @@ Files read (docs/outputs.md); each is optional except summary.json:
   error_estimate.csv Result.error_estimate (analysis.error_estimate: the estimated errors at every comparison step,
                      rows in (step, trajectory) order; None without the file) and Result.error_estimates(i);
                      trajectories.csv has each trajectory's last estimate and its horizon
+  frequency_spectra.csv  Result.frequency_spectra (analysis.frequencies with spectra: the strongest terms of each
+                     signal, rows in trajectory order; None without the file)
+  frequency_signals.npy  Result.frequency_signals() (analysis.frequencies: the sampled signals q_k + i p_k as a
+                     complex array [trajectory, signal, sample], memory-mapped); trajectories.csv has the frequencies
+                     and the diffusion index, Result.frequency_analysis the settings (summary.json)
   (trajectories.csv) Result.select(where): the trajectories of some values of swept parameters; and
                      Result.chaotic_fraction(...): the fraction of orbits past an indicator's threshold against a
                      swept parameter, with binomial (Wilson score) intervals
@@ -240,6 +245,29 @@ class Result:
         rows = self._rows_of("error_estimate", index)
         return ErrorEstimates(rows["step"], rows["t"], rows["estimated_phase_error"],
                               rows["estimated_relative_energy_error"], rows["separated"])
+
+    @property
+    def frequency_analysis(self):
+        """The run's frequency map analysis, summary.json's analysis.frequencies (signals, every, samples, tau,
+        columns, ...), or None."""
+        return (self.summary.get("analysis") or {}).get("frequencies")
+
+    @property
+    def frequency_spectra(self):
+        """Every row of frequency_spectra.csv as a structured array (trajectory, signal, term, frequency,
+        amplitude_re, amplitude_im); None when the run wrote none (no analysis.frequencies.spectra)."""
+        return self.dynamics.get("frequency_spectra")
+
+    def frequency_signals(self):
+        """The sampled signals of analysis.frequencies, frequency_signals.npy, as a read-only memory-mapped complex
+        array of shape (trajectories, signals, samples): signal j of trajectory i at sample k is q + i p of degree of
+        freedom frequency_analysis["signals"][j] at step (k + 1) every, t = (k + 1) tau. A trajectory that stopped
+        early has zeros after its last sample. Raises FileNotFoundError when the run wrote none."""
+        path = self.directory / "frequency_signals.npy"
+        if not path.is_file():
+            raise FileNotFoundError(f"{self.directory} has no frequency_signals.npy (the run had no "
+                                    "analysis.frequencies)")
+        return np.load(path, mmap_mode="r")
 
     @property
     def section(self):

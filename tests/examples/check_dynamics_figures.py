@@ -11,7 +11,9 @@
     coupling, and has regular and chaotic orbits; lyapunov.csv ends at each orbit's <Y> of trajectories.csv;
   - on the shell H = 8 (stability_map_shell8, chaotic_fraction), every coupling up to 0.3 was swept and every orbit
     completed with |dH/H0| below 1e-6 (Gauss-Legendre at dt = 0.02), and the chaotic fraction (<Y> > 2.5) that
-    the picture shows is that of trajectories.csv counted here, with some chaotic and some regular orbits.
+    the picture shows is that of trajectories.csv counted here, with some chaotic and some regular orbits;
+  - the frequency map analysed every orbit, its diffusion index tells tori (< -5) from chaotic orbits (> -3), and
+    every frequency lies within the sampling band.
 
     /usr/bin/python3 tests/examples/check_dynamics_figures.py OUT_DIR
 """
@@ -42,9 +44,10 @@ def png_chunks(data):
         at += 12 + length
 
 
-JOBS = ("poincare_portrait", "chaos_map", "stability_map", "stability_map_shell8", "chaotic_fraction")
+JOBS = ("poincare_portrait", "chaos_map", "stability_map", "stability_map_shell8", "chaotic_fraction",
+        "frequency_map")
 PICTURES = ("dynamics_poincare", "dynamics_chaos_map", "dynamics_stability_map", "dynamics_stability_map_shell8",
-            "dynamics_chaotic_fraction")
+            "dynamics_chaotic_fraction", "dynamics_frequency_map")
 
 
 def check_pictures(out):
@@ -122,11 +125,32 @@ def check_shell8(out):
           "the chaotic fraction's grids have no chaotic (<Y> > 4) or no regular (<Y> near 2) orbit")
 
 
+def check_frequency_map(out):
+    """Every orbit analysed, the torus and the chaotic sea told apart by the diffusion index, and each frequency
+    within the sampling band |nu| < pi / tau; the printed range is trajectories.csv's."""
+    summary = json.loads((out / "frequency_map/summary.json").read_text())
+    facts = summary["analysis"]["frequencies"]
+    check(facts["analysed"] == summary["trajectories"], f"frequency map: {facts['analysed']} orbits analysed of "
+          f"{summary['trajectories']}")
+    table = rows(out / "frequency_map/trajectories.csv")
+    index = [float(r["diffusion"]) for r in table]
+    check(min(index) < -5.0 and max(index) > -3.0,
+          f"the frequency map has no torus (index < -5) or no chaotic orbit (index > -3): {min(index)}, {max(index)}")
+    band = math.pi / facts["tau"]
+    for r in table:
+        for k in ("frequency0", "frequency1"):
+            check(abs(float(r[k])) < band, f"frequency map: {k} of trajectory {r['trajectory']} is {r[k]}")
+    printed = (out / "plot_dynamics.txt").read_text()
+    check(f"diffusion index from {min(index):.2f} to {max(index):.2f}" in printed,
+          f"plot_dynamics.py printed another range of the diffusion index: {printed}")
+
+
 def main():
     out = Path(sys.argv[1])
     check_pictures(out)
     check_numbers(out)
     check_shell8(out)
+    check_frequency_map(out)
     for failure in failures[:20]:
         print(f"FAIL {failure}", file=sys.stderr)
     return 1 if failures else 0

@@ -208,6 +208,26 @@ inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::pat
   return parse_csv(read_text(path));
 }
 
+// The rows of a CSV file (a run's trajectories.csv, ...) as one map of named cells per row; an empty file throws.
+inline std::vector<std::map<std::string, std::string>> table(const std::filesystem::path& path) {
+  const auto rows = read_csv(path);
+  if (rows.empty()) throw std::runtime_error(path.string() + " has no header");
+  std::vector<std::map<std::string, std::string>> result;
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    std::map<std::string, std::string> row;
+    for (std::size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = c < rows[r].size() ? rows[r][c] : "";
+    result.push_back(std::move(row));
+  }
+  return result;
+}
+
+// The number in the cell `name` of a row of table(); throws when the row has no such column.
+inline double cell(const std::map<std::string, std::string>& row, const std::string& name) {
+  const auto found = row.find(name);
+  if (found == row.end()) throw std::runtime_error("no column " + name);
+  return std::strtod(found->second.c_str(), nullptr);
+}
+
 // A run's results as one JSON value: summary.json with "trajectories" set to one object per row of
 // trajectories.csv: {index, status, final {t, step, q, p}, energy {initial, final, relative_error_final,
 // relative_error_max_abs}, stop {step, t, variable} (when it stopped early), message (when there is one),

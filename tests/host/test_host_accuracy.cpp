@@ -26,17 +26,7 @@ constexpr double quarter_period = 0.3863765573361232;
 constexpr double p_at_quarter = -1.5723027555148466;
 const nonsep::reference::MathewsLakshmanan oscillator{0.5, 1.0};
 
-// trajectories.csv (or any of a run's CSV files) as one map per row, empty cells NaN.
-std::vector<std::map<std::string, std::string>> table(const std::filesystem::path& path) {
-  const auto rows = read_csv(path);
-  std::vector<std::map<std::string, std::string>> result;
-  for (std::size_t r = 1; r < rows.size(); ++r) {
-    std::map<std::string, std::string> row;
-    for (std::size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = c < rows[r].size() ? rows[r][c] : "";
-    result.push_back(std::move(row));
-  }
-  return result;
-}
+// Empty cells are NaN.
 double number(const std::map<std::string, std::string>& row, const std::string& name) {
   const std::string& text = row.at(name);
   return text.empty() ? std::nan("") : std::stod(text);

@@ -36,24 +36,6 @@ json paper2d_job(json initial, json time, json analysis) {
 
 json state2(const std::vector<double>& q, const std::vector<double>& p) { return {{"q", q}, {"p", p}}; }
 
-// A CSV file as rows of named cells.
-std::vector<std::map<std::string, std::string>> table(const std::filesystem::path& path) {
-  const auto rows = read_csv(path);
-  REQUIRE(!rows.empty());
-  std::vector<std::map<std::string, std::string>> result;
-  for (std::size_t r = 1; r < rows.size(); ++r) {
-    std::map<std::string, std::string> row;
-    for (std::size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = c < rows[r].size() ? rows[r][c] : "";
-    result.push_back(std::move(row));
-  }
-  return result;
-}
-
-double cell(const std::map<std::string, std::string>& row, const std::string& name) {
-  REQUIRE(row.count(name) == 1);
-  return std::strtod(row.at(name).c_str(), nullptr);
-}
-
 // Runs `job` as folder/name and returns the process result (no status check).
 Result run_named(const TemporaryFolder& folder, const std::string& name, const json& job,
                  const std::vector<std::string>& extra = {}) {

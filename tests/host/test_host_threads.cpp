@@ -95,8 +95,8 @@ TEST_CASE("no output depends on where chunks end: one step each, sized by the cl
   // processor runs by default (whose multiply-adds round differently from the evaluation path's). paper2d (its orbits
   // diverge from step 14 on with dt = 0.01: blocks redo chunks step by step) through the state kernel (basic,
   // triplet, mpe), the tangent kernels with all four indicators, the comparators and mpe with tangent vectors
-  // through the evaluation path, a Poincare section; blowup with states that diverge mid-run and a plugin that fails
-  // mid-run.
+  // through the evaluation path, a Poincare section, a frequency map; blowup with states that diverge mid-run (with
+  // and without a frequency map) and a plugin that fails mid-run.
   TemporaryFolder folder;
   use_test_plugins();
   const std::string paper2d = std::string(NONSEP_SHIPPED_PLUGIN_DIR) + "/paper2d.so";
@@ -120,6 +120,10 @@ TEST_CASE("no output depends on where chunks end: one step each, sized by the cl
   json diverging_job = blowup_job(diverging);
   diverging_job["time"] = {{"dt", 0.001}, {"steps", 500}};
   diverging_job["output"] = {{"every", 0}};
+  const auto frequencies_of = [](json job) {
+    job["analysis"] = {{"frequencies", {{"every", 5}}}};
+    return job;
+  };
   json failing_job = diverging_job;
   failing_job["model"]["parameters"] = {{"fail_above", 2.0}};
   const json poincare = {{"poincare", {{"component", "q1"}, {"value", 0.0}, {"direction", "+"}}}};
@@ -133,7 +137,9 @@ TEST_CASE("no output depends on where chunks end: one step each, sized by the cl
       {"gauss_tangents", on_paper2d({{"scheme", "gauss"}, {"stages", 2}}, indicators)},
       {"tao_tangents", on_paper2d({{"scheme", "tao"}, {"order", 4}}, {{"lyapunov", {{"vectors", 1}}}})},
       {"poincare", on_paper2d({{"scheme", "basic"}}, poincare)},
+      {"frequencies", on_paper2d({{"scheme", "basic"}}, {{"frequencies", {{"every", 1}, {"spectra", 2}}}})},
       {"diverging", diverging_job},
+      {"diverging_frequencies", frequencies_of(diverging_job)},
       {"failing", failing_job}};
   for (const std::string set : {"baseline", "default"}) {
     CAPTURE(set);

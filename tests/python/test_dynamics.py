@@ -208,6 +208,44 @@ class DynamicsPlotTest(SharedRun):
 
 
 
+class FrequencyMapTest(FolderTestCase):
+    def test_frequency_columns_spectra_signals_and_the_map(self):
+        # Henon-Heiles (a model given by H) on H = 1/8, four starting points on the section q0 = 0, gauss 3 stages.
+        job = {"model": {"plugin": "henon_heiles"}, "integrator": {"scheme": "gauss", "stages": 3},
+               "initial": {"grid": {"q": [0.0, {"from": -0.3, "to": 0.3, "count": 2}],
+                                    "p": [0.0, {"from": -0.2, "to": 0.2, "count": 2}]},
+                           "energy": 0.125, "solve_for": "p0"},
+               "time": {"dt": 0.1, "t_end": 200}, "output": {"every": 2000},
+               "analysis": {"frequencies": {"every": 2, "spectra": 3}}}
+        result = nonsep.run(job, output="out")
+        table = result.trajectories
+        header, rows = read_csv(result.directory / "trajectories.csv")
+        for column in ("frequency0", "frequency1_second", "diffusion"):
+            at = header.index(column)
+            self.assertEqual(list(table[column]), [float(r[at]) for r in rows])  # bit for bit
+        facts = result.frequency_analysis
+        self.assertEqual(facts["samples"], 1000)
+        self.assertEqual(facts["signals"], [0, 1])
+        spectra = result.frequency_spectra
+        self.assertEqual(len(spectra), len(table) * 2 * 3)
+        first = spectra[(spectra["trajectory"] == 1) & (spectra["signal"] == 1) & (spectra["term"] == 0)]
+        self.assertEqual(first["frequency"][0], table["frequency1"][1])
+        signals = result.frequency_signals()
+        self.assertEqual(signals.shape, (len(table), 2, 1000))
+        self.assertEqual(signals.dtype, np.complex128)
+        # Sample k is the state at step 2 (k + 1): the last one is the final state of trajectory.csv.
+        final = result.orbit(2)
+        self.assertEqual(signals[2, 0, -1], complex(final.q[-1, 0], final.p[-1, 0]))
+        ax = nonsep.plot.frequency_map(result)
+        self.assertIn("Frequency map", ax.get_title())
+        self.assertEqual(len(ax.collections[0].get_offsets()), len(table))
+        ax.figure.savefig(self.folder / "frequency_map.png", dpi=60)
+        plt.close(ax.figure)
+        ax = nonsep.plot.chaos_map(result, value="diffusion", x="q1", y="p1")
+        self.assertIn("diffusion index", ax.figure.axes[-1].get_ylabel())
+        plt.close(ax.figure)
+
+
 class FailedRunTest(FolderTestCase):
     def test_a_run_error_carries_the_crossings_of_the_trajectories_that_went_on(self):
         # tests/host/plugins/blowup.cpp in 2D: the first state's crossing of q0 = 0.5 cannot be located (grad V

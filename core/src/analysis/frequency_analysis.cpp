@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <string>
 #include <unsupported/Eigen/FFT>
@@ -109,7 +110,13 @@ double wrap(double u) {  // into [-pi, pi)
 struct FrequencyAnalysis::Workspace {
   Eigen::FFT<double> fft;
   std::vector<std::complex<double>> padded, spectrum;
-  std::vector<double> window;                    // chi_k
+  // The window of each length seen, kept: a frequency map alternates between a run's samples and its halves.
+  struct Window {
+    std::vector<double> chi;  // chi_k
+    double sum = 0.0;         // sum_k chi_k
+  };
+  std::map<std::size_t, Window> windows;
+  std::vector<double> window;                    // chi_k of the current length
   double window_sum = 0.0;                       // sum_k chi_k
   std::vector<double> signal_re, signal_im;      // chi_k z_k
   std::vector<double> residual_re, residual_im;  // chi_k r_k
@@ -118,14 +125,18 @@ struct FrequencyAnalysis::Workspace {
   void prepare(std::span<const std::complex<double>> z) {
     const std::size_t n = z.size();
     if (window.size() != n) {
-      // chi_k = 1 - cos(2 pi k / (N-1)) = 1 + cos(u x_k) with u = 2 pi / (N-1).
-      window.resize(n);
-      window_sum = 0.0;
-      exponentials.set(two_pi / static_cast<double>(n - 1), n);
-      exponentials.for_each([&](std::size_t k, double er, double) {
-        window[k] = 1.0 + er;
-        window_sum += window[k];
-      });
+      auto [known, added] = windows.try_emplace(n);
+      if (added) {
+        // chi_k = 1 - cos(2 pi k / (N-1)) = 1 + cos(u x_k) with u = 2 pi / (N-1).
+        known->second.chi.resize(n);
+        exponentials.set(two_pi / static_cast<double>(n - 1), n);
+        exponentials.for_each([&](std::size_t k, double er, double) {
+          known->second.chi[k] = 1.0 + er;
+          known->second.sum += known->second.chi[k];
+        });
+      }
+      window = known->second.chi;
+      window_sum = known->second.sum;
     }
     signal_re.resize(n);
     signal_im.resize(n);

@@ -9,6 +9,7 @@
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/cluster/merge_outputs.hpp"
 #include "nonsep/host/cluster/merge_results_h5.hpp"
+#include "nonsep/host/observers/frequency_map.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -155,6 +156,12 @@ RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const
   merge("poincare.csv", {"step", "trajectory"});
   merge("lyapunov.csv", {"step", "trajectory"});
   merge("trajectories.csv", {"trajectory"});
+  merge("frequency_spectra.csv", {"trajectory"});
+  if (std::filesystem::exists(parts.front().path / FrequencyMapObserver::signals_file_name)) {
+    std::vector<UnitFile> files = parts;
+    for (UnitFile& file : files) file.path /= FrequencyMapObserver::signals_file_name;
+    merge_signals(files, directory / FrequencyMapObserver::signals_file_name);
+  }
   RunOutcome outcome;
   outcome.distributed = true;
   outcome.summary = merge_summaries(summaries, firsts, plan.trajectories, directory, wall_seconds);

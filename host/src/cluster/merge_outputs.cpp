@@ -1,6 +1,10 @@
 #include "nonsep/host/cluster/merge_outputs.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
+#include <cerrno>
 #include <charconv>
 #include <memory>
 #include <optional>
@@ -8,6 +12,7 @@
 #include <tuple>
 
 #include "nonsep/host/launch/run_job.hpp"
+#include "nonsep/host/observers/frequency_map.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/csv_reader.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -109,6 +114,63 @@ void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& out
   file.commit();
 }
 
+void merge_signals(std::span<const UnitFile> parts, const std::filesystem::path& output) {
+  struct Unit {
+    int descriptor;
+    std::uint64_t offset, bytes;
+  };
+  std::vector<Unit> units;
+  const auto close_all = [&] {
+    for (const Unit& unit : units) ::close(unit.descriptor);
+  };
+  std::uint64_t trajectories = 0;
+  std::optional<std::array<std::uint64_t, 3>> first;
+  try {
+    for (const UnitFile& file : parts) {
+      const auto refuse = [&](const std::string& what) {
+        throw OutputError(file.path.string() + ": " + what + " (a unit's file of a distributed run cannot be merged)");
+      };
+      const int descriptor = open_regular_file(file.path);
+      if (descriptor < 0) refuse("missing");
+      units.push_back({descriptor, 0, 0});
+      std::string header(10, '\0');
+      if (::pread(descriptor, header.data(), 10, 0) != 10) refuse("not a NumPy file");
+      header.resize(10 + static_cast<unsigned char>(header[8]) + 256u * static_cast<unsigned char>(header[9]));
+      const auto length = static_cast<ssize_t>(header.size() - 10);
+      if (::pread(descriptor, header.data() + 10, header.size() - 10, 10) != length) refuse("a short header");
+      const auto shape = FrequencyMapObserver::signals_shape(header);
+      if (!shape) refuse("not an array of frequency map signals");
+      if (first && ((*first)[1] != (*shape)[1] || (*first)[2] != (*shape)[2]))
+        refuse("signals or samples other than the first unit's");
+      if (!first) first = shape;
+      units.back().offset = header.size();
+      units.back().bytes = (*shape)[0] * (*shape)[1] * (*shape)[2] * sizeof(double) * 2;
+      trajectories += (*shape)[0];
+    }
+    if (!first) throw OutputError(output.string() + ": no unit to merge");
+    AtomicFile merged(output);
+    merged.write(FrequencyMapObserver::signals_header(trajectories, (*first)[1], (*first)[2]));
+    std::string buffer(std::size_t{1} << 20, '\0');
+    for (std::size_t u = 0; u < units.size(); ++u)
+      for (std::uint64_t done = 0; done < units[u].bytes;) {
+        const std::uint64_t size = std::min<std::uint64_t>(buffer.size(), units[u].bytes - done);
+        const ssize_t n = ::pread(units[u].descriptor, buffer.data(), size, static_cast<off_t>(units[u].offset + done));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0)
+          throw OutputError(parts[u].path.string() +
+                            ": shorter than its header says (a unit's file of a distributed "
+                            "run cannot be merged)");
+        merged.write(std::string_view(buffer.data(), static_cast<std::size_t>(n)));
+        done += static_cast<std::uint64_t>(n);
+      }
+    merged.commit();
+  } catch (...) {
+    close_all();
+    throw;
+  }
+  close_all();
+}
+
 namespace {
 
 using json = nlohmann::ordered_json;
@@ -163,6 +225,10 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
     if (merged.contains("analysis") && merged["analysis"].contains("poincare"))
       merged["analysis"]["poincare"]["crossings"] = merged["analysis"]["poincare"]["crossings"].get<std::uint64_t>() +
                                                     unit["analysis"]["poincare"]["crossings"].get<std::uint64_t>();
+    if (merged.contains("analysis") && merged["analysis"].contains("frequencies"))
+      merged["analysis"]["frequencies"]["analysed"] =
+          merged["analysis"]["frequencies"]["analysed"].get<std::uint64_t>() +
+          unit["analysis"]["frequencies"]["analysed"].get<std::uint64_t>();
   }
   // The largest energy error: strictly larger wins, as one process scans the trajectories in order.
   json largest = nullptr;

@@ -1,6 +1,7 @@
-// /analysis/poincare and the chaos indicators (/analysis/lyapunov, /megno, /sali, /gali, /fli: the list of
-// indicators.cpp): the dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the Hessians the
-// tangent map needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
+// /analysis/poincare, /analysis/frequencies and the chaos indicators (/analysis/lyapunov, /megno, /sali, /gali, /fli:
+// the list of indicators.cpp): the dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the
+// Hessians the tangent map needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
+#include <algorithm>
 #include <limits>
 
 #include "indicators.hpp"
@@ -89,12 +90,54 @@ std::optional<PoincareSection> read_poincare(Checker& check, const json& value, 
   return section;
 }
 
+std::optional<FrequencyMap> read_frequencies(Checker& check, const json& value, std::size_t dimension) {
+  const std::string path = "/analysis/frequencies";
+  if (!check.object(value, path, "an object {\"every\": k, \"signals\": [degrees of freedom], \"spectra\": m}"))
+    return std::nullopt;
+  const KeyTable& keys = frequencies_keys();
+  check.known_keys(value, path, keys.names());
+  const std::size_t issues = check.issue_count();
+  FrequencyMap frequencies;
+  if (const json* every = check.member(value, path, "every", false, ""))
+    if (auto n = check.integer(*every, child(path, "every"), keys["every"].minimum, keys["every"].maximum,
+                               "an integer >= 1: steps between samples (default 1)"))
+      frequencies.every = static_cast<std::uint64_t>(*n);
+  if (const json* spectra = check.member(value, path, "spectra", false, ""))
+    if (auto n = check.integer(*spectra, child(path, "spectra"), keys["spectra"].minimum, keys["spectra"].maximum,
+                               "an integer from 0 to 1000: terms per signal in frequency_spectra.csv (0: no file)"))
+      frequencies.spectra = static_cast<std::size_t>(*n);
+  const std::string degrees = dimension > 0 ? "from 0 to " + std::to_string(dimension - 1) : "below the dimension";
+  if (const json* signals = check.member(value, path, "signals", false, "")) {
+    const std::string what =
+        "a non-empty list of distinct degrees of freedom k (" + degrees + "): the signals q_k + i p_k, numbered from 0";
+    if (!signals->is_array() || signals->empty()) check.issue(child(path, "signals"), describe(*signals), what);
+    for (std::size_t i = 0; signals->is_array() && i < signals->size(); ++i) {
+      const std::string at = child(path, "signals") + "/" + std::to_string(i);
+      const auto k = check.integer((*signals)[i], at, 0, std::numeric_limits<std::int64_t>::max(), what);
+      if (!k) continue;
+      const auto degree = static_cast<std::size_t>(*k);
+      if (dimension > 0 && degree >= dimension)
+        check.issue(at, std::to_string(degree), "a degree of freedom " + degrees + " (numbered from 0)");
+      else if (std::find(frequencies.signals.begin(), frequencies.signals.end(), degree) != frequencies.signals.end())
+        check.issue(at, std::to_string(degree) + " again", "each degree of freedom once");
+      else
+        frequencies.signals.push_back(degree);
+    }
+  } else {
+    for (std::size_t k = 0; k < dimension; ++k) frequencies.signals.push_back(k);
+  }
+  if (check.issue_count() != issues) return std::nullopt;
+  return frequencies;
+}
+
 }  // namespace
 
 void read_dynamics(Checker& check, const json& value, std::size_t dimension, Analysis& analysis) {
   const std::string path = "/analysis";
   if (const json* poincare = check.member(value, path, "poincare", false, ""))
     analysis.poincare = read_poincare(check, *poincare, dimension);
+  if (const json* frequencies = check.member(value, path, "frequencies", false, ""))
+    analysis.frequencies = read_frequencies(check, *frequencies, dimension);
   for (const IndicatorEntry& entry : indicator_entries())
     if (const json* member = check.member(value, path, entry.rule.name, false, ""))
       if (auto indicator = entry.read(check, *member, child(path, entry.rule.name), dimension, analysis))

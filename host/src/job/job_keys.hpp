@@ -77,8 +77,9 @@ const KeyTable& run_time_keys();    // a run's /time: "dt" and exactly one of "t
 const KeyTable& study_time_keys();  // a study's /time
 const KeyTable& output_keys();
 const KeyTable& analysis_keys();
-const KeyTable& poincare_keys();  // /analysis/poincare
-const KeyTable& lyapunov_keys();  // /analysis/lyapunov
+const KeyTable& poincare_keys();     // /analysis/poincare
+const KeyTable& frequencies_keys();  // /analysis/frequencies
+const KeyTable& lyapunov_keys();     // /analysis/lyapunov
 const KeyTable& checkpoint_keys();
 const KeyTable& study_keys();  // at most one of "steps", "dt"
 // /integrator {"scheme": "auto", ...}: the keys besides "scheme" (study/scheme_choice.hpp).

@@ -1,4 +1,5 @@
-// The key tables of a job's /analysis section and its /analysis/poincare and /analysis/lyapunov objects
+// The key tables of a job's /analysis section and its /analysis/poincare, /analysis/frequencies and
+// /analysis/lyapunov objects
 // (job_keys.hpp). Descriptions are the schema's; the limits are the analyses' own constants.
 #include <limits>
 
@@ -28,6 +29,15 @@ const KeyTable& analysis_keys() {
                         "a fractional step of the run's integrator (|normal . (q, p) - value| at round-off). Exactly "
                         "one of component and normal.",
          .keys = poincare_keys},
+        {.name = "frequencies",
+         .type = ValueType::object,
+         .description = "Frequency map analysis (Laskar): the fundamental frequency of each signal q_k + i p_k, "
+                        "sampled every `every` steps, by NAFF (Hann window) over the whole run and over its first and "
+                        "second half, and the diffusion index log10 |nu_second - nu_first| / |nu|: trajectories.csv "
+                        "columns frequency<k>, frequency<k>_first, frequency<k>_second (radians per unit time) and "
+                        "diffusion; the sampled signals in frequency_signals.npy; with spectra, the strongest terms "
+                        "in frequency_spectra.csv. Needs at least 32 samples. Any model: no Hessians needed.",
+         .keys = frequencies_keys},
     }};
     for (const IndicatorEntry& entry : indicator_entries()) t.rules.push_back(entry.rule);
     t.rules.push_back(
@@ -96,6 +106,31 @@ const KeyTable& poincare_keys() {
       },
       {{"oneOf", {{{"required", {"component"}}}, {{"required", {"normal"}}}}},
        {"not", {{"required", {"value", "offset"}}}}}};
+  return table;
+}
+
+const KeyTable& frequencies_keys() {
+  static const KeyTable table{{
+      {.name = "every",
+       .type = ValueType::integer,
+       .minimum = 1,
+       .maximum = steps_limit,
+       .default_value = 1,
+       .description = "Steps between samples: the signals are sampled at steps every, 2 every, ..., N every (N = "
+                      "steps / every, at least 32)."},
+      {.name = "signals",
+       .type = ValueType::defined,
+       .description = "The degrees of freedom k whose signals q_k + i p_k are analysed, in column order (0-based, "
+                      "below the dimension, each once). Absent: every degree of freedom.",
+       .definition = "indices"},
+      {.name = "spectra",
+       .type = ValueType::integer,
+       .minimum = 0,
+       .maximum = 1000,
+       .default_value = 0,
+       .description = "Write the strongest this many terms (frequency, complex amplitude) of each signal over the "
+                      "whole run to frequency_spectra.csv; 0: no such file."},
+  }};
   return table;
 }
 

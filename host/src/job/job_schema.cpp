@@ -227,6 +227,8 @@ schema_json definitions() {
          "every initial state (docs/dynamics.md). Every set must give the model the same dimension: a sweep of a "
          "parameter that sets it (lattice_chain's sites) is refused."}}}};
   defs["vector"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("finite")}};
+  defs["indices"] = {
+      {"type", "array"}, {"minItems", 1}, {"uniqueItems", true}, {"items", {{"type", "integer"}, {"minimum", 0}}}};
   defs["state"] = object_schema(state_keys());
   defs["initial"] = {{"oneOf",
                       {ref("state"),

@@ -49,6 +49,14 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     run.time = read_time(check, document);
     if (const json* analysis = check.member(document, "", "analysis", false, ""))
       run.analysis = read_analysis(check, *analysis, job.initial.dimension);
+    if (const auto& frequencies = run.analysis.frequencies; frequencies && run.time.steps > 0)
+      if (run.time.steps / frequencies->every < minimum_frequency_samples)
+        check.issue("/analysis/frequencies/every",
+                    std::to_string(frequencies->every) + " (" + std::to_string(run.time.steps / frequencies->every) +
+                        " samples of " + std::to_string(run.time.steps) + " steps)",
+                    "at most steps / " + std::to_string(minimum_frequency_samples) + " = " +
+                        std::to_string(run.time.steps / minimum_frequency_samples) + ": at least " +
+                        std::to_string(minimum_frequency_samples) + " samples, 16 in each half of the run");
     check_sweep_size(check, job);
   }
   read_output(check, document, job);

@@ -85,6 +85,14 @@ MemoryEstimate estimate_run_memory(const LoadedJob& loaded, std::size_t trajecto
           stepped * (points * (2 * n + 2) + 2 * 2 * n) * number);
     }
     if (analysis.poincare) add("/analysis/poincare", "the state before each step", stepped * state);
+    if (const auto& frequencies = analysis.frequencies) {
+      // One chunk's samples per trajectory, and per block (at most 8 + stepped / 2) one analysis's signal, its FFT
+      // and the transforms' tables: some 6 copies of N complex numbers.
+      const double samples = static_cast<double>(run.time.steps / frequencies->every);
+      const double blocks = std::min(stepped, 8.0 + stepped / 2.0);
+      add("/analysis/frequencies", "the signals of the block's analyses (frequency_signals.npy holds the samples)",
+          blocks * 6 * samples * 2 * number + stepped * static_cast<double>(frequencies->signals.size()) * 64.0);
+    }
     if (analysis.closest_return_after)
       add("/analysis/closest_return_after", "the initial states compared with", stepped * state);
     if (run.every > 0)

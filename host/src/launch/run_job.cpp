@@ -48,6 +48,25 @@ nlohmann::ordered_json poincare_facts(const PoincareSection& section, const Poin
            "found by TOMS 748 (core/include/nonsep/core/analysis/poincare_crossing.hpp)"}};
 }
 
+nlohmann::ordered_json frequency_facts(const FrequencyMap& map, const FrequencyMapObserver& observer) {
+  std::vector<std::string> columns;
+  observer.columns(columns);
+  return {{"signals", observer.signals()},
+          {"signal", "q_k + i p_k of each degree of freedom k listed"},
+          {"every", map.every},
+          {"samples", observer.samples()},
+          {"tau", observer.tau()},
+          {"window", "Hann (Laskar's window of order 1)"},
+          {"method", "NAFF (core/include/nonsep/core/analysis/frequency_analysis.hpp)"},
+          {"columns", columns},
+          {"units", "radians per unit time, signed"},
+          {"analysed", observer.analysed()},
+          {"signals_file", FrequencyMapObserver::signals_file_name},
+          {"spectra", map.spectra},
+          {"spectra_file", map.spectra > 0 ? nlohmann::ordered_json(FrequencyMapObserver::spectra_file_name)
+                                           : nlohmann::ordered_json(nullptr)}};
+}
+
 nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
   nlohmann::ordered_json facts = {
       {"vectors", analysis.tangent_vectors()},
@@ -194,6 +213,8 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   outcome.summary = run_summary(facts);
   if (plan.poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *plan.poincare);
   if (plan.chaos) outcome.summary["analysis"]["tangent_map"] = tangent_facts(run.analysis);
+  if (plan.frequencies)
+    outcome.summary["analysis"]["frequencies"] = frequency_facts(*run.analysis.frequencies, *plan.frequencies);
   if (!choice.is_null()) outcome.summary["scheme_choice"] = std::move(choice);
   if (plan.estimate)
     outcome.summary["analysis"]["error_estimate"] =
@@ -214,6 +235,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
     std::vector<const TrajectoryColumns*> columns{&plan.energy};
     if (plan.closest) columns.push_back(&*plan.closest);
     if (plan.poincare) columns.push_back(&*plan.poincare);
+    if (plan.frequencies) columns.push_back(&*plan.frequencies);
     if (plan.chaos) columns.push_back(&*plan.chaos);
     if (plan.estimate) columns.push_back(&*plan.estimate);
     write_trajectories_csv(directory / trajectories_file_name, facts, columns);

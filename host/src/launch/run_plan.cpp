@@ -98,6 +98,13 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
                      driver.time(), job.initial.dimension, count, driver.energy_available(), options.resume);
   else
     remove_stale(directory / PoincareSectionObserver::file_name);
+  if (const auto& map = run.analysis.frequencies) {
+    frequencies.emplace(directory, *map, driver.time(), job.initial.dimension, count, options.resume);
+    if (map->spectra == 0) remove_stale(directory / FrequencyMapObserver::spectra_file_name);
+  } else {
+    remove_stale(directory / FrequencyMapObserver::signals_file_name);
+    remove_stale(directory / FrequencyMapObserver::spectra_file_name);
+  }
   const std::uint64_t series_every = run.analysis.lyapunov ? run.analysis.lyapunov->every : 0;
   if (run.analysis.tangent_vectors() > 0)
     chaos.emplace(directory / IndicatorColumns::file_name, run.analysis.indicators, series_every, driver.records(),
@@ -117,6 +124,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (hdf5_samples) watch(*hdf5_samples);
 #endif
   if (poincare) watch(*poincare);
+  if (frequencies) watch(*frequencies);
   if (estimate) watch(*estimate);
   saver.emplace(directory / checkpoint_file_name, identity_, run.checkpoint, driver, checkpointed);
   progress.emplace(options.progress, options.progress_interval, driver, &energy, options.progress_label,

@@ -20,6 +20,7 @@
 #include "nonsep/host/observers/closest_return.hpp"
 #include "nonsep/host/observers/energy_error.hpp"
 #include "nonsep/host/observers/error_estimate.hpp"
+#include "nonsep/host/observers/frequency_map.hpp"
 #include "nonsep/host/observers/indicator_columns.hpp"
 #include "nonsep/host/observers/poincare_section.hpp"
 #include "nonsep/host/observers/progress.hpp"
@@ -58,6 +59,7 @@ class RunPlan {
   std::optional<Hdf5SampleWriter> hdf5_samples;
 #endif
   std::optional<PoincareSectionObserver> poincare;
+  std::optional<FrequencyMapObserver> frequencies;
   std::optional<IndicatorColumns> chaos;
   std::optional<ErrorEstimateObserver> estimate;  // /analysis/error_estimate: its finer run is done by the plan
   // The observers above that the driver tells, in the order it tells them; the saver and the progress bar follow.

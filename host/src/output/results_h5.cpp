@@ -12,7 +12,7 @@ void write_results_file(const std::filesystem::path& path, bool has_samples, con
                         const nlohmann::ordered_json& summary) {
   Hdf5File file = has_samples ? Hdf5File::open(path) : Hdf5File::create(path);
   write_csv_table(file, "/trajectories", directory / trajectories_file_name);
-  for (const char* table : {"poincare", "lyapunov", "error_estimate"}) {
+  for (const char* table : {"poincare", "lyapunov", "error_estimate", "frequency_spectra"}) {
     const std::filesystem::path csv = directory / (std::string(table) + ".csv");
     if (std::filesystem::exists(held_path(csv))) {
       write_csv_table(file, table, csv);

@@ -473,6 +473,7 @@ void apply_choice(Job& job, const SchemeChoice& choice) {
     run.analysis.lyapunov->every *= m;
     run.analysis.lyapunov->renormalize_every *= m;
   }
+  if (run.analysis.frequencies) run.analysis.frequencies->every *= m;  // the same sampling times
 }
 
 void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& recorded,

@@ -123,9 +123,21 @@ struct LyapunovAnalysis {
   std::uint64_t every = 0;              // lyapunov.csv every this many steps; 0: no time series
 };
 
+// /analysis/frequencies: frequency map analysis (observers/frequency_map.hpp): the fundamental frequencies of the
+// signals z_k = q_k + i p_k of the degrees of freedom `signals`, sampled every `every` steps, by NAFF over the whole
+// run and over its two halves, and Laskar's diffusion index.
+// The fewest samples a frequency map takes: 16 in each half (nonsep::FrequencyAnalysis::minimum_samples).
+inline constexpr std::uint64_t minimum_frequency_samples = 32;
+struct FrequencyMap {
+  std::uint64_t every = 1;           // steps between samples
+  std::vector<std::size_t> signals;  // degrees of freedom, in column order (all of them when the job gives none)
+  std::size_t spectra = 0;           // terms per signal in frequency_spectra.csv; 0: no such file
+};
+
 // Per-trajectory analysis of a single run (/analysis).
 struct Analysis {
   std::optional<PoincareSection> poincare;   // /analysis/poincare
+  std::optional<FrequencyMap> frequencies;   // /analysis/frequencies
   std::optional<LyapunovAnalysis> lyapunov;  // /analysis/lyapunov
   // The chaos indicators asked for (/analysis/lyapunov, /megno, /sali, /gali, /fli), in the order of their columns
   // (host/src/job/indicators.cpp: the one list).

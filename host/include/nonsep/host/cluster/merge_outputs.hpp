@@ -26,12 +26,17 @@ struct UnitFile {
 // OutputError naming the file that cannot be read or does not fit.
 void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& output, std::span<const std::string> keys);
 
+// frequency_signals.npy of the whole run (observers/frequency_map.hpp) from the units' (in trajectory order): their
+// arrays, which must agree in signals and samples, one after the other. Written atomically. Throws OutputError
+// naming the unit file that cannot be read or does not fit.
+void merge_signals(std::span<const UnitFile> parts, const std::filesystem::path& output);
+
 // summary.json of the whole run from the units' summaries (in trajectory order; `first_trajectories` as above):
 // the first unit's, with what depends on the ensemble recomputed: status (the first of interrupted, failed,
 // diverged, inaccurate, completed that a unit has), error, counts and evaluations (sums), steps completed (the
 // largest), the largest energy error (the first unit's largest that no later unit exceeds, as one process finds it),
-// the scheme's figures (the largest: Tao's copy distance), Poincare crossings (sum), the number of trajectories and
-// states, the output folder, and wall_seconds (the run's, passed in).
+// the scheme's figures (the largest: Tao's copy distance), Poincare crossings and analysed frequency maps (sums), the
+// number of trajectories and states, the output folder, and wall_seconds (the run's, passed in).
 nlohmann::ordered_json merge_summaries(std::span<const nlohmann::ordered_json> units,
                                        std::span<const std::size_t> first_trajectories, std::size_t trajectories,
                                        const std::filesystem::path& directory, double wall_seconds);
