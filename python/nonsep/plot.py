@@ -350,15 +350,26 @@ def chaotic_fraction(result, x=None, value="mean_megno", threshold=None, where=N
     return ax
 
 
-def frequency_map(result, ax=None, x="frequency0", y="frequency1", value="diffusion", where=None, cmap=None,
-                  colorbar=True, **style):
+def frequency_map(result, ax=None, x=None, y=None, value="diffusion", where=None, cmap=None, colorbar=True,
+                  **style):
     """Laskar's frequency map: each analysed trajectory as a point at its fundamental frequencies (x, y: columns of
-    trajectories.csv from /analysis/frequencies, by default nu_0 and nu_1 over the whole run), coloured by `value`
+    trajectories.csv from /analysis/frequencies, by default the whole run's frequencies of the first two signals the
+    run analysed, "frequency0" and "frequency1" for a 2D model), coloured by `value`
     (the diffusion index by default: blue where the frequencies stay put between the halves of the run, a torus; red
     where they drift, a chaotic zone). On a family of tori the points lie on smooth curves; resonances show as lines
     the points gather on, chaotic zones as scattered red points. Trajectories without an analysis (not completed)
     are left out, and counted in the title. `where` chooses trajectories (Result.select); `style` goes to
     ax.scatter. Returns the axes."""
+    if x is None or y is None:
+        facts = (result.summary.get("analysis") or {}).get("frequencies")
+        if facts is None:
+            raise ValueError(f"{result.directory} has no frequency map (the run had no analysis.frequencies)")
+        signals = facts["signals"]
+        if len(signals) < 2:
+            raise ValueError(f"the run analysed one signal (frequency{signals[0]}): give x and y, e.g. "
+                             f"x=\"frequency{signals[0]}_first\", y=\"frequency{signals[0]}_second\"")
+        x = x or f"frequency{signals[0]}"
+        y = y or f"frequency{signals[1]}"
     chosen = result.select(where)
     xs, ys = (_per_trajectory(result, name)[chosen] for name in (x, y))
     values = _per_trajectory(result, value)[chosen]

@@ -337,7 +337,7 @@ TEST_CASE(
     INFO("stderr: " << refused.err);
     CHECK(refused.status == 2);
     const std::string option = before.contains("omega") ? "integrator.omega" : "integrator.max_iterations";
-    CHECK(refused.err.find("its " + option + " differ") != std::string::npos);
+    CHECK(refused.err.find("its " + option + " differs") != std::string::npos);
     CHECK(read_text(folder / "out" / "checkpoint.json") == checkpoint);
   }
 }

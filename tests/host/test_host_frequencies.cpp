@@ -133,6 +133,39 @@ TEST_CASE("frequency map: a resume refuses a signals file that is not the one it
   CHECK(resumed.err.find("--force") != std::string::npos);
 }
 
+TEST_CASE("frequency map: a resume with other frequency settings is refused, naming the analysis") {
+  TemporaryFolder folder;
+  json job = ensemble_job(6000);
+  job["checkpoint"] = {{"every_steps", 500}, {"every_seconds", 0}};
+  const auto file = write_job(folder / "job.json", job);
+  kill_after_checkpoint(file, folder / "out", 1000, folder.path());
+  job["analysis"]["frequencies"]["every"] = 6;
+  const auto changed = write_job(folder / "changed.json", job);
+  const auto resumed = run_nonsep(
+      {"run", "--quiet", "--resume", "--output", (folder / "out").string(), changed.string()}, folder.path());
+  INFO("stderr: " << resumed.err);
+  CHECK(resumed.status == 2);
+  CHECK(resumed.err.find("belongs to a different job: its analysis differs") != std::string::npos);
+}
+
+TEST_CASE("frequency map: the frequency columns do not depend on how many terms the spectra hold") {
+  // The spectra's terms are projected together, which changes their amplitudes and can rank a later term first;
+  // the columns are the strongest term found alone.
+  TemporaryFolder folder;
+  json few = ensemble_job(2000), many = few;
+  few["analysis"]["frequencies"]["spectra"] = 0;
+  many["analysis"]["frequencies"]["spectra"] = 166;  // samples / 4
+  REQUIRE(run_into(folder, "few", few).status == 0);
+  REQUIRE(run_into(folder, "many", many).status == 0);
+  const auto a = table(folder / "few/trajectories.csv"), b = table(folder / "many/trajectories.csv");
+  REQUIRE(a.size() == b.size());
+  for (std::size_t t = 0; t < a.size(); ++t)
+    for (const char* column : {"frequency0", "frequency1_first", "diffusion"})
+      CHECK(a[t].at(column) == b[t].at(column));
+  const auto spectra = table(folder / "many/frequency_spectra.csv");
+  CHECK(spectra.size() > 24 * 2 * 100);
+}
+
 TEST_CASE("frequency map: an orbit that diverges has empty cells, one stopped early by max_crossings is analysed") {
   TemporaryFolder folder;
   use_test_plugins();

@@ -273,5 +273,5 @@ TEST_CASE("resume refuses a checkpoint of another plugin file with the same name
   }
   const auto refused = run_nonsep({"run", "--quiet", "--resume", file.string()}, folder.path());
   CHECK(refused.status == 2);
-  CHECK(contains(refused.err, "belongs to a different job: its plugin differ"));
+  CHECK(contains(refused.err, "belongs to a different job: its plugin differs"));
 }

@@ -385,7 +385,7 @@ TEST_CASE("resume refuses a missing checkpoint and another job's, with exit 2 an
   write_job(file, job);
   const auto other = run_nonsep({"run", "--quiet", "--resume", file.string()}, folder.path());
   CHECK(other.status == 2);
-  CHECK(contains(other.err, "belongs to a different job: its time differ"));
+  CHECK(contains(other.err, "belongs to a different job: its time differs"));
   CHECK(contains(other.err, "run with --force to start over"));
 
   // A damaged checkpoint is refused, not trusted.

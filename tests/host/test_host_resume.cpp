@@ -247,7 +247,7 @@ TEST_CASE("a resume with analysis.error_estimate added belongs to a different jo
       run_nonsep({"run", "--quiet", "--resume", "--output", out.string(), added.string()}, folder.path());
   INFO(resumed.err);
   CHECK(resumed.status == 2);
-  CHECK(resumed.err.find("belongs to a different job: its analysis differ") != std::string::npos);
+  CHECK(resumed.err.find("belongs to a different job: its analysis differs") != std::string::npos);
   CHECK(resumed.err.find("damaged") == std::string::npos);
 }
 

@@ -244,6 +244,15 @@ class FrequencyMapTest(FolderTestCase):
         ax = nonsep.plot.chaos_map(result, value="diffusion", x="q1", y="p1")
         self.assertIn("diffusion index", ax.figure.axes[-1].get_ylabel())
         plt.close(ax.figure)
+        # One signal: the map needs its axes named, and says which.
+        job["analysis"]["frequencies"] = {"every": 2, "signals": [1]}
+        one = nonsep.run(job, output="one")
+        self.assertEqual(list(one.frequency_analysis["signals"]), [1])
+        with self.assertRaisesRegex(ValueError, "frequency1_first"):
+            nonsep.plot.frequency_map(one)
+        ax = nonsep.plot.frequency_map(one, x="frequency1_first", y="frequency1_second")
+        self.assertIn("first half", ax.get_xlabel())
+        plt.close(ax.figure)
 
 
 class FailedRunTest(FolderTestCase):

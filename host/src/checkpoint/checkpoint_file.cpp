@@ -140,6 +140,10 @@ std::string job_fingerprint(const LoadedJob& loaded) {
     analysis += "|" + indicator->name();
     for (const auto& [name, value] : indicator->settings()) analysis += " " + std::to_string(value);
   }
+  if (const auto& frequencies = run.analysis.frequencies) {
+    analysis += "|frequencies " + std::to_string(frequencies->every) + ' ' + std::to_string(frequencies->spectra);
+    for (std::size_t k : frequencies->signals) analysis += ' ' + std::to_string(k);
+  }
   if (run.analysis.error_estimate) analysis += "|error_estimate";
   parts.emplace_back("analysis", std::move(analysis));
   std::string fingerprint;
@@ -157,6 +161,11 @@ std::string fingerprint_difference(const std::string& a, const std::string& b) {
   for (const auto& [name, hash] : second)
     if (!first.contains(name)) add(name);
   return differ.empty() ? "the job's identity" : differ;
+}
+
+std::string what_differs(const std::string& a, const std::string& b) {
+  const std::string parts = fingerprint_difference(a, b);
+  return parts + (parts.find(',') == std::string::npos ? " differs" : " differ");
 }
 
 std::string stepping_identity(const LoadedJob& job) {
@@ -254,9 +263,8 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
   const std::string fingerprint = read.string(read.member(document, "job_fingerprint"), "job_fingerprint");
   if (fingerprint != identity.fingerprint)
     throw CheckpointError(
-        path.string() + " belongs to a different job: its " +
-        fingerprint_difference(fingerprint, identity.fingerprint) +
-        " differ (the plugin part covers the plugin file's bytes, integrator.NAME is the integrator's option NAME, "
+        path.string() + " belongs to a different job: its " + what_differs(fingerprint, identity.fingerprint) +
+        " (the plugin part covers the plugin file's bytes, integrator.NAME is the integrator's option NAME, "
         "output covers output.every, energy_every and format, auto scheme auto's tolerance and measure); run with "
         "--force to start over, or resume with the "
         "job that wrote it");

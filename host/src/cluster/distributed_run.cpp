@@ -95,8 +95,7 @@ void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Pl
       throw CheckpointError(
           path.string() + " was written by another job, or by this job before it was changed" +
           (saved.contains("job_fingerprint") && saved["job_fingerprint"].is_string()
-               ? " (its " + fingerprint_difference(saved["job_fingerprint"].get<std::string>(), fingerprint) +
-                     " differ)"
+               ? " (its " + what_differs(saved["job_fingerprint"].get<std::string>(), fingerprint) + ")"
                : std::string()) +
           "; run it again without --resume (--force discards the units)");
     for (std::size_t u = 0; u < plan.units; ++u) {

@@ -97,7 +97,7 @@ void verify_unit(const std::filesystem::path& folder, const UnitIdentity& identi
         seal.at("first_trajectory") != identity.first || seal.at("trajectories") != identity.size)
       refuse("is sealed as another unit (" + folder.filename().string() + " holds " + seal.dump() + ")");
     if (const std::string sealed = seal.at("job_fingerprint").get<std::string>(); sealed != identity.fingerprint)
-      refuse("was computed by another job: its " + fingerprint_difference(sealed, identity.fingerprint) + " differ");
+      refuse("was computed by another job: its " + what_differs(sealed, identity.fingerprint));
     for (const auto& [name, facts] : seal.at("files").items())
       if (!files.contains(name)) refuse("has lost its " + name);
     for (const auto& [name, facts] : files.items()) {

@@ -49,7 +49,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     run.time = read_time(check, document);
     if (const json* analysis = check.member(document, "", "analysis", false, ""))
       run.analysis = read_analysis(check, *analysis, job.initial.dimension);
-    if (const auto& frequencies = run.analysis.frequencies; frequencies && run.time.steps > 0)
+    if (const auto& frequencies = run.analysis.frequencies; frequencies && run.time.steps > 0) {
       if (run.time.steps / frequencies->every < minimum_frequency_samples)
         check.issue("/analysis/frequencies/every",
                     std::to_string(frequencies->every) + " (" + std::to_string(run.time.steps / frequencies->every) +
@@ -57,6 +57,13 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
                     "at most steps / " + std::to_string(minimum_frequency_samples) + " = " +
                         std::to_string(run.time.steps / minimum_frequency_samples) + ": at least " +
                         std::to_string(minimum_frequency_samples) + " samples, 16 in each half of the run");
+      else if (frequencies->spectra > run.time.steps / frequencies->every / 4)
+        check.issue("/analysis/frequencies/spectra",
+                    std::to_string(frequencies->spectra) + " (of " +
+                        std::to_string(run.time.steps / frequencies->every) + " samples)",
+                    "at most samples / 4 = " + std::to_string(run.time.steps / frequencies->every / 4) +
+                        ": the window's main lobe is 4 frequency bins wide, so no more terms can be told apart");
+    }
     check_sweep_size(check, job);
   }
   read_output(check, document, job);

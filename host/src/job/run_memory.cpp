@@ -86,12 +86,14 @@ MemoryEstimate estimate_run_memory(const LoadedJob& loaded, std::size_t trajecto
     }
     if (analysis.poincare) add("/analysis/poincare", "the state before each step", stepped * state);
     if (const auto& frequencies = analysis.frequencies) {
-      // One chunk's samples per trajectory, and per block (at most 8 + stepped / 2) one analysis's signal, its FFT
-      // and the transforms' tables: some 6 copies of N complex numbers.
+      // Per trajectory and signal the samples not yet written, and per block (at most 8 + stepped / 2) one
+      // analysis's signal, its FFT and the transforms' tables: some 6 copies of N complex numbers.
       const double samples = static_cast<double>(run.time.steps / frequencies->every);
       const double blocks = std::min(stepped, 8.0 + stepped / 2.0);
-      add("/analysis/frequencies", "the signals of the block's analyses (frequency_signals.npy holds the samples)",
-          blocks * 6 * samples * 2 * number + stepped * static_cast<double>(frequencies->signals.size()) * 64.0);
+      add("/analysis/frequencies", "the samples not yet in frequency_signals.npy and the blocks' analyses",
+          stepped * static_cast<double>(std::max<std::size_t>(frequencies->signals.size(), 1)) *
+                  static_cast<double>(frequency_samples_in_memory) * 2 * number +
+              blocks * 6 * samples * 2 * number);
     }
     if (analysis.closest_return_after)
       add("/analysis/closest_return_after", "the initial states compared with", stepped * state);

@@ -211,9 +211,10 @@ FrequencyMapObserver::Result FrequencyMapObserver::analyse(std::size_t trajector
     for (std::size_t j = 0; j < m; ++j) {
       read(trajectory, j, count, state.samples);
       const std::span<const std::complex<double>> z = state.samples;
-      const std::vector<FrequencyTerm> terms = state.analysis.terms(z, tau_, std::max<std::size_t>(spectra_, 1));
-      whole[j] = terms.front().frequency;
-      if (spectra_ > 0) spectra.push_back(terms);
+      // The column is the strongest term alone: the amplitudes of several terms found together are their joint
+      // projection, which can rank a later term first.
+      whole[j] = state.analysis.fundamental_frequency(z, tau_);
+      if (spectra_ > 0) spectra.push_back(state.analysis.terms(z, tau_, spectra_));
       first[j] = state.analysis.fundamental_frequency(z.first(half), tau_);
       second[j] = state.analysis.fundamental_frequency(z.subspan(half, half), tau_);
     }
@@ -260,7 +261,7 @@ void FrequencyMapObserver::after_chunk(std::uint64_t) {
   // A write per trajectory and signal once it has some 16 kB: a write per chunk each would cost some 3% of a run
   // that samples every step.
   for (std::size_t trajectory = 0; trajectory < trajectories_; ++trajectory)
-    if (pending_[trajectory * signals_.size()].size() >= flush_samples) flush(trajectory);
+    if (pending_[trajectory * signals_.size()].size() >= frequency_samples_in_memory) flush(trajectory);
 }
 
 void FrequencyMapObserver::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {

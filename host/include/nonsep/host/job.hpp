@@ -128,6 +128,8 @@ struct LyapunovAnalysis {
 // run and over its two halves, and Laskar's diffusion index.
 // The fewest samples a frequency map takes: 16 in each half (nonsep::FrequencyAnalysis::minimum_samples).
 inline constexpr std::uint64_t minimum_frequency_samples = 32;
+// Samples of one signal a trajectory keeps in memory before they are written to frequency_signals.npy (16 kB).
+inline constexpr std::size_t frequency_samples_in_memory = 1024;
 struct FrequencyMap {
   std::uint64_t every = 1;           // steps between samples
   std::vector<std::size_t> signals;  // degrees of freedom, in column order (all of them when the job gives none)

@@ -52,6 +52,8 @@ struct Checkpoint {
 std::string job_fingerprint(const LoadedJob& job);
 // The names of the parts in which two fingerprints differ ("plugin, integrator.omega, time").
 std::string fingerprint_difference(const std::string& a, const std::string& b);
+// The same as a sentence's end: "time differs", "plugin, integrator.omega, time differ".
+std::string what_differs(const std::string& a, const std::string& b);
 
 // How this process steps `job`'s plugin, which decides the last bits of the numbers: the instruction set of the
 // plugin's kernel it uses ("x86-64-v4", Plugin::kernels()), or "evaluation" for the evaluation path (the plugin has

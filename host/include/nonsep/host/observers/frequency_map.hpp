@@ -9,13 +9,13 @@
 // every dt. The halves are samples 0 .. N/2 - 1 and N/2 .. 2 (N/2) - 1.
 //
 // Where the samples go: frequency_signals.npy, a NumPy array of complex128 (little-endian) of shape (trajectories,
-// signals, N), trajectory by trajectory, created at its full size (sparse) and filled as the run goes: each chunk's
-// samples are kept in memory per trajectory and written (pwrite) once there are flush_samples of them, and all of
-// them before a checkpoint, a trajectory's analysis at its retirement and the end; a chunk that the driver redoes
-// step by step is forgotten (restore_block: what was kept before the chunk stays). Memory holds some 16 kB per
-// trajectory and signal, not the run's samples. A trajectory that stops
-// early keeps zeros after its last sample. The file is a result of its own (numpy.load(..., mmap_mode="r")), and
-// what a resumed run reads its samples back from.
+// signals, N), trajectory by trajectory, created at its full size (sparse) and filled as the run goes: the samples
+// are kept in memory per trajectory and signal and written (pwrite) once there are frequency_samples_in_memory
+// (job.hpp: 16 kB) of them, and all of them before a checkpoint, at a trajectory's retirement and at the end; a
+// chunk that the driver redoes step by step is forgotten (restore_block: what was kept before the chunk stays).
+// Memory holds some 16 kB per trajectory and signal, not the run's samples. A trajectory that stops early keeps
+// zeros after its last sample. The file is a result of its own (numpy.load(..., mmap_mode="r")), and what a resumed
+// run reads its samples back from.
 //
 // When the frequencies are computed: when a trajectory takes its N-th sample, on the worker thread of its block (so
 // the analyses of an ensemble run in parallel; a redone chunk computes them again); a trajectory that completes
@@ -58,8 +58,6 @@ class FrequencyMapObserver : public Observer,
  public:
   static constexpr const char* signals_file_name = "frequency_signals.npy";
   static constexpr const char* spectra_file_name = "frequency_spectra.csv";
-  // Samples a trajectory's signal keeps in memory before they are written (16 kB).
-  static constexpr std::size_t flush_samples = 1024;
 
   // Creates frequency_signals.npy in `directory` at its full size, or, when `resuming`, opens the one there (its
   // header must be this run's). Throws OutputError.
