@@ -125,18 +125,19 @@ struct FrequencyAnalysis::Workspace {
   void prepare(std::span<const std::complex<double>> z) {
     const std::size_t n = z.size();
     if (window.size() != n) {
-      auto [known, added] = windows.try_emplace(n);
-      if (added) {
+      const auto found = windows.try_emplace(n);
+      Window& known = found.first->second;
+      if (found.second) {
         // chi_k = 1 - cos(2 pi k / (N-1)) = 1 + cos(u x_k) with u = 2 pi / (N-1).
-        known->second.chi.resize(n);
+        known.chi.resize(n);
         exponentials.set(two_pi / static_cast<double>(n - 1), n);
         exponentials.for_each([&](std::size_t k, double er, double) {
-          known->second.chi[k] = 1.0 + er;
-          known->second.sum += known->second.chi[k];
+          known.chi[k] = 1.0 + er;
+          known.sum += known.chi[k];
         });
       }
-      window = known->second.chi;
-      window_sum = known->second.sum;
+      window = known.chi;
+      window_sum = known.sum;
     }
     signal_re.resize(n);
     signal_im.resize(n);
