@@ -52,25 +52,23 @@ const char* const frequency_files[] = {"trajectories.csv", "frequency_spectra.cs
 }  // namespace
 
 TEST_CASE("frequency map: the diffusion index is small on paper2d's regular orbit and large on its chaotic one") {
-  // t = 400 (about 70 turns of q + i p), 16000 samples. Measured: diffusion -6.9 on the regular orbit and -1.9 on the
-  // chaotic one; FLI 7.3 and 139 (docs/dynamics.md).
+  // t = 400 (about 70 turns of q + i p), 16000 samples. Measured: diffusion -6.3 on the regular orbit and -1.3 on the
+  // chaotic one. FLI separates the same two orbits (7.3 and 139.5: the test "MEGNO: <Y> -> 2 within 5% ... FLI").
   TemporaryFolder folder;
   const json job = {{"model", {{"plugin", "paper2d"}}},
                     {"integrator", {{"scheme", "mpe"}, {"order", 4}}},
                     {"initial", {{{"q", regular_q}, {"p", regular_p}}, {{"q", chaotic_q}, {"p", chaotic_p}}}},
                     {"time", {{"dt", 0.005}, {"steps", 80000}}},
                     {"output", {{"every", 0}}},
-                    {"analysis", {{"frequencies", {{"every", 5}}}, {"fli", true}}}};
+                    {"analysis", {{"frequencies", {{"every", 5}}}}}};
   const auto result = run_into(folder, "run", job);
   INFO("stderr: " << result.err);
   REQUIRE(result.status == 0);
   const auto rows = table(folder / "run/trajectories.csv");
   REQUIRE(rows.size() == 2);
-  MESSAGE("diffusion: regular " << rows[0].at("diffusion") << ", chaotic " << rows[1].at("diffusion")
-                                << "; FLI: regular " << rows[0].at("fli") << ", chaotic " << rows[1].at("fli"));
+  MESSAGE("diffusion: regular " << rows[0].at("diffusion") << ", chaotic " << rows[1].at("diffusion"));
   CHECK(number(rows[0], "diffusion") < -5.0);
   CHECK(number(rows[1], "diffusion") > -3.0);
-  CHECK(number(rows[1], "fli") > 5.0 * number(rows[0], "fli"));
   // The torus's frequencies are the same in both halves to the index's precision; each is within the sampling band.
   for (const char* k : {"0", "1"}) {
     const std::string name = std::string("frequency") + k;
