@@ -2,8 +2,8 @@
 
 Column types are decided by the column's name, never by its position, so that files with more, fewer or
 reordered columns load alike:
-  - integers (int64): trajectory, step, steps, basic_steps, grad_T, grad_V, crossing, poincare_crossings (never
-    empty in nonsep's files);
+  - integers (int64): trajectory, step, steps, basic_steps, grad_T, grad_V, crossing, poincare_crossings, and
+    frequency_spectra.csv's signal and term (never empty in nonsep's files);
   - text (fixed-width str): status, stop_variable, message, integrator, scheme, order, error_estimate;
   - booleans: symplectic, separated ("true" / "false"; an empty cell is false);
   - every other column is a float64 column, where an empty cell is NaN; a column of another name that holds
@@ -18,7 +18,7 @@ import io
 import numpy as np
 
 INTEGER_COLUMNS = frozenset({"trajectory", "step", "steps", "basic_steps", "grad_T", "grad_V", "crossing",
-                             "poincare_crossings"})
+                             "poincare_crossings", "signal", "term"})
 TEXT_COLUMNS = frozenset({"status", "stop_variable", "message", "integrator", "scheme", "order", "error_estimate"})
 BOOLEAN_COLUMNS = frozenset({"symplectic", "separated"})
 

@@ -228,6 +228,8 @@ class FrequencyMapTest(FolderTestCase):
         self.assertEqual(facts["signals"], [0, 1])
         spectra = result.frequency_spectra
         self.assertEqual(len(spectra), len(table) * 2 * 3)
+        self.assertEqual(spectra["signal"].dtype, np.int64)
+        self.assertEqual(list(spectra["term"][:3]), [0, 1, 2])
         first = spectra[(spectra["trajectory"] == 1) & (spectra["signal"] == 1) & (spectra["term"] == 0)]
         self.assertEqual(first["frequency"][0], table["frequency1"][1])
         signals = result.frequency_signals()
