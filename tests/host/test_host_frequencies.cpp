@@ -195,3 +195,25 @@ TEST_CASE("frequency map: an orbit that diverges has empty cells, one stopped ea
   MESSAGE("stopped at step " << stopped_rows[0].at("step") << ", diffusion " << stopped_rows[0].at("diffusion"));
   CHECK(number(stopped_rows[0], "diffusion") < -4.0);
 }
+
+TEST_CASE("frequency map: validate says what will be sampled and how large the signals file will be") {
+  TemporaryFolder folder;
+  json job = ensemble_job(6000);  // 24 orbits, 2 signals, 2000 samples: 1.536 MB
+  job["analysis"]["frequencies"]["spectra"] = 3;
+  const auto file = write_job(folder / "job.json", job);
+  const auto result = run_nonsep({"validate", file.string()}, folder.path());
+  INFO("stdout: " << result.out << "stderr: " << result.err);
+  REQUIRE(result.status == 0);
+  CHECK(result.out.find("frequencies: 2 signals q_k + i p_k, 2000 samples every 3 steps (tau = 0.015), "
+                        "frequency_signals.npy 1.5 MB, frequency_spectra.csv with 3 terms a signal") !=
+        std::string::npos);
+  CHECK(result.out.find("H_TTV") != std::string::npos);
+  job["model"] = {{"plugin", "henon_heiles"}};
+  job["integrator"] = {{"scheme", "gauss"}, {"stages", 2}};
+  job["initial"] = {{"q", {0.0, 0.1}}, {"p", {0.3, 0.0}}};
+  const auto given = write_job(folder / "given.json", job);
+  const auto by_h = run_nonsep({"validate", given.string()}, folder.path());
+  INFO("stdout: " << by_h.out);
+  CHECK(by_h.out.find("H given by the model") != std::string::npos);
+  CHECK(by_h.out.find("H_TTV") == std::string::npos);
+}

@@ -58,7 +58,7 @@ std::string sweep_text(const Job& job, bool loaded);
 std::string parameters_text(nlohmann::json parameters, const Job& job);
 // The "  integrator: ..." line of `nonsep validate`: the scheme and its options, or with scheme auto `auto_text`
 // (describe_auto's), and the form.
-std::string integrator_line(const SingleRun& run, const std::string& auto_text);
+std::string integrator_line(const SingleRun& run, const std::string& auto_text, bool given_by_h);
 int command_schema();
 
 // Texts of --help, generated from the scheme catalogue and the exit statuses.

@@ -97,7 +97,8 @@ int report_formula_job(const std::string& job_file, const Job& job) {
             << (job.is_study()
                     ? ""
                     : integrator_line(job.run(),
-                                      job.run().auto_scheme ? describe_auto(job, auto_model(model), false) : ""))
+                                      job.run().auto_scheme ? describe_auto(job, auto_model(model), false) : "",
+                                      model.h_tree.has_value()))
             << sweep_text(job, false)
             << "  not compiled: the first run compiles it (or finds it in the cache); what needs the compiled model "
                "(initial states on an energy shell, the gradient check) is checked then\n";

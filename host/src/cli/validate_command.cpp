@@ -1,3 +1,4 @@
+#include <cmath>
 #include <iostream>
 #include <string>
 
@@ -34,9 +35,11 @@ std::string integrator_text(const IntegratorSpec& spec) {
   return text;
 }
 
-std::string integrator_line(const SingleRun& run, const std::string& auto_text) {
-  return "  integrator:  " + (run.auto_scheme ? auto_text : integrator_text(run.integrator)) + ", H_" +
-         (run.integrator.form == HamiltonianForm::TTV ? "TTV" : "VVT") + "\n";
+std::string integrator_line(const SingleRun& run, const std::string& auto_text, bool given_by_h) {
+  const std::string form = given_by_h                                    ? "H given by the model"
+                           : run.integrator.form == HamiltonianForm::TTV ? "H_TTV"
+                                                                         : "H_VVT";
+  return "  integrator:  " + (run.auto_scheme ? auto_text : integrator_text(run.integrator)) + ", " + form + "\n";
 }
 
 std::string parameters_text(nlohmann::json parameters, const Job& job) {
@@ -73,6 +76,20 @@ std::string sweep_text(const Job& job, bool loaded) {
   return text + ", " + std::to_string(job.initial.count) + " of them on the energy shell\n";
 }
 
+// What /analysis/frequencies will sample and write, or "" without it.
+std::string frequencies_text(const SingleRun& run, std::size_t dimension, std::size_t trajectories) {
+  const auto& map = run.analysis.frequencies;
+  if (!map) return "";
+  const std::size_t signals = map->signals.empty() ? dimension : map->signals.size();
+  const std::uint64_t samples = run.time.steps / map->every;
+  const double bytes =
+      static_cast<double>(trajectories) * static_cast<double>(signals) * static_cast<double>(samples) * 16.0;
+  return "  frequencies: " + counted(signals, "signal") + " q_k + i p_k, " + std::to_string(samples) +
+         " samples every " + counted(map->every, "step") + " (tau = " + format_number(run.time.dt * map->every) +
+         "), frequency_signals.npy " + format_number(std::round(bytes / 1e5) / 10.0) + " MB" +
+         (map->spectra > 0 ? ", frequency_spectra.csv with " + counted(map->spectra, "term") + " a signal" : "") + "\n";
+}
+
 int command_validate(const std::string& job_file) {
   try {
     if (const auto formula_job = read_formula_job(job_file)) return report_formula_job(job_file, *formula_job);
@@ -98,14 +115,15 @@ int command_validate(const std::string& job_file) {
               << "  model:       " << loaded.plugin.name() << " " << loaded.plugin.version() << " ("
               << loaded.plugin.path().string() << "), dimension " << loaded.model.dimension() << "\n"
               << "  parameters:  " << parameters_text(loaded.model.parameters(), job) << "\n"
-              << integrator_line(run, run.auto_scheme ? describe_auto(loaded) : "")
+              << integrator_line(run, run.auto_scheme ? describe_auto(loaded) : "", loaded.plugin.general_hamiltonian())
               << "  initial:     " << job.initial.count
               << (job.sweep.empty() ? (job.initial.count == 1 ? " state" : " states")
                                     : (job.initial.count == 1 ? " trajectory" : " trajectories"))
               << " (" << job.initial.shape << initial_shell_text(job.initial, !job.sweep.empty()) << ")\n"
               << sweep_text(job, true) << "  time:        " << time_text(run.time) << "\n"
               << "  output:      " << job.output_directory.string() << ", trajectory every " << run.every
-              << (run.every == 0 ? " (none)" : " steps") << "\n";
+              << (run.every == 0 ? " (none)" : " steps") << "\n"
+              << frequencies_text(run, loaded.model.dimension(), job.initial.count);
     return to_int(ExitStatus::success);
   } catch (const InvalidJob& error) {
     return report_invalid_job(error);

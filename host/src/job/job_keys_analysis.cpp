@@ -33,10 +33,11 @@ const KeyTable& analysis_keys() {
          .type = ValueType::object,
          .description = "Frequency map analysis (Laskar): the fundamental frequency of each signal q_k + i p_k, "
                         "sampled every `every` steps, by NAFF (Hann window) over the whole run and over its first and "
-                        "second half, and the diffusion index log10 |nu_second - nu_first| / |nu|: trajectories.csv "
-                        "columns frequency<k>, frequency<k>_first, frequency<k>_second (radians per unit time) and "
-                        "diffusion; the sampled signals in frequency_signals.npy; with spectra, the strongest terms "
-                        "in frequency_spectra.csv. Needs at least 32 samples. Any model: no Hessians needed.",
+                        "second half, and the diffusion index log10 |nu_second - nu_first| / max(|nu_first|, "
+                        "|nu_second|): trajectories.csv columns frequency<k>, frequency<k>_first, frequency<k>_second "
+                        "(radians per unit time) and diffusion; the sampled signals in frequency_signals.npy; with "
+                        "spectra, the strongest terms in frequency_spectra.csv. Needs at least 32 samples. Any model: "
+                        "no Hessians needed.",
          .keys = frequencies_keys},
     }};
     for (const IndicatorEntry& entry : indicator_entries()) t.rules.push_back(entry.rule);
@@ -129,7 +130,7 @@ const KeyTable& frequencies_keys() {
        .maximum = 1000,
        .default_value = 0,
        .description = "Write the strongest this many terms (frequency, complex amplitude) of each signal over the "
-                      "whole run to frequency_spectra.csv; 0: no such file."},
+                      "whole run to frequency_spectra.csv, at most samples / 4; 0: no such file."},
   }};
   return table;
 }
