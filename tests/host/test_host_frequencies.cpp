@@ -150,7 +150,9 @@ TEST_CASE("frequency map: the frequency columns do not depend on how many terms 
   // The spectra's terms are projected together, which changes their amplitudes and can rank a later term first;
   // the columns are the strongest term found alone.
   TemporaryFolder folder;
-  json few = ensemble_job(2000), many = few;
+  json few = ensemble_job(2000);
+  few["initial"] = json::array({few["initial"][0], few["initial"][11], few["initial"][23]});
+  json many = few;
   few["analysis"]["frequencies"]["spectra"] = 0;
   many["analysis"]["frequencies"]["spectra"] = 166;  // samples / 4
   REQUIRE(run_into(folder, "few", few).status == 0);
@@ -161,7 +163,7 @@ TEST_CASE("frequency map: the frequency columns do not depend on how many terms 
     for (const char* column : {"frequency0", "frequency1_first", "diffusion"})
       CHECK(a[t].at(column) == b[t].at(column));
   const auto spectra = table(folder / "many/frequency_spectra.csv");
-  CHECK(spectra.size() > 24 * 2 * 100);
+  CHECK(spectra.size() > 3 * 2 * 100);
 }
 
 TEST_CASE("frequency map: an orbit that diverges has empty cells, one stopped early by max_crossings is analysed") {
