@@ -165,6 +165,17 @@ inline Result run_nonsep(const std::vector<std::string>& args, const std::filesy
   return finish(start_nonsep(args, folder));
 }
 
+// Runs `nonsep run --quiet --output FOLDER/NAME [EXTRA...] FOLDER/NAME.json` with `job` written there, to completion;
+// the process result (no status check).
+inline Result run_named(const TemporaryFolder& folder, const std::string& name, const nlohmann::json& job,
+                        const std::vector<std::string>& extra = {}) {
+  const auto file = write_job(folder / (name + ".json"), job);
+  std::vector<std::string> args{"run", "--quiet", "--output", (folder / name).string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  args.push_back(file.string());
+  return run_nonsep(args, folder.path());
+}
+
 // Starts `nonsep run --quiet --output OUTPUT JOB_FILE`, waits until its checkpoint.json is at step `at_least` or
 // later, kills the process with SIGKILL and returns the step of the checkpoint it left (a test then resumes it).
 // Throws (failing the test) when no such checkpoint appears within wait_until's timeout.

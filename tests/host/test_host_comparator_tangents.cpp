@@ -41,15 +41,6 @@ json ensemble_job(const std::string& scheme, std::uint64_t steps) {
           {"analysis", {{"lyapunov", {{"vectors", 4}, {"renormalize_every", 5}, {"every", 100}}}, {"megno", true}}}};
 }
 
-Result run_named(const TemporaryFolder& folder, const std::string& name, const json& job,
-                 const std::vector<std::string>& extra = {}) {
-  const auto file = write_job(folder / (name + ".json"), job);
-  std::vector<std::string> args{"run", "--quiet", "--output", (folder / name).string()};
-  args.insert(args.end(), extra.begin(), extra.end());
-  args.push_back(file.string());
-  return run_nonsep(args, folder.path());
-}
-
 // The cells of column `name` of trajectories.csv.
 std::vector<double> column(const std::filesystem::path& file, const std::string& name) {
   const auto rows = read_csv(file);

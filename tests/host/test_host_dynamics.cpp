@@ -36,16 +36,6 @@ json paper2d_job(json initial, json time, json analysis) {
 
 json state2(const std::vector<double>& q, const std::vector<double>& p) { return {{"q", q}, {"p", p}}; }
 
-// Runs `job` as folder/name and returns the process result (no status check).
-Result run_named(const TemporaryFolder& folder, const std::string& name, const json& job,
-                 const std::vector<std::string>& extra = {}) {
-  const auto file = write_job(folder / (name + ".json"), job);
-  std::vector<std::string> args{"run", "--quiet", "--output", (folder / name).string()};
-  args.insert(args.end(), extra.begin(), extra.end());
-  args.push_back(file.string());
-  return run_nonsep(args, folder.path());
-}
-
 }  // namespace
 
 TEST_CASE("poincare.csv: every crossing of q0 = 0 upwards lies on the plane to 1e-12, between its step's samples") {

@@ -38,15 +38,6 @@ json ensemble_job(std::uint64_t steps) {
           {"analysis", {{"frequencies", {{"every", 3}, {"spectra", 2}}}}}};
 }
 
-Result run_into(const TemporaryFolder& folder, const std::string& name, const json& job,
-                const std::vector<std::string>& extra = {}) {
-  const auto file = write_job(folder / (name + ".json"), job);
-  std::vector<std::string> args{"run", "--quiet", "--output", (folder / name).string()};
-  args.insert(args.end(), extra.begin(), extra.end());
-  args.push_back(file.string());
-  return run_nonsep(args, folder.path());
-}
-
 const char* const frequency_files[] = {"trajectories.csv", "frequency_spectra.csv", "frequency_signals.npy"};
 
 }  // namespace
@@ -61,7 +52,7 @@ TEST_CASE("frequency map: the diffusion index is small on paper2d's regular orbi
                     {"time", {{"dt", 0.005}, {"steps", 80000}}},
                     {"output", {{"every", 0}}},
                     {"analysis", {{"frequencies", {{"every", 5}}}}}};
-  const auto result = run_into(folder, "run", job);
+  const auto result = run_named(folder, "run", job);
   INFO("stderr: " << result.err);
   REQUIRE(result.status == 0);
   const auto rows = table(folder / "run/trajectories.csv");
@@ -88,10 +79,10 @@ TEST_CASE(
   TemporaryFolder folder;
   json job = ensemble_job(6000);
   job["checkpoint"] = {{"every_steps", 500}, {"every_seconds", 0}};
-  const auto reference = run_into(folder, "reference", job, {"--threads", "1"});
+  const auto reference = run_named(folder, "reference", job, {"--threads", "1"});
   INFO("stderr: " << reference.err);
   REQUIRE(reference.status == 0);
-  const auto two = run_into(folder, "two", job, {"--threads", "2"});
+  const auto two = run_named(folder, "two", job, {"--threads", "2"});
   REQUIRE(two.status == 0);
   const auto file = write_job(folder / "job.json", job);
   const auto step = kill_after_checkpoint(file, folder / "killed", 1000, folder.path());
@@ -155,8 +146,8 @@ TEST_CASE("frequency map: the frequency columns do not depend on how many terms 
   json many = few;
   few["analysis"]["frequencies"]["spectra"] = 0;
   many["analysis"]["frequencies"]["spectra"] = 166;  // samples / 4
-  REQUIRE(run_into(folder, "few", few).status == 0);
-  REQUIRE(run_into(folder, "many", many).status == 0);
+  REQUIRE(run_named(folder, "few", few).status == 0);
+  REQUIRE(run_named(folder, "many", many).status == 0);
   const auto a = table(folder / "few/trajectories.csv"), b = table(folder / "many/trajectories.csv");
   REQUIRE(a.size() == b.size());
   for (std::size_t t = 0; t < a.size(); ++t)
@@ -175,7 +166,7 @@ TEST_CASE("frequency map: an orbit that diverges has empty cells, one stopped ea
   diverging["time"] = {{"dt", 0.001}, {"steps", 2000}};
   diverging["output"] = {{"every", 0}};
   diverging["analysis"] = {{"frequencies", {{"every", 10}}}};
-  const auto blown = run_into(folder, "blowup", diverging);
+  const auto blown = run_named(folder, "blowup", diverging);
   INFO("stderr: " << blown.err);
   const auto rows = table(folder / "blowup/trajectories.csv");
   REQUIRE(rows.size() == 2);
@@ -188,7 +179,7 @@ TEST_CASE("frequency map: an orbit that diverges has empty cells, one stopped ea
   json stopped = ensemble_job(80000);
   stopped["initial"] = json::array({{{"q", regular_q}, {"p", regular_p}}});
   stopped["analysis"]["poincare"] = {{"component", "q1"}, {"value", 0.0}, {"max_crossings", 40}};
-  const auto result = run_into(folder, "stopped", stopped);
+  const auto result = run_named(folder, "stopped", stopped);
   INFO("stderr: " << result.err);
   REQUIRE(result.status == 0);
   const auto stopped_rows = table(folder / "stopped/trajectories.csv");

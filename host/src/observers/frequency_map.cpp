@@ -16,7 +16,6 @@
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/content_hash.hpp"
-#include "nonsep/host/output/held_folder.hpp"
 #include "nonsep/host/run/saved_state.hpp"
 
 namespace nonsep::host {
@@ -78,17 +77,7 @@ FrequencyMapObserver::FrequencyMapObserver(const std::filesystem::path& director
                       "(/analysis/frequencies/every)");
   const std::uint64_t size = data_offset_ + rows * samples_ * sample_bytes;
   const std::string verb = resuming ? "cannot resume " : "cannot create ";
-  const FileLocation location(signals_path_);
-  descriptor_ = ::openat(location.folder(), location.name(),
-                         O_RDWR | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | (resuming ? 0 : O_CREAT | O_TRUNC), 0644);
-  if (descriptor_ < 0) {
-    const int error = errno;
-    struct stat status {};
-    if ((error == ENXIO || error == ELOOP) &&
-        ::fstatat(location.folder(), location.name(), &status, AT_SYMLINK_NOFOLLOW) == 0)
-      throw OutputError(verb + signals_path_.string() + ": it is " + file_kind(status.st_mode));
-    throw OutputError(verb + signals_path_.string() + ": " + std::strerror(error));
-  }
+  descriptor_ = open_regular_file_for_writing(signals_path_, O_RDWR | (resuming ? 0 : O_CREAT | O_TRUNC), verb);
   const auto refuse = [&](const std::string& reason) {
     ::close(descriptor_);
     descriptor_ = -1;
@@ -96,8 +85,6 @@ FrequencyMapObserver::FrequencyMapObserver(const std::filesystem::path& director
   };
   struct stat status {};
   if (::fstat(descriptor_, &status) != 0) refuse(std::strerror(errno));
-  if (!S_ISREG(status.st_mode)) refuse("it is " + file_kind(status.st_mode) + ", not a regular file");
-  ::fcntl(descriptor_, F_SETFL, 0);
   if (resuming) {
     std::string found(header.size(), '\0');
     if (static_cast<std::uint64_t>(status.st_size) != size ||

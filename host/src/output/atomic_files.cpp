@@ -80,6 +80,28 @@ int open_regular_file(const std::filesystem::path& path) {
   return descriptor;
 }
 
+int open_regular_file_for_writing(const std::filesystem::path& path, int flags, const std::string& verb) {
+  const FileLocation location(path);
+  const int descriptor =
+      ::openat(location.folder(), location.name(), flags | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+  if (descriptor < 0) {
+    const int error = errno;
+    struct stat status {};
+    if ((error == ENXIO || error == ELOOP) &&
+        ::fstatat(location.folder(), location.name(), &status, AT_SYMLINK_NOFOLLOW) == 0)
+      throw OutputError(verb + path.string() + ": it is " + file_kind(status.st_mode));
+    throw OutputError(verb + path.string() + ": " + std::strerror(error));
+  }
+  struct stat status {};
+  if (::fstat(descriptor, &status) != 0 || !S_ISREG(status.st_mode)) {
+    const std::string what = file_kind(status.st_mode);
+    ::close(descriptor);
+    throw OutputError(verb + path.string() + ": it is " + what);
+  }
+  ::fcntl(descriptor, F_SETFL, flags & O_APPEND);  // a regular file: plain blocking writes
+  return descriptor;
+}
+
 std::optional<std::string> read_regular_file(const std::filesystem::path& path, std::size_t limit) {
   const int descriptor = open_regular_file(path);
   if (descriptor < 0) return std::nullopt;

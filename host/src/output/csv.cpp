@@ -32,27 +32,8 @@ void append_csv_text(std::string& row, std::string_view text) {
 }
 
 void CsvAppender::open(int flags) {
-  // Never through a link, and never waiting: a FIFO put in the way would block the open until a reader came.
-  const std::string verb = flags & O_TRUNC ? "cannot create " : "cannot open ";
-  const FileLocation location(path_);
   descriptor_ =
-      ::openat(location.folder(), location.name(), flags | O_WRONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
-  if (descriptor_ < 0) {
-    const int error = errno;
-    struct stat status {};
-    if ((error == ENXIO || error == ELOOP) &&
-        ::fstatat(location.folder(), location.name(), &status, AT_SYMLINK_NOFOLLOW) == 0)
-      throw OutputError(verb + path_.string() + ": it is " + file_kind(status.st_mode));
-    throw OutputError(verb + path_.string() + ": " + std::strerror(error));
-  }
-  struct stat status {};
-  if (::fstat(descriptor_, &status) != 0 || !S_ISREG(status.st_mode)) {
-    const std::string what = file_kind(status.st_mode);
-    ::close(descriptor_);
-    descriptor_ = -1;
-    throw OutputError(verb + path_.string() + ": it is " + what);
-  }
-  ::fcntl(descriptor_, F_SETFL, 0);
+      open_regular_file_for_writing(path_, flags | O_WRONLY, flags & O_TRUNC ? "cannot create " : "cannot open ");
   buffer_.reserve(buffer_capacity + 4096);
 }
 

@@ -57,6 +57,12 @@ std::string file_kind(unsigned mode);
 // cannot be opened.
 int open_regular_file(const std::filesystem::path& path);
 
+// Opens the regular file at `path` for writing with `flags` (O_WRONLY or O_RDWR, with O_CREAT | O_TRUNC to create
+// it, O_APPEND, ...), without following a symbolic link at its last component and without blocking (a FIFO there
+// would wait for a reader forever); its type is checked through the descriptor, which is then blocking. Throws
+// OutputError "<verb><path>: <reason>" (verb such as "cannot create ").
+int open_regular_file_for_writing(const std::filesystem::path& path, int flags, const std::string& verb);
+
 // The content of the regular file at `path` (open_regular_file), at most its first `limit` bytes; nothing when
 // nothing is there. Throws OutputError as open_regular_file does, or when it cannot be read.
 std::optional<std::string> read_regular_file(const std::filesystem::path& path,
