@@ -5,7 +5,8 @@ chaotic orbit q = (0.5, 0), p = (0, 2.5), its variational equations derived by h
 plugins and automatic differentiation), integrated
 by an s-stage Gauss-Legendre method (order 2s) in mpmath at `dps` digits, stage equations solved by fixed-point
 iteration to 10^-(dps-3). Prints lambda_1(10), lambda_1(20), continuous Y and <Y> at 10, 20, and the discrete MEGNO of
-REBOUND's right-endpoint sums (first order in dt) on the grid dt_grid (= h * integer).
+REBOUND's right-endpoint sums (first order in dt) on the grid dt_grid (= h * integer), and FLI and OFLI (suprema over
+the steps of h of ln |w| and of ln(|w_perp| / |w_perp(0)|), w_perp the vector's component across the flow).
 usage: reference_mp.py H STAGES DPS [COUPLING]"""
 import sys, mpmath as mp
 h_s, s, dps = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
@@ -40,6 +41,10 @@ def rhs(t, u):
 w = [mp.mpf(1), mp.mpf(1)/2, mp.mpf(1)/3, mp.mpf(1)/4]; nw = mp.sqrt(sum(v*v for v in w))
 u = [mp.mpf('0.5'), mp.mpf(0), mp.mpf(0), mp.mpf('2.5')] + [v/nw for v in w] + [mp.mpf(0), mp.mpf(0)]
 N = int(mp.nint(20/h)); tol = mp.mpf(10)**(-(dps - 3))
+def across(t, u):  # ln(|w_perp| / |w|), w_perp = w - (w.f / f.f) f, f the flow (the first four of rhs)
+    f = rhs(t, u)[:4]; w = u[4:8]; c = sum(x*y for x, y in zip(w, f))/sum(x*x for x in f)
+    return mp.log(mp.sqrt(sum((x - c*y)**2 for x, y in zip(w, f)))/mp.sqrt(sum(x*x for x in w)))
+a0 = across(mp.mpf(1), u); fli = ofli = mp.mpf(0)
 logn = mp.mpf(0); lns = [logn]; out = {}; K = None
 for n in range(N):
     t0 = n*h
@@ -53,9 +58,11 @@ for n in range(N):
     u = [u[j] + h*sum(b[i]*K[i][j] for i in range(s)) for j in range(10)]
     nn = mp.sqrt(sum(v*v for v in u[4:8])); logn += mp.log(nn); u[4:8] = [v/nn for v in u[4:8]]; lns.append(logn)
     t = (n + 1)*h
+    fli = max(fli, logn); ofli = max(ofli, logn + across(t, u) - a0)
     if abs(t - 10) < h/2 or n == N - 1:
         T = int(mp.nint(t)); out[f"lambda1_{T}"] = logn/T; out[f"Y_cont_{T}"] = 2*u[8]/T; out[f"meanY_cont_{T}"] = u[9]/T
-        print(T, mp.nstr(out[f"lambda1_{T}"], 15), mp.nstr(out[f"Y_cont_{T}"], 15), mp.nstr(out[f"meanY_cont_{T}"], 15), flush=True)
+        print(T, mp.nstr(out[f"lambda1_{T}"], 15), mp.nstr(out[f"Y_cont_{T}"], 15), mp.nstr(out[f"meanY_cont_{T}"], 15),
+              "FLI", mp.nstr(fli, 15), "OFLI", mp.nstr(ofli, 15), flush=True)
 for g in ('0.005', '0.0025', '0.00125', '0.000625', '0.0003125', '0.00025'):
     e = int(mp.nint(mp.mpf(g)/h))
     if e == 0 or abs(e*h - mp.mpf(g)) > h/1000: continue

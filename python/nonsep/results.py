@@ -79,7 +79,8 @@ class LyapunovSeries(NamedTuple):
     """The running estimates of one trajectory (lyapunov.csv), in step order: exponents is [rows, k] (columns
     lyapunov0 .. lyapunov<k-1>, k = 0 when only MEGNO was asked for); megno (Y) and mean_megno (<Y>) are None when
     the run did not compute MEGNO; sali is None without analysis.sali; gali is [rows, k - 1] (columns gali2 ..
-    gali<k>: gali[:, j - 2] is GALI_j) or None without analysis.gali; fli is None without analysis.fli."""
+    gali<k>: gali[:, j - 2] is GALI_j) or None without analysis.gali; fli is None without analysis.fli, ofli without
+    analysis.ofli."""
     step: np.ndarray
     t: np.ndarray
     exponents: np.ndarray
@@ -88,6 +89,7 @@ class LyapunovSeries(NamedTuple):
     sali: object = None
     gali: object = None
     fli: object = None
+    ofli: object = None
 
 
 class ChaoticFraction(NamedTuple):
@@ -283,7 +285,7 @@ class Result:
         return Crossings(rows["crossing"], rows["step"], rows["t"], q, p, rows["H"])
 
     def lyapunov_series(self, index):
-        """The running Lyapunov / MEGNO / SALI / GALI / FLI estimates of trajectory `index` as a LyapunovSeries. Raises
+        """The running Lyapunov / MEGNO / SALI / GALI / FLI / OFLI estimates of trajectory `index` as a LyapunovSeries. Raises
         FileNotFoundError when the run wrote no lyapunov.csv, KeyError for an index that is not a trajectory."""
         rows = self._rows_of("lyapunov", index)
         names = rows.dtype.names
@@ -295,7 +297,8 @@ class Result:
         k_gali = sum(1 for name in names if re.fullmatch(r"gali\d+", name)) + 1
         gali = np.column_stack([rows[f"gali{j}"] for j in range(2, k_gali + 1)]) if k_gali > 1 else None
         fli = rows["fli"] if "fli" in names else None
-        return LyapunovSeries(rows["step"], rows["t"], exponents, megno, mean_megno, sali, gali, fli)
+        ofli = rows["ofli"] if "ofli" in names else None
+        return LyapunovSeries(rows["step"], rows["t"], exponents, megno, mean_megno, sali, gali, fli, ofli)
 
     @property
     def swept(self):

@@ -105,10 +105,12 @@ TEST_CASE("a general normal, direction both, and max_crossings stopping a trajec
   }
 }
 
-TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaotic one, FLI, and lyapunov.csv") {
+TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaotic one, FLI, OFLI, and lyapunov.csv") {
   TemporaryFolder folder;
-  const json analysis = {
-      {"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 10000}}}, {"megno", true}, {"fli", true}};
+  const json analysis = {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 10000}}},
+                         {"megno", true},
+                         {"fli", true},
+                         {"ofli", true}};
   const auto result = run_named(folder, "run",
                                 paper2d_job(json::array({state2(regular_q, regular_p), state2(chaotic_q, chaotic_p)}),
                                             {{"dt", 0.005}, {"steps", 80000}}, analysis));
@@ -130,6 +132,13 @@ TEST_CASE("MEGNO: <Y> -> 2 within 5% on the regular orbit, growing on the chaoti
   CHECK(cell(rows[1], "fli") < 400.0 * cell(rows[1], "lyapunov0") + 5.0);
   CHECK(cell(rows[0], "fli") < 2.0 * std::log(400.0));
   CHECK(cell(rows[1], "fli") > 5.0 * cell(rows[0], "fli"));
+  // OFLI leaves out the growth along the flow: on the torus it stays below FLI and near ln t (the shear across the
+  // flow remains); on the chaotic orbit the growth is across the flow, OFLI close to FLI.
+  MESSAGE("OFLI(400): regular " << rows[0].at("ofli") << ", chaotic " << rows[1].at("ofli"));
+  CHECK(cell(rows[0], "ofli") < cell(rows[0], "fli"));
+  CHECK(cell(rows[0], "ofli") < 2.0 * std::log(400.0));
+  CHECK(std::abs(cell(rows[1], "ofli") - cell(rows[1], "fli")) < 5.0);
+  CHECK(cell(rows[1], "ofli") > 5.0 * cell(rows[0], "ofli"));
   // The series: the chaotic <Y> grows (like lambda t / 2), the regular one stays near 2.
   const auto series = table(folder / "run/lyapunov.csv");
   REQUIRE(series.size() == 16);  // 2 trajectories at steps 10000, 20000, ..., 80000
@@ -254,7 +263,8 @@ json ensemble_job(std::uint64_t steps, std::uint64_t max_crossings) {
                           {"megno", true},
                           {"sali", true},
                           {"gali", 3},
-                          {"fli", true}});
+                          {"fli", true},
+                          {"ofli", true}});
   job["output"]["every"] = 250;
   job["integrator"] = {{"scheme", "basic"}, {"t2", -3.0}};
   return job;

@@ -122,8 +122,9 @@ TEST_CASE("a model given by H: initial states on an energy shell, solved for p1 
     CHECK(std::abs(trajectory["energy"]["initial"].get<double>() - 0.125) < 1e-15);
 }
 
-TEST_CASE("a model given by H: killed and resumed bit for bit, with threads, a sweep, MEGNO and results.h5") {
-  // A magnetic bottle swept over its mirror, gauss 3 stages with MEGNO and a Lyapunov exponent: the files of one
+TEST_CASE("a model given by H: killed and resumed bit for bit, with threads, a sweep, MEGNO, OFLI and results.h5") {
+  // A magnetic bottle swept over its mirror, gauss 3 stages with MEGNO, OFLI (grad H of each set's model at time 0
+  // and every step) and a Lyapunov exponent: the files of one
   // thread, of two, and of a run killed after a checkpoint and resumed are the same bytes; HDF5 output completes.
   const json job = {
       {"model", {{"plugin", "magnetic_bottle"}, {"parameters", {{"omega", 0.2}, {"mirror", json::array({0.3, 0.6})}}}}},
@@ -134,7 +135,8 @@ TEST_CASE("a model given by H: killed and resumed bit for bit, with threads, a s
           {"p", {0.0, {{"from", -0.5}, {"to", 0.5}, {"count", 2}}, 0.5}}}}}},
       {"time", {{"dt", 0.02}, {"steps", 20000}}},
       {"output", {{"every", 5000}}},
-      {"analysis", {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 1000}}}, {"megno", true}}},
+      {"analysis",
+       {{"lyapunov", {{"vectors", 1}, {"renormalize_every", 10}, {"every", 1000}}}, {"megno", true}, {"ofli", true}}},
       {"checkpoint", {{"every_steps", 1000}, {"every_seconds", 0}}}};
   TemporaryFolder folder;
   const auto file = write_job(folder / "job.json", job);

@@ -21,7 +21,7 @@ def paper2d_job(q_count=4, p_count=3, t_end=12.0, poincare=True, every=0):
     """paper2d on the shell H = 7, a grid over (q0, p0) at q1 = 0 with p1 >= 0 solved for (points off the shell are
     left out), MPE 4 at dt = 0.005 (the settings of examples/dynamics, on a coarse grid for a short time)."""
     analysis = {"lyapunov": {"vectors": 2, "renormalize_every": 10, "every": every}, "megno": True, "sali": True,
-                "gali": 3, "fli": True}
+                "gali": 3, "fli": True, "ofli": True}
     if poincare:
         analysis["poincare"] = {"component": "q1", "value": 0.0, "direction": "+", "max_crossings": MAX_CROSSINGS}
     return {"model": {"plugin": "paper2d", "parameters": {"coupling": 0.2}},
@@ -73,10 +73,10 @@ class DynamicsResultTest(SharedRun):
         lyapunov = self.result.lyapunov
         self.assertEqual(list(lyapunov.dtype.names),
                          ["trajectory", "step", "t", "lyapunov0", "lyapunov1", "megno", "mean_megno", "sali", "gali2",
-                          "gali3", "fli"])
+                          "gali3", "fli", "ofli"])
         self.assertTableIsTheFile(lyapunov, self.result.directory / "lyapunov.csv")
         trajectories = self.result.trajectories
-        for name in ("lyapunov0", "lyapunov1", "megno", "mean_megno", "sali", "gali2", "gali3", "fli",
+        for name in ("lyapunov0", "lyapunov1", "megno", "mean_megno", "sali", "gali2", "gali3", "fli", "ofli",
                      "poincare_crossings"):
             self.assertIn(name, trajectories.dtype.names)
         self.assertTableIsTheFile(trajectories, self.result.directory / "trajectories.csv")
@@ -106,6 +106,7 @@ class DynamicsResultTest(SharedRun):
             self.assertEqual(series.gali.shape, (len(mine), 2))
             np.testing.assert_array_equal(series.gali[:, 1], mine["gali3"])
             np.testing.assert_array_equal(series.fli, mine["fli"])
+            np.testing.assert_array_equal(series.ofli, mine["ofli"])
             np.testing.assert_array_equal(series.step, np.sort(series.step))
         with self.assertRaises(KeyError):
             self.result.crossings(len(trajectories))

@@ -1,5 +1,5 @@
-// /analysis/poincare, /analysis/frequencies and the chaos indicators (/analysis/lyapunov, /megno, /sali, /gali, /fli:
-// the list of indicators.cpp): the dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the
+// /analysis/poincare, /analysis/frequencies and the chaos indicators (/analysis/lyapunov, /megno, /sali, /gali, /fli,
+// /ofli: the list of indicators.cpp): the dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the
 // Hessians the tangent map needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
 #include <algorithm>
 #include <limits>

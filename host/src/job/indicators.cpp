@@ -7,6 +7,7 @@
 #include "nonsep/core/analysis/fast_lyapunov_indicator.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
+#include "nonsep/core/analysis/orthogonal_fast_lyapunov_indicator.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -123,6 +124,21 @@ const std::vector<IndicatorEntry>& indicator_entries() {
          return read_boolean(check, value, path,
                              "the fast Lyapunov indicator of the first tangent vector (trajectories.csv fli)",
                              [] { return std::make_shared<const FastLyapunovIndicator>(); });
+       }},
+      {KeyRule{.name = "ofli",
+               .type = ValueType::boolean,
+               .default_value = false,
+               .description =
+                   "The orthogonal fast Lyapunov indicator (Fouchard, Lega, Froeschle and Froeschle 2002): "
+                   "trajectories.csv column ofli, the supremum over the steps of ln |w_perp(t)|, w_perp the first "
+                   "tangent vector's component across the flow J grad H, |w_perp(0)| = 1 (~ lambda t on chaotic "
+                   "orbits, ~ ln t on regular ones, bounded on periodic ones). One gradient of H per state and "
+                   "step: the plugin must have Hessians and third derivatives, or be given by H."},
+       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
+         return read_boolean(check, value, path,
+                             "the orthogonal fast Lyapunov indicator of the first tangent vector (trajectories.csv "
+                             "ofli)",
+                             [] { return std::make_shared<const OrthogonalFastLyapunovIndicator>(); });
        }},
   };
   return entries;

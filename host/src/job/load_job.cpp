@@ -220,6 +220,15 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
       issues.push_back({"/integrator/measure",
                         "\"energy\" with the plugin '" + loaded.plugin.name() + "', which has no Hessians",
                         "\"phase\": the energy H = T_i V_ij T_j needs the Hessians (hessian_T, hessian_V)"});
+    for (const auto& indicator : checked.run().analysis.indicators)
+      if (indicator->needs().across_flow && !has_gradient_of_h)
+        issues.push_back({"/analysis/" + indicator->name(),
+                          "true with the plugin '" + loaded.plugin.name() + "', which has " +
+                              (loaded.plugin.has_hessians() ? "no third derivatives (d3T, d3V)"
+                                                            : "no Hessians (hessian_T, hessian_V)"),
+                          "a plugin with Hessians and third derivatives, or one given by H: " + indicator->name() +
+                              " measures the tangent vector across the flow J grad H (the SDK provides the "
+                              "derivatives by automatic differentiation)"});
     if (checked.run().analysis.tangent_vectors() > 0 && !checked.run().auto_scheme &&
         Integrator(checked.run().integrator).is_comparator() && has_gradient_of_h &&
         !loaded.plugin.has_hamiltonian_hessian_products())

@@ -102,7 +102,7 @@ void BlockStepper::checked_step(Block& block, Worker& worker, std::uint64_t step
       else
         block.integrator.step_part(worker.model, x, integrator_before, first, before.count(), time.dt);
     });
-    if (block.tangents) block.tangents->after_step(time.dt);
+    if (block.tangents) block.tangents->after_step(worker.model, block.batch, time.dt);
   }
   std::vector<bool> retire(block.trajectories.size(), false);
   for (std::size_t slot = 0; slot < block.trajectories.size(); ++slot) {

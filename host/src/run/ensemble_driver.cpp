@@ -222,6 +222,11 @@ struct EnsembleDriver::Impl {
           records[block.trajectories[slot]].energy_initial = block.energy(slot);
       });
     apply_departures();
+    // The indicators that measure the first tangent vector across the flow take it at time 0 with each block's model
+    // (a parameter set's own).
+    if (setup.tangent_vectors > 0)
+      for_each_block(
+          [&](Block& block, Worker& worker) { block.tangents->start_across_flow(worker.model, block.batch); });
     notify_event(0, energy_available);
   }
 

@@ -141,8 +141,8 @@ struct Analysis {
   std::optional<PoincareSection> poincare;   // /analysis/poincare
   std::optional<FrequencyMap> frequencies;   // /analysis/frequencies
   std::optional<LyapunovAnalysis> lyapunov;  // /analysis/lyapunov
-  // The chaos indicators asked for (/analysis/lyapunov, /megno, /sali, /gali, /fli), in the order of their columns
-  // (host/src/job/indicators.cpp: the one list).
+  // The chaos indicators asked for (/analysis/lyapunov, /megno, /sali, /gali, /fli, /ofli), in the order of their
+  // columns (host/src/job/indicators.cpp: the one list).
   IndicatorList indicators;
   // Tangent vectors per trajectory the run must follow, shared by every indicator: the most any of them needs; 0
   // for none.

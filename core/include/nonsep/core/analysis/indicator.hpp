@@ -13,6 +13,10 @@
 //   after_step(state, growth, dt)    after each step of dt, for an indicator that needs().first_growth, with
 //                                    growth = ln(|v_1(t_k)| / |v_1(t_{k-1})|), the first vector's log-growth over
 //                                    the step;
+//   across_flow(state, a, at_start) for an indicator that needs().across_flow: once at time 0 (after start, with
+//                                    at_start) and after each step (after after_step), with a = ln(|w_perp| / |w|)
+//                                    of the first vector w, w_perp its component orthogonal to the flow direction
+//                                    J grad H at the state (Euclidean, over (dq, dp)); a is NaN where grad H fails;
 //   after_orthonormalization(state, r, k)  at each re-orthonormalisation of the run's k vectors (k at least what the
 //                                    indicator needs), with its triangular factor R (k x k, row-major:
 //                                    orthonormalize_state; needs().orthonormalization_factors);
@@ -33,6 +37,8 @@ struct IndicatorNeeds {
   std::size_t tangent_vectors = 0;          // the first k vectors of the shared ones (the run follows the most asked)
   bool first_growth = false;                // the first vector's log-growth at every step
   bool orthonormalization_factors = false;  // the triangular factor of every re-orthonormalisation
+  bool across_flow = false;                 // the first vector's share across the flow at time 0 and every step
+                                            // (one gradient of H per state and step: the model needs grad H)
   std::size_t state_size = 0;               // numbers per trajectory
 };
 
@@ -52,6 +58,7 @@ class Indicator {
 
   virtual void start(std::span<double> /*state*/) const {}
   virtual void after_step(std::span<double> /*state*/, double /*growth*/, double /*dt*/) const {}
+  virtual void across_flow(std::span<double> /*state*/, double /*a*/, bool /*at_start*/) const {}
   virtual void after_orthonormalization(std::span<double> /*state*/, std::span<const double> /*r*/,
                                         std::size_t /*k*/) const {}
   virtual void values(std::span<const double> state, const LyapunovRecord& lyapunov, std::span<double> out) const = 0;

@@ -6,8 +6,8 @@
 //                     finite-time exponents at the last re-orthonormalisation), megno, mean_megno (Y and <Y> of the
 //                     first tangent vector: <Y> -> 2 on a quasi-periodic orbit, ~ lambda t / 2 on a chaotic one, 0 on
 //                     a stable periodic one), sali and gali2 .. gali<k> (at the last re-orthonormalisation,
-//                     nonsep/core/analysis/alignment_indices.hpp), fli, each when asked for; empty for a trajectory
-//                     that diverged or failed.
+//                     nonsep/core/analysis/alignment_indices.hpp), fli, ofli, each when asked for; empty for a
+//                     trajectory that diverged or failed.
 //   lyapunov.csv      with /analysis/lyapunov/every = s > 0, the running values every s-th step:
 //                     trajectory,step,t, then the same columns, in (step, trajectory) order.
 // Checkpoints: lyapunov.csv's size and content hash, like trajectory.csv; the indicators' states are the driver's.
