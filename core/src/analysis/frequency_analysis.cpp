@@ -22,45 +22,45 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 
 // exp(-i u x_k) for the N centred indices x_k = k - c, as base(b) * step(j) with k = b B + j: B steps and N/B bases
 // from std::cos and std::sin, each product exact to a few ulp (a rotation by repeated multiplication would drift by
-// one ulp per sample). B ~ sqrt(N) keeps the 2 sqrt(N) sines and cosines small against the N products.
+// one ulp per sample). B ~ sqrt(N) keeps the 2 sqrt(N) sines and cosines small against the N products, which are
+// kept in two arrays (re, im) that the sums below read in lanes.
 class Exponentials {
  public:
   void set(double u, std::size_t n) {
-    n_ = n;
-    block_ = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
-    const std::size_t blocks = (n + block_ - 1) / block_;
-    step_re_.resize(block_);
-    step_im_.resize(block_);
-    base_re_.resize(blocks);
-    base_im_.resize(blocks);
+    const auto block = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
+    const std::size_t blocks = (n + block - 1) / block;
+    step_re_.resize(block);
+    step_im_.resize(block);
+    re_.resize(n);
+    im_.resize(n);
     const double centre = 0.5 * static_cast<double>(n - 1);
-    for (std::size_t j = 0; j < block_; ++j) {
+    for (std::size_t j = 0; j < block; ++j) {
       const double angle = -u * static_cast<double>(j);
       step_re_[j] = std::cos(angle);
       step_im_[j] = std::sin(angle);
     }
     for (std::size_t b = 0; b < blocks; ++b) {
-      const double angle = -u * (static_cast<double>(b * block_) - centre);
-      base_re_[b] = std::cos(angle);
-      base_im_[b] = std::sin(angle);
+      const double angle = -u * (static_cast<double>(b * block) - centre);
+      const double br = std::cos(angle), bi = std::sin(angle);
+      const std::size_t k0 = b * block, end = std::min(block, n - k0);
+      for (std::size_t j = 0; j < end; ++j) {
+        re_[k0 + j] = br * step_re_[j] - bi * step_im_[j];
+        im_[k0 + j] = br * step_im_[j] + bi * step_re_[j];
+      }
     }
   }
 
-  // body(k, re, im) for k = 0 .. N-1 with re + i im = exp(-i u x_k).
-  template <class Body>
-  void for_each(Body&& body) const {
-    for (std::size_t b = 0, k0 = 0; k0 < n_; ++b, k0 += block_) {
-      const double br = base_re_[b], bi = base_im_[b];
-      const std::size_t end = std::min(block_, n_ - k0);
-      for (std::size_t j = 0; j < end; ++j)
-        body(k0 + j, br * step_re_[j] - bi * step_im_[j], br * step_im_[j] + bi * step_re_[j]);
-    }
-  }
+  std::size_t size() const { return re_.size(); }
+  const double* re() const { return re_.data(); }
+  const double* im() const { return im_.data(); }
 
  private:
-  std::size_t n_ = 0, block_ = 1;
-  std::vector<double> step_re_, step_im_, base_re_, base_im_;
+  std::vector<double> step_re_, step_im_, re_, im_;
 };
+
+// Sums over k in `lanes` independent partial sums (k mod lanes), added at the end: the loops vectorise without
+// reassociation by the compiler, and the sums are as accurate as one running sum or more.
+constexpr std::size_t lanes = 4;
 
 // sum_k w_k exp(-i u x_k) x_k^p for p = 0, 1, 2 (w = chi times the signal, split into real and imaginary parts).
 struct Moments {
@@ -68,36 +68,66 @@ struct Moments {
 };
 
 Moments moments(const Exponentials& e, const std::vector<double>& w_re, const std::vector<double>& w_im) {
-  const double centre = 0.5 * static_cast<double>(w_re.size() - 1);
-  double s0r = 0, s0i = 0, s1r = 0, s1i = 0, s2r = 0, s2i = 0;
-  e.for_each([&](std::size_t k, double er, double ei) {
-    const double pr = w_re[k] * er - w_im[k] * ei, pi = w_re[k] * ei + w_im[k] * er;
+  const std::size_t n = e.size();
+  const double centre = 0.5 * static_cast<double>(n - 1);
+  const double *er = e.re(), *ei = e.im(), *wr = w_re.data(), *wi = w_im.data();
+  double s[6][lanes] = {};
+  std::size_t k = 0;
+  for (; k + lanes <= n; k += lanes)
+    for (std::size_t l = 0; l < lanes; ++l) {
+      const double pr = wr[k + l] * er[k + l] - wi[k + l] * ei[k + l];
+      const double pi = wr[k + l] * ei[k + l] + wi[k + l] * er[k + l];
+      const double x = static_cast<double>(k + l) - centre;
+      s[0][l] += pr;
+      s[1][l] += pi;
+      s[2][l] += x * pr;
+      s[3][l] += x * pi;
+      s[4][l] += x * x * pr;
+      s[5][l] += x * x * pi;
+    }
+  for (std::size_t l = 0; k < n; ++k, ++l) {
+    const double pr = wr[k] * er[k] - wi[k] * ei[k], pi = wr[k] * ei[k] + wi[k] * er[k];
     const double x = static_cast<double>(k) - centre;
-    s0r += pr;
-    s0i += pi;
-    s1r += x * pr;
-    s1i += x * pi;
-    s2r += x * x * pr;
-    s2i += x * x * pi;
-  });
-  return {{s0r, s0i}, {s1r, s1i}, {s2r, s2i}};
+    s[0][l] += pr;
+    s[1][l] += pi;
+    s[2][l] += x * pr;
+    s[3][l] += x * pi;
+    s[4][l] += x * x * pr;
+    s[5][l] += x * x * pi;
+  }
+  double t[6];
+  for (std::size_t i = 0; i < 6; ++i) t[i] = (s[i][0] + s[i][1]) + (s[i][2] + s[i][3]);
+  return {{t[0], t[1]}, {t[2], t[3]}, {t[4], t[5]}};
 }
 
 std::complex<double> transform(const Exponentials& e, const std::vector<double>& w_re,
                                const std::vector<double>& w_im) {
-  double sr = 0, si = 0;
-  e.for_each([&](std::size_t k, double er, double ei) {
-    sr += w_re[k] * er - w_im[k] * ei;
-    si += w_re[k] * ei + w_im[k] * er;
-  });
-  return {sr, si};
+  const std::size_t n = e.size();
+  const double *er = e.re(), *ei = e.im(), *wr = w_re.data(), *wi = w_im.data();
+  double sr[lanes] = {}, si[lanes] = {};
+  std::size_t k = 0;
+  for (; k + lanes <= n; k += lanes)
+    for (std::size_t l = 0; l < lanes; ++l) {
+      sr[l] += wr[k + l] * er[k + l] - wi[k + l] * ei[k + l];
+      si[l] += wr[k + l] * ei[k + l] + wi[k + l] * er[k + l];
+    }
+  for (std::size_t l = 0; k < n; ++k, ++l) {
+    sr[l] += wr[k] * er[k] - wi[k] * ei[k];
+    si[l] += wr[k] * ei[k] + wi[k] * er[k];
+  }
+  return {(sr[0] + sr[1]) + (sr[2] + sr[3]), (si[0] + si[1]) + (si[2] + si[3])};
 }
 
 // sum_k chi_k exp(-i u x_k), real since chi is symmetric about the centre.
 double window_transform(const Exponentials& e, const std::vector<double>& chi) {
-  double sum = 0;
-  e.for_each([&](std::size_t k, double er, double) { sum += chi[k] * er; });
-  return sum;
+  const std::size_t n = e.size();
+  const double* er = e.re();
+  double sum[lanes] = {};
+  std::size_t k = 0;
+  for (; k + lanes <= n; k += lanes)
+    for (std::size_t l = 0; l < lanes; ++l) sum[l] += chi[k + l] * er[k + l];
+  for (std::size_t l = 0; k < n; ++k, ++l) sum[l] += chi[k] * er[k];
+  return (sum[0] + sum[1]) + (sum[2] + sum[3]);
 }
 
 double wrap(double u) {  // into [-pi, pi)
@@ -131,10 +161,10 @@ struct FrequencyAnalysis::Workspace {
         // chi_k = 1 - cos(2 pi k / (N-1)) = 1 + cos(u x_k) with u = 2 pi / (N-1).
         known.chi.resize(n);
         exponentials.set(two_pi / static_cast<double>(n - 1), n);
-        exponentials.for_each([&](std::size_t k, double er, double) {
-          known.chi[k] = 1.0 + er;
+        for (std::size_t k = 0; k < n; ++k) {
+          known.chi[k] = 1.0 + exponentials.re()[k];
           known.sum += known.chi[k];
-        });
+        }
       }
       window = known.chi;
       window_sum = known.sum;
@@ -293,11 +323,12 @@ std::vector<FrequencyTerm> FrequencyAnalysis::terms(std::span<const std::complex
     for (std::size_t j = 0; j < size; ++j) {
       w.exponentials.set(u[j], n);
       const double ar = amplitude[j].real(), ai = amplitude[j].imag();
-      w.exponentials.for_each([&](std::size_t k, double er, double ei) {
+      const double *er = w.exponentials.re(), *ei = w.exponentials.im();
+      for (std::size_t k = 0; k < n; ++k) {
         // a exp(+i u x) = (ar + i ai)(er - i ei)
-        w.residual_re[k] -= w.window[k] * (ar * er + ai * ei);
-        w.residual_im[k] -= w.window[k] * (ai * er - ar * ei);
-      });
+        w.residual_re[k] -= w.window[k] * (ar * er[k] + ai * ei[k]);
+        w.residual_im[k] -= w.window[k] * (ai * er[k] - ar * ei[k]);
+      }
     }
   }
   std::vector<FrequencyTerm> result(u.size());
