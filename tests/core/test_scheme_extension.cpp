@@ -42,7 +42,8 @@ struct RepeatedOptions {
   int substeps = 2;
   double t2 = ChinCoefficients::default_t2();
   static constexpr auto members() {
-    return std::tuple{option("substeps", &RepeatedOptions::substeps), option("t2", &RepeatedOptions::t2)};
+    return std::tuple{option("substeps", &RepeatedOptions::substeps, "basic steps per step, an integer >= 1"),
+                      option("t2", &RepeatedOptions::t2, "free coefficient of the basic step", true)};
   }
 };
 
@@ -57,8 +58,7 @@ struct RepeatedScheme {
             "chin",
             true,
             true,
-            {number_parameter("substeps", "2", "basic steps per step, an integer >= 1"),
-             number_parameter("t2", "-2", "free coefficient of the basic step", true)},
+            describe_options(RepeatedOptions{}),
             1,
             {}};
   }
@@ -122,7 +122,7 @@ TEST_CASE("an added scheme: its options are set and read by their catalogue name
   ExtendedSpec spec{"repeated"};
   for (const auto& p : ExtendedIntegrator::catalogue().back().parameters) set_option(spec, p, default_option_value(p));
   CHECK(std::get<RepeatedOptions>(spec.options).substeps == 2);
-  CHECK(std::get<RepeatedOptions>(spec.options).t2 == -2.0);
+  CHECK(std::get<RepeatedOptions>(spec.options).t2 == ChinCoefficients::default_t2());
   set_option(spec, parameter("substeps"), 3.0);
   CHECK(std::get<RepeatedOptions>(spec.options).substeps == 3);
   CHECK(std::get<double>(option_value(spec, parameter("substeps"))) == 3.0);
@@ -180,4 +180,41 @@ TEST_CASE("an added scheme's tangent map: the states as the integrator steps the
   CHECK(same(vectors, hand_vectors));
   CHECK_FALSE(same(vectors, testing::identity_tangents(2)));
   CHECK(tangent.hessian_evaluations().hessian_T == base.hessian_evaluations().hessian_T);
+}
+
+namespace nonsep::extension_test {
+
+// Each option of scheme S as the catalogue's default text gives it is the option of scheme_defaults<S>().
+template <class S>
+void check_catalogue_defaults() {
+  const SchemeDescription description = S::description();
+  CAPTURE(description.name);
+  const typename S::Options defaults = scheme_defaults<S>();
+  for (const ParameterDescription& parameter : description.parameters) {
+    CAPTURE(parameter.name);
+    CHECK(!parameter.default_text.empty());
+    CHECK(default_option_value(parameter) == read_option(defaults, parameter.name));
+  }
+}
+template <class... S>
+struct CatalogueDefaults {
+  static void check() { (check_catalogue_defaults<S>(), ...); }
+};
+
+}  // namespace nonsep::extension_test
+
+TEST_CASE(
+    "every scheme's catalogue defaults are its options' defaults, written once; a spec without options has them") {
+  WithShippedSchemes<CatalogueDefaults, RepeatedScheme>::check();
+  // The compositions share ChinOptions with the basic step and default to order 4/3 (their defaults()).
+  for (const char* scheme : {"triplet", "mpe"}) {
+    CAPTURE(scheme);
+    const IntegratorSpec spec{scheme};
+    const auto& entry = *std::find_if(scheme_catalogue().begin(), scheme_catalogue().end(),
+                                      [&](const auto& e) { return e.name == scheme; });
+    CHECK(std::get<Fraction>(option_value(spec, entry.parameters[0])) == Fraction(4, 3));
+    CHECK(Integrator(spec).describe().order == Fraction(4, 3));
+  }
+  CHECK(std::get<Fraction>(option_value(IntegratorSpec{"basic"}, scheme_catalogue()[0].parameters[0])) ==
+        Fraction(2, 3));
 }

@@ -24,7 +24,7 @@ namespace nonsep {
 template <IntegrationScheme... Schemes>
 struct BasicIntegratorSpec {
   std::string scheme = "basic";  // a catalogue entry's name
-  // The scheme's options; none (std::monostate): its Options{} (BasicIntegratorSpec::options_of).
+  // The scheme's options; none (std::monostate): its defaults (scheme_defaults, BasicIntegratorSpec::options_of).
   DistinctVariantWithNone<typename Schemes::Options...> options = std::monostate{};
   HamiltonianForm form = HamiltonianForm::TTV;
 
@@ -39,7 +39,7 @@ struct BasicIntegratorSpec {
   // it holds another scheme's options (a programming error).
   template <class A>
   typename A::Options options_of() const {
-    if (std::holds_alternative<std::monostate>(options)) return {};
+    if (std::holds_alternative<std::monostate>(options)) return scheme_defaults<A>();
     if (const auto* held = std::get_if<typename A::Options>(&options)) return *held;
     throw std::logic_error("the integrator spec of scheme '" + scheme + "' holds the options of another scheme");
   }

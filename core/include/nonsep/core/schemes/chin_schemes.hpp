@@ -2,10 +2,11 @@
 // The paper's schemes as the runtime-chosen integrators offer them (stepper.hpp): the basic step (eq. (expalg)),
 // its triplet composition (eqs. (sym43), (sym63)) and its multi-product expansion (eqs. (mpe43), (mpe63)), each
 // built over the basic step with the separable flows of K(p) + U(q) around it (separable_composition.hpp), which is
-// the basic step itself for a model without them. They share their options: the order and t2.
-#include <cstdio>
+// the basic step itself for a model without them. They share their options, the order and t2, and differ in the
+// default order: 2/3 for the basic step (ChinOptions{}), 4/3 for the compositions (their defaults()).
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "nonsep/core/schemes/chin_basic_step.hpp"
 #include "nonsep/core/schemes/multi_product_expansion.hpp"
@@ -19,23 +20,21 @@ struct ChinOptions {
   Fraction order = Fraction(2, 3);  // 2j/3; which j a scheme has, its catalogue entry says
   double t2 = ChinCoefficients::default_t2();
   static constexpr auto members() {
-    return std::tuple{option("order", &ChinOptions::order), option("t2", &ChinOptions::t2)};
+    return std::tuple{option("order", &ChinOptions::order),
+                      option("t2", &ChinOptions::t2,
+                             "free coefficient of the basic step, any finite non-zero number; t1 = -t2, v1 = 1/t2^2, "
+                             "v2 = -v1/2, v0 = -2(v1+v2). The default -6^(1/3) makes e_TTTTV = e_VTTTV; the paper "
+                             "uses -2 for Figure 1 and about -3 for Figure 2",
+                             true)};
   }
 };
 
 namespace chin_scheme {
-inline ParameterDescription t2_parameter() {
-  char default_t2[32];
-  std::snprintf(default_t2, sizeof default_t2, "%.17g", ChinCoefficients::default_t2());
-  return number_parameter("t2", default_t2,
-                          "free coefficient of the basic step, any finite non-zero number; t1 = -t2, v1 = 1/t2^2, "
-                          "v2 = -v1/2, v0 = -2(v1+v2). The default -6^(1/3) makes e_TTTTV = e_VTTTV; the paper uses "
-                          "-2 for Figure 1 and about -3 for Figure 2",
-                          true);
-}
-inline ParameterDescription order_up_to(const std::string& default_order, int highest_order_index) {
-  return order_parameter(default_order,
-                         "any of " + chin_orders_text() + " up to " + Fraction(2 * highest_order_index, 3).to_string());
+// The catalogue's options of a Chin scheme with `defaults` and orders 2j/3 up to j = highest_order_index.
+inline std::vector<ParameterDescription> options(const ChinOptions& defaults, int highest_order_index) {
+  return describe_options(defaults, highest_order_index == 1 ? "only 2/3 exists"
+                                                             : "any of " + chin_orders_text() + " up to " +
+                                                                   Fraction(2 * highest_order_index, 3).to_string());
 }
 // The basic step of `options` (InvalidArgument for t2 = 0 or not finite): t2 is checked before the order.
 inline SeparableBasicStep base(const ChinOptions& options, HamiltonianForm form) {
@@ -55,7 +54,7 @@ struct BasicScheme {
             "chin",
             true,
             true,
-            {order_parameter("2/3", "only 2/3 exists"), chin_scheme::t2_parameter()},
+            chin_scheme::options(ChinOptions{}, 1),
             1,
             {}};
   }
@@ -70,6 +69,7 @@ struct TripletScheme {
   using Options = ChinOptions;
   using Stepper = TripletComposition<SeparableBasicStep>;
   static constexpr int orders = Stepper::max_levels + 1;  // order 2j/3 has j - 1 levels
+  static Options defaults() { return {Fraction(4, 3)}; }
   static SchemeDescription description() {
     return {"triplet",
             "Triplet composition of the basic step",
@@ -79,7 +79,7 @@ struct TripletScheme {
             "chin",
             true,
             true,
-            {chin_scheme::order_up_to("4/3", orders), chin_scheme::t2_parameter()},
+            chin_scheme::options(defaults(), orders),
             orders,
             {}};
   }
@@ -93,6 +93,7 @@ struct MultiProductExpansionScheme {
   using Options = ChinOptions;
   using Stepper = MultiProductExpansion<SeparableBasicStep>;
   static constexpr int orders = Stepper::max_terms;  // order 2m/3 has m terms
+  static Options defaults() { return {Fraction(4, 3)}; }
   static SchemeDescription description() {
     return {"mpe",
             "Multi-product expansion of the basic step",
@@ -102,7 +103,7 @@ struct MultiProductExpansionScheme {
             "chin",
             false,
             false,
-            {chin_scheme::order_up_to("4/3", orders), chin_scheme::t2_parameter()},
+            chin_scheme::options(defaults(), orders),
             orders,
             {}};
   }

@@ -19,18 +19,19 @@ inline const std::string cost_note =
     " Needs the plugin's Hessians and third derivatives (one grad H = grad T or V, two Hessians, one d3 "
     "contraction); its tangent map (Lyapunov/MEGNO) also the directional derivative of grad H (hvp_H, plugin ABI "
     "version 5).";
-inline ParameterDescription max_iterations_parameter() {
-  return number_parameter("max_iterations", std::to_string(GaussLegendre::default_max_iterations),
-                          "most fixed-point iterations per step, an integer >= 1; a state that has not converged by "
-                          "then retires as failed, with the reason");
-}
+inline constexpr const char* max_iterations_text =
+    "most fixed-point iterations per step, an integer >= 1; a state that has not converged by then retires as "
+    "failed, with the reason";
 }  // namespace comparator_scheme
 
 struct TaoOptions {
   Fraction order = Fraction(2);
   double omega = TaoExtendedPhaseSpace::default_omega;
   static constexpr auto members() {
-    return std::tuple{option("order", &TaoOptions::order), option("omega", &TaoOptions::omega)};
+    return std::tuple{option("order", &TaoOptions::order),
+                      option("omega", &TaoOptions::omega,
+                             "binding of the two copies, finite and > 0; Tao's error bound grows with omega and needs "
+                             "dt << omega^(-1/order)")};
   }
 };
 
@@ -49,10 +50,7 @@ struct TaoScheme {
             "comparator",
             true,
             true,
-            {order_parameter("2", "2, 4 or 6"),
-             number_parameter("omega", "20",
-                              "binding of the two copies, finite and > 0; Tao's error bound grows "
-                              "with omega and needs dt << omega^(-1/order)")},
+            describe_options(TaoOptions{}, "2, 4 or 6"),
             1,
             {Fraction(2), Fraction(4), Fraction(6)}};
   }
@@ -69,7 +67,8 @@ struct TaoScheme {
 struct ImplicitMidpointOptions {
   int max_iterations = GaussLegendre::default_max_iterations;
   static constexpr auto members() {
-    return std::tuple{option("max_iterations", &ImplicitMidpointOptions::max_iterations)};
+    return std::tuple{
+        option("max_iterations", &ImplicitMidpointOptions::max_iterations, comparator_scheme::max_iterations_text)};
   }
 };
 
@@ -90,7 +89,7 @@ struct ImplicitMidpointScheme {
             "comparator",
             true,
             true,
-            {comparator_scheme::max_iterations_parameter()},
+            describe_options(ImplicitMidpointOptions{}),
             1,
             {Fraction(2)}};
   }
@@ -101,7 +100,8 @@ struct GaussOptions {
   int stages = 2;
   int max_iterations = GaussLegendre::default_max_iterations;
   static constexpr auto members() {
-    return std::tuple{option("stages", &GaussOptions::stages), option("max_iterations", &GaussOptions::max_iterations)};
+    return std::tuple{option("stages", &GaussOptions::stages, "number of stages s, 1 to 8 (orders 2 to 16)"),
+                      option("max_iterations", &GaussOptions::max_iterations, comparator_scheme::max_iterations_text)};
   }
 };
 
@@ -124,8 +124,7 @@ struct GaussScheme {
         "comparator",
         true,
         true,
-        {number_parameter("stages", "2", "number of stages s, 1 to 8 (orders 2 to 16)"),
-         comparator_scheme::max_iterations_parameter()},
+        describe_options(GaussOptions{}),
         1,
         {Fraction(2), Fraction(4), Fraction(6), Fraction(8), Fraction(10), Fraction(12), Fraction(14), Fraction(16)}};
   }

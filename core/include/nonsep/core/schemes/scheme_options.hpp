@@ -6,18 +6,25 @@
 //   struct TaoOptions {
 //     Fraction order = Fraction(2);
 //     double omega = 20.0;
-//     static constexpr auto members() { return std::tuple{option("order", &TaoOptions::order), ...}; }
+//     static constexpr auto members() {
+//       return std::tuple{option("order", &TaoOptions::order), option("omega", &TaoOptions::omega, "binding ...")};
+//     }
 //   };
 //
 // Members are Fraction (an order), double or int. A job file gives an order as a Fraction and every other option as
-// a number (OptionValue); an int member takes only a whole number.
+// a number (OptionValue); an int member takes only a whole number. Each option's name, default and description are
+// written there once: the catalogue's entries (ParameterDescription) are made from them by describe_options, with
+// the defaults of the scheme (a scheme type's defaults(), or its Options as constructed: scheme_defaults in
+// stepper.hpp).
 #include <cmath>
 #include <concepts>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <tuple>
 #include <type_traits>
 #include <variant>
+#include <vector>
 
 #include "nonsep/core/base/error.hpp"
 #include "nonsep/core/base/fraction.hpp"
@@ -28,15 +35,20 @@ namespace nonsep {
 // An option's value as a job file gives it: a Fraction for an order, a number otherwise.
 using OptionValue = std::variant<Fraction, double>;
 
-// One member of an options struct and its catalogue name.
+// One member of an options struct: its catalogue name, what the catalogue says of it (an order's words come from its
+// scheme: describe_options), and whether it must not be 0 (t2: the scheme refuses 0 when it is built, the schema
+// states it).
 template <class Options, class T>
 struct OptionMember {
   const char* name;
   T Options::*member;
+  const char* description;
+  bool nonzero;
 };
 template <class Options, class T>
-constexpr OptionMember<Options, T> option(const char* name, T Options::*member) {
-  return {name, member};
+constexpr OptionMember<Options, T> option(const char* name, T Options::*member, const char* description = "",
+                                          bool nonzero = false) {
+  return {name, member, description, nonzero};
 }
 
 template <class O>
@@ -98,14 +110,37 @@ void write_option(O& options, const std::string& name, const OptionValue& value)
   });
 }
 
-// How the catalogue describes an option.
-inline ParameterDescription number_parameter(const std::string& name, const std::string& default_text,
-                                             const std::string& description, bool nonzero = false) {
-  return {name, ParameterDescription::Kind::Number, default_text, description, nonzero};
-}
-inline ParameterDescription order_parameter(const std::string& default_order, const std::string& which) {
-  return {"order", ParameterDescription::Kind::Order, default_order,
-          "order of convergence as an exact fraction; " + which, false};
+// The catalogue's entries for the options of `defaults`' type, in members() order: each member's name, its kind
+// (Order for a Fraction, Number otherwise), its default (its value in `defaults`, as a job file writes it: "4/3",
+// "-1.8171205928321397", "20") and its description; an order's description is "order of convergence as an exact
+// fraction; " followed by `orders`, the scheme's words for the orders it has.
+template <SchemeOptions O>
+std::vector<ParameterDescription> describe_options(const O& defaults, const std::string& orders = "") {
+  std::vector<ParameterDescription> parameters;
+  std::apply(
+      [&](const auto&... members) {
+        (
+            [&](const auto& m) {
+              using T = std::decay_t<decltype(defaults.*m.member)>;
+              const T& value = defaults.*m.member;
+              ParameterDescription parameter{m.name, ParameterDescription::Kind::Number, "", m.description, m.nonzero};
+              if constexpr (std::is_same_v<T, Fraction>) {
+                parameter.kind = ParameterDescription::Kind::Order;
+                parameter.default_text = value.to_string();
+                parameter.description = "order of convergence as an exact fraction; " + orders;
+              } else if constexpr (std::is_same_v<T, int>) {
+                parameter.default_text = std::to_string(value);
+              } else {
+                char text[32];
+                std::snprintf(text, sizeof text, "%.17g", value);
+                parameter.default_text = text;
+              }
+              parameters.push_back(std::move(parameter));
+            }(members),
+            ...);
+      },
+      O::members());
+  return parameters;
 }
 
 }  // namespace nonsep

@@ -5,7 +5,9 @@
 //   struct TripletScheme {                       // IntegrationScheme: the algorithm
 //     using Options = ChinOptions;               // its options, typed (scheme_options.hpp)
 //     using Stepper = TripletComposition<...>;   // its stepper
-//     static SchemeDescription description();    // its catalogue entry: name, options with defaults, orders, flags
+//     static Options defaults();                 // optional: its options' defaults, when not Options{}'s
+//     static SchemeDescription description();    // its catalogue entry: name, options (describe_options of its
+//                                                // defaults), orders, flags
 //     static Stepper make(const Options&, HamiltonianForm);  // InvalidArgument for an option it refuses
 //   };
 //
@@ -55,6 +57,19 @@ concept IntegrationScheme = SchemeOptions<typename A::Options> && Stepper<typena
   { A::description() } -> std::convertible_to<SchemeDescription>;
   { A::make(options, form) } -> std::same_as<typename A::Stepper>;
 };
+
+// The defaults of scheme A's options: A::defaults() where it has one (schemes that share an options struct and differ
+// in a default: the triplet composition's order 4/3 where the basic step has 2/3), otherwise A::Options{}. Its
+// catalogue entry's defaults are these (describe_options), so a job file that leaves an option out gets them.
+template <IntegrationScheme A>
+typename A::Options scheme_defaults() {
+  if constexpr (requires {
+                  { A::defaults() } -> std::convertible_to<typename A::Options>;
+                })
+    return A::defaults();
+  else
+    return typename A::Options{};
+}
 
 // A stepper that keeps private state per state (Tao's copies): the integrators hand batch changes on to it and its
 // state out and back.
