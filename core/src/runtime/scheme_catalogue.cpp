@@ -13,4 +13,9 @@ const Scheme* find_scheme(const std::string& name) {
   return nullptr;
 }
 
+bool is_comparator(const std::string& name) {
+  const Scheme* scheme = find_scheme(name);
+  return scheme != nullptr && scheme->family == "comparator";
+}
+
 }  // namespace nonsep

@@ -43,7 +43,7 @@ void check_schemes_for_general_hamiltonian(const Job& job, const std::string& mo
          "no form (TTV, the default): the forms choose between the product-form Hamiltonians "
          "T_i V_ij T_j and V_i T_ij V_j"});
   const auto check = [&](const IntegratorSpec& spec, const std::string& path) {
-    if (!Integrator(spec).is_comparator())
+    if (!is_comparator(spec.scheme))
       issues.push_back(
           {path, chin_scheme_with_general_hamiltonian(spec.scheme, model), schemes_for_general_hamiltonian()});
   };
@@ -199,7 +199,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
   // plugin's grad_H. Chin's schemes split H into T and V: a general plugin has neither.
   const bool has_gradient_of_h = general || (loaded.plugin.has_hessians() && loaded.plugin.has_third_derivatives());
   const auto check_comparator = [&](const IntegratorSpec& spec, const std::string& path) {
-    if (!Integrator(spec).is_comparator() || has_gradient_of_h) return;
+    if (!is_comparator(spec.scheme) || has_gradient_of_h) return;
     issues.push_back(
         {path,
          "\"" + spec.scheme + "\" with the plugin '" + loaded.plugin.name() + "', which has " +
@@ -230,7 +230,7 @@ std::optional<LoadedJob> load_model(Job job, std::vector<JobIssue>& issues, std:
                               " measures the tangent vector across the flow J grad H (the SDK provides the "
                               "derivatives by automatic differentiation)"});
     if (checked.run().analysis.tangent_vectors() > 0 && !checked.run().auto_scheme &&
-        Integrator(checked.run().integrator).is_comparator() && has_gradient_of_h &&
+        is_comparator(checked.run().integrator.scheme) && has_gradient_of_h &&
         !loaded.plugin.has_hamiltonian_hessian_products())
       issues.push_back({checked.run().analysis.tangent_key(),
                         "tangent vectors with the comparator scheme \"" + checked.run().integrator.scheme +

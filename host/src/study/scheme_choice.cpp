@@ -355,10 +355,10 @@ std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& mode
   const bool gradient_of_h = general || model.hessians_and_third_derivatives;
   std::vector<AutoCandidate> usable;
   for (auto& candidate : all) {
-    if (Integrator(candidate.spec).is_comparator() ? !gradient_of_h : general) continue;
+    if (is_comparator(candidate.spec.scheme) ? !gradient_of_h : general) continue;
     // A comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
     if (run.analysis.tangent_vectors() > 0 &&
-        (!has_tangent_map(candidate.spec) || (Integrator(candidate.spec).is_comparator() && !model.hessian_products)))
+        (!has_tangent_map(candidate.spec) || (is_comparator(candidate.spec.scheme) && !model.hessian_products)))
       continue;
     usable.push_back(std::move(candidate));
   }

@@ -22,5 +22,8 @@ using Scheme = SchemeDescription;
 std::span<const Scheme> scheme_catalogue();
 // The catalogue entry named `name`, or nullptr.
 const Scheme* find_scheme(const std::string& name);
+// Whether the scheme named `name` is of the family "comparator" (it integrates H from its gradient), read from the
+// catalogue without building it; false for a name the catalogue lacks.
+bool is_comparator(const std::string& name);
 
 }  // namespace nonsep
