@@ -204,7 +204,7 @@ struct CatalogueDefaults {
 }  // namespace nonsep::extension_test
 
 TEST_CASE(
-    "every scheme's catalogue defaults are its options' defaults, written once; a spec without options has them") {
+    "every scheme's catalogue defaults are its options' defaults, written once, and a spec without options has them") {
   WithShippedSchemes<CatalogueDefaults, RepeatedScheme>::check();
   // The compositions share ChinOptions with the basic step and default to order 4/3 (their defaults()).
   for (const char* scheme : {"triplet", "mpe"}) {

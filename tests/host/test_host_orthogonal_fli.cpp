@@ -15,7 +15,8 @@
 
 using namespace nonsep::host_testing;
 
-TEST_CASE("OFLI in one degree of freedom: ln(|f(x0)| / min |f(x_s)|) over the steps, exactly; FLI grows like ln t") {
+TEST_CASE(
+    "OFLI in one degree of freedom: ln(|f(x0)| / min |f(x_s)|) over the steps, exactly, while FLI grows like ln t") {
   // In one degree of freedom the area w x f(x) is conserved along the orbit (both are transported by the tangent map,
   // which preserves area), so |w_perp(t)| |f(x_t)| = |w_perp(0)| |f(x_0)|: OFLI(t) = max over the steps of
   // ln(|f(x_0)| / |f(x_s)|), bounded, while the shear along the orbit makes |w| and FLI grow. paper1d:
