@@ -89,7 +89,7 @@ TEST_CASE("a general normal, direction both, and max_crossings stopping a trajec
   const auto rows = table(folder / "run/trajectories.csv");
   for (std::size_t t = 0; t < 2; ++t) {
     CHECK(rows[t].at("status") == "completed");
-    CHECK(rows[t].at("message").find("2-th Poincare crossing (max_crossings)") != std::string::npos);
+    CHECK(rows[t].at("message").find("2nd Poincare crossing (max_crossings)") != std::string::npos);
     CHECK(cell(rows[t], "step") < 5000);
     double last_step = 0.0;
     for (const auto& row : crossings) {
@@ -402,7 +402,7 @@ TEST_CASE("a chunk redone step by step after a divergence keeps the crossings an
   REQUIRE(run_named(folder, "together", together).status == 1);  // diverged
   const auto rows = table(folder / "together/trajectories.csv");
   CHECK(rows[1].at("status") == "diverged");
-  CHECK(rows[0].at("message").find("3-th Poincare crossing") != std::string::npos);
+  CHECK(rows[0].at("message").find("3rd Poincare crossing") != std::string::npos);
   CHECK(read_text(folder / "together/poincare.csv") == read_text(folder / "alone/poincare.csv"));
   const auto single = table(folder / "alone/trajectories.csv");
   for (const char* column : {"step", "q0", "q1", "p0", "p1", "mean_megno", "poincare_crossings"}) {

@@ -40,6 +40,21 @@ TEST_CASE("numbers are written in the shortest text that reads back to the same 
   }
 }
 
+TEST_CASE("ordinals in messages: 1st, 2nd, 3rd, 4th, 11th to 13th, 21st, 102nd, 111th") {
+  using nonsep::host::ordinal;
+  CHECK(ordinal(1) == "1st");
+  CHECK(ordinal(2) == "2nd");
+  CHECK(ordinal(3) == "3rd");
+  CHECK(ordinal(4) == "4th");
+  CHECK(ordinal(11) == "11th");
+  CHECK(ordinal(12) == "12th");
+  CHECK(ordinal(13) == "13th");
+  CHECK(ordinal(21) == "21st");
+  CHECK(ordinal(102) == "102nd");
+  CHECK(ordinal(111) == "111th");
+  CHECK(ordinal(0) == "0th");
+}
+
 TEST_CASE("CsvAppender: header, rows of cells, empty cells for unknown numbers, quoted text where needed") {
   TemporaryFolder folder;
   const auto path = folder / "table.csv";

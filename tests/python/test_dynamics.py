@@ -118,7 +118,7 @@ class DynamicsResultTest(SharedRun):
         self.assertEqual(self.result.status, "completed")  # run() returned: exit status 0, no RunError
         self.assertTrue((trajectories["status"] == "completed").all())
         for row in trajectories[stopped]:
-            self.assertEqual(row["message"], f"stopped at its {MAX_CROSSINGS}-th Poincare crossing (max_crossings)")
+            self.assertEqual(row["message"], f"stopped at its {MAX_CROSSINGS}th Poincare crossing (max_crossings)")
             self.assertEqual(row["step"], self.result.crossings(int(row["trajectory"])).step[-1])
             self.assertLess(row["t"], self.result.summary["time"]["t_end"])
         for row in trajectories[~stopped]:

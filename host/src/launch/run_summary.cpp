@@ -38,7 +38,7 @@ json energy_facts(const RunFacts& facts) {
           {"relative_error_definition", "(H - H0) / H0; unknown when H0 = 0"},
           {"evaluated_at",
            "step 0, every written sample (output.every), " +
-               (run.energy_every > 0 ? "every " + std::to_string(run.energy_every) + "-th step (output.energy_every), "
+               (run.energy_every > 0 ? "every " + ordinal(run.energy_every) + " step (output.energy_every), "
                                      : std::string()) +
                "the last step, and the final state of a trajectory that stopped early"},
           {"largest_relative_error", largest},

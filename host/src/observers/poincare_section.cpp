@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "nonsep/core/base/error.hpp"
+#include "nonsep/host/number_format.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/saved_state.hpp"
 
@@ -86,7 +87,7 @@ void PoincareSectionObserver::on_step(std::uint64_t step, double, const BlockVie
     if (max_crossings_ && counts_[trajectory] == *max_crossings_ && block.retire)
       block.retire->push_back(
           stop_request(trajectory, TrajectoryStatus::completed,
-                       "stopped at its " + std::to_string(*max_crossings_) + "-th Poincare crossing (max_crossings)"));
+                       "stopped at its " + ordinal(*max_crossings_) + " Poincare crossing (max_crossings)"));
   }
   remember(block);
 }

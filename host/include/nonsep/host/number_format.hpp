@@ -25,6 +25,17 @@ inline std::string format_number(double value) {
 
 namespace nonsep::host {
 
+// n as an English ordinal: "1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "102nd".
+inline std::string ordinal(unsigned long long n) {
+  const unsigned long long tens = n % 100, units = n % 10;
+  const char* suffix = tens >= 11 && tens <= 13 ? "th"
+                       : units == 1             ? "st"
+                       : units == 2             ? "nd"
+                       : units == 3             ? "rd"
+                                                : "th";
+  return std::to_string(n) + suffix;
+}
+
 // The double written by append_number (the whole of `text`, nothing else), or nothing.
 inline std::optional<double> parse_number(std::string_view text) {
   double x = 0.0;
