@@ -15,8 +15,9 @@
 // Hessians). The stepping of the run itself is not changed.
 //
 // max_crossings: a trajectory that reaches it stops at that step, status "completed" with the message
-// "stopped at its Nth Poincare crossing (max_crossings)" (1st, 2nd, ...); its final state is the state at that step. When the
-// plugin fails while a crossing is located, the trajectory stops at that step as "failed", with the plugin's message.
+// "stopped at its Nth Poincare crossing (max_crossings)" (1st, 2nd, ...); its final state is the state at that step.
+// When the plugin fails while a crossing is located, the trajectory stops at that step as "failed", with the plugin's
+// message.
 //
 // Checkpoints: the file's size and content hash (like trajectory.csv) and each trajectory's crossing count.
 // trajectories.csv gets a column poincare_crossings.
