@@ -1,11 +1,13 @@
 // The tangent maps of the comparators (gauss with 1, 2, 3 stages, implicit_midpoint, tao of orders 2, 4, 6) and the
 // directional derivative of grad H they evaluate (the SDK's hvp_H): each is the derivative of what it differentiates
-// (central differences), in both forms and with a separable part K + U; Gauss's is symplectic to round-off; Tao's
+// (central differences), in both forms and with a separable part K + U; Gauss's is symplectic to round-off, and its
+// linear stages solved directly and by iteration agree; Tao's
 // copies' part follows a renormalisation of the vectors and its private state restores bit for bit; a symplectic
 // scheme's full Lyapunov spectrum sums to zero. The models are the shipped plugins' classes behind the SDK's adapter.
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <optional>
@@ -172,6 +174,43 @@ TEST_CASE("the tangent map of Gauss-Legendre is symplectic to round-off, and a s
       integrator.step(paper2d, y, tangents, -0.03);
       CHECK((testing::as_matrix(tangents) - Eigen::MatrixXd::Identity(4, 4)).cwiseAbs().maxCoeff() < 1e-12);
     }
+}
+
+TEST_CASE("Gauss-Legendre's linear stages solved directly and by iteration give the same tangent map to round-off") {
+  // Five sites, 2n = 10: one vector per state is iterated, three are solved directly (with 1 to 3 stages).
+  const auto lattice = sdk::ModelAdapter<LatticeChainModel<64>>::from_json(R"({"sites": 5})");
+  CHECK_FALSE(TangentGaussLegendre::solves_directly(5, 1, 3));
+  CHECK(TangentGaussLegendre::solves_directly(5, 3, 3));
+  CHECK_FALSE(TangentGaussLegendre::solves_directly(5, 3, 4));  // the LU would pass 40 x 40
+  CHECK(TangentGaussLegendre::solves_directly(1, 1, 8));
+  const std::vector<double> q{0.1, -0.2, 0.3, 0.05, -0.15}, p{0.4, 0.1, -0.3, 0.2, 0.0};
+  const std::vector<double> dq{1.0, 0.0, -0.5, 0.25, 0.3}, dp{-0.2, 0.6, 0.1, 0.0, 0.8};
+  for (int stages : {1, 2, 3}) {
+    CAPTURE(stages);
+    const IntegratorSpec gauss{"gauss", GaussOptions{stages}};
+    auto x1 = PhaseSpaceBatch::single(q, p), x3 = x1;
+    auto one = PhaseSpaceBatch::single(dq, dp);
+    PhaseSpaceBatch three(5, 3);
+    for (std::size_t j = 0; j < 3; ++j) {
+      std::copy(dq.begin(), dq.end(), three.q(j).begin());
+      std::copy(dp.begin(), dp.end(), three.p(j).begin());
+      three.q(j)[j] += 0.5;  // the other two vectors differ from the first
+    }
+    std::copy(dq.begin(), dq.end(), three.q(0).begin());
+    TangentIntegrator iterated(gauss, 1), direct(gauss, 3);
+    for (int s = 0; s < 5; ++s) {
+      iterated.step(lattice, x1, one, 0.05);
+      direct.step(lattice, x3, three, 0.05);
+    }
+    CHECK(std::equal(x1.q().begin(), x1.q().end(), x3.q().begin()));  // the states bit for bit
+    double difference = 0.0, size = 0.0;
+    for (std::size_t c = 0; c < 5; ++c) {
+      difference = std::max({difference, std::abs(one.q()[c] - three.q(0)[c]), std::abs(one.p()[c] - three.p(0)[c])});
+      size = std::max({size, std::abs(one.q()[c]), std::abs(one.p()[c])});
+    }
+    CAPTURE(difference / size);
+    CHECK(difference / size < 1e-13);
+  }
 }
 
 TEST_CASE("Tao's copies' part follows a renormalisation of the vectors: the result is the map's Jacobian times it") {

@@ -11,22 +11,29 @@
 // (hamiltonian_gradient.hpp, ModelWithHamiltonianHessian; the plugin entry hvp_H), one batched call per iteration
 // for every tangent vector still iterating.
 //
-// Solving the linear stages: fixed-point iteration dZ^{m+1}_i = dt sum_j a_ij J(Y_j) (dz + dZ^m_j) from dZ^0 = 0,
-// with the stages' own stopping rule (gauss_legendre.hpp) per tangent vector: relative change
-// max |dZ^{m+1} - dZ^m| / max(|dz|_inf, |dZ^{m+1}|_inf) at one ulp, or stalled at round-off (<= 64 ulp and not
-// decreasing); dz' then takes the products of the last iteration. It contracts at the rate of the stages' iteration
-// (dt |J| |A|), so it takes about as many iterations as the step did, each one hvp_H per stage and vector: O(n) per
-// vector for a sparse model. A linear solve would form J(Y_i) (2n products per stage) and factor a 2ns x 2ns
-// matrix: cheaper only for k close to 2n on small n; the iteration is chosen for every k (one code path, O(k n)
-// memory per state). Converged to round-off, the map is symplectic (M^T J M = J) to round-off as the step is.
+// Solving the linear stages, one of two ways chosen by n, k and s alone (solves_directly), so that every state of a
+// run takes the same path whatever its batch:
+// - directly (gauss_linear_stages.hpp): J(Y_i) formed from 2n products per stage point (hvp_H along each unit
+//   vector), then one LU of the 2ns x 2ns system per state, solved for its k vectors together. Costs s 2n products
+//   per state whatever k, plus the LU.
+// - by fixed-point iteration dZ^{m+1}_i = dt sum_j a_ij J(Y_j) (dz + dZ^m_j) from dZ^0 = 0, with the stages' own
+//   stopping rule (gauss_legendre.hpp) per tangent vector: relative change
+//   max |dZ^{m+1} - dZ^m| / max(|dz|_inf, |dZ^{m+1}|_inf) at one ulp, or stalled at round-off (<= 64 ulp and not
+//   decreasing); dz' then takes the products of the last iteration. It contracts at the rate of the stages'
+//   iteration (dt |J| |A|), so it takes about as many iterations as the step did (5 to 10): s k products per
+//   iteration, O(n) per vector for a sparse model, O(k n) memory per state.
+// The direct solve is taken when 2n <= 4k (its products cost at most what 4 iterations of the k vectors cost) and
+// 2ns <= 32 (the LU stays under about 11000 flops): paper1d, paper2d and Henon-Heiles with one vector, any model of
+// up to 2 degrees of freedom per vector with several. Both give the map's exact derivative to round-off, and it is
+// symplectic (M^T J M = J) to round-off as the step is.
 //
 // The states are stepped by GaussLegendre::step, bit for bit as the plain scheme steps them; each tangent vector's
 // numbers depend only on its state and itself (batch equals single). Layout of the tangent vectors: that of
 // tangent_basic_step.hpp (vector j of state b at entry b*k + j, dq in q(), dp in p()).
 //
 // Errors: InvalidArgument for tangents that do not fit x, or a model without hvp_H (require_hamiltonian_hessian);
-// ModelError from the step (its states that failed), or naming the states whose tangent iteration failed (not
-// finite, or no convergence in max_iterations); the model's exceptions propagate. The tangents are then unspecified.
+// ModelError from the step (its states that failed), or naming the states whose tangent vectors failed (not finite,
+// or no convergence in max_iterations); the model's exceptions propagate. The tangents are then unspecified.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -38,6 +45,7 @@
 
 #include "nonsep/core/base/hamiltonian_gradient.hpp"
 #include "nonsep/core/schemes/gauss_legendre.hpp"
+#include "nonsep/core/tangent/gauss_linear_stages.hpp"
 #include "nonsep/core/tangent/tangent_basic_step.hpp"
 
 namespace nonsep {
@@ -49,10 +57,12 @@ class TangentGaussLegendre {
   const GaussLegendre& base() const { return base_; }
   HamiltonianForm form() const { return base_.form(); }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
-  // hvp_H: s per tangent vector per iteration.
+  // hvp_H: s 2n per state solved directly, s per tangent vector and iteration otherwise.
   const HessianCounts& hessian_evaluations() const { return hessians_; }
-  // Iterations of the linear stages each tangent vector of the last step took (vector j of state b at b*k + j).
-  std::span<const int> tangent_iterations() const { return iterations_; }
+  // Whether the linear stages of n degrees of freedom, k vectors per state and s stages are solved directly (above).
+  static bool solves_directly(std::size_t n, std::size_t k, int s) {
+    return 2 * n <= 4 * k && 2 * n * static_cast<std::size_t>(s) <= 32;
+  }
 
   // Advances x by dt as GaussLegendre::step does and maps the tangent vectors by the step's derivative. Errors above.
   template <class M>
@@ -80,16 +90,77 @@ class TangentGaussLegendre {
   std::vector<SchemeFigure> report() const { return base_.report(); }
 
  private:
+  template <class M>
+  void map_tangents(const M& model, const PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, std::size_t k, double dt) {
+    if (solves_directly(x.dimension(), k, base_.stages()))
+      map_tangents_directly(model, x, tangents, k, dt);
+    else
+      map_tangents_by_iteration(model, x, tangents, k, dt);
+  }
+
+  // Stage point i of state b along unit direction e (e < n: dq_e, else dp_{e-n}) at point ((i*B + b)*2n + e), B the
+  // states; the point's components at that index times n. J(Y_i) of state b goes column-major into jacobians_.
+  template <class M>
+  void map_tangents_directly(const M& model, const PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, std::size_t k,
+                             double dt) {
+    const GaussLegendreTableau& tableau = base_.tableau();
+    const std::size_t s = static_cast<std::size_t>(tableau.stages), n = x.dimension(), d = 2 * n;
+    const std::size_t states = x.count(), size = x.size(), points = s * states * d;
+    const std::span<const double> stage_q = base_.stage_points_q(), stage_p = base_.stage_points_p();
+    for (auto* v : {&point_q_, &point_p_, &product_q_, &product_p_}) v->resize(points * n);
+    for (auto* v : {&direction_q_, &direction_p_}) v->assign(points * n, 0.0);
+    for (std::size_t i = 0; i < s; ++i)
+      for (std::size_t b = 0; b < states; ++b)
+        for (std::size_t e = 0; e < d; ++e) {
+          const std::size_t to = ((i * states + b) * d + e) * n;
+          std::copy_n(stage_q.begin() + static_cast<std::ptrdiff_t>(i * size + b * n), n, point_q_.begin() + to);
+          std::copy_n(stage_p.begin() + static_cast<std::ptrdiff_t>(i * size + b * n), n, point_p_.begin() + to);
+          (e < n ? direction_q_[to + e] : direction_p_[to + e - n]) = 1.0;
+        }
+    model.hvp_H(base_.form(), point_q_, point_p_, direction_q_, direction_p_, product_q_, product_p_, points);
+    hessians_.hvp_H += points;
+    jacobians_.resize(s * d * d);
+    vectors_.resize(k * d);
+    std::vector<std::size_t> failed;
+    for (std::size_t b = 0; b < states; ++b) {
+      // Column e of J(Y_i) = (d(dH/dp), -d(dH/dq)) along e.
+      for (std::size_t i = 0; i < s; ++i)
+        for (std::size_t e = 0; e < d; ++e) {
+          const std::size_t from = ((i * states + b) * d + e) * n, to = (i * d + e) * d;
+          for (std::size_t c = 0; c < n; ++c) {
+            jacobians_[to + c] = product_p_[from + c];
+            jacobians_[to + n + c] = -product_q_[from + c];
+          }
+        }
+      for (std::size_t j = 0; j < k; ++j)
+        for (std::size_t c = 0; c < n; ++c) {
+          vectors_[j * d + c] = tangents.q()[(b * k + j) * n + c];
+          vectors_[j * d + n + c] = tangents.p()[(b * k + j) * n + c];
+        }
+      if (!map_by_linear_stages(tableau, dt, jacobians_, d, vectors_, k)) {
+        for (std::size_t j = 0; j < k; ++j) failed.push_back(b * k + j);
+        continue;
+      }
+      for (std::size_t j = 0; j < k; ++j)
+        for (std::size_t c = 0; c < n; ++c) {
+          tangents.q()[(b * k + j) * n + c] = vectors_[j * d + c];
+          tangents.p()[(b * k + j) * n + c] = vectors_[j * d + n + c];
+        }
+    }
+    if (!failed.empty())
+      throw ModelError(failure_message(failed, k, states, "the linear stages are singular or not finite"));
+  }
+
   // Work arrays of the rows (tangent vectors) still iterating, stage-major: stage i, row a of active_, component c
   // at (i*A + a)*n + c (A = active_.size()); dZ per row and stage at (i*R + r)*n + c (R = all rows).
   template <class M>
-  void map_tangents(const M& model, const PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, std::size_t k, double dt) {
+  void map_tangents_by_iteration(const M& model, const PhaseSpaceBatch& x, PhaseSpaceBatch& tangents, std::size_t k,
+                                 double dt) {
     const GaussLegendreTableau& tableau = base_.tableau();
     const std::size_t s = static_cast<std::size_t>(tableau.stages), n = x.dimension(), size = x.size();
     const std::size_t rows = tangents.count();
     const std::span<const double> stage_q = base_.stage_points_q(), stage_p = base_.stage_points_p();
     for (auto* v : {&dZ_q_, &dZ_p_}) v->assign(s * rows * n, 0.0);
-    iterations_.assign(rows, 0);
     last_change_.assign(rows, std::numeric_limits<double>::infinity());
     active_.resize(rows);
     for (std::size_t r = 0; r < rows; ++r) active_[r] = r;
@@ -114,7 +185,6 @@ class TangentGaussLegendre {
       still_.clear();
       for (std::size_t a = 0; a < count; ++a) {
         const std::size_t r = active_[a];
-        ++iterations_[r];
         // dZ^{m+1}_i = dt sum_j a_ij (d(dH/dp)_j, -d(dH/dq)_j); change and size as the stages measure them.
         double change = 0.0, scale = 0.0, probe = 0.0;
         for (std::size_t c = 0; c < n; ++c)
@@ -167,14 +237,18 @@ class TangentGaussLegendre {
       active_.swap(still_);
     }
     failed.insert(failed.end(), active_.begin(), active_.end());
-    if (!failed.empty()) throw ModelError(failure_message(failed, k, x.count()));
+    if (!failed.empty())
+      throw ModelError(failure_message(failed, k, x.count(),
+                                       "the iteration of the linear stages did not converge in " +
+                                           std::to_string(base_.max_iterations()) +
+                                           " iterations, or an iterate is not finite"));
   }
 
-  std::string failure_message(std::vector<std::size_t> failed, std::size_t k, std::size_t count) const {
+  std::string failure_message(std::vector<std::size_t> failed, std::size_t k, std::size_t count,
+                              const std::string& what) const {
     std::sort(failed.begin(), failed.end());
     std::string message = "the tangent map of Gauss-Legendre collocation (order " + std::to_string(base_.order()) +
-                          "): the iteration of the linear stages did not converge in " +
-                          std::to_string(base_.max_iterations()) + " iterations, or an iterate is not finite, for";
+                          "): " + what + ", for";
     for (std::size_t i = 0; i < failed.size(); ++i)
       message += (i ? ", " : " ") + std::string("vector ") + std::to_string(failed[i] % k) +
                  (count > 1 ? " of state " + std::to_string(failed[i] / k) : std::string());
@@ -185,7 +259,7 @@ class TangentGaussLegendre {
   HessianCounts hessians_;
   std::vector<double> dZ_q_, dZ_p_, next_q_, next_p_;
   std::vector<double> point_q_, point_p_, direction_q_, direction_p_, product_q_, product_p_;
-  std::vector<int> iterations_;
+  std::vector<double> jacobians_, vectors_;
   std::vector<double> last_change_;
   std::vector<std::size_t> active_, still_;
 };
