@@ -534,7 +534,8 @@ class ModelAdapter {
   // solved H, K + U included, times the tangent (dq, dp) of each state, into out_q = d(dH/dq), out_p = d(dH/dp); all
   // six spans in the gradient layout. Per state: the gradient and two Hessian-vector products of the outer function
   // (T in TTV), two of the inner, one mixed third derivative of each and one mixed fourth of the inner, each one
-  // pass over the gradient templates (O(n) for a sparse model) or over T and V; plus K'' dp and U'' dq.
+  // pass over the gradient templates (O(n) for a sparse model) or over T and V (fewer when dq or dp is zero); plus
+  // K'' dp and U'' dq.
   void hvp_H(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<const double> dq,
              std::span<const double> dp, std::span<double> out_q, std::span<double> out_p,
              std::size_t count) const requires has_hamiltonian_hessian {
@@ -560,20 +561,34 @@ class ModelAdapter {
       const double* dy = (ttv ? dq : dp).data() + at;
       double* out_x = (ttv ? out_p : out_q).data() + at;
       double* out_y = (ttv ? out_q : out_p).data() + at;
+      // out_y = Y''''[g, g, dy] + 2 Y'''[g, dg],  out_x = 2 X'''[dx, w] + 2 X'' (Y'''[g, dy] + Y'' dg),  dg = X'' dx,
+      // w = Y'' g. A tangent without an x part (dx = 0: dg = 0) or without a y part skips the passes whose terms
+      // are then zero, with the same numbers: the unit directions Gauss's tangent map forms its Jacobians from
+      // (tangent_gauss_legendre.hpp) take 4 or 7 passes instead of 9.
+      const bool moves_x = std::any_of(dx, dx + n, [](double v) { return v != 0.0; });
+      const bool moves_y = std::any_of(dy, dy + n, [](double v) { return v != 0.0; });
       gradient_of(ttv, x, g, n);
-      product_of(ttv, x, dx, dg, n);
-      product_of(!ttv, y, g, w, n);
-      // out_y = Y''''[g, g, dy] + 2 Y'''[g, dg]
-      mixed_fourth_of(!ttv, y, g, g, dy, out_y, n);
-      mixed_third_of(!ttv, y, g, dg, third, n);
-      for (std::size_t i = 0; i < n; ++i) out_y[i] += 2.0 * third[i];
-      // out_x = 2 X'''[dx, w] + 2 X'' (Y'''[g, dy] + Y'' dg)
-      mixed_third_of(!ttv, y, g, dy, sum, n);
-      product_of(!ttv, y, dg, third, n);
-      for (std::size_t i = 0; i < n; ++i) sum[i] += third[i];
+      std::fill(out_y, out_y + n, 0.0);
+      std::fill(sum, sum + n, 0.0);
+      if (moves_y) {
+        mixed_fourth_of(!ttv, y, g, g, dy, out_y, n);
+        mixed_third_of(!ttv, y, g, dy, sum, n);
+      }
+      if (moves_x) {
+        product_of(ttv, x, dx, dg, n);
+        mixed_third_of(!ttv, y, g, dg, third, n);
+        for (std::size_t i = 0; i < n; ++i) out_y[i] += 2.0 * third[i];
+        product_of(!ttv, y, dg, third, n);
+        for (std::size_t i = 0; i < n; ++i) sum[i] += third[i];
+      }
       product_of(ttv, x, sum, out_x, n);
-      mixed_third_of(ttv, x, dx, w, third, n);
-      for (std::size_t i = 0; i < n; ++i) out_x[i] = 2.0 * (third[i] + out_x[i]);
+      if (moves_x) {
+        product_of(!ttv, y, g, w, n);
+        mixed_third_of(ttv, x, dx, w, third, n);
+        for (std::size_t i = 0; i < n; ++i) out_x[i] = 2.0 * (third[i] + out_x[i]);
+      } else {
+        for (std::size_t i = 0; i < n; ++i) out_x[i] = 2.0 * out_x[i];
+      }
       if constexpr (HasK<M>) add_separable_product<true>(p.data() + at, dp.data() + at, out_p.data() + at, n);
       if constexpr (HasU<M>) add_separable_product<false>(q.data() + at, dq.data() + at, out_q.data() + at, n);
     }
