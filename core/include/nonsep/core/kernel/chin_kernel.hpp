@@ -63,10 +63,26 @@ inline bool eps_per_state(const ChinStepsCall& call) {
   return call.weights.empty() && call.substeps == 1 && call.eps.size() != 1;
 }
 
+// A call of no steps (chin_outer_gradient) for states [first, first + B) of dimension N: the outer gradient in local
+// arrays of its own, with the code the steps' blocks evaluate it with (so the same numbers). The blocks below branch
+// here before they form their arrays: evaluated on those arrays, the branch kept them out of registers (paper1d's
+// basic step took 1.45x the time, bench/compare_builds.py).
+template <std::size_t N, std::size_t B, Model M>
+inline void chin_outer_gradient_in_local_arrays(const M& model, const ChinStepsCall& call, std::size_t first) {
+  constexpr std::size_t size = B * N;
+  std::array<double, size> point, gradient;
+  const bool ttv = call.form == HamiltonianForm::TTV;
+  const auto offset = static_cast<std::ptrdiff_t>(first * N);
+  std::copy_n((ttv ? call.q : call.p).begin() + offset, size, point.begin());
+  chin_gradient(model, ttv, point, gradient, B);
+  std::copy_n(gradient.begin(), size, call.outer_gradient.begin() + offset);
+}
+
 // The call's steps for states [first, first + B) of dimension N, in local arrays; Expansion: call.weights is not
 // empty (a separate instantiation, so that the basic steps' code is not shaped by the expansion's).
 template <std::size_t N, std::size_t B, bool Expansion, Model M>
 inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call, std::size_t first) {
+  if (call.steps == 0) return chin_outer_gradient_in_local_arrays<N, B>(model, call, first);
   constexpr std::size_t size = B * N;
   std::array<double, size> q, p, outer_gradient, inner_gradient;
   std::array<double, B> eps;
@@ -82,7 +98,7 @@ inline void chin_steps_in_local_arrays(const M& model, const ChinStepsCall& call
   const ChinStepsCall block{call.form, call.coefficients, block_eps,      call.substeps, call.steps, B, q,
                             p,         outer_gradient,    inner_gradient, call.weights};
   if constexpr (!Expansion) {
-    chin_scheduled_stages<size>(model, block);
+    chin_scheduled_steps<size>(model, block);
   } else if constexpr (size <= 128) {  // the expansion's scratch on the stack too (8 KB at most)
     std::array<double, chin_expansion_scratch(size)> scratch;
     chin_expansion_stages<size>(model, block, scratch);
@@ -112,8 +128,9 @@ inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::
                            call.outer_gradient.subspan(offset, size),
                            call.inner_gradient.subspan(offset, size),
                            call.weights};
+  if (chin_outer_gradient(model, part)) return;  // a call of no steps
   if constexpr (!Expansion) {
-    chin_scheduled_stages(model, part);
+    chin_scheduled_steps(model, part);
   } else {
     std::vector<double> scratch(chin_expansion_scratch(size));
     chin_expansion_stages(model, part, scratch);
@@ -123,6 +140,7 @@ inline void chin_steps_in_place(const M& model, const ChinStepsCall& call, std::
 // A tangent call's steps for states [first, first + B) of dimension N in local arrays (the tangent vectors too).
 template <std::size_t N, std::size_t B, Model M>
 inline void chin_tangent_steps_in_local_arrays(const M& model, const ChinTangentStepsCall& call, std::size_t first) {
+  if (call.steps.steps == 0) return chin_outer_gradient_in_local_arrays<N, B>(model, call.steps, first);
   constexpr std::size_t size = B * N, capacity = size * 2 * N;  // k <= 2n vectors per state
   const std::size_t k = call.vectors, tangent_size = size * k;
   std::array<double, size> q, p, outer_gradient, inner_gradient;
@@ -175,6 +193,7 @@ inline void chin_tangent_steps_in_place(const M& model, const ChinTangentStepsCa
                                   k,
                                   call.tangent_q.subspan(offset * k, tangent_size),
                                   call.tangent_p.subspan(offset * k, tangent_size)};
+  if (chin_outer_gradient(model, part.steps)) return;  // a call of no steps
   chin_tangent_stages(model, part, {scratch.first(tangent_size), scratch.subspan(tangent_size, tangent_size)});
 }
 

@@ -192,11 +192,11 @@ inline void chin_stages(const M& model, HamiltonianForm form, const ChinCoeffici
   }
 }
 
-// The steps of `call` (requires chin_eps_fit(call.eps.size(), call.substeps, call.count) and chin_stages' sizes), or
-// with no steps the outer gradient alone (chin_outer_gradient). StaticSize as for chin_stages.
+// The steps of `call` (requires chin_eps_fit(call.eps.size(), call.substeps, call.count) and chin_stages' sizes; a
+// call of no steps does nothing). StaticSize as for chin_stages. The kernels' blocks (chin_kernel.hpp) call this one
+// and answer a call of no steps themselves, outside the arrays of their steps.
 template <std::size_t StaticSize = 0, Model M>
-inline void chin_scheduled_stages(const M& model, const ChinStepsCall& call) {
-  if (chin_outer_gradient(model, call)) return;
+inline void chin_scheduled_steps(const M& model, const ChinStepsCall& call) {
   if (call.substeps == 1) {
     chin_stages<StaticSize>(model, call.form, call.coefficients, call.eps, call.steps, call.count, call.q, call.p,
                             call.outer_gradient, call.inner_gradient);
@@ -206,6 +206,13 @@ inline void chin_scheduled_stages(const M& model, const ChinStepsCall& call) {
     for (std::size_t s = 0; s < call.substeps; ++s)
       chin_stages<StaticSize>(model, call.form, call.coefficients, call.eps.subspan(s, 1), 1, call.count, call.q,
                               call.p, call.outer_gradient, call.inner_gradient);
+}
+
+// chin_scheduled_steps, or with no steps the outer gradient alone (chin_outer_gradient).
+template <std::size_t StaticSize = 0, Model M>
+inline void chin_scheduled_stages(const M& model, const ChinStepsCall& call) {
+  if (chin_outer_gradient(model, call)) return;
+  chin_scheduled_steps<StaticSize>(model, call);
 }
 
 }  // namespace nonsep
