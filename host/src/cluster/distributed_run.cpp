@@ -299,7 +299,20 @@ RunOutcome run_distributed(const LoadedJob& loaded, const RunOptions& options, c
         unit_options.force = !unit_options.resume;  // a unit killed before its first checkpoint starts over
         unit_options.whole_ensemble = loaded.job.initial.count;
         const LoadedJob job = unit_job(loaded, plan.first(unit), plan.size(unit));
-        const RunOutcome outcome = run_job(job, unit_options);
+        RunOutcome outcome;
+        try {
+          outcome = run_job(job, unit_options);
+        } catch (const CheckpointError& error) {
+          if (!unit_options.resume) throw;
+          // A rank killed hard can leave a unit's files unreadable past its checkpoint (results.h5's deflated chunk
+          // rewritten in place when the kill came). The plan's fingerprint already matched this job, and a unit's
+          // trajectories depend only on themselves: run it again from its start, which gives the same bytes.
+          std::fprintf(stderr, "nonsep: warning: work unit %s: %s; running it again from its start\n",
+                       path.string().c_str(), failure_text(error).c_str());
+          unit_options.resume = false;
+          unit_options.force = true;
+          outcome = run_job(job, unit_options);
+        }
         if (outcome.exit_status == ExitStatus::interrupted)
           interrupted = true;
         else
