@@ -511,7 +511,8 @@ int main(int argc, char** argv) {
            host_exponents.clear();
            for (const auto& trajectory : outcome.trajectories) {
              host_q.push_back(trajectory.final_q.at(0));
-             host_exponents.push_back(trajectory.lyapunov.empty() ? std::nan("") : trajectory.lyapunov.at(0));
+             // The job's one indicator is lyapunov with one vector: its first column is lyapunov0.
+             host_exponents.push_back(trajectory.indicators.empty() ? std::nan("") : trajectory.indicators.at(0));
            }
            return elapsed.count();
          },
