@@ -14,11 +14,11 @@ the new build). Prints each build's median, range and the pairwise ratios' media
 """
 import argparse
 import json
-import resource
 import statistics
-import subprocess
 import tempfile
 from pathlib import Path
+
+from timed_run import timed_run
 
 
 def default_job():
@@ -27,14 +27,6 @@ def default_job():
             "initial": [{"q": [0.2 + 1.8 * j / 1024], "p": [0.0]} for j in range(1024)],
             "time": {"dt": 1e-6, "steps": 195312},
             "output": {"every": 0}}
-
-
-def run(nonsep, job, out, threads):
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([nonsep, "run", "-q", "--force", "--threads", str(threads), "--output", str(out), str(job)],
-                   check=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
 
 
 def main():
@@ -54,7 +46,7 @@ def main():
         times = {"old": [], "new": []}
         for _ in range(arguments.repeats):
             for name in ("old", "new"):
-                times[name].append(run(getattr(arguments, name), job.resolve(), folder / name, arguments.threads))
+                times[name].append(timed_run(getattr(arguments, name), job.resolve(), folder / name, arguments.threads)[0])
         for name in ("old", "new"):
             cpu = times[name]
             print(f"{name} ({getattr(arguments, name)}): CPU {statistics.median(cpu):.3f} s "

@@ -11,13 +11,12 @@ Prints the medians and ranges of both and their ratio (the analysis's cost is th
 samples every EVERY-th step instead, with 2^14 EVERY steps, so that the number of samples stays 2^14.
 """
 import json
-import resource
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
+
+from timed_run import timed_run
 
 nonsep = sys.argv[1]
 repeats = int(sys.argv[2]) if len(sys.argv) > 2 else 5
@@ -38,13 +37,7 @@ def job(with_analysis):
 
 
 def run(path, folder):
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    subprocess.run([nonsep, "run", "-q", "--force", "--threads", threads, "--output", str(folder / "out"),
-                    str(path)], check=True)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime, wall
+    return timed_run(nonsep, path, folder / "out", threads)
 
 
 def describe(name, times):

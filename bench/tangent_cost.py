@@ -11,12 +11,12 @@ Prints the medians and ranges of both, their ratio, and the grad H per state and
 evaluation counts: the iterations of the stages, times the stages).
 """
 import json
-import resource
 import statistics
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from timed_run import timed_run
 
 nonsep = sys.argv[1]
 repeats = int(sys.argv[2]) if len(sys.argv) > 2 else 5
@@ -44,10 +44,7 @@ def job(with_tangents):
 
 
 def run(path, out):
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([nonsep, "run", "-q", "--force", "--threads", "1", "--output", str(out), str(path)], check=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    return timed_run(nonsep, path, out)[0]
 
 
 def evaluations(out):
