@@ -133,22 +133,14 @@ PluginModel Plugin::create(const json& parameters_or_null) const {
     throw PluginError(who + ": the parameters must be a JSON object such as {\"name\": value} (found " +
                       std::string(given.type_name()) + ")");
   const auto declared = parameters();
-  json effective = json::object();
-  for (const auto& [key, value] : given.items()) {
-    const auto row =
-        std::find_if(declared.begin(), declared.end(), [&name = key](const auto& p) { return p.name == name; });
-    if (row == declared.end()) {
-      std::string known;
-      for (const auto& p : declared) known += (known.empty() ? "" : ", ") + p.name;
-      throw PluginError(who + ": unknown parameter '" + key + "' (" +
-                        (known.empty() ? "this model has no parameters" : "known parameters: " + known) + ")");
-    }
-    const std::string problem = sdk::check_parameter_value(key, row->type, row->minimum, row->maximum, value);
-    if (!problem.empty()) throw PluginError(who + ": " + problem);
-    effective[key] = value;
+  json effective;
+  try {
+    effective = sdk::checked_parameters(
+        std::span<const PluginParameter>(declared), given, [](const PluginParameter& p) { return p.type; },
+        [](const PluginParameter& p) { return p.default_value; });
+  } catch (const sdk::InvalidParameter& refused) {
+    throw PluginError(who + ": " + refused.what());
   }
-  for (const auto& p : declared)
-    if (!effective.contains(p.name)) effective[p.name] = p.default_value;
 
   const nonsep_plugin_api& api = *loaded_->api;
   auto instance = std::make_shared<PluginModel::Instance>();

@@ -160,6 +160,32 @@ class ParameterValues {
   nlohmann::json values_;
 };
 
+// The parameter object `given` checked against a model's declared rows and completed with their defaults: the one
+// walk of the rules above, shared by the SDK (parse_parameters, inside a plugin) and the host's plugin loader (over
+// the rows of the plugin's metadata). A row has name, minimum and maximum; type_of(row) gives its type's name,
+// default_of(row) its default as JSON. Throws InvalidParameter naming the first key refused.
+template <class Row, class TypeOf, class DefaultOf>
+nlohmann::json checked_parameters(std::span<const Row> rows, const nlohmann::json& given, TypeOf type_of,
+                                  DefaultOf default_of) {
+  nlohmann::json checked = nlohmann::json::object();
+  for (const auto& [key, value] : given.items()) {
+    const auto row = std::find_if(rows.begin(), rows.end(), [&name = key](const Row& p) { return name == p.name; });
+    if (row == rows.end()) {
+      std::string known;
+      for (const Row& p : rows) known += (known.empty() ? "" : ", ") + std::string(p.name);
+      throw InvalidParameter(key, "unknown parameter '" + key + "' (" +
+                                      (known.empty() ? "this model has no parameters" : "known parameters: " + known) +
+                                      ")");
+    }
+    const std::string problem = check_parameter_value(key, type_of(*row), row->minimum, row->maximum, value);
+    if (!problem.empty()) throw InvalidParameter(key, problem);
+    checked[key] = value;
+  }
+  for (const Row& p : rows)
+    if (!checked.contains(p.name)) checked[p.name] = default_of(p);
+  return checked;
+}
+
 // Parses and checks parameters given as JSON text against a table (an empty text means "{}").
 // Throws InvalidParameter naming the parameter; see the rules at the top of this file.
 inline ParameterValues parse_parameters(std::span<const Parameter> table, std::string_view json_text) {
@@ -172,24 +198,8 @@ inline ParameterValues parse_parameters(std::span<const Parameter> table, std::s
   if (!given.is_object())
     throw InvalidParameter("", "the parameters must be a JSON object such as {\"name\": value} (found " +
                                    std::string(given.type_name()) + ")");
-  nlohmann::json checked = nlohmann::json::object();
-  for (const auto& [key, value] : given.items()) {
-    const auto row =
-        std::find_if(table.begin(), table.end(), [&name = key](const Parameter& p) { return name == p.name; });
-    if (row == table.end()) {
-      std::string known;
-      for (const auto& p : table) known += (known.empty() ? "" : ", ") + std::string(p.name);
-      throw InvalidParameter(key, "unknown parameter '" + key + "' (" +
-                                      (known.empty() ? "this model has no parameters" : "known parameters: " + known) +
-                                      ")");
-    }
-    const std::string problem = check_parameter_value(key, to_string(row->type), row->minimum, row->maximum, value);
-    if (!problem.empty()) throw InvalidParameter(key, problem);
-    checked[key] = value;
-  }
-  for (const auto& p : table)
-    if (!checked.contains(p.name)) checked[p.name] = default_as_json(p);
-  return ParameterValues(std::move(checked));
+  return ParameterValues(checked_parameters(
+      table, given, [](const Parameter& p) { return to_string(p.type); }, default_as_json));
 }
 
 // The "parameters" array of the plugin metadata for a table.
