@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Round-off in H over 10^7 steps of Gauss-Legendre (docs/performance.md, "Round-off").
+"""Round-off in H over 10^7 steps of Gauss-Legendre (docs/accuracy.md, "Round-off of Gauss-Legendre").
 
 64 paper1d orbits (q0 = 0.2 + 0.8 j/64, p0 = 0), gauss with --stages stages (3) at dt = --dt (0.001: the truncation
 error in H is below 1e-16 there), --steps steps (10^7), H written every steps/1000 steps. For each written step the

@@ -1,4 +1,4 @@
-// The cost of following tangent vectors (docs/performance.md, "Tangent map"): time per basic step of
+// The cost of following tangent vectors (docs/performance-tangent.md): time per basic step of
 // TangentBasicStep with k tangent vectors per trajectory over the plain ChinBasicStep, same model, same states, in
 // the same run. k = 1 (largest Lyapunov exponent, MEGNO) and k = 2n (the whole spectrum), on paper1d and paper2d
 // compiled in (the shipped model classes through ModelAdapter: analytic gradients, Hessians by the SDK's
