@@ -89,7 +89,7 @@ Timing median_time(const std::function<double()>& run) {
 
 std::string label(const IntegratorSpec& spec) {
   if (spec.scheme == "basic" || spec.scheme == "implicit_midpoint") return spec.scheme;
-  return spec.scheme + " " + Integrator(spec).describe().order.to_string();
+  return spec.scheme + " " + Integrator::describe(spec).order.to_string();
 }
 
 std::vector<IntegratorSpec> symplectic_schemes() {

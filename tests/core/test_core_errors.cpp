@@ -171,7 +171,14 @@ TEST_CASE("each catalogue entry builds exactly its orders, with its own flags") 
     };
     for (const Fraction& order : orders) {
       CAPTURE(order.to_string());
-      const auto description = Integrator(spec_of(order)).describe();
+      const Integrator integrator(spec_of(order));
+      const auto description = Integrator::describe(spec_of(order));
+      // Described without building a stepper, it is what the stepper built says of itself.
+      IntegratorDescription built = std::visit([](const auto& s) { return description_of(s); }, integrator.stepper());
+      built.scheme = scheme.name;  // gauss's stepper serves implicit_midpoint too
+      CHECK(description == built);
+      CHECK(integrator.describe() == description);
+      CHECK(Integrator::describe(spec_of_order(scheme, order)).order == order);
       CHECK(description.scheme == scheme.name);
       CHECK(description.family == scheme.family);
       CHECK(description.order == order);
@@ -179,6 +186,13 @@ TEST_CASE("each catalogue entry builds exactly its orders, with its own flags") 
       CHECK(description.time_reversible == scheme.time_reversible);
       CHECK(description.t2 == (chin ? -2.0 : 0.0));
     }
+    // The orders scheme "auto" tries are among the scheme's.
+    for (const Fraction& order : scheme.auto_orders)
+      CHECK(std::find(orders.begin(), orders.end(), order) != orders.end());
+    const Fraction absent(orders.back().numerator() + 1, orders.back().denominator());
+    CHECK(contains(error_of([&] { spec_of_order(scheme, absent); }), "the scheme '" + scheme.name + "' has no order " +
+                                                                         absent.to_string() + "; its orders are " +
+                                                                         orders.front().to_string()));
     if (chin) {
       // The next order of the family is beyond the entry's list, and the default order is one of its orders.
       const Fraction beyond(2 * (scheme.highest_order_index + 1), 3);
@@ -186,12 +200,28 @@ TEST_CASE("each catalogue entry builds exactly its orders, with its own flags") 
                        Integrator(IntegratorSpec{scheme.name, ChinOptions{beyond}});
                      }),
                      "beyond the highest order"));
+      CHECK(error_of([&] {
+              Integrator::describe(IntegratorSpec{scheme.name, ChinOptions{beyond}});
+            }) == error_of([&] {
+              Integrator(IntegratorSpec{scheme.name, ChinOptions{beyond}});
+            }));
+      // t2 is refused before the order, described or built.
+      CHECK(error_of([&] {
+              Integrator::describe(IntegratorSpec{scheme.name, ChinOptions{beyond, 0.0}});
+            }) == error_of([&] {
+              Integrator(IntegratorSpec{scheme.name, ChinOptions{beyond, 0.0}});
+            }));
+      CHECK(contains(error_of([&] {
+                       Integrator::describe(IntegratorSpec{scheme.name, ChinOptions{beyond, 0.0}});
+                     }),
+                     "t2"));
       CHECK(std::find(orders.begin(), orders.end(), Fraction::parse(scheme.parameters[0].default_text)) !=
             orders.end());
     } else if (scheme.name != "implicit_midpoint") {
       // The order after the last (tao 8, gauss 9 stages) does not exist: the message names the valid ones.
       const Fraction beyond(orders.back().numerator() + 2);
       CHECK(contains(error_of([&] { Integrator(spec_of(beyond)); }), scheme.name == "tao" ? "2, 4" : "1 to 8"));
+      CHECK(error_of([&] { Integrator::describe(spec_of(beyond)); }) == error_of([&] { Integrator(spec_of(beyond)); }));
     }
   }
 }
@@ -209,6 +239,13 @@ TEST_CASE("comparator options: each bad value has its own message") {
   CHECK(contains(error_of([&] { Integrator{gauss}; }), "1 to 8 stages"));
   gauss.options = GaussOptions{2, 0};
   CHECK(contains(error_of([&] { Integrator{gauss}; }), "max_iterations >= 1"));
+  CHECK(contains(error_of([&] { Integrator::describe(gauss); }), "max_iterations >= 1"));
+  CHECK(contains(error_of([&] {
+                   Integrator::describe(IntegratorSpec{"implicit_midpoint", ImplicitMidpointOptions{0}});
+                 }),
+                 "max_iterations >= 1"));
+  CHECK(contains(error_of([&] { Integrator::describe(tao); }), "omega must be finite and positive"));
+  CHECK(contains(error_of([&] { Integrator::describe(IntegratorSpec{"rk4"}); }), "unknown integrator scheme 'rk4'"));
   // A comparator has no t2: its options have no member for it (a programming error, not a job's).
   IntegratorSpec midpoint{"implicit_midpoint"};
   CHECK_THROWS_AS(set_option(midpoint, find_scheme("basic")->parameters[1], 0.0), std::logic_error);

@@ -22,11 +22,11 @@ class RepeatedBasicStep {
   const SeparableBasicStep& base() const { return base_; }
   int substeps() const { return substeps_; }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
-  IntegratorDescription describe() const {
-    IntegratorDescription d = base_.describe();
-    d.scheme = "repeated";
-    d.basic_steps_per_step = static_cast<std::uint64_t>(substeps_);
-    return d;
+  IntegratorDescription describe() const { return description(base_.describe(), substeps_); }
+  static IntegratorDescription description(IntegratorDescription base, int substeps) {
+    base.scheme = "repeated";
+    base.basic_steps_per_step = static_cast<std::uint64_t>(substeps);
+    return base;
   }
   template <Model M>
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
@@ -51,20 +51,26 @@ struct RepeatedScheme {
   using Options = RepeatedOptions;
   using Stepper = RepeatedBasicStep;
   static SchemeDescription description() {
-    return {"repeated",
-            "The basic step repeated",
-            "eq. (expalg)",
-            "substeps basic steps of dt / substeps.",
-            "chin",
-            true,
-            true,
-            describe_options(RepeatedOptions{}),
-            1,
-            {}};
+    return {.name = "repeated",
+            .method = "The basic step repeated",
+            .equations = "eq. (expalg)",
+            .summary = "substeps basic steps of dt / substeps.",
+            .family = "chin",
+            .symplectic = true,
+            .time_reversible = true,
+            .parameters = describe_options(RepeatedOptions{}),
+            .highest_order_index = 1,
+            .comparator_orders = {},
+            .auto_orders = {}};
   }
-  static Stepper make(const Options& options, HamiltonianForm form) {
+  static IntegratorDescription describe(const Options& options) {
+    const IntegratorDescription base = ChinBasicStep::description(ChinCoefficients::from_t2(options.t2).t2);
     if (options.substeps < 1)
       throw InvalidArgument("repeated needs substeps >= 1 (found " + std::to_string(options.substeps) + ")");
+    return Stepper::description(base, options.substeps);
+  }
+  static Stepper make(const Options& options, HamiltonianForm form) {
+    describe(options);
     return Stepper(SeparableBasicStep(ChinBasicStep(form, options.t2)), options.substeps);
   }
 };
@@ -149,6 +155,7 @@ TEST_CASE("an added scheme steps through the integrator bit for bit as its stepp
   CHECK(integrator.evaluations().grad_T == basic.evaluations().grad_T);
 
   const IntegratorDescription d = integrator.describe();
+  CHECK(d == ExtendedIntegrator::describe(spec));  // what it is, without building it
   CHECK(d.scheme == "repeated");
   CHECK(d.order == Fraction(2, 3));
   CHECK(d.basic_steps_per_step == 3);

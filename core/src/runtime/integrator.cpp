@@ -1,5 +1,6 @@
 #include "nonsep/core/runtime/integrator.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <stdexcept>
 
@@ -21,6 +22,25 @@ IntegratorSpec default_spec(const Scheme& scheme, HamiltonianForm form) {
   spec.form = form;
   for (const auto& parameter : scheme.parameters)
     if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
+  return spec;
+}
+
+IntegratorSpec spec_of_order(const Scheme& scheme, const Fraction& order, HamiltonianForm form) {
+  IntegratorSpec spec = default_spec(scheme, form);
+  const auto orders = scheme.orders();
+  if (std::find(orders.begin(), orders.end(), order) == orders.end()) {
+    std::string known;
+    for (const Fraction& o : orders) known += (known.empty() ? "" : ", ") + o.to_string();
+    throw InvalidArgument("the scheme '" + scheme.name + "' has no order " + order.to_string() + "; its orders are " +
+                          known);
+  }
+  for (const auto& parameter : scheme.parameters) {
+    if (parameter.name == "order") set_option(spec, parameter, order);
+    if (parameter.name == "stages") set_option(spec, parameter, order.value() / 2.0);
+  }
+  if (Integrator::describe(spec).order != order)
+    throw std::logic_error("the catalogue entry '" + scheme.name + "' lists order " + order.to_string() +
+                           " but no option sets it");
   return spec;
 }
 

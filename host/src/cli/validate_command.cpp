@@ -24,7 +24,7 @@ std::string initial_shell_text(const InitialStates& initial, bool sweep) {
 
 // "triplet, order 4/3, t2 = -1.8171205928321397": the scheme, the order it has and its other catalogue options.
 std::string integrator_text(const IntegratorSpec& spec) {
-  std::string text = spec.scheme + ", order " + Integrator(spec).describe().order.to_string();
+  std::string text = spec.scheme + ", order " + Integrator::describe(spec).order.to_string();
   for (const auto& parameter : find_scheme(spec.scheme)->parameters) {
     if (parameter.name == "order") continue;
     const auto value = option_value(spec, parameter);

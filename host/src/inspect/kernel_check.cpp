@@ -71,7 +71,7 @@ std::string checked_schemes_text(const std::vector<IntegratorSpec>& specs) {
     text += i == 0 ? "" : i + 1 == specs.size() ? " and " : ", ";
     text += specs[i].scheme;
     if (find_scheme(specs[i].scheme)->highest_order_index > 1)
-      text += " " + Integrator(specs[i]).describe().order.to_string();
+      text += " " + Integrator::describe(specs[i]).order.to_string();
   }
   return text;
 }

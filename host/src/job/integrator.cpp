@@ -99,14 +99,14 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
     }
     const auto value = read_option(check, parameter, *given, option_path);
     if (!value || !scheme) continue;
-    // The core decides what is valid: build the scheme with this one option set and the others at their defaults
-    // (setting an integer option refuses a number that is not whole).
+    // The core decides what is valid: the scheme described with this one option set and the others at their
+    // defaults (setting an integer option refuses a number that is not whole).
     IntegratorSpec probe{scheme->name, {}, spec.form};
     for (const auto& other : parameters)
       if (!other.default_text.empty()) set_option(probe, other, default_option_value(other));
     try {
       set_option(probe, parameter, *value);
-      const Integrator probe_integrator(probe);
+      Integrator::describe(probe);
       set_option(spec, parameter, *value);
     } catch (const InvalidArgument& error) {
       check.issue(option_path, describe(*given), error.what());

@@ -90,7 +90,7 @@ std::string default_label(const IntegratorSpec& spec) {
       scheme && scheme->family == "chin" && scheme->highest_order_index == 1)
     return spec.scheme;
   try {
-    return spec.scheme + " " + Integrator(spec).describe().order.to_string();
+    return spec.scheme + " " + Integrator::describe(spec).order.to_string();
   } catch (const InvalidArgument&) {
     return spec.scheme;
   }

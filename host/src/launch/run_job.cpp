@@ -218,7 +218,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   if (!choice.is_null()) outcome.summary["scheme_choice"] = std::move(choice);
   if (plan.estimate)
     outcome.summary["analysis"]["error_estimate"] =
-        error_estimate_facts(*plan.estimate, Integrator(run.integrator).describe().order.value());
+        error_estimate_facts(*plan.estimate, Integrator::describe(run.integrator).order.value());
   if (const auto& shell = job.initial.shell)
     outcome.summary["energy_shell"] = {{"energy", shell->energy},
                                        {"solve_for", shell->solve_for},

@@ -112,7 +112,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (!chaos || series_every == 0) remove_stale(directory / IndicatorColumns::file_name);
   if (run.analysis.error_estimate)
     estimate.emplace(directory / ErrorEstimateObserver::file_name, run_finer(loaded, options),
-                     Integrator(run.integrator).describe().order.value(), job.initial.dimension, options.resume);
+                     Integrator::describe(run.integrator).order.value(), job.initial.dimension, options.resume);
   else
     remove_stale(directory / ErrorEstimateObserver::file_name);
   watch(energy);

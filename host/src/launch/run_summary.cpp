@@ -63,7 +63,7 @@ json stepping_facts(const RunFacts& facts) {
 json run_summary(const RunFacts& facts) {
   const Job& job = facts.loaded.job;
   const SingleRun& run = job.run();
-  const auto description = Integrator(run.integrator).describe();
+  const auto description = Integrator::describe(run.integrator);
   const RunOutcome& outcome = facts.outcome;
   json summary;
   summary["status"] = to_string(outcome.status);

@@ -79,7 +79,7 @@ class StudyExecution {
     for (const auto& list : runs_)
       for (const auto& run : list) ++outcome.run_counts[run.status];
     for (std::size_t i = 0; i < runs_.size(); ++i)
-      outcome.fits.push_back(fit_study(study_.integrators[i], Integrator(study_.integrators[i].spec).describe(),
+      outcome.fits.push_back(fit_study(study_.integrators[i], Integrator::describe(study_.integrators[i].spec),
                                        runs_[i], !reference_q_.empty(), reference_length()));
     outcome.runs = std::move(runs_);
     outcome.summary = summary(outcome, std::chrono::duration<double>(Clock::now() - start).count());
@@ -114,7 +114,7 @@ class StudyExecution {
     run.steps = steps;
     const TimeGrid time = TimeGrid::to_end(study_.t_end, study_.t_end / static_cast<double>(steps), steps);
     run.dt = time.dt;
-    run.basic_steps = steps * Integrator(study_integrator.spec).describe().basic_steps_per_step;
+    run.basic_steps = steps * Integrator::describe(study_integrator.spec).basic_steps_per_step;
     // The timed runs (study.repeats of them) evaluate H only at step 0 and the last step, as a plain run does; one
     // more run, not timed, evaluates it at every step for the largest |dH/H0| over the run (a symplectic scheme's
     // energy error oscillates, so its value at t_end may be far below the maximum). Its numbers are those of the
@@ -164,7 +164,7 @@ class StudyExecution {
   }
 
   void write_row(const StudyIntegrator& integrator, const StudyRun& run) {
-    const auto description = Integrator(integrator.spec).describe();
+    const auto description = Integrator::describe(integrator.spec);
     std::string& row = csv_.row();
     append_csv_text(row, integrator.label);
     row += "," + description.scheme + "," + description.order.to_string() + ",";

@@ -5,11 +5,11 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <utility>
+#include <vector>
 
-#include "nonsep/core/runtime/scheme_catalogue.hpp"
-#include "nonsep/core/runtime/tangent_integrator.hpp"
+#include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
-#include "nonsep/host/formula/formula_model.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
@@ -27,19 +27,6 @@ constexpr double pilot_round_off = 1e-13;
 constexpr double asymptotic_within = 2.5;
 // The pilots' states are kept at t_p k / pilot_marks (k = 1 .. pilot_marks), for the growth of the phase error.
 constexpr std::uint64_t pilot_marks = 8;
-
-// The catalogue's scheme `name` with its defaults, and `order` or `stages` for the option of that name.
-IntegratorSpec spec_of(const std::string& name, Fraction order, double stages, HamiltonianForm form) {
-  IntegratorSpec spec;
-  spec.scheme = name;
-  spec.form = form;
-  for (const auto& parameter : find_scheme(name)->parameters) {
-    if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
-    if (parameter.name == "order") set_option(spec, parameter, order);
-    if (parameter.name == "stages") set_option(spec, parameter, stages);
-  }
-  return spec;
-}
 
 // One pilot run: its states at t_p k / pilot_marks (k = 1 .. pilot_marks; those that fall on a step) and its largest
 // |dH/H0| up to t_p / 2 and t_p (energy evaluated at every step when the measure is the energy).
@@ -177,7 +164,7 @@ class Pilots {
     const double spent_before = choice_.pilot_seconds;
     PilotResult result;
     result.candidate = candidate;
-    const double order = Integrator(candidate.spec).describe().order.value();
+    const double order = Integrator::describe(candidate.spec).order.value();
     const bool energy = choice_.measure == AutoScheme::Measure::energy;
     const std::size_t width = 2 * loaded_.job.initial.dimension;
     std::map<std::uint64_t, PilotRun> runs;
@@ -322,49 +309,6 @@ json number_or_null(double x, bool known) { return known && std::isfinite(x) ? j
 
 }  // namespace
 
-AutoModel auto_model(const Plugin& plugin) {
-  return {plugin.general_hamiltonian(), plugin.has_hessians() && plugin.has_third_derivatives(),
-          plugin.has_hamiltonian_hessian_products()};
-}
-
-AutoModel auto_model(const formula::FormulaModel& model) {
-  // Its plugin's functions are templates of the number type: the SDK differentiates them to every order.
-  return {model.h_tree.has_value(), true, true};
-}
-
-std::vector<AutoCandidate> auto_candidates(const LoadedJob& loaded) {
-  return auto_candidates(loaded.job, auto_model(loaded.plugin));
-}
-
-std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& model) {
-  const SingleRun& run = job.run();
-  const HamiltonianForm form = run.integrator.form;
-  // Fastest first, so that the pilots of slower ones are cut short: Gauss by falling order (on paper1d order 16
-  // needs the fewest grad H of all stage counts to meet 1e-8 or tighter: bench/comparators.cpp), then Chin's.
-  std::vector<AutoCandidate> all{
-      {"gauss 16", spec_of("gauss", Fraction(2, 3), 8, form)},
-      {"gauss 8", spec_of("gauss", Fraction(2, 3), 4, form)},
-      {"gauss 6", spec_of("gauss", Fraction(2, 3), 3, form)},
-      {"gauss 4", spec_of("gauss", Fraction(2, 3), 2, form)},
-      {"mpe 4", spec_of("mpe", Fraction(4), 2, form)},
-      {"triplet 8/3", spec_of("triplet", Fraction(8, 3), 2, form)},
-      {"triplet 2", spec_of("triplet", Fraction(2), 2, form)},
-  };
-  // A model given by H (general_hamiltonian) has the gradient of H and no product form for Chin's schemes.
-  const bool general = model.general;
-  const bool gradient_of_h = general || model.hessians_and_third_derivatives;
-  std::vector<AutoCandidate> usable;
-  for (auto& candidate : all) {
-    if (is_comparator(candidate.spec.scheme) ? !gradient_of_h : general) continue;
-    // A comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
-    if (run.analysis.tangent_vectors() > 0 &&
-        (!has_tangent_map(candidate.spec) || (is_comparator(candidate.spec.scheme) && !model.hessian_products)))
-      continue;
-    usable.push_back(std::move(candidate));
-  }
-  return usable;
-}
-
 namespace {
 
 // The choice by `measure`: the pilots at each fraction of t_end in turn until some candidate is usable.
@@ -507,10 +451,10 @@ json candidates_json(const std::vector<PilotResult>& pilots) {
   json candidates = json::array();
   for (const PilotResult& pilot : pilots) {
     const bool usable = pilot.excluded.empty();
-    const double order = Integrator(pilot.candidate.spec).describe().order.value();
+    const double order = Integrator::describe(pilot.candidate.spec).order.value();
     candidates.push_back({{"label", pilot.candidate.label},
                           {"scheme", pilot.candidate.spec.scheme},
-                          {"order", Integrator(pilot.candidate.spec).describe().order.to_string()},
+                          {"order", Integrator::describe(pilot.candidate.spec).order.to_string()},
                           {"excluded", usable ? json(nullptr) : json(pilot.excluded)},
                           {"pilot_steps", pilot.pilot_steps ? json(4 * pilot.pilot_steps) : json(nullptr)},
                           {"pilot_dt", number_or_null(pilot.pilot_dt, pilot.pilot_steps > 0)},

@@ -91,7 +91,19 @@ class BasicIntegrator {
 
   // Throws InvalidArgument naming the problem: unknown scheme (listing the known ones), an option the scheme
   // refuses (t2 zero or not finite, an order it does not have, listing the valid ones; omega, stages).
-  explicit BasicIntegrator(const Spec& spec) : spec_(spec), index_(spec.index_of(spec.scheme)), stepper_(build()) {}
+  explicit BasicIntegrator(const Spec& spec) : spec_(spec), index_(known_index(spec)), stepper_(build()) {}
+
+  // What the spec's scheme is (its name, order, flags, family and cost in basic steps), read from the scheme's type
+  // and options without building a stepper. Throws InvalidArgument as the constructor does.
+  static IntegratorDescription describe(const Spec& spec) {
+    std::optional<IntegratorDescription> d;
+    with_scheme_at<Schemes...>(known_index(spec), [&](auto scheme) {
+      using A = typename decltype(scheme)::type;
+      d = A::describe(spec.template options_of<A>());
+    });
+    d->scheme = spec.scheme;  // one stepper type may serve two entries (gauss, implicit_midpoint): the entry's name
+    return *d;
+  }
 
   template <Model M>
   void step(const M& model, PhaseSpaceBatch& x, double dt) {
@@ -156,11 +168,7 @@ class BasicIntegrator {
     return std::visit([](const auto& stepper) -> const EvaluationCounts& { return stepper.evaluations(); }, stepper_);
   }
   // The scheme's name, order, flags and family (a comparator's t2 is 0 and basic_steps_per_step 1).
-  IntegratorDescription describe() const {
-    IntegratorDescription d = std::visit([](const auto& stepper) { return description_of(stepper); }, stepper_);
-    d.scheme = spec_.scheme;  // one stepper type may serve two entries (gauss, implicit_midpoint): the entry's name
-    return d;
-  }
+  IntegratorDescription describe() const { return describe(spec_); }
   // Whether the scheme is of the catalogue's family "comparator" (Tao, Gauss-Legendre): it steps only a model with
   // Hessians and third derivatives.
   bool is_comparator() const { return catalogue()[index_].family == "comparator"; }
@@ -170,12 +178,17 @@ class BasicIntegrator {
   const Stepper& stepper() const { return stepper_; }
 
  private:
-  Stepper build() const {
-    if (index_ == sizeof...(Schemes)) {
+  // The index of the spec's scheme in the list; InvalidArgument naming the known ones for a name not in it.
+  static std::size_t known_index(const Spec& spec) {
+    const std::size_t index = spec.index_of(spec.scheme);
+    if (index == sizeof...(Schemes)) {
       std::string known;
       for (const auto& scheme : catalogue()) known += (known.empty() ? "" : ", ") + scheme.name;
-      throw InvalidArgument("unknown integrator scheme '" + spec_.scheme + "'; the schemes are " + known);
+      throw InvalidArgument("unknown integrator scheme '" + spec.scheme + "'; the schemes are " + known);
     }
+    return index;
+  }
+  Stepper build() const {
     std::optional<Stepper> built;
     with_scheme_at<Schemes...>(index_, [&](auto scheme) {
       using A = typename decltype(scheme)::type;

@@ -23,5 +23,8 @@ using SchemeStepper = Integrator::Stepper;
 // The spec of `scheme` with every option at its catalogue default (required options, without one, at their
 // Options{} values), in form `form`.
 IntegratorSpec default_spec(const Scheme& scheme, HamiltonianForm form = HamiltonianForm::TTV);
+// The spec of `scheme` of order `order`, its other options at their defaults: the option "order" set to it, or
+// "stages" to order / 2 (Gauss-Legendre). InvalidArgument naming the scheme's orders when it has not this one.
+IntegratorSpec spec_of_order(const Scheme& scheme, const Fraction& order, HamiltonianForm form = HamiltonianForm::TTV);
 
 }  // namespace nonsep

@@ -23,15 +23,17 @@ namespace nonsep {
 
 // Whether the scheme `spec` names has a tangent map (TangentIntegrator builds one): the one place that says so, for
 // the job reader and scheme "auto". Every scheme of the catalogue has one; a comparator's needs the model's
-// directional derivative of grad H besides (the job reader checks the plugin for it). Throws InvalidArgument as
-// Integrator(spec) does.
+// directional derivative of grad H besides (the job reader checks the plugin for it). Read from the scheme's stepper
+// type without building one; throws InvalidArgument as Integrator(spec) does.
 template <class... Schemes>
 bool has_tangent_map(const BasicIntegratorSpec<Schemes...>& spec) {
-  return std::visit(
-      [](const auto& stepper) {
-        return requires { tangent_map_of(stepper, std::size_t{1}); };
-      },
-      BasicIntegrator<Schemes...>(spec).stepper());
+  BasicIntegrator<Schemes...>::describe(spec);
+  bool has = false;
+  with_scheme_at<Schemes...>(spec.index_of(spec.scheme), [&](auto scheme) {
+    using S = typename decltype(scheme)::type::Stepper;
+    has = requires(const S& stepper) { tangent_map_of(stepper, std::size_t{1}); };
+  });
+  return has;
 }
 
 // The tangent map type of stepper type S, or void without one.

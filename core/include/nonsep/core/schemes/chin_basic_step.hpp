@@ -96,7 +96,9 @@ class ChinBasicStep {
   const ChinCoefficients& coefficients() const { return c_; }
   const EvaluationCounts& evaluations() const { return evaluations_; }
 
-  IntegratorDescription describe() const { return {"basic", Fraction(2, 3), true, true, 1, c_.t2}; }
+  IntegratorDescription describe() const { return description(c_.t2); }
+  // The description of the basic step of coefficient t2 (its scheme's, chin_schemes.hpp, without building one).
+  static IntegratorDescription description(double t2) { return {"basic", Fraction(2, 3), true, true, 1, t2}; }
 
   // Advances every state of `x` by dt (finite, non-zero). Throws InvalidArgument on a bad dt or a batch whose
   // dimension differs from the model's; propagates the model's exceptions.

@@ -36,7 +36,12 @@ inline std::vector<ParameterDescription> options(const ChinOptions& defaults, in
                                                              : "any of " + chin_orders_text() + " up to " +
                                                                    Fraction(2 * highest_order_index, 3).to_string());
 }
-// The basic step of `options` (InvalidArgument for t2 = 0 or not finite): t2 is checked before the order.
+// The description of the basic step of `options` (InvalidArgument for t2 = 0 or not finite): t2 is checked before
+// the order.
+inline IntegratorDescription base_description(const ChinOptions& options) {
+  return ChinBasicStep::description(ChinCoefficients::from_t2(options.t2).t2);
+}
+// The basic step of `options`, checked by its scheme's describe().
 inline SeparableBasicStep base(const ChinOptions& options, HamiltonianForm form) {
   return SeparableBasicStep(ChinBasicStep(form, options.t2));
 }
@@ -46,22 +51,29 @@ struct BasicScheme {
   using Options = ChinOptions;
   using Stepper = SeparableBasicStep;
   static SchemeDescription description() {
-    return {"basic",
-            "Chin basic 9-stage splitting",
-            "eq. (expalg)",
-            "One palindromic 9-stage splitting of the separable T(p) + V(q) with eps = cbrt(dt); solves H_TTV "
-            "(or H_VVT with T and V interchanged). Order 2/3; 4 grad T + 4 grad V evaluations per step.",
-            "chin",
-            true,
-            true,
-            chin_scheme::options(ChinOptions{}, 1),
-            1,
-            {}};
+    return {.name = "basic",
+            .method = "Chin basic 9-stage splitting",
+            .equations = "eq. (expalg)",
+            .summary =
+                "One palindromic 9-stage splitting of the separable T(p) + V(q) with eps = cbrt(dt); solves H_TTV "
+                "(or H_VVT with T and V interchanged). Order 2/3; 4 grad T + 4 grad V evaluations per step.",
+            .family = "chin",
+            .symplectic = true,
+            .time_reversible = true,
+            .parameters = chin_scheme::options(ChinOptions{}, 1),
+            .highest_order_index = 1,
+            .comparator_orders = {},
+            .auto_orders = {}};
+  }
+  // What the scheme of `options` is, without building it; InvalidArgument for an option it refuses.
+  static IntegratorDescription describe(const Options& options) {
+    IntegratorDescription d = chin_scheme::base_description(options);
+    chin_order_index(options.order, 1, "basic");
+    return d;
   }
   static Stepper make(const Options& options, HamiltonianForm form) {
-    Stepper base = chin_scheme::base(options, form);
-    chin_order_index(options.order, 1, "basic");
-    return base;
+    describe(options);
+    return chin_scheme::base(options, form);
   }
 };
 
@@ -71,22 +83,29 @@ struct TripletScheme {
   static constexpr int orders = Stepper::max_levels + 1;  // order 2j/3 has j - 1 levels
   static Options defaults() { return {Fraction(4, 3)}; }
   static SchemeDescription description() {
-    return {"triplet",
-            "Triplet composition of the basic step",
-            "eqs. (sym43), (sym63), applied recursively",
-            "T_{(k+2)/3}(dt) = T_{k/3}(dt/(2-s)) T_{k/3}(-s dt/(2-s)) T_{k/3}(dt/(2-s)), s = 2^(3/(k+3)). "
-            "Symplectic and time-reversible; order 2j/3 costs 3^(j-1) basic steps per step.",
-            "chin",
-            true,
-            true,
-            chin_scheme::options(defaults(), orders),
-            orders,
-            {}};
+    return {.name = "triplet",
+            .method = "Triplet composition of the basic step",
+            .equations = "eqs. (sym43), (sym63), applied recursively",
+            .summary =
+                "T_{(k+2)/3}(dt) = T_{k/3}(dt/(2-s)) T_{k/3}(-s dt/(2-s)) T_{k/3}(dt/(2-s)), s = 2^(3/(k+3)). "
+                "Symplectic and time-reversible; order 2j/3 costs 3^(j-1) basic steps per step.",
+            .family = "chin",
+            .symplectic = true,
+            .time_reversible = true,
+            .parameters = chin_scheme::options(defaults(), orders),
+            .highest_order_index = orders,
+            .comparator_orders = {},
+            .auto_orders = {Fraction(8, 3), Fraction(2)}};
+  }
+  static IntegratorDescription describe(const Options& options) {
+    const IntegratorDescription base = chin_scheme::base_description(options);
+    return Stepper::description(base, levels(options));
   }
   static Stepper make(const Options& options, HamiltonianForm form) {
-    SeparableBasicStep base = chin_scheme::base(options, form);
-    return Stepper(std::move(base), chin_order_index(options.order, orders, "triplet") - 1);
+    describe(options);
+    return Stepper(chin_scheme::base(options, form), levels(options));
   }
+  static int levels(const Options& options) { return chin_order_index(options.order, orders, "triplet") - 1; }
 };
 
 struct MultiProductExpansionScheme {
@@ -95,22 +114,29 @@ struct MultiProductExpansionScheme {
   static constexpr int orders = Stepper::max_terms;  // order 2m/3 has m terms
   static Options defaults() { return {Fraction(4, 3)}; }
   static SchemeDescription description() {
-    return {"mpe",
-            "Multi-product expansion of the basic step",
-            "eqs. (mpe43), (mpe63), any number of terms",
-            "sum_i c_i T^i(dt/i), c_i = prod_{j != i} i^n/(i^n - j^n), n = 2/3. Not symplectic, not exactly "
-            "time-reversible; order 2m/3 with m terms costs m(m+1)/2 basic steps per step.",
-            "chin",
-            false,
-            false,
-            chin_scheme::options(defaults(), orders),
-            orders,
-            {}};
+    return {.name = "mpe",
+            .method = "Multi-product expansion of the basic step",
+            .equations = "eqs. (mpe43), (mpe63), any number of terms",
+            .summary =
+                "sum_i c_i T^i(dt/i), c_i = prod_{j != i} i^n/(i^n - j^n), n = 2/3. Not symplectic, not exactly "
+                "time-reversible; order 2m/3 with m terms costs m(m+1)/2 basic steps per step.",
+            .family = "chin",
+            .symplectic = false,
+            .time_reversible = false,
+            .parameters = chin_scheme::options(defaults(), orders),
+            .highest_order_index = orders,
+            .comparator_orders = {},
+            .auto_orders = {Fraction(4)}};
+  }
+  static IntegratorDescription describe(const Options& options) {
+    const IntegratorDescription base = chin_scheme::base_description(options);
+    return Stepper::description(base, terms(options));
   }
   static Stepper make(const Options& options, HamiltonianForm form) {
-    SeparableBasicStep base = chin_scheme::base(options, form);
-    return Stepper(std::move(base), chin_order_index(options.order, orders, "mpe"));
+    describe(options);
+    return Stepper(chin_scheme::base(options, form), terms(options));
   }
+  static int terms(const Options& options) { return chin_order_index(options.order, orders, "mpe"); }
 };
 
 }  // namespace nonsep

@@ -39,28 +39,38 @@ struct TaoScheme {
   using Options = TaoOptions;
   using Stepper = TaoExtendedPhaseSpace;
   static SchemeDescription description() {
-    return {"tao",
-            "Tao's explicit symplectic integrator in extended phase space, for any H",
-            "M. Tao, Phys. Rev. E 94, 043303 (2016)",
-            "Two copies (q, p), (x, y) bound by omega |(q, p) - (x, y)|^2 / 2; Strang splitting of the three "
-            "exactly solvable parts (order 2), triple jumps for 4 and 6. Explicit; symplectic and symmetric on "
-            "the extended phase space, not on (q, p) alone. Cost 3^(order/2) grad H per step plus 1 at the "
-            "start. Reports the largest distance between the copies (summary.json comparator.max_copy_distance)." +
+    return {.name = "tao",
+            .method = "Tao's explicit symplectic integrator in extended phase space, for any H",
+            .equations = "M. Tao, Phys. Rev. E 94, 043303 (2016)",
+            .summary =
+                "Two copies (q, p), (x, y) bound by omega |(q, p) - (x, y)|^2 / 2; Strang splitting of the three "
+                "exactly solvable parts (order 2), triple jumps for 4 and 6. Explicit; symplectic and symmetric on "
+                "the extended phase space, not on (q, p) alone. Cost 3^(order/2) grad H per step plus 1 at the "
+                "start. Reports the largest distance between the copies (summary.json comparator.max_copy_distance)." +
                 comparator_scheme::cost_note,
-            "comparator",
-            true,
-            true,
-            describe_options(TaoOptions{}, "2, 4 or 6"),
-            1,
-            {Fraction(2), Fraction(4), Fraction(6)}};
+            .family = "comparator",
+            .symplectic = true,
+            .time_reversible = true,
+            .parameters = describe_options(TaoOptions{}, "2, 4 or 6"),
+            .highest_order_index = 1,
+            .comparator_orders = {Fraction(2), Fraction(4), Fraction(6)},
+            .auto_orders = {}};
   }
   // Order 2, 4 or 6: the Strang step and its triple jumps.
+  static IntegratorDescription describe(const Options& options) {
+    return Stepper::description(order(options), options.omega).integrator_description();
+  }
   static Stepper make(const Options& options, HamiltonianForm form) {
-    const Fraction& order = options.order;
-    if (order.denominator() != 1 || (order.numerator() != 2 && order.numerator() != 4 && order.numerator() != 6))
-      throw InvalidArgument("Tao's extended phase-space integrator has orders 2, 4 and 6 (found " + order.to_string() +
+    return Stepper(form, order(options), options.omega);
+  }
+  // The order, checked with omega (InvalidArgument for either refused).
+  static int order(const Options& options) {
+    const Fraction& asked = options.order;
+    if (asked.denominator() != 1 || (asked.numerator() != 2 && asked.numerator() != 4 && asked.numerator() != 6))
+      throw InvalidArgument("Tao's extended phase-space integrator has orders 2, 4 and 6 (found " + asked.to_string() +
                             ")");
-    return Stepper(form, static_cast<int>(order.numerator()), options.omega);
+    Stepper::check(static_cast<int>(asked.numerator()), options.omega);
+    return static_cast<int>(asked.numerator());
   }
 };
 
@@ -76,22 +86,28 @@ struct ImplicitMidpointScheme {
   using Options = ImplicitMidpointOptions;
   using Stepper = GaussLegendre;
   static SchemeDescription description() {
-    return {"implicit_midpoint",
-            "Implicit midpoint rule, for any H",
-            "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VIII.6",
-            "z' = z + dt f((z + z')/2), Gauss-Legendre with 1 stage; order 2, symplectic and symmetric. Solved by "
-            "fixed-point iteration (no Newton) from the last step's stage extrapolated, 1 grad H per state per "
-            "iteration. Stopping rule per state: converged when the relative change of the stages is <= 1 ulp, or "
-            "stops decreasing while "
-            "<= 64 ulp; failed when an iterate is not finite or after max_iterations: the trajectory then "
-            "retires with status failed and the reason, never with an inaccurate step." +
+    return {.name = "implicit_midpoint",
+            .method = "Implicit midpoint rule, for any H",
+            .equations = "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VIII.6",
+            .summary =
+                "z' = z + dt f((z + z')/2), Gauss-Legendre with 1 stage; order 2, symplectic and symmetric. Solved by "
+                "fixed-point iteration (no Newton) from the last step's stage extrapolated, 1 grad H per state per "
+                "iteration. Stopping rule per state: converged when the relative change of the stages is <= 1 ulp, or "
+                "stops decreasing while "
+                "<= 64 ulp; failed when an iterate is not finite or after max_iterations: the trajectory then "
+                "retires with status failed and the reason, never with an inaccurate step." +
                 comparator_scheme::cost_note,
-            "comparator",
-            true,
-            true,
-            describe_options(ImplicitMidpointOptions{}),
-            1,
-            {Fraction(2)}};
+            .family = "comparator",
+            .symplectic = true,
+            .time_reversible = true,
+            .parameters = describe_options(ImplicitMidpointOptions{}),
+            .highest_order_index = 1,
+            .comparator_orders = {Fraction(2)},
+            .auto_orders = {}};
+  }
+  static IntegratorDescription describe(const Options& options) {
+    Stepper::check(1, options.max_iterations);
+    return Stepper::description(1, options.max_iterations).integrator_description();
   }
   static Stepper make(const Options& options, HamiltonianForm form) { return Stepper(form, 2, options.max_iterations); }
 };
@@ -110,28 +126,32 @@ struct GaussScheme {
   using Stepper = GaussLegendre;
   static SchemeDescription description() {
     return {
-        "gauss",
-        "Gauss-Legendre collocation, for any H",
-        "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6",
-        "s-stage Gauss-Legendre Runge-Kutta method on Hamilton's equations of H, order 2s; symplectic and "
-        "symmetric, its coefficients arranged so that it stays symplectic in floating point (round-off in H grows "
-        "like the square root of the steps). Fixed-point iteration (no Newton) from the last step's stages "
-        "extrapolated, s grad H per state per iteration, with the "
-        "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed). Implicit: a step "
-        "costs more than an explicit one of the same order, but stays accurate at larger steps on strongly "
-        "coupled or chaotic orbits, which makes it the safer choice for chaos maps (docs/dynamics.md)." +
+        .name = "gauss",
+        .method = "Gauss-Legendre collocation, for any H",
+        .equations = "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6",
+        .summary =
+            "s-stage Gauss-Legendre Runge-Kutta method on Hamilton's equations of H, order 2s; symplectic and "
+            "symmetric, its coefficients arranged so that it stays symplectic in floating point (round-off in H grows "
+            "like the square root of the steps). Fixed-point iteration (no Newton) from the last step's stages "
+            "extrapolated, s grad H per state per iteration, with the "
+            "stopping rule of implicit_midpoint (non-convergence retires the trajectory as failed). Implicit: a step "
+            "costs more than an explicit one of the same order, but stays accurate at larger steps on strongly "
+            "coupled or chaotic orbits, which makes it the safer choice for chaos maps (docs/dynamics.md)." +
             comparator_scheme::cost_note,
-        "comparator",
-        true,
-        true,
-        describe_options(GaussOptions{}),
-        1,
-        {Fraction(2), Fraction(4), Fraction(6), Fraction(8), Fraction(10), Fraction(12), Fraction(14), Fraction(16)}};
+        .family = "comparator",
+        .symplectic = true,
+        .time_reversible = true,
+        .parameters = describe_options(GaussOptions{}),
+        .highest_order_index = 1,
+        .comparator_orders = {Fraction(2), Fraction(4), Fraction(6), Fraction(8), Fraction(10), Fraction(12),
+                              Fraction(14), Fraction(16)},
+        .auto_orders = {Fraction(16), Fraction(8), Fraction(6), Fraction(4)}};
+  }
+  static IntegratorDescription describe(const Options& options) {
+    Stepper::check(options.stages, options.max_iterations);
+    return Stepper::description(options.stages, options.max_iterations).integrator_description();
   }
   static Stepper make(const Options& options, HamiltonianForm form) {
-    if (options.stages < 1 || options.stages > GaussLegendreTableau::max_stages)
-      throw InvalidArgument("Gauss-Legendre collocation has 1 to 8 stages (orders 2 to 16); found " +
-                            std::to_string(options.stages));
     return Stepper(form, 2 * options.stages, options.max_iterations);
   }
 };

@@ -83,10 +83,14 @@ struct GaussLegendreTableau {
   std::vector<double> a, b, c, mu, nu;
 
   // Throws InvalidArgument unless 1 <= stages <= max_stages.
-  static GaussLegendreTableau for_stages(int stages) {
+  static void check_stages(int stages) {
     if (stages < 1 || stages > max_stages)
       throw InvalidArgument("Gauss-Legendre collocation has 1 to 8 stages (orders 2 to 16); found " +
                             std::to_string(stages) + " stages");
+  }
+  // Throws InvalidArgument unless 1 <= stages <= max_stages.
+  static GaussLegendreTableau for_stages(int stages) {
+    check_stages(stages);
     using Real = long double;
     const std::size_t s = static_cast<std::size_t>(stages);
     std::vector<Real> c(s), b(s);
@@ -171,6 +175,11 @@ class GaussLegendre {
         gradient_(form),
         max_iterations_(max_iterations),
         extrapolate_(extrapolate) {
+    check(stages(), max_iterations);
+  }
+  // Throws InvalidArgument unless 1 <= stages <= GaussLegendreTableau::max_stages and max_iterations >= 1.
+  static void check(int stages, int max_iterations) {
+    GaussLegendreTableau::check_stages(stages);
     if (max_iterations < 1)
       throw InvalidArgument("the fixed-point iteration needs max_iterations >= 1 (found " +
                             std::to_string(max_iterations) + ")");
@@ -192,20 +201,23 @@ class GaussLegendre {
   std::span<const double> stage_points_q() const { return final_q_; }
   std::span<const double> stage_points_p() const { return final_p_; }
 
-  ComparatorDescription describe() const {
+  ComparatorDescription describe() const { return description(stages(), max_iterations_); }
+  // The description of the method of this many stages and iterations (its schemes', comparator_schemes.hpp,
+  // without building one).
+  static ComparatorDescription description(int stages, int max_iterations) {
     ComparatorDescription d;
     d.scheme = "gauss";
-    d.method = "Gauss-Legendre collocation, " + std::to_string(stages()) + " stage" + (stages() > 1 ? "s" : "") +
-               (stages() == 1 ? " (implicit midpoint rule)" : "");
+    d.method = "Gauss-Legendre collocation, " + std::to_string(stages) + " stage" + (stages > 1 ? "s" : "") +
+               (stages == 1 ? " (implicit midpoint rule)" : "");
     d.reference = "Hairer, Lubich, Wanner, Geometric Numerical Integration, II.1.3, VI.4, VIII.6";
-    d.order = order();
+    d.order = 2 * stages;
     d.properties = "symplectic and symmetric on (q, p), up to the round-off the fixed-point iteration leaves";
-    d.grad_H_per_iteration = static_cast<std::uint64_t>(stages());
-    d.cost = std::to_string(stages()) +
+    d.grad_H_per_iteration = static_cast<std::uint64_t>(stages);
+    d.cost = std::to_string(stages) +
              " grad H per state per fixed-point iteration; iterations run from the last step's stages "
              "extrapolated until the stages stop changing (at most " +
-             std::to_string(max_iterations_) + ")";
-    d.parameters = {{"max_iterations", static_cast<double>(max_iterations_)}};
+             std::to_string(max_iterations) + ")";
+    d.parameters = {{"max_iterations", static_cast<double>(max_iterations)}};
     return d;
   }
 

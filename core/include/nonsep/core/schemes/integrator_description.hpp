@@ -37,6 +37,10 @@ struct SchemeDescription {
   int highest_order_index = 1;
   // A comparator's orders (2, 4, 6) when they are not of the form 2j/3; empty for Chin's schemes.
   std::vector<Fraction> comparator_orders;
+  // The orders scheme "auto" tries of this scheme (the host's scheme_choice.hpp), highest first; empty: none. Auto
+  // tries the comparators' before Chin's, each by falling order (on paper1d the highest Gauss order needs the fewest
+  // grad H to meet 1e-8 or tighter: bench/comparators.cpp).
+  std::vector<Fraction> auto_orders;
   std::vector<Fraction> orders() const;
 };
 
@@ -48,6 +52,7 @@ struct IntegratorDescription {
   std::uint64_t basic_steps_per_step = 1;
   double t2 = 0.0;
   std::string family = "chin";
+  friend bool operator==(const IntegratorDescription&, const IntegratorDescription&) = default;
 };
 
 // Orders of the paper's family are 2j/3, j = 1, 2, 3, ... (2/3, 4/3, 2, 8/3, 10/3, 4, ...).

@@ -92,18 +92,20 @@ class MultiProductExpansion {
 
   int terms() const { return static_cast<int>(weights_.size()); }
   const std::vector<double>& weights() const { return weights_; }
-  Fraction order() const { return Fraction(2 * terms(), 3); }
+  Fraction order() const { return description({}, terms()).order; }
   const Base& base() const { return base_; }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
-  IntegratorDescription describe() const {
-    IntegratorDescription d = base_.describe();
-    d.scheme = "mpe";
-    d.order = order();
-    d.symplectic = false;
-    d.time_reversible = false;
-    const auto m = static_cast<std::uint64_t>(terms());
-    d.basic_steps_per_step *= m * (m + 1) / 2;
-    return d;
+  IntegratorDescription describe() const { return description(base_.describe(), terms()); }
+  // The description of the expansion of `terms` terms over a base step described by `base` (its scheme's,
+  // chin_schemes.hpp, without building one).
+  static IntegratorDescription description(IntegratorDescription base, int terms) {
+    base.scheme = "mpe";
+    base.order = Fraction(2 * terms, 3);
+    base.symplectic = false;
+    base.time_reversible = false;
+    const auto m = static_cast<std::uint64_t>(terms);
+    base.basic_steps_per_step *= m * (m + 1) / 2;
+    return base;
   }
 
   // Advances every state of `x` by dt, the terms batched (above).

@@ -8,8 +8,12 @@
 //     static Options defaults();                 // optional: its options' defaults, when not Options{}'s
 //     static SchemeDescription description();    // its catalogue entry: name, options (describe_options of its
 //                                                // defaults), orders, flags
+//     static IntegratorDescription describe(const Options&);  // what it is with these options (order, flags,
+//                                                // cost), without building a stepper; InvalidArgument as make
 //     static Stepper make(const Options&, HamiltonianForm);  // InvalidArgument for an option it refuses
 //   };
+//
+// describe(options) and the stepper's own describe() say the same: both read the stepper's static description().
 //
 // A Stepper steps a batch (step(model, x, dt)) and counts its evaluations; what else it offers the integrators find
 // by asking: step_n (n steps in one call, bit for bit n steps), prime (the first-same-as-last gradient), private
@@ -55,6 +59,7 @@ template <class A>
 concept IntegrationScheme = SchemeOptions<typename A::Options> && Stepper<typename A::Stepper> &&
     requires(const typename A::Options& options, HamiltonianForm form) {
   { A::description() } -> std::convertible_to<SchemeDescription>;
+  { A::describe(options) } -> std::convertible_to<IntegratorDescription>;
   { A::make(options, form) } -> std::same_as<typename A::Stepper>;
 };
 

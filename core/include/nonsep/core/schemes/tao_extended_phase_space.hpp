@@ -72,6 +72,10 @@ class TaoExtendedPhaseSpace {
   explicit TaoExtendedPhaseSpace(HamiltonianForm form = HamiltonianForm::TTV, int order = 2,
                                  double omega = default_omega)
       : gradient_(form), order_(order), omega_(omega) {
+    check(order, omega);
+  }
+  // Throws InvalidArgument unless order is 2, 4 or 6 and omega is finite and positive.
+  static void check(int order, double omega) {
     if (order != 2 && order != 4 && order != 6)
       throw InvalidArgument("Tao's extended phase-space integrator has orders 2, 4 and 6 (found " +
                             std::to_string(order) + ")");
@@ -86,18 +90,21 @@ class TaoExtendedPhaseSpace {
   const EvaluationCounts& evaluations() const { return gradient_.evaluations(); }
   void add_evaluations(const EvaluationCounts& counts) { gradient_.add_evaluations(counts); }
 
-  ComparatorDescription describe() const {
-    const int strang = order_ == 2 ? 1 : order_ == 4 ? 3 : 9;
+  ComparatorDescription describe() const { return description(order_, omega_); }
+  // The description of the integrator of this order and omega (its scheme's, comparator_schemes.hpp, without
+  // building one).
+  static ComparatorDescription description(int order, double omega) {
+    const int strang = order == 2 ? 1 : order == 4 ? 3 : 9;
     ComparatorDescription d;
     d.scheme = "tao";
     d.method = "Tao's explicit symplectic integrator in extended phase space";
     d.reference = "M. Tao, Phys. Rev. E 94, 043303 (2016); triple jump: H. Yoshida, Phys. Lett. A 150, 262 (1990)";
-    d.order = order_;
+    d.order = order;
     d.properties = "symplectic and symmetric on the extended phase space (q, p, x, y), not on (q, p) alone";
     d.grad_H_per_step = static_cast<std::uint64_t>(3 * strang);
     d.cost = std::to_string(3 * strang) + " grad H per state per step (" + std::to_string(strang) + " Strang step" +
              (strang > 1 ? "s" : "") + " of 3), plus 1 at the start of a run";
-    d.parameters = {{"omega", omega_}};
+    d.parameters = {{"omega", omega}};
     return d;
   }
 

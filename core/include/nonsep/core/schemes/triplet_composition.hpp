@@ -36,18 +36,20 @@ class TripletComposition {
   }
 
   int levels() const { return levels_; }
-  Fraction order() const { return Fraction(2 * (levels_ + 1), 3); }
+  Fraction order() const { return description({}, levels_).order; }
   // The s of the composition that raises order k/3 = 2*level/3 to (k+2)/3.
   static double s_for_level(int level) { return std::pow(2.0, 3.0 / (2.0 * level + 3.0)); }
 
   const Base& base() const { return base_; }
   const EvaluationCounts& evaluations() const { return base_.evaluations(); }
-  IntegratorDescription describe() const {
-    IntegratorDescription d = base_.describe();
-    d.scheme = "triplet";
-    d.order = order();
-    d.basic_steps_per_step *= static_cast<std::uint64_t>(std::pow(3.0, levels_));
-    return d;
+  IntegratorDescription describe() const { return description(base_.describe(), levels_); }
+  // The description of the composition of `levels` levels over a base step described by `base` (its scheme's,
+  // chin_schemes.hpp, without building one).
+  static IntegratorDescription description(IntegratorDescription base, int levels) {
+    base.scheme = "triplet";
+    base.order = Fraction(2 * (levels + 1), 3);
+    base.basic_steps_per_step *= static_cast<std::uint64_t>(std::pow(3.0, levels));
+    return base;
   }
 
   template <Model M>

@@ -2,11 +2,12 @@
 // Scheme "auto" (/integrator {"scheme": "auto", "tolerance": e, "measure": "phase" | "energy"}): pilot runs on the
 // job's own model and states choose the scheme and the step that meet the tolerance at the least predicted cost.
 //
-// Candidates (auto_candidates): what the plugin and the job allow, fastest first by docs/work-precision.md. With
-// Hessians and third derivatives the comparators Gauss-Legendre 6 and 4; Chin's schemes, which need gradients
-// only: MPE 4 (not symplectic), triplet 8/3, triplet 2. Tangent vectors (/analysis/lyapunov, /megno) keep only the
-// schemes that have a tangent map (nonsep::has_tangent_map). A separable part K(p) + U(q) is solved by every one of
-// them.
+// Candidates (auto_candidates): the catalogue's auto_orders (scheme_catalogue.hpp) that the plugin and the job
+// allow, fastest first by docs/work-precision.md: the comparators' before Chin's, each by falling order. With
+// Hessians and third derivatives the comparators Gauss-Legendre 16, 8, 6 and 4; Chin's schemes, which need
+// gradients only: MPE 4 (not symplectic), triplet 8/3, triplet 2. Tangent vectors (/analysis/lyapunov, /megno) keep
+// only the schemes that have a tangent map (nonsep::has_tangent_map). A separable part K(p) + U(q) is solved by every
+// one of them.
 //
 // Pilots: up to auto_pilot_states of the job's states (evenly spread; with a sweep, as many of each parameter set's
 // states, at least one per set, each stepped with its set's parameters as the run steps it, so that the choice
