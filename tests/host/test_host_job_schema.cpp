@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "host_test_support.hpp"
@@ -232,4 +233,42 @@ TEST_CASE("a misspelt key is named as such, both where it is unknown and where t
   job.erase("outptu");
   job["colour"] = 1;  // nothing like any key: no guess
   CHECK(issues_of(job).front().found == "the unknown key \"colour\"");
+}
+
+TEST_CASE("a value its key table refuses is reported once, with the rule's text, and read no further") {
+  // Each of these is checked by its object's key table alone (key_reader.hpp): one issue at the key's path, whose
+  // text says what the table allows, and nothing else about it (no second message from the section's reader).
+  const std::vector<std::tuple<std::string, json, std::string>> cases{
+      {"/analysis/megno", json{{"megno", 1}}, "true or false: MEGNO of the first tangent vector"},
+      {"/analysis/gali", json{{"gali", 40}}, "an integer from 2 to 2n (at most 32)"},
+      {"/analysis/lyapunov/every", json{{"lyapunov", {{"every", -1}}}}, "an integer >= 0: write lyapunov.csv"},
+      {"/analysis/poincare/direction", json{{"poincare", {{"component", "q0"}, {"direction", "up"}}}},
+       "\"+\" (normal . (q, p) - value goes from < 0 to >= 0; the default), \"-\" or \"both\""},
+      {"/analysis/frequencies/spectra", json{{"frequencies", {{"spectra", 1001}}}}, "an integer from 0 to 1000"},
+      {"/analysis/error_estimate", json{{"error_estimate", "yes"}}, "true or false: estimate each trajectory's"},
+  };
+  for (const auto& [path_text, analysis, allowed_text] : cases) {
+    const std::string &path = path_text, &allowed = allowed_text;  // clang 14 cannot capture a structured binding
+    CAPTURE(path);
+    json job = full_run();
+    job["analysis"] = analysis;
+    const auto issues = issues_of(job);
+    REQUIRE(issues.size() == 1);
+    CHECK(issues[0].path == path);
+    CHECK(issues[0].allowed.find(allowed) == 0);
+  }
+  // The dimension's own limit stays with the reader: paper1d has n = 1, so GALI_3 is refused there, by it.
+  json job = full_run();
+  job["analysis"] = {{"gali", 3}};
+  const auto issues = issues_of(job);
+  REQUIRE(issues.size() == 1);
+  CHECK(issues[0].path == "/analysis/gali");
+  CHECK(issues[0].allowed.find("an integer from 2 to 2 (2n, at most 32)") == 0);
+  // A missing required key is named with the same text.
+  job = full_run();
+  job["initial"] = json::parse(R"({"grid": {"q": [{"from": 0.1, "to": 0.5}], "p": [0.0]}})");
+  const auto missing = issues_of(job);
+  REQUIRE(missing.size() == 1);
+  CHECK(missing[0].path == "/initial/grid/q/0/count");
+  CHECK(missing[0].allowed.find("the number of values, an integer from 1 to ") == 0);
 }

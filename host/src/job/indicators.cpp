@@ -21,41 +21,36 @@ std::size_t most_tangent_vectors(std::size_t dimension) {
   return std::min<std::size_t>(LyapunovRecord::max_exponents, dimension > 0 ? 2 * dimension : 2);
 }
 
+// Refuses a number of tangent vectors above the most the states' dimension allows (the table allows up to 32).
+bool within_dimension(Checker& check, std::int64_t k, std::int64_t least, std::size_t dimension, const std::string& at,
+                      const std::string& meaning) {
+  const std::size_t most = most_tangent_vectors(dimension);
+  if (k <= static_cast<std::int64_t>(most)) return true;
+  check.issue(
+      at, std::to_string(k),
+      "an integer from " + std::to_string(least) + " to " + std::to_string(most) + " (2n, at most 32): " + meaning);
+  return false;
+}
+
 std::shared_ptr<const Indicator> read_lyapunov(Checker& check, const json& value, const std::string& path,
                                                std::size_t dimension, Analysis& analysis) {
-  if (!check.object(value, path, "an object {\"vectors\": k, \"renormalize_every\": m, \"every\": s}")) return nullptr;
-  check.known_keys(value, path, lyapunov_keys().names());
   const std::size_t issues = check.issue_count();
+  const KeyReader keys(check, value, path, lyapunov_keys(),
+                       "an object {\"vectors\": k, \"renormalize_every\": m, \"every\": s}");
   LyapunovAnalysis lyapunov;
-  const std::size_t most = most_tangent_vectors(dimension);
-  if (const json* k = check.member(value, path, "vectors", false, ""))
-    if (auto n = check.integer(*k, child(path, "vectors"), 1, static_cast<std::int64_t>(most),
-                               "an integer from 1 to " + std::to_string(most) +
-                                   " (2n, at most 32): the number of largest exponents (default 1)"))
-      lyapunov.vectors = static_cast<std::size_t>(*n);
-  if (const json* m = check.member(value, path, "renormalize_every", false, ""))
-    if (auto n = check.integer(*m, child(path, "renormalize_every"), 1, static_cast<std::int64_t>(max_steps),
-                               "an integer >= 1: steps between re-orthonormalisations of the tangent vectors "
-                               "(default 1)"))
-      lyapunov.renormalize_every = static_cast<std::uint64_t>(*n);
-  if (const json* every = check.member(value, path, "every", false, ""))
-    if (auto n = check.integer(*every, child(path, "every"), 0, static_cast<std::int64_t>(max_steps),
-                               "an integer >= 0: write lyapunov.csv every n-th step (0: no time series; the "
-                               "default)"))
-      lyapunov.every = static_cast<std::uint64_t>(*n);
+  if (const auto k = keys.integer("vectors"); k && within_dimension(check, *k, 1, dimension, keys.path("vectors"),
+                                                                    "the number of largest exponents (default 1)"))
+    lyapunov.vectors = static_cast<std::size_t>(*k);
+  if (const auto m = keys.integer("renormalize_every")) lyapunov.renormalize_every = static_cast<std::uint64_t>(*m);
+  if (const auto every = keys.integer("every")) lyapunov.every = static_cast<std::uint64_t>(*every);
   if (check.issue_count() != issues) return nullptr;
   analysis.lyapunov = lyapunov;
   return std::make_shared<LyapunovIndicator>(lyapunov.vectors);
 }
 
-// A boolean key: `meaning` completes "true or false: " in its message; `make` the indicator it asks for.
+// A boolean key (its value checked by /analysis's table): `make` the indicator it asks for when true.
 template <class Made>
-std::shared_ptr<const Indicator> read_boolean(Checker& check, const json& value, const std::string& path,
-                                              const std::string& meaning, Made&& make) {
-  if (!value.is_boolean()) {
-    check.issue(path, describe(value), "true or false: " + meaning);
-    return nullptr;
-  }
+std::shared_ptr<const Indicator> when_true(const json& value, Made&& make) {
   return value.get<bool>() ? make() : nullptr;
 }
 
@@ -77,11 +72,10 @@ const std::vector<IndicatorEntry>& indicator_entries() {
                .description =
                    "MEGNO of the first tangent vector (Cincotta and Simo): trajectories.csv columns megno (Y) and "
                    "mean_megno (<Y>: -> 2 on quasi-periodic orbits, ~ lambda t / 2 on chaotic ones). The plugin "
-                   "must have Hessians."},
-       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
-         return read_boolean(check, value, path,
-                             "MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)",
-                             [] { return std::make_shared<const MegnoIndicator>(); });
+                   "must have Hessians.",
+               .allowed = "true or false: MEGNO of the first tangent vector (trajectories.csv megno, mean_megno)"},
+       [](Checker&, const json& value, const std::string&, std::size_t, Analysis&) {
+         return when_true(value, [] { return std::make_shared<const MegnoIndicator>(); });
        }},
       {KeyRule{.name = "sali",
                .type = ValueType::boolean,
@@ -89,10 +83,10 @@ const std::vector<IndicatorEntry>& indicator_entries() {
                .description =
                    "SALI of the first two tangent vectors (Skokos 2001), min(|u1 + u2|, |u1 - u2|) of their unit "
                    "vectors: trajectories.csv column sali (-> 0 exponentially on chaotic orbits, stays away from 0 "
-                   "on regular ones). Shares the vectors of lyapunov (at least 2). The plugin must have Hessians."},
-       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
-         return read_boolean(check, value, path, "SALI of the first two tangent vectors (trajectories.csv sali)",
-                             [] { return std::make_shared<const AlignmentIndicator>(AlignmentIndicator::sali()); });
+                   "on regular ones). Shares the vectors of lyapunov (at least 2). The plugin must have Hessians.",
+               .allowed = "true or false: SALI of the first two tangent vectors (trajectories.csv sali)"},
+       [](Checker&, const json& value, const std::string&, std::size_t, Analysis&) {
+         return when_true(value, [] { return std::make_shared<const AlignmentIndicator>(AlignmentIndicator::sali()); });
        }},
       {KeyRule{.name = "gali",
                .type = ValueType::integer,
@@ -102,16 +96,16 @@ const std::vector<IndicatorEntry>& indicator_entries() {
                    "k (at most 2n): GALI_2 .. GALI_k (Skokos, Bountis and Antonopoulos 2007), the volume spanned "
                    "by the unit vectors of the first j tangent vectors: trajectories.csv columns gali2 .. gali<k> "
                    "(exponential decay on chaotic orbits; constant for j <= N, ~ t^(-2(j-N)) on an N-torus). Shares "
-                   "the vectors of lyapunov. The plugin must have Hessians."},
+                   "the vectors of lyapunov. The plugin must have Hessians.",
+               .allowed = "an integer from 2 to 2n (at most 32): GALI_2 .. GALI_k of the first k tangent vectors "
+                          "(trajectories.csv gali2 .. gali<k>)"},
        [](Checker& check, const json& value, const std::string& path, std::size_t dimension,
           Analysis&) -> std::shared_ptr<const Indicator> {
-         const std::size_t most = most_tangent_vectors(dimension);
-         const auto k = check.integer(value, path, 2, static_cast<std::int64_t>(most),
-                                      "an integer from 2 to " + std::to_string(most) +
-                                          " (2n, at most 32): GALI_2 .. GALI_k of the first k tangent vectors "
-                                          "(trajectories.csv gali2 .. gali<k>)");
-         if (!k) return nullptr;
-         return std::make_shared<const AlignmentIndicator>(AlignmentIndicator::gali(static_cast<std::size_t>(*k)));
+         const std::int64_t k = *integral_value(value);
+         if (!within_dimension(check, k, 2, dimension, path,
+                               "GALI_2 .. GALI_k of the first k tangent vectors (trajectories.csv gali2 .. gali<k>)"))
+           return nullptr;
+         return std::make_shared<const AlignmentIndicator>(AlignmentIndicator::gali(static_cast<std::size_t>(k)));
        }},
       {KeyRule{.name = "fli",
                .type = ValueType::boolean,
@@ -119,11 +113,11 @@ const std::vector<IndicatorEntry>& indicator_entries() {
                .description =
                    "The fast Lyapunov indicator of the first tangent vector (Froeschle, Lega and Gonczi 1997): "
                    "trajectories.csv column fli, the supremum over the steps of ln |w(t)| with |w(0)| = 1 (~ lambda "
-                   "t on chaotic orbits, ~ ln t on regular ones). The plugin must have Hessians."},
-       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
-         return read_boolean(check, value, path,
-                             "the fast Lyapunov indicator of the first tangent vector (trajectories.csv fli)",
-                             [] { return std::make_shared<const FastLyapunovIndicator>(); });
+                   "t on chaotic orbits, ~ ln t on regular ones). The plugin must have Hessians.",
+               .allowed = "true or false: the fast Lyapunov indicator of the first tangent vector (trajectories.csv "
+                          "fli)"},
+       [](Checker&, const json& value, const std::string&, std::size_t, Analysis&) {
+         return when_true(value, [] { return std::make_shared<const FastLyapunovIndicator>(); });
        }},
       {KeyRule{.name = "ofli",
                .type = ValueType::boolean,
@@ -133,12 +127,11 @@ const std::vector<IndicatorEntry>& indicator_entries() {
                    "trajectories.csv column ofli, the supremum over the steps of ln |w_perp(t)|, w_perp the first "
                    "tangent vector's component across the flow J grad H, |w_perp(0)| = 1 (~ lambda t on chaotic "
                    "orbits, ~ ln t on regular ones, bounded on periodic ones). One gradient of H per state and "
-                   "step: the plugin must have Hessians and third derivatives, or be given by H."},
-       [](Checker& check, const json& value, const std::string& path, std::size_t, Analysis&) {
-         return read_boolean(check, value, path,
-                             "the orthogonal fast Lyapunov indicator of the first tangent vector (trajectories.csv "
-                             "ofli)",
-                             [] { return std::make_shared<const OrthogonalFastLyapunovIndicator>(); });
+                   "step: the plugin must have Hessians and third derivatives, or be given by H.",
+               .allowed = "true or false: the orthogonal fast Lyapunov indicator of the first tangent vector "
+                          "(trajectories.csv ofli)"},
+       [](Checker&, const json& value, const std::string&, std::size_t, Analysis&) {
+         return when_true(value, [] { return std::make_shared<const OrthogonalFastLyapunovIndicator>(); });
        }},
   };
   return entries;

@@ -18,7 +18,8 @@ namespace nonsep::host::job_reader {
 
 struct IndicatorEntry {
   KeyRule rule;
-  // Reads the key's value at `path` (present in the job) for initial states of `dimension` (0 when unknown): the
+  // Reads the key's value at `path` (present in the job, and of the rule's type and range: /analysis's KeyReader
+  // checked it) for initial states of `dimension` (0 when unknown): the
   // indicator it asks for, or nothing (false, or an issue was reported). May set what the indicator shares with
   // the run (analysis.lyapunov: the tangent vectors' renormalisation and the series).
   std::shared_ptr<const Indicator> (*read)(Checker& check, const nlohmann::json& value, const std::string& path,

@@ -122,28 +122,18 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
     return std::nullopt;
   }
   if (value.contains("values")) {
-    check.known_keys(value, path, values_axis_keys().names());
-    const json& values = value["values"];
-    if (values.is_array() && values.size() > max_initial_states) {
-      check.issue(child(path, "values"), std::to_string(values.size()) + " values",
+    const KeyReader keys(check, value, path, values_axis_keys(), what);
+    const json* values = keys.value("values");
+    if (values->is_array() && values->size() > max_initial_states) {
+      check.issue(keys.path("values"), std::to_string(values->size()) + " values",
                   "at most " + std::to_string(max_initial_states) + " values");
       return std::nullopt;
     }
-    return check.vector(values, child(path, "values"));
+    return check.vector(*values, keys.path("values"));
   }
-  const KeyTable& keys = range_axis_keys();
-  check.known_keys(value, path, keys.names());
-  std::optional<double> from, to;
-  std::optional<std::int64_t> count;
-  if (const json* v = check.member(value, path, "from", keys["from"].required, "the first value, a finite number"))
-    from = check.finite_number(*v, child(path, "from"), "the first value, a finite number");
-  if (const json* v = check.member(value, path, "to", keys["to"].required, "the last value, a finite number"))
-    to = check.finite_number(*v, child(path, "to"), "the last value, a finite number");
-  if (const json* v =
-          check.member(value, path, "count", keys["count"].required, "the number of values, an integer >= 1"))
-    count = check.integer(*v, child(path, "count"), keys["count"].minimum, keys["count"].maximum,
-                          "the number of values, an integer from " + std::to_string(keys["count"].minimum) + " to " +
-                              std::to_string(keys["count"].maximum));
+  const KeyReader keys(check, value, path, range_axis_keys(), what);
+  const auto from = keys.number("from"), to = keys.number("to");
+  const auto count = keys.integer("count");
   if (!from || !to || !count) return std::nullopt;
   std::vector<double> values(static_cast<std::size_t>(*count));
   for (std::size_t k = 0; k < values.size(); ++k) values[k] = range_value(*from, *to, values.size(), k);
@@ -175,16 +165,16 @@ void fill_grid(const std::vector<std::vector<double>>& axes, std::size_t n, std:
 
 void read_grid(Checker& check, const json& grid, InitialStates& states) {
   const std::string path = "/initial/grid";
-  if (!check.object(grid, path, "an object {\"q\": [axis, ...], \"p\": [axis, ...]}, one axis per component")) return;
-  check.known_keys(grid, path, grid_keys().names());
+  const KeyReader keys(check, grid, path, grid_keys(),
+                       "an object {\"q\": [axis, ...], \"p\": [axis, ...]}, one axis per component");
+  if (!keys.is_object()) return;
   std::vector<std::vector<double>> axes;
   std::size_t count = 1;  // states: the product of the axes' sizes
   std::size_t sizes[2] = {0, 0};
   bool ok = true;
   for (int which = 0; which < 2; ++which) {
     const std::string name = which == 0 ? "q" : "p";
-    const json* list =
-        check.member(grid, path, name, grid_keys()[name].required, "an array of axes, one per component");
+    const json* list = keys.value(name);
     if (!list) {
       ok = false;
       continue;
@@ -228,11 +218,9 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
 
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
                 const std::string& first_path) {
-  if (!check.object(value, path, "a state {\"q\": [...], \"p\": [...]}")) return;
-  const KeyTable& keys = state_keys();
-  check.known_keys(value, path, keys.names());
-  const json* q_value = check.member(value, path, "q", keys["q"].required, "the positions, an array of finite numbers");
-  const json* p_value = check.member(value, path, "p", keys["p"].required, "the momenta, an array of finite numbers");
+  const KeyReader keys(check, value, path, state_keys(), "a state {\"q\": [...], \"p\": [...]}");
+  const json* q_value = keys.value("q");
+  const json* p_value = keys.value("p");
   // Sizes first, so that an array over the limit is not copied.
   const std::size_t q_size = q_value && q_value->is_array() ? q_value->size() : 0;
   if (q_size > max_initial_values) {
@@ -294,7 +282,8 @@ InitialStates read_initial(Checker& check, const json& document, const std::file
     }
   } else if (initial->is_object() && initial->contains("grid")) {
     states.shape = "grid";
-    check.known_keys(*initial, "/initial", initial_grid_keys().names());
+    check.known_keys(*initial, "/initial",
+                     initial_grid_keys().names());  // grid: read_grid; the shell: energy_shell.cpp
     read_grid(check, (*initial)["grid"], states);
     read_energy_shell(check, *initial, states);
   } else if (initial->is_object() && initial->contains("file")) {

@@ -93,7 +93,8 @@ const KeyTable& model_keys() {
            .type = ValueType::path,
            .description =
                "A plugin name (looked up as <name>.so on the search path, see `nonsep models`) or a path to a "
-               ".so file (contains '/' or ends in .so; relative to the job file's folder)."},
+               ".so file (contains '/' or ends in .so; relative to the job file's folder).",
+           .allowed = "a plugin name (see `nonsep models`) or a path to a .so file"},
           {.name = "formula",
            .type = ValueType::defined,
            .description = "Instead of a plugin: T(p) and V(q) as formulas (or the path of a model file holding them), "
@@ -115,11 +116,13 @@ const KeyTable& run_time_keys() {
       {.name = "dt",
        .type = ValueType::nonzero,
        .required = true,
-       .description = "Time step; negative integrates backwards (t_end must then be negative too)."},
+       .description = "Time step; negative integrates backwards (t_end must then be negative too).",
+       .allowed = "the time step, a finite non-zero number (negative integrates backwards in time)"},
       {.name = "t_end",
        .type = ValueType::nonzero,
        .description = "End time, same sign as dt. steps = ceil((t_end/dt)(1 - 1e-9)), and the step actually used "
-                      "is t_end/steps, so the run ends exactly at t_end."},
+                      "is t_end/steps, so the run ends exactly at t_end.",
+       .allowed = "the end time, a finite non-zero number of the same sign as dt"},
       {.name = "steps",
        .type = ValueType::integer,
        .minimum = 1,
@@ -134,7 +137,8 @@ const KeyTable& study_time_keys() {
       {.name = "t_end",
        .type = ValueType::nonzero,
        .required = true,
-       .description = "The end time of every run of the study."},
+       .description = "The end time of every run of the study.",
+       .allowed = "the end time, a finite non-zero number (negative integrates backwards)"},
   }};
   return table;
 }
@@ -144,21 +148,25 @@ const KeyTable& output_keys() {
       {.name = "directory",
        .type = ValueType::path,
        .description = "Output folder, relative to the job file's folder; default <job file name without .json>.out "
-                      "beside the job file. `nonsep run --output DIR` overrides it."},
+                      "beside the job file. `nonsep run --output DIR` overrides it.",
+       .allowed = "a folder name or path, relative to the job file's folder"},
       {.name = "every",
        .type = ValueType::integer,
        .minimum = 0,
        .maximum = int64_limit,
        .default_value = 1,
        .description = "trajectory.csv gets steps 0, every, 2 every, ... and the final step; 0 writes no "
-                      "trajectory.csv."},
+                      "trajectory.csv.",
+       .allowed = "an integer >= 0: write every n-th step to trajectory.csv (0: no trajectory)"},
       {.name = "energy_every",
        .type = ValueType::integer,
        .minimum = 0,
        .maximum = int64_limit,
        .default_value = 0,
        .description = "H is evaluated at step 0, at every written sample and at the end; energy_every > 0 also "
-                      "evaluates it every energy_every-th step. Costs about a step's work per evaluation."},
+                      "evaluates it every energy_every-th step. Costs about a step's work per evaluation.",
+       .allowed = "an integer >= 0: also evaluate H every n-th step (0: only at the written samples, the start and "
+                  "the end)"},
       {.name = "format",
        .type = ValueType::choice,
        .default_value = "csv",
@@ -177,12 +185,15 @@ const KeyTable& checkpoint_keys() {
        .minimum = 0,
        .maximum = steps_limit,
        .default_value = 0,
-       .description = "Save a checkpoint every n steps; 0: not by steps."},
+       .description = "Save a checkpoint every n steps; 0: not by steps.",
+       .allowed = "an integer from 0 to " + std::to_string(steps_limit) +
+                  ": save a checkpoint every n steps (0: not by steps)"},
       {.name = "every_seconds",
        .type = ValueType::nonnegative,
        .default_value = 60,
        .description = "Save a checkpoint when this many seconds of wall time have passed since the last one; 0: "
-                      "not by time."},
+                      "not by time.",
+       .allowed = "a finite number >= 0: save a checkpoint every s seconds of wall time (0: not by time)"},
   }};
   return table;
 }
@@ -195,6 +206,7 @@ const KeyTable& study_keys() {
            .required = true,
            .description = "The integrators, each as /integrator of a run with an optional label and its own steps or "
                           "dt.",
+           .allowed = "a non-empty array of integrators, each as /integrator of a run",
            .definition = "study_integrators"},
           {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
           {.name = "dt", .type = ValueType::defined, .definition = "step_sizes"},
@@ -217,7 +229,8 @@ const KeyTable& study_keys() {
            .default_value = 1,
            .description = "How many times each run is repeated for its wall time: work_precision.csv gives the median "
                           "over the repeats and their count (the errors and evaluation counts are those of the first: "
-                          "every repeat computes the same numbers)."},
+                          "every repeat computes the same numbers).",
+           .allowed = "a whole number of repeats from 1 to 1000"},
       },
       {{"dependentSchemas", {{"reference_run", {{"not", {{"required", {"reference"}}}}}}}}}};
   return table;
@@ -241,11 +254,13 @@ const KeyTable& state_keys() {
        .type = ValueType::defined,
        .required = true,
        .description = "Positions, one per degree of freedom.",
+       .allowed = "the positions, an array of finite numbers",
        .definition = "vector"},
       {.name = "p",
        .type = ValueType::defined,
        .required = true,
        .description = "Momenta, as many as q.",
+       .allowed = "the momenta, an array of finite numbers",
        .definition = "vector"},
   }};
   return table;
@@ -296,11 +311,13 @@ const KeyTable& grid_keys() {
        .type = ValueType::defined,
        .required = true,
        .description = "The axes of q0, q1, ...",
+       .allowed = "an array of axes, one per component",
        .definition = "axes"},
       {.name = "p",
        .type = ValueType::defined,
        .required = true,
        .description = "The axes of p0, p1, ...",
+       .allowed = "an array of axes, one per component",
        .definition = "axes"},
   }};
   return table;
@@ -308,14 +325,23 @@ const KeyTable& grid_keys() {
 
 const KeyTable& range_axis_keys() {
   static const KeyTable table{{
-      {.name = "from", .type = ValueType::finite, .required = true, .description = "The first value."},
-      {.name = "to", .type = ValueType::finite, .required = true, .description = "The last value."},
+      {.name = "from",
+       .type = ValueType::finite,
+       .required = true,
+       .description = "The first value.",
+       .allowed = "the first value, a finite number"},
+      {.name = "to",
+       .type = ValueType::finite,
+       .required = true,
+       .description = "The last value.",
+       .allowed = "the last value, a finite number"},
       {.name = "count",
        .type = ValueType::integer,
        .required = true,
        .minimum = 1,
        .maximum = states_limit,
-       .description = "The number of values."},
+       .description = "The number of values.",
+       .allowed = "the number of values, an integer from 1 to " + std::to_string(states_limit)},
   }};
   return table;
 }

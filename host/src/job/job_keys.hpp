@@ -1,11 +1,10 @@
 #pragma once
 // Internal to the job reader (host/src/job/): the keys of every object of a job file, with their types, integer
-// ranges, defaults and whether they are required. The section readers take their known-key lists, required flags,
-// integer ranges and the keys a study refuses from these tables, and `nonsep schema` (job_schema.cpp) writes
-// schemas/job.schema.json from the same tables and the scheme catalogue, so the schema cannot drift from the
-// reader. The types of numbers are checked by the readers' own calls (each with its own message);
-// tests/host/test_host_job_schema.cpp holds the readers to the types written here. Other messages stay with the
-// readers.
+// ranges, defaults and whether they are required. The section readers read their objects by these tables
+// (KeyReader, key_reader.hpp: known keys, required keys, each value's type, range and choices, with the rule's
+// `allowed` text as the message), and `nonsep schema` (job_schema.cpp) writes schemas/job.schema.json from the same
+// tables and the scheme catalogue, so the schema cannot drift from the reader; tests/host/test_host_job_schema.cpp
+// holds the readers to the types written here. What relates keys to each other stays with the readers.
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -49,10 +48,12 @@ struct KeyRule {
   std::int64_t minimum = 0, maximum = 0;           // ValueType::integer
   nlohmann::ordered_json default_value = nullptr;  // as a job file would write it; null: no default
   std::string description = {};                    // for the schema
-  const KeyTable& (*keys)() = nullptr;             // ValueType::object
-  std::string definition = {};                     // ValueType::defined
-  std::vector<std::string> choices = {};           // ValueType::choice
-  std::string pattern = {};  // ValueType::string: a regular expression the string matches (in the schema)
+  // What a message for a refused value says is allowed (key_reader.hpp); empty: one built from the type and range.
+  std::string allowed = {};
+  const KeyTable& (*keys)() = nullptr;    // ValueType::object
+  std::string definition = {};            // ValueType::defined
+  std::vector<std::string> choices = {};  // ValueType::choice
+  std::string pattern = {};               // ValueType::string: a regular expression the string matches (in the schema)
   // A document key refused in a study: what the issue says was found and what is allowed instead.
   bool run_only = false;
   std::string in_study_found = {}, in_study_allowed = {};

@@ -17,11 +17,15 @@ const KeyTable& analysis_keys() {
          .type = ValueType::finite,
          .description = "From |t| >= this time on, the smallest Euclidean phase-space distance |(q, p) - (q0, p0)| "
                         "of each trajectory to its initial state is tracked at every step (trajectories.csv: "
-                        "closest_return_distance, _t, _step)."},
+                        "closest_return_distance, _t, _step).",
+         .allowed = "a finite time: from then on the smallest phase-space distance to the initial state is "
+                    "tracked"},
         {.name = "max_relative_energy_error",
          .type = ValueType::positive,
          .description = "A bound on the relative energy error |H(t) - H0| / |H0|: a trajectory that exceeds it is "
-                        "retired with status \"inaccurate\". Absent: no bound."},
+                        "retired with status \"inaccurate\". Absent: no bound.",
+         .allowed = "a finite number > 0: a trajectory whose |H - H0| / |H0| exceeds it stops with status "
+                    "\"inaccurate\""},
         {.name = "poincare",
          .type = ValueType::object,
          .description = "A surface of section normal . (q, p) = value: every crossing of every trajectory goes to "
@@ -51,7 +55,8 @@ const KeyTable& analysis_keys() {
                         "estimated_phase_error, estimated_relative_energy_error, error_estimate_t, "
                         "error_estimate_horizon, error_estimate. Where the two runs separate (their difference above "
                         "0.1 of |(q, p)|: a chaotic orbit) the estimate ends: error_estimate_horizon is that time. "
-                        "Costs twice the run."});
+                        "Costs twice the run.",
+         .allowed = "true or false: estimate each trajectory's global error by a second run with half the step"});
     return t;
   }();
   return table;
@@ -82,6 +87,7 @@ const KeyTable& poincare_keys() {
           {.name = "component",
            .type = ValueType::string,
            .description = "The plane component = value, e.g. \"q0\" or \"p1\" (0-based, below the dimension).",
+           .allowed = "\"q<i>\" or \"p<i>\" (i from 0, below the dimension), a component of the state",
            .pattern = "^[qp](0|[1-9][0-9]*)$"},
           {.name = "normal",
            .type = ValueType::defined,
@@ -90,20 +96,28 @@ const KeyTable& poincare_keys() {
           {.name = "value",
            .type = ValueType::finite,
            .default_value = 0,
-           .description = "The offset c of the plane normal . (q, p) = c."},
-          {.name = "offset", .type = ValueType::finite, .default_value = 0, .description = "Another name for value."},
+           .description = "The offset c of the plane normal . (q, p) = c.",
+           .allowed = "a finite number: the plane is normal . (q, p) = value (default 0)"},
+          {.name = "offset",
+           .type = ValueType::finite,
+           .default_value = 0,
+           .description = "Another name for value.",
+           .allowed = "a finite number: the plane is normal . (q, p) = value (default 0)"},
           {.name = "direction",
            .type = ValueType::choice,
            .default_value = "+",
            .description = "\"+\": crossings where normal . (q, p) - value goes from < 0 to >= 0; \"-\": from > 0 "
                           "to <= 0; \"both\".",
+           .allowed = "\"+\" (normal . (q, p) - value goes from < 0 to >= 0; the default), \"-\" or \"both\"",
            .choices = {"+", "-", "both"}},
           {.name = "max_crossings",
            .type = ValueType::integer,
            .minimum = 1,
            .maximum = std::numeric_limits<std::int64_t>::max(),
            .description = "A trajectory stops at the step of its N-th crossing, with status \"completed\" and a "
-                          "message saying so. Absent: no limit."},
+                          "message saying so. Absent: no limit.",
+           .allowed = "an integer >= 1: a trajectory stops (status \"completed\", with a message) at the step of its "
+                      "N-th crossing"},
       },
       {{"oneOf", {{{"required", {"component"}}}, {{"required", {"normal"}}}}},
        {"not", {{"required", {"value", "offset"}}}}}};
@@ -118,7 +132,8 @@ const KeyTable& frequencies_keys() {
        .maximum = steps_limit,
        .default_value = 1,
        .description = "Steps between samples: the signals are sampled at steps every, 2 every, ..., N every (N = "
-                      "steps / every, at least 32)."},
+                      "steps / every, at least 32).",
+       .allowed = "an integer >= 1: steps between samples (default 1)"},
       {.name = "signals",
        .type = ValueType::defined,
        .description = "The degrees of freedom k whose signals q_k + i p_k are analysed, in column order (0-based, "
@@ -130,7 +145,8 @@ const KeyTable& frequencies_keys() {
        .maximum = 1000,
        .default_value = 0,
        .description = "Write the strongest this many terms (frequency, complex amplitude) of each signal over the "
-                      "whole run to frequency_spectra.csv, at most samples / 4; 0: no such file."},
+                      "whole run to frequency_spectra.csv, at most samples / 4; 0: no such file.",
+       .allowed = "an integer from 0 to 1000: terms per signal in frequency_spectra.csv (0: no file)"},
   }};
   return table;
 }
@@ -142,20 +158,23 @@ const KeyTable& lyapunov_keys() {
        .minimum = 1,
        .maximum = static_cast<std::int64_t>(LyapunovRecord::max_exponents),
        .default_value = 1,
-       .description = "k, the number of largest exponents (at most 2n)."},
+       .description = "k, the number of largest exponents (at most 2n).",
+       .allowed = "an integer from 1 to 2n (at most 32): the number of largest exponents (default 1)"},
       {.name = "renormalize_every",
        .type = ValueType::integer,
        .minimum = 1,
        .maximum = steps_limit,
        .default_value = 1,
-       .description = "Steps between re-orthonormalisations (modified Gram-Schmidt) of the tangent vectors."},
+       .description = "Steps between re-orthonormalisations (modified Gram-Schmidt) of the tangent vectors.",
+       .allowed = "an integer >= 1: steps between re-orthonormalisations of the tangent vectors (default 1)"},
       {.name = "every",
        .type = ValueType::integer,
        .minimum = 0,
        .maximum = steps_limit,
        .default_value = 0,
        .description = "Write the running estimates to lyapunov.csv every n-th step (with megno and mean_megno when "
-                      "megno is true, sali and gali2 .. gali<k> when asked); 0: no time series."},
+                      "megno is true, sali and gali2 .. gali<k> when asked); 0: no time series.",
+       .allowed = "an integer >= 0: write lyapunov.csv every n-th step (0: no time series; the default)"},
   }};
   return table;
 }

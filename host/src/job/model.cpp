@@ -12,20 +12,18 @@ void read_model(Checker& check, const json& document, Job& job) {
   const std::string what =
       "an object {\"plugin\": name or path, \"parameters\": {...}} or {\"formula\": {\"T\": ..., \"V\": ...}}";
   const json* model = check.member(document, "", "model", document_keys()["model"].required, what);
-  if (!model || !check.object(*model, "/model", what)) return;
-  const KeyTable& keys = model_keys();
-  check.known_keys(*model, "/model", keys.names());
-  if (model->contains("plugin") == model->contains("formula"))
+  if (!model) return;
+  const KeyReader keys(check, *model, "/model", model_keys(), what);
+  if (!keys.is_object()) return;
+  if (keys.given("plugin") == keys.given("formula"))
     check.issue("/model",
-                model->contains("plugin") ? "both \"plugin\" and \"formula\"" : "neither \"plugin\" nor \"formula\"",
+                keys.given("plugin") ? "both \"plugin\" and \"formula\"" : "neither \"plugin\" nor \"formula\"",
                 "exactly one of \"plugin\" (a compiled model) and \"formula\" (T and V as formulas, "
                 "docs/formula-models.md)");
-  const std::string plugin_what = "a plugin name (see `nonsep models`) or a path to a .so file";
-  if (const json* plugin = check.member(*model, "/model", "plugin", false, plugin_what))
-    if (auto name = check.path_string(*plugin, "/model/plugin", plugin_what)) job.plugin = *name;
-  if (const json* formula = check.member(*model, "/model", "formula", false, ""))
+  if (const auto plugin = keys.string("plugin")) job.plugin = *plugin;
+  if (const json* formula = keys.value("formula"))
     job.formula = formula::read_formula_model(*formula, "/model/formula", job.directory, check.issues());
-  if (const json* parameters = check.member(*model, "/model", "parameters", false, ""))
+  if (const json* parameters = keys.value("parameters"))
     if (check.object(*parameters, "/model/parameters", "an object of the plugin's parameters (see `nonsep inspect`)"))
       for (const auto& [name, value] : parameters->items()) {
         if (!value.is_array() && !value.is_object()) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "job_keys.hpp"
+#include "key_reader.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/json/checker.hpp"
 #include "nonsep/host/json/parameter_check.hpp"
@@ -81,12 +82,9 @@ Study read_study(Checker& check, const json& study, HamiltonianForm form, double
 void read_output(Checker& check, const json& document, Job& job);
 // read_analysis needs the dimension of the initial states (0 when unknown) for /analysis/poincare and /lyapunov.
 Analysis read_analysis(Checker& check, const json& value, std::size_t dimension);
-// /analysis/poincare and the chaos indicators (dynamics.cpp, indicators.hpp), into `analysis`.
-void read_dynamics(Checker& check, const json& value, std::size_t dimension, Analysis& analysis);
-// The boolean `key` of the object `value` at `path` into `flag`, when present; otherwise an issue saying "true or
-// false: " and `meaning` (outputs.cpp).
-void read_flag(Checker& check, const json& value, const std::string& path, const std::string& key,
-               const std::string& meaning, bool& flag);
+// /analysis/poincare, /analysis/frequencies and the chaos indicators (dynamics.cpp, indicators.hpp) of /analysis as
+// its KeyReader checked it, into `analysis`.
+void read_dynamics(Checker& check, const KeyReader& analysis_keys, std::size_t dimension, Analysis& analysis);
 CheckpointPolicy read_checkpoint(Checker& check, const json& value);
 
 }  // namespace nonsep::host::job_reader

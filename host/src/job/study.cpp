@@ -103,16 +103,14 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
   const std::string path = "/study";
   const std::string what =
       "an object {\"integrators\": [...], \"steps\": [...] or \"dt\": [...], \"reference\": {\"q\", \"p\"}}";
-  if (!check.object(study_value, path, what)) return study;
-  const KeyTable& keys = study_keys();
-  check.known_keys(study_value, path, keys.names());
+  const KeyReader keys(check, study_value, path, study_keys(), what);
+  if (!keys.is_object()) return study;
   std::string study_from;
   const std::size_t before = check.issue_count();
   const auto study_steps = read_steps_or_dt(check, study_value, path, t_end, false, study_from, "study.");
   const bool study_steps_invalid = check.issue_count() != before;
 
-  const json* list = check.member(study_value, path, "integrators", keys["integrators"].required,
-                                  "a non-empty array of integrators, each as /integrator of a run");
+  const json* list = keys.value("integrators");
   if (list && (!list->is_array() || list->empty())) {
     check.issue(child(path, "integrators"), describe(*list),
                 "a non-empty array of integrators, each {\"scheme\": ..., options, \"label\", \"steps\" or \"dt\"}");
@@ -149,8 +147,8 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
     study.integrators.push_back(std::move(integrator));
   }
 
-  if (const json* run = check.member(study_value, path, "reference_run", false, "")) {
-    const std::string run_path = child(path, "reference_run");
+  if (const json* run = keys.value("reference_run")) {
+    const std::string run_path = keys.path("reference_run");
     if (study_value.contains("reference"))
       check.issue(run_path, "a reference run together with " + child(path, "reference"),
                   "either \"reference\" (the state at t_end) or \"reference_run\" (an integrator that computes it)");
@@ -171,12 +169,9 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
       }
     }
   }
-  if (const json* repeats = check.member(study_value, path, "repeats", false, ""))
-    if (const auto n = check.integer(*repeats, child(path, "repeats"), keys["repeats"].minimum, keys["repeats"].maximum,
-                                     "a whole number of repeats from 1 to 1000"))
-      study.repeats = static_cast<int>(*n);
-  if (const json* reference = check.member(study_value, path, "reference", false, "")) {
-    const std::string reference_path = child(path, "reference");
+  if (const auto repeats = keys.integer("repeats")) study.repeats = static_cast<int>(*repeats);
+  if (const json* reference = keys.value("reference")) {
+    const std::string reference_path = keys.path("reference");
     if (check.object(*reference, reference_path, "the exact state at t_end {\"q\": [...], \"p\": [...]}")) {
       InitialStates state;
       read_state(check, *reference, reference_path, state, reference_path);

@@ -25,36 +25,25 @@ TimeGrid read_time(Checker& check, const json& document) {
   TimeGrid grid;
   const std::string what = "an object with \"dt\" and either \"t_end\" or \"steps\"";
   const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
-  if (!time || !check.object(*time, "/time", what)) return grid;
-  const KeyTable& keys = run_time_keys();
-  check.known_keys(*time, "/time", keys.names());
+  if (!time) return grid;
+  const KeyReader keys(check, *time, "/time", run_time_keys(), what);
+  if (!keys.is_object()) return grid;
   // NaN marks a value that is missing or invalid (and already reported).
-  double dt = std::nan("");
-  if (const json* value =
-          check.member(*time, "/time", "dt", keys["dt"].required, "the time step, a finite non-zero number")) {
-    if (const auto x = check.finite_number(*value, "/time/dt", "the time step, a finite non-zero number")) {
-      if (*x == 0.0)
-        check.issue("/time/dt", describe(*value), "a finite non-zero number (negative integrates backwards in time)");
-      else
-        dt = *x;
-    }
-  }
-  const json* t_end_value = check.member(*time, "/time", "t_end", false, "");
-  const json* steps_value = check.member(*time, "/time", "steps", false, "");
-  if (t_end_value && steps_value) {
-    check.issue("/time/steps", describe(*steps_value) + " together with /time/t_end",
+  const double dt = keys.number("dt").value_or(std::nan(""));
+  if (keys.given("t_end") && keys.given("steps")) {
+    check.issue("/time/steps", describe((*time)["steps"]) + " together with /time/t_end",
                 "either \"t_end\" or \"steps\", not both");
     return grid;
   }
-  if (!t_end_value && !steps_value) {
+  if (!keys.given("t_end") && !keys.given("steps")) {
     check.issue("/time/t_end", "nothing (neither \"t_end\" nor \"steps\" is given)",
                 "either \"t_end\" (the time to end at) or \"steps\" (the number of steps of dt)");
     return grid;
   }
-  if (t_end_value) {
-    const auto t_end = check.finite_number(*t_end_value, "/time/t_end", "the end time, a finite non-zero number");
+  if (keys.given("t_end")) {
+    const auto t_end = keys.number("t_end");
     if (!t_end || std::isnan(dt)) return grid;
-    const std::string found = describe(*t_end_value) + " with dt = " + format_number(dt);
+    const std::string found = describe((*time)["t_end"]) + " with dt = " + format_number(dt);
     if (!(*t_end / dt > 0.0)) {
       check.issue("/time/t_end", found, "a non-zero end time of the same sign as dt (the run starts at t = 0)");
       return grid;
@@ -63,14 +52,11 @@ TimeGrid read_time(Checker& check, const json& document) {
       grid = TimeGrid::to_end(*t_end, dt, *steps);
     return grid;
   }
-  const KeyRule& rule = keys["steps"];
-  const auto steps =
-      check.integer(*steps_value, "/time/steps", rule.minimum, rule.maximum,
-                    "an integer from " + std::to_string(rule.minimum) + " to " + std::to_string(rule.maximum));
+  const auto steps = keys.integer("steps");
   if (!steps || std::isnan(dt)) return grid;
   grid = TimeGrid::of_steps(static_cast<std::uint64_t>(*steps), dt);
   if (!std::isfinite(grid.t_end))
-    check.issue("/time/steps", describe(*steps_value) + " with dt = " + format_number(dt),
+    check.issue("/time/steps", describe((*time)["steps"]) + " with dt = " + format_number(dt),
                 "a number of steps whose end time steps * dt is finite");
   return grid;
 }
@@ -79,17 +65,9 @@ TimeGrid read_study_time(Checker& check, const json& document) {
   TimeGrid grid;
   const std::string what = "an object {\"t_end\": T}: a study runs every integrator to T with its own step counts";
   const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
-  if (!time || !check.object(*time, "/time", what)) return grid;
-  const KeyTable& keys = study_time_keys();
-  check.known_keys(*time, "/time", keys.names());
-  if (const json* value =
-          check.member(*time, "/time", "t_end", keys["t_end"].required, "the end time, a finite non-zero number"))
-    if (const auto t_end = check.finite_number(*value, "/time/t_end", "the end time, a finite non-zero number")) {
-      if (*t_end == 0.0)
-        check.issue("/time/t_end", describe(*value), "a finite non-zero number (negative integrates backwards)");
-      else
-        grid.t_end = *t_end;
-    }
+  if (!time) return grid;
+  const KeyReader keys(check, *time, "/time", study_time_keys(), what);
+  if (const auto t_end = keys.number("t_end")) grid.t_end = *t_end;
   return grid;
 }
 

@@ -1,0 +1,151 @@
+// Reading one object of a job file by its key table (key_reader.hpp).
+#include "key_reader.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nonsep::host::job_reader {
+
+std::string allowed_text(const KeyRule& rule) {
+  if (!rule.allowed.empty()) return rule.allowed;
+  switch (rule.type) {
+    case ValueType::finite:
+      return "a finite number";
+    case ValueType::nonzero:
+      return "a finite non-zero number";
+    case ValueType::positive:
+      return "a finite number > 0";
+    case ValueType::nonnegative:
+      return "a finite number >= 0";
+    case ValueType::integer:
+      return "an integer from " + std::to_string(rule.minimum) + " to " + std::to_string(rule.maximum);
+    case ValueType::boolean:
+      return "true or false";
+    case ValueType::text:
+      return "a string";
+    case ValueType::string:
+      return "a non-empty string";
+    case ValueType::path:
+      return "a non-empty path";
+    case ValueType::choice:
+    case ValueType::form: {
+      std::vector<std::string> names = rule.choices;
+      if (rule.type == ValueType::form)
+        for (const auto& form : hamiltonian_forms()) names.push_back(form.name);
+      std::string list;
+      for (std::size_t i = 0; i < names.size(); ++i)
+        list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + ("\"" + names[i] + "\"");
+      return list;
+    }
+    case ValueType::object:
+    case ValueType::defined:
+      return rule.description;
+  }
+  return rule.description;
+}
+
+KeyReader::KeyReader(Checker& check, const json& object, std::string path, const KeyTable& table,
+                     const std::string& what)
+    : check_(check), path_(std::move(path)), table_(table) {
+  if (!check_.object(object, path_, what)) return;
+  object_ = &object;
+  check_.known_keys(object, path_, table.names());
+  for (const KeyRule& rule : table.rules) {
+    const auto it = object.find(rule.name);
+    if (it == object.end()) {
+      if (rule.required) check_.member(object, path_, rule.name, true, allowed_text(rule));
+    } else if (!valid(*it, rule)) {
+      refused_.push_back(rule.name);
+    }
+  }
+}
+
+namespace {
+
+// Whether `value` is of the rule's type, in its range and among its choices. The messages are built only for a
+// value refused (a job may hold a million states, each read by a table).
+bool accepted(const json& value, const KeyRule& rule) {
+  const auto number = [&](auto&& holds) {
+    if (!value.is_number()) return false;
+    const double x = value.get<double>();
+    return std::isfinite(x) && holds(x);
+  };
+  switch (rule.type) {
+    case ValueType::finite:
+      return number([](double) { return true; });
+    case ValueType::nonzero:
+      return number([](double x) { return x != 0.0; });
+    case ValueType::positive:
+      return number([](double x) { return x > 0.0; });
+    case ValueType::nonnegative:
+      return number([](double x) { return x >= 0.0; });
+    case ValueType::integer: {
+      const auto x = integral_value(value);
+      return x && *x >= rule.minimum && *x <= rule.maximum;
+    }
+    case ValueType::boolean:
+      return value.is_boolean();
+    case ValueType::text:
+      return value.is_string();
+    case ValueType::string:
+    case ValueType::path:
+      return value.is_string() && !value.get_ref<const std::string&>().empty();
+    case ValueType::choice:
+      return value.is_string() && std::ranges::find(rule.choices, value.get<std::string>()) != rule.choices.end();
+    case ValueType::form:
+      return value.is_string() && std::ranges::any_of(hamiltonian_forms(), [&](const FormName& form) {
+               return form.name == value.get<std::string>();
+             });
+    case ValueType::object:
+    case ValueType::defined:
+      return true;  // the section reader reads what is inside
+  }
+  return true;
+}
+
+}  // namespace
+
+bool KeyReader::valid(const json& value, const KeyRule& rule) {
+  if (!accepted(value, rule)) {
+    check_.issue(child(path_, rule.name), describe(value), allowed_text(rule));
+    return false;
+  }
+  // A path the file system cannot take: said as Checker::path_string says it.
+  if (rule.type == ValueType::path && value.get_ref<const std::string&>().find('\0') != std::string::npos) {
+    check_.issue(child(path_, rule.name), describe(value) + ", which contains NUL (\\u0000)",
+                 allowed_text(rule) + ", without NUL characters");
+    return false;
+  }
+  return true;
+}
+
+const json* KeyReader::value(std::string_view key) const {
+  const KeyRule& rule = table_[key];  // a key without a rule is a programming error
+  if (!object_ || std::ranges::find(refused_, rule.name) != refused_.end()) return nullptr;
+  const auto it = object_->find(rule.name);
+  return it == object_->end() ? nullptr : &*it;
+}
+
+bool KeyReader::given(std::string_view key) const { return object_ && object_->contains(table_[key].name); }
+
+std::optional<double> KeyReader::number(std::string_view key) const {
+  const json* v = value(key);
+  return v ? std::optional<double>(v->get<double>()) : std::nullopt;
+}
+
+std::optional<std::int64_t> KeyReader::integer(std::string_view key) const {
+  const json* v = value(key);
+  return v ? integral_value(*v) : std::nullopt;
+}
+
+std::optional<bool> KeyReader::boolean(std::string_view key) const {
+  const json* v = value(key);
+  return v ? std::optional<bool>(v->get<bool>()) : std::nullopt;
+}
+
+std::optional<std::string> KeyReader::string(std::string_view key) const {
+  const json* v = value(key);
+  return v ? std::optional<std::string>(v->get<std::string>()) : std::nullopt;
+}
+
+}  // namespace nonsep::host::job_reader

@@ -1,0 +1,50 @@
+#pragma once
+// Internal to the job reader (host/src/job/): one object of a job file read by its key table (job_keys.hpp). The
+// table checks what it can say key by key: that the value is an object, that its keys are known ("did you mean"),
+// that required keys are there, and each given value's type, integer range and choices, in table order, with the
+// rule's `allowed` text as the message. The section reader then takes the checked values and keeps only the checks
+// that relate keys to each other (exactly one of two keys, a value against the state's dimension).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "job_keys.hpp"
+#include "nonsep/host/json/checker.hpp"
+
+namespace nonsep::host::job_reader {
+
+class KeyReader {
+ public:
+  // Reads `object` at `path` by `table`; `what` is the message for a value that is not an object.
+  KeyReader(Checker& check, const json& object, std::string path, const KeyTable& table, const std::string& what);
+
+  // Whether the value was an object (nothing else is read otherwise).
+  bool is_object() const { return object_ != nullptr; }
+  // Key `key`'s value: present and valid by its rule; nullptr when absent or refused (an issue says which).
+  const json* value(std::string_view key) const;
+  // Whether `key` is present, valid or not.
+  bool given(std::string_view key) const;
+  // The checked value of a rule of that type (nothing when absent or refused).
+  std::optional<double> number(std::string_view key) const;  // finite, nonzero, positive, nonnegative
+  std::optional<std::int64_t> integer(std::string_view key) const;
+  std::optional<bool> boolean(std::string_view key) const;
+  std::optional<std::string> string(std::string_view key) const;  // string, path, text, choice, form
+  // The JSON Pointer of `key`.
+  std::string path(std::string_view key) const { return child(path_, std::string(key)); }
+
+ private:
+  bool valid(const json& value, const KeyRule& rule);
+
+  Checker& check_;
+  const json* object_ = nullptr;
+  std::string path_;
+  const KeyTable& table_;
+  std::vector<std::string> refused_;  // present keys whose value its rule refused
+};
+
+// What a rule allows, for messages: its `allowed` text, or one built from its type and range.
+std::string allowed_text(const KeyRule& rule);
+
+}  // namespace nonsep::host::job_reader
