@@ -253,12 +253,9 @@ void read_state(Checker& check, const json& value, const std::string& path, Init
   ++states.count;
 }
 
-InitialStates read_initial(Checker& check, const json& document, const std::filesystem::path& directory) {
+InitialStates read_initial(Checker& check, const KeyReader& document, const std::filesystem::path& directory) {
   InitialStates states;
-  const std::string what =
-      "one state {\"q\": [...], \"p\": [...]}, an array of such states, {\"grid\": {\"q\": [axes], \"p\": [axes]}} "
-      "or {\"file\": \"states.npy\"}";
-  const json* initial = check.member(document, "", "initial", document_keys()["initial"].required, what);
+  const json* initial = document.value("initial");
   if (!initial) return states;
   if (initial->is_array()) {
     states.shape = "list";
@@ -293,7 +290,7 @@ InitialStates read_initial(Checker& check, const json& document, const std::file
     states.shape = "single";
     read_state(check, *initial, "/initial", states, "/initial");
   } else {
-    check.issue("/initial", describe(*initial), what);
+    check.issue("/initial", describe(*initial), allowed_text(document_keys()["initial"]));
   }
   return states;
 }

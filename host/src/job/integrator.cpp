@@ -56,13 +56,10 @@ std::vector<ParameterDescription> options_of(const Scheme* scheme) {
 
 }  // namespace
 
-HamiltonianForm read_hamiltonian(Checker& check, const json& document) {
-  if (const json* form = check.member(document, "", "hamiltonian", false, "")) {
+HamiltonianForm read_hamiltonian(const KeyReader& document) {
+  if (const auto form = document.string("hamiltonian"))
     for (const auto& [name, value] : hamiltonian_forms())
       if (*form == name) return value;
-    check.issue("/hamiltonian", describe(*form),
-                "\"TTV\" (H = T_i V_ij T_j, the default) or \"VVT\" (H = V_i T_ij V_j)");
-  }
   return HamiltonianForm::TTV;
 }
 
@@ -115,10 +112,13 @@ IntegratorSpec read_integrator_object(Checker& check, const json& integrator, co
   return spec;
 }
 
-IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form,
+IntegratorSpec read_integrator(Checker& check, const KeyReader& document, HamiltonianForm form,
                                std::optional<AutoScheme>& auto_scheme) {
-  const json* integrator = check.member(document, "", "integrator", true,
-                                        "an object with \"scheme\" (" + scheme_names() + " or \"auto\") and options");
+  // Required in a run (the table cannot say so: a study refuses it).
+  const json* integrator = document.value("integrator");
+  if (!integrator)
+    check.member(document.object(), "", "integrator", true,
+                 "an object with \"scheme\" (" + scheme_names() + " or \"auto\") and options");
   IntegratorSpec spec;
   spec.form = form;
   if (!integrator || !check.object(*integrator, "/integrator", "an object with \"scheme\" and the scheme's options"))

@@ -22,6 +22,8 @@ class KeyReader {
 
   // Whether the value was an object (nothing else is read otherwise).
   bool is_object() const { return object_ != nullptr; }
+  // The object read (only when is_object()).
+  const json& object() const { return *object_; }
   // Key `key`'s value: present and valid by its rule; nullptr when absent or refused (an issue says which).
   const json* value(std::string_view key) const;
   // Whether `key` is present, valid or not.

@@ -8,12 +8,10 @@
 
 namespace nonsep::host::job_reader {
 
-void read_model(Checker& check, const json& document, Job& job) {
-  const std::string what =
-      "an object {\"plugin\": name or path, \"parameters\": {...}} or {\"formula\": {\"T\": ..., \"V\": ...}}";
-  const json* model = check.member(document, "", "model", document_keys()["model"].required, what);
+void read_model(Checker& check, const KeyReader& document, Job& job) {
+  const json* model = document.value("model");
   if (!model) return;
-  const KeyReader keys(check, *model, "/model", model_keys(), what);
+  const KeyReader keys(check, *model, "/model", model_keys(), allowed_text(document_keys()["model"]));
   if (!keys.is_object()) return;
   if (keys.given("plugin") == keys.given("formula"))
     check.issue("/model",

@@ -25,11 +25,11 @@ OutputFormat read_format(Checker& check, const std::string& format, bool study) 
 
 }  // namespace
 
-void read_output(Checker& check, const json& document, Job& job) {
+void read_output(Checker& check, const KeyReader& document, Job& job) {
   SingleRun study_strides;  // a study's /output/every and /output/energy_every are checked but not used
   SingleRun& run = job.is_study() ? study_strides : std::get<SingleRun>(job.plan);
   std::filesystem::path output = job.file.stem().string() + ".out";
-  if (const json* section = check.member(document, "", "output", false, "")) {
+  if (const json* section = document.value("output")) {
     const KeyReader keys(check, *section, "/output", output_keys(), "an object {\"directory\": ..., \"every\": ...}");
     if (const auto directory = keys.string("directory")) output = *directory;
     if (const auto every = keys.integer("every")) run.every = static_cast<std::uint64_t>(*every);

@@ -13,24 +13,18 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
   Job job;
   job.file = job_file;
   job.directory = job_file.parent_path().empty() ? std::filesystem::path(".") : job_file.parent_path();
-  if (!check.object(document, "",
-                    "a JSON object with the keys model, integrator, initial, time (" + manual_location() +
-                        " and its docs/user-guide.md)"))
-    return job;
-  check.known_keys(document, "", document_keys().names());
-  if (const json* value = check.member(document, "", "$schema", false, ""))
-    check.string(*value, "/$schema", "a string (the JSON Schema the file follows; ignored by nonsep)");
-  if (const json* value = check.member(document, "", "description", false, ""))
-    if (!value->is_string()) check.issue("/description", describe(*value), "a string (free text, ignored by nonsep)");
-
-  read_model(check, document, job);
-  const HamiltonianForm form = read_hamiltonian(check, document);
-  job.initial = read_initial(check, document, job.directory);
-  if (const json* study_value = check.member(document, "", "study", false, "")) {
+  const KeyReader keys(check, document, "", document_keys(),
+                       "a JSON object with the keys model, integrator, initial, time (" + manual_location() +
+                           " and its docs/user-guide.md)");
+  if (!keys.is_object()) return job;
+  read_model(check, keys, job);
+  const HamiltonianForm form = read_hamiltonian(keys);
+  job.initial = read_initial(check, keys, job.directory);
+  if (const json* study_value = keys.value("study")) {
     for (const KeyRule& rule : document_keys().rules)
       if (rule.run_only && document.contains(rule.name))
         check.issue(child("", rule.name), rule.in_study_found, rule.in_study_allowed);
-    const double t_end = read_study_time(check, document).t_end;
+    const double t_end = read_study_time(check, keys).t_end;
     Study& study = job.plan.emplace<Study>(read_study(check, *study_value, form, t_end));
     study.form = form;
     study.t_end = t_end;
@@ -45,9 +39,9 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
                   std::to_string(job.initial.dimension) + ", as many as the initial state has");
   } else {
     SingleRun& run = job.plan.emplace<SingleRun>();
-    run.integrator = read_integrator(check, document, form, run.auto_scheme);
-    run.time = read_time(check, document);
-    if (const json* analysis = check.member(document, "", "analysis", false, ""))
+    run.integrator = read_integrator(check, keys, form, run.auto_scheme);
+    run.time = read_time(check, keys);
+    if (const json* analysis = keys.value("analysis"))
       run.analysis = read_analysis(check, *analysis, job.initial.dimension);
     if (const auto& frequencies = run.analysis.frequencies; frequencies && run.time.steps > 0) {
       if (run.time.steps / frequencies->every < minimum_frequency_samples)
@@ -66,8 +60,8 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     }
     check_sweep_size(check, job);
   }
-  read_output(check, document, job);
-  if (const json* checkpoint = check.member(document, "", "checkpoint", false, "")) {
+  read_output(check, keys, job);
+  if (const json* checkpoint = keys.value("checkpoint")) {
     const CheckpointPolicy policy = read_checkpoint(check, *checkpoint);  // refused above in a study
     if (!job.is_study()) std::get<SingleRun>(job.plan).checkpoint = policy;
   }

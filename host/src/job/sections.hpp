@@ -1,7 +1,8 @@
 #pragma once
 // Internal to the job reader (host/src/job/): one reader per section of a job file, each in its own file, called by
-// parse_job (parse_job.cpp) in the order of the key-by-key table of docs/user-guide.md. Each takes the parsed document
-// (or the section's value) and a Checker, returns what it read, and adds one issue per problem; what it returns is
+// parse_job (parse_job.cpp) in the order of the key-by-key table of docs/user-guide.md. Each takes the document as its
+// key table read it (a KeyReader: the document's keys known, required ones present, scalars of their type) or the
+// section's value, and a Checker, returns what it read, and adds one issue per problem; what it returns is
 // meaningful only if it added none.
 #include <cstdint>
 #include <filesystem>
@@ -19,7 +20,7 @@
 namespace nonsep::host::job_reader {
 
 // /model (model.cpp): sets job.plugin, job.parameters and job.sweep.
-void read_model(Checker& check, const json& document, Job& job);
+void read_model(Checker& check, const KeyReader& document, Job& job);
 // The declared parameter `name` (model.cpp), or nothing and an issue at `path` naming the plugin's parameters.
 const PluginParameter* find_parameter(Checker& check, const std::vector<PluginParameter>& declared,
                                       const std::string& name, const std::string& path);
@@ -33,16 +34,16 @@ void check_sweep_size(Checker& check, const Job& job);
 
 // /hamiltonian and /integrator (integrator.cpp). read_integrator_object reads one integrator object at `path`
 // (a run's /integrator or a study's /study/integrators/<i>); `extra_keys` are keys its caller reads itself.
-HamiltonianForm read_hamiltonian(Checker& check, const json& document);
+HamiltonianForm read_hamiltonian(const KeyReader& document);
 // /integrator of a run; with "scheme": "auto", also its tolerance and measure into `auto_scheme`.
-IntegratorSpec read_integrator(Checker& check, const json& document, HamiltonianForm form,
+IntegratorSpec read_integrator(Checker& check, const KeyReader& document, HamiltonianForm form,
                                std::optional<AutoScheme>& auto_scheme);
 IntegratorSpec read_integrator_object(Checker& check, const json& integrator, const std::string& path,
                                       HamiltonianForm form, const std::vector<std::string>& extra_keys = {});
 
 // /time (time.cpp): a run's {"dt", "t_end" or "steps"}, a study's {"t_end"}.
-TimeGrid read_time(Checker& check, const json& document);
-TimeGrid read_study_time(Checker& check, const json& document);
+TimeGrid read_time(Checker& check, const KeyReader& document);
+TimeGrid read_study_time(Checker& check, const KeyReader& document);
 // The step count from t_end and dt (TimeGrid's steps_to_reach) within max_steps, or an issue at `path` that shows
 // `found` and the count it would need (or that t_end / dt overflows). t_end / dt must be positive.
 std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt, const std::string& path,
@@ -59,7 +60,7 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
 double range_value(double from, double to, std::size_t count, std::size_t k);
 // /initial (initial.cpp). read_state appends one state {"q", "p"} at `path` to `states` when it is valid;
 // `first_path` names the state whose dimension the others must have.
-InitialStates read_initial(Checker& check, const json& document, const std::filesystem::path& directory);
+InitialStates read_initial(Checker& check, const KeyReader& document, const std::filesystem::path& directory);
 // A CSV file of initial states (/initial/file) is read a row at a time within these bounds, checked as it is read
 // (a file without line ends is refused after at most this many cells of its first line): at most 2^21 columns
 // (states of dimension 2^20; larger ones as .npy) and 32 bytes per cell (a float64 needs at most 24).
@@ -79,7 +80,7 @@ Study read_study(Checker& check, const json& study, HamiltonianForm form, double
 
 // /output, /analysis and /checkpoint (outputs.cpp). read_output sets job.output_directory and, in a single run,
 // its every and energy_every (job.plan must already say which kind of job it is).
-void read_output(Checker& check, const json& document, Job& job);
+void read_output(Checker& check, const KeyReader& document, Job& job);
 // read_analysis needs the dimension of the initial states (0 when unknown) for /analysis/poincare and /lyapunov.
 Analysis read_analysis(Checker& check, const json& value, std::size_t dimension);
 // /analysis/poincare, /analysis/frequencies and the chaos indicators (dynamics.cpp, indicators.hpp) of /analysis as

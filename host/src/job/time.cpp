@@ -21,10 +21,10 @@ std::optional<std::uint64_t> step_count(Checker& check, double t_end, double dt,
   return std::nullopt;
 }
 
-TimeGrid read_time(Checker& check, const json& document) {
+TimeGrid read_time(Checker& check, const KeyReader& document) {
   TimeGrid grid;
   const std::string what = "an object with \"dt\" and either \"t_end\" or \"steps\"";
-  const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
+  const json* time = document.value("time");
   if (!time) return grid;
   const KeyReader keys(check, *time, "/time", run_time_keys(), what);
   if (!keys.is_object()) return grid;
@@ -61,10 +61,10 @@ TimeGrid read_time(Checker& check, const json& document) {
   return grid;
 }
 
-TimeGrid read_study_time(Checker& check, const json& document) {
+TimeGrid read_study_time(Checker& check, const KeyReader& document) {
   TimeGrid grid;
   const std::string what = "an object {\"t_end\": T}: a study runs every integrator to T with its own step counts";
-  const json* time = check.member(document, "", "time", document_keys()["time"].required, what);
+  const json* time = document.value("time");
   if (!time) return grid;
   const KeyReader keys(check, *time, "/time", study_time_keys(), what);
   if (const auto t_end = keys.number("t_end")) grid.t_end = *t_end;
