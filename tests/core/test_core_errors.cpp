@@ -285,3 +285,38 @@ static_assert(StepperWithPerStateStepSizes<ChinBasicStep>);
 static_assert(!StepperWithPerStateStepSizes<TripletComposition<>>);
 static_assert(mpe_accepts<ChinBasicStep>);
 static_assert(!mpe_accepts<TripletComposition<>>);
+
+TEST_CASE("an option's declared range is what its scheme accepts, at both ends") {
+  // The catalogue states each option's range (the job schema prints it); the scheme's own check decides. They agree:
+  // the bounds are accepted (an exclusive one is refused), and the nearest values outside them are refused.
+  int ranges = 0;
+  for (const auto& scheme : scheme_catalogue())
+    for (const auto& parameter : scheme.parameters) {
+      if (!std::isfinite(parameter.minimum) && !std::isfinite(parameter.maximum)) continue;
+      CAPTURE(scheme.name);
+      CAPTURE(parameter.name);
+      ++ranges;
+      const auto accepts = [&](double value) {
+        IntegratorSpec spec = default_spec(scheme);
+        set_option(spec, parameter, value);
+        try {
+          Integrator::describe(spec);
+          Integrator built(spec);
+          return true;
+        } catch (const InvalidArgument&) {
+          return false;
+        }
+      };
+      const double step = parameter.integer ? 1.0 : 1e-9;
+      if (std::isfinite(parameter.minimum)) {
+        CHECK(accepts(parameter.minimum) != parameter.minimum_exclusive);
+        CHECK_FALSE(accepts(parameter.minimum - step));
+        if (parameter.minimum_exclusive) CHECK(accepts(parameter.minimum + step));
+      }
+      if (std::isfinite(parameter.maximum)) {
+        CHECK(accepts(parameter.maximum));
+        CHECK_FALSE(accepts(parameter.maximum + step));
+      }
+    }
+  CHECK(ranges == 4);  // tao omega > 0; implicit_midpoint and gauss max_iterations >= 1; gauss stages 1 to 8
+}

@@ -3,6 +3,8 @@
 #include "nonsep/host/job_schema.hpp"
 
 #include <charconv>
+#include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -117,8 +119,17 @@ schema_json option_schema(const ParameterDescription& parameter, const Scheme& s
     for (const Fraction& order : scheme.orders()) orders.push_back(order.to_string());
     schema["examples"] = std::move(orders);
     if (!parameter.default_text.empty()) schema["default"] = parameter.default_text;
+  } else if (parameter.integer) {
+    schema = {{"type", "integer"}};
+    if (std::isfinite(parameter.minimum)) schema["minimum"] = static_cast<std::int64_t>(parameter.minimum);
+    if (std::isfinite(parameter.maximum)) schema["maximum"] = static_cast<std::int64_t>(parameter.maximum);
+    if (!parameter.default_text.empty())
+      schema["default"] = static_cast<std::int64_t>(number_from_text(parameter.default_text));
   } else {
     schema = ref(parameter.nonzero ? "nonzero" : "finite");
+    if (std::isfinite(parameter.minimum))
+      schema[parameter.minimum_exclusive ? "exclusiveMinimum" : "minimum"] = parameter.minimum;
+    if (std::isfinite(parameter.maximum)) schema["maximum"] = parameter.maximum;
     if (!parameter.default_text.empty()) schema["default"] = number_from_text(parameter.default_text);
   }
   schema["description"] = parameter.description;

@@ -31,7 +31,8 @@ struct TaoOptions {
     return std::tuple{option("order", &TaoOptions::order),
                       option("omega", &TaoOptions::omega,
                              "binding of the two copies, finite and > 0; Tao's error bound grows with omega and needs "
-                             "dt << omega^(-1/order)")};
+                             "dt << omega^(-1/order)")
+                          .above(0)};
   }
 };
 
@@ -78,7 +79,8 @@ struct ImplicitMidpointOptions {
   int max_iterations = GaussLegendre::default_max_iterations;
   static constexpr auto members() {
     return std::tuple{
-        option("max_iterations", &ImplicitMidpointOptions::max_iterations, comparator_scheme::max_iterations_text)};
+        option("max_iterations", &ImplicitMidpointOptions::max_iterations, comparator_scheme::max_iterations_text)
+            .at_least(1)};
   }
 };
 
@@ -116,8 +118,10 @@ struct GaussOptions {
   int stages = 2;
   int max_iterations = GaussLegendre::default_max_iterations;
   static constexpr auto members() {
-    return std::tuple{option("stages", &GaussOptions::stages, "number of stages s, 1 to 8 (orders 2 to 16)"),
-                      option("max_iterations", &GaussOptions::max_iterations, comparator_scheme::max_iterations_text)};
+    return std::tuple{
+        option("stages", &GaussOptions::stages, "number of stages s, 1 to 8 (orders 2 to 16)")
+            .within(1, GaussLegendreTableau::max_stages),
+        option("max_iterations", &GaussOptions::max_iterations, comparator_scheme::max_iterations_text).at_least(1)};
   }
 };
 

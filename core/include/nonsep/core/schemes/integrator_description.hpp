@@ -3,6 +3,7 @@
 // method family: what the JSON reader accepts and what `--help` and `nonsep schema` print; an IntegratorDescription
 // describes one configured instance (what a run reports in its summary).
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,13 @@ struct ParameterDescription {
   std::string description;
   // A Number that must not be 0 (t2). The scheme refuses 0 when it is built; the job schema states it.
   bool nonzero = false;
+  // A whole number (stages, max_iterations): the job reader refuses 1.5, the schema says "integer".
+  bool integer = false;
+  // The range the scheme accepts (stages 1 to 8, omega > 0), as its options declare it (scheme_options.hpp):
+  // infinite where there is no bound; minimum_exclusive for a bound the value must exceed.
+  double minimum = -std::numeric_limits<double>::infinity();
+  double maximum = std::numeric_limits<double>::infinity();
+  bool minimum_exclusive = false;
 };
 
 struct SchemeDescription {

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <concepts>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -38,17 +39,36 @@ using OptionValue = std::variant<Fraction, double>;
 // One member of an options struct: its catalogue name, what the catalogue says of it (an order's words come from its
 // scheme: describe_options), and whether it must not be 0 (t2: the scheme refuses 0 when it is built, the schema
 // states it).
+// Its range, when it has one, is declared with it (option(...).within(1, 8), .at_least(1), .above(0)): the catalogue
+// and the job schema state it, and the host's tests hold the scheme to it (the scheme's own check refuses a value
+// outside it with its own words).
 template <class Options, class T>
 struct OptionMember {
   const char* name;
   T Options::*member;
   const char* description;
   bool nonzero;
+  double minimum;
+  double maximum;
+  bool minimum_exclusive;
+  constexpr OptionMember within(double low, double high) const {
+    return {name, member, description, nonzero, low, high, false};
+  }
+  constexpr OptionMember at_least(double low) const {
+    return {name, member, description, nonzero, low, maximum, false};
+  }
+  constexpr OptionMember above(double low) const { return {name, member, description, nonzero, low, maximum, true}; }
 };
 template <class Options, class T>
 constexpr OptionMember<Options, T> option(const char* name, T Options::*member, const char* description = "",
                                           bool nonzero = false) {
-  return {name, member, description, nonzero};
+  return {name,
+          member,
+          description,
+          nonzero,
+          -std::numeric_limits<double>::infinity(),
+          std::numeric_limits<double>::infinity(),
+          false};
 }
 
 template <class O>
@@ -123,7 +143,15 @@ std::vector<ParameterDescription> describe_options(const O& defaults, const std:
             [&](const auto& m) {
               using T = std::decay_t<decltype(defaults.*m.member)>;
               const T& value = defaults.*m.member;
-              ParameterDescription parameter{m.name, ParameterDescription::Kind::Number, "", m.description, m.nonzero};
+              ParameterDescription parameter{m.name,
+                                             ParameterDescription::Kind::Number,
+                                             "",
+                                             m.description,
+                                             m.nonzero,
+                                             std::is_same_v<T, int>,
+                                             m.minimum,
+                                             m.maximum,
+                                             m.minimum_exclusive};
               if constexpr (std::is_same_v<T, Fraction>) {
                 parameter.kind = ParameterDescription::Kind::Order;
                 parameter.default_text = value.to_string();
