@@ -21,11 +21,12 @@ std::size_t most_tangent_vectors(std::size_t dimension) {
   return std::min<std::size_t>(LyapunovRecord::max_exponents, dimension > 0 ? 2 * dimension : 2);
 }
 
-// Refuses a number of tangent vectors above the most the states' dimension allows (the table allows up to 32).
+// Refuses a number of tangent vectors above the most the states' dimension allows (the table allows up to 32). With
+// the dimension unknown (the initial states have a problem of their own, reported) there is nothing to hold k to.
 bool within_dimension(Checker& check, std::int64_t k, std::int64_t least, std::size_t dimension, const std::string& at,
                       const std::string& meaning) {
   const std::size_t most = most_tangent_vectors(dimension);
-  if (k <= static_cast<std::int64_t>(most)) return true;
+  if (dimension == 0 || k <= static_cast<std::int64_t>(most)) return true;
   check.issue(
       at, std::to_string(k),
       "an integer from " + std::to_string(least) + " to " + std::to_string(most) + " (2n, at most 32): " + meaning);
