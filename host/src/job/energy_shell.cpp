@@ -14,8 +14,8 @@ namespace nonsep::host {
 
 namespace job_reader {
 
-void read_energy_shell(Checker& check, const json& initial, InitialStates& states) {
-  const bool has_energy = initial.contains("energy"), has_solve = initial.contains("solve_for");
+void read_energy_shell(Checker& check, const KeyReader& initial, InitialStates& states) {
+  const bool has_energy = initial.given("energy"), has_solve = initial.given("solve_for");
   if (!has_energy && !has_solve) return;
   if (has_energy != has_solve) {
     check.issue(has_energy ? "/initial/solve_for" : "/initial/energy", "nothing",
@@ -23,18 +23,18 @@ void read_energy_shell(Checker& check, const json& initial, InitialStates& state
     return;
   }
   EnergyShell shell;
-  const auto energy =
-      check.finite_number(initial["energy"], "/initial/energy", "a finite number: the energy H of every state");
-  const json& solve = initial["solve_for"];
-  std::string text = solve.is_string() ? solve.get<std::string>() : "";
+  const auto energy = initial.number("energy");
+  const auto solve = initial.string("solve_for");
+  if (!solve) return;  // refused by the table
+  std::string text = *solve;
   shell.solve_for = text;
-  shell.negative = !text.empty() && text[0] == '-';
+  shell.negative = text[0] == '-';
   if (shell.negative) text.erase(0, 1);
   bool valid = text.size() >= 2 && text[0] == 'p' && text.size() < 8;
   for (std::size_t i = 1; valid && i < text.size(); ++i) valid = text[i] >= '0' && text[i] <= '9';
   if (valid) shell.component = static_cast<std::size_t>(std::stoul(text.substr(1)));
   if (!valid || (states.dimension > 0 && shell.component >= states.dimension)) {
-    check.issue("/initial/solve_for", describe(solve),
+    check.issue("/initial/solve_for", describe(initial.object()["solve_for"]),
                 "\"p<i>\" (the root p_i >= 0) or \"-p<i>\" (the root p_i <= 0), i from 0 to " +
                     std::to_string(states.dimension > 0 ? states.dimension - 1 : 0));
     return;

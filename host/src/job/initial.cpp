@@ -279,10 +279,9 @@ InitialStates read_initial(Checker& check, const KeyReader& document, const std:
     }
   } else if (initial->is_object() && initial->contains("grid")) {
     states.shape = "grid";
-    check.known_keys(*initial, "/initial",
-                     initial_grid_keys().names());  // grid: read_grid; the shell: energy_shell.cpp
+    const KeyReader keys(check, *initial, "/initial", initial_grid_keys(), allowed_text(document_keys()["initial"]));
     read_grid(check, (*initial)["grid"], states);
-    read_energy_shell(check, *initial, states);
+    read_energy_shell(check, keys, states);
   } else if (initial->is_object() && initial->contains("file")) {
     states.shape = "file";
     read_initial_file(check, *initial, directory, states);

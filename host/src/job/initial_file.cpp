@@ -301,11 +301,9 @@ std::optional<Problem> read_csv(int descriptor, const std::string& shown, Initia
 }  // namespace
 
 void read_initial_file(Checker& check, const json& initial, const fs::path& directory, InitialStates& states) {
-  check.known_keys(initial, "/initial", initial_file_keys().names());
-  const std::string what = "the path of a .npy or .csv file of initial states, relative to the job file's folder";
-  const json* value = check.member(initial, "/initial", "file", true, what);
-  if (!value) return;
-  const auto name = check.path_string(*value, file_path, what);
+  const KeyReader keys(check, initial, "/initial", initial_file_keys(), "");
+  const std::string what = allowed_text(initial_file_keys()["file"]);
+  const auto name = keys.string("file");
   if (!name) return;
   const fs::path path = fs::path(*name).is_absolute() ? fs::path(*name) : directory / *name;
   const std::string extension = path.extension().string();

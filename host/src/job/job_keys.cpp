@@ -292,10 +292,12 @@ const KeyTable& initial_grid_keys() {
            .type = ValueType::finite,
            .description = "Put every state of the grid on the energy shell H = energy by solving for the momentum "
                           "component solve_for names (the grid's value of it is ignored); states that cannot reach the "
-                          "shell are left out (summary.json energy_shell.left_out)."},
+                          "shell are left out (summary.json energy_shell.left_out).",
+           .allowed = "a finite number: the energy H of every state"},
           {.name = "solve_for",
            .type = ValueType::string,
            .description = "\"p<i>\": the root p_i >= 0 nearest to 0; \"-p<i>\": the root p_i <= 0.",
+           .allowed = "\"p<i>\" (the root p_i >= 0) or \"-p<i>\" (the root p_i <= 0), i from 0 below the dimension",
            .pattern = "^-?p(0|[1-9][0-9]*)$"},
       },
       {{"dependentRequired", {{"energy", {"solve_for"}}, {"solve_for", {"energy"}}}}}};
@@ -311,7 +313,8 @@ const KeyTable& initial_file_keys() {
                       "p0..p(n-1): a NumPy .npy file of a little-endian float64 array of shape (states, 2n) or (2n,) "
                       "(numpy.save), or a .csv file with the header q0,...,q(n-1),p0,...,p(n-1). At most " +
                       std::to_string(max_initial_states) + " states and " + std::to_string(max_initial_values) +
-                      " numbers in q, every number finite."},
+                      " numbers in q, every number finite.",
+       .allowed = "the path of a .npy or .csv file of initial states, relative to the job file's folder"},
   }};
   return table;
 }

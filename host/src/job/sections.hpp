@@ -70,7 +70,7 @@ inline constexpr std::size_t max_initial_csv_cell_bytes = 32;
 void read_initial_file(Checker& check, const json& initial, const std::filesystem::path& directory,
                        InitialStates& states);
 // /initial/energy and /initial/solve_for of a grid (energy_shell.cpp), into states.shell.
-void read_energy_shell(Checker& check, const json& initial, InitialStates& states);
+void read_energy_shell(Checker& check, const KeyReader& initial, InitialStates& states);
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
                 const std::string& first_path);
 
