@@ -36,20 +36,18 @@ std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& mode
     const bool a_first = a.first->family == "comparator", b_first = b.first->family == "comparator";
     return a_first != b_first ? a_first : b.second.value() < a.second.value();
   });
-  std::vector<AutoCandidate> all;
-  for (const auto& [scheme, order] : orders)
-    all.push_back({scheme->name + " " + order.to_string(), spec_of_order(*scheme, order, form)});
-  // A model given by H (general_hamiltonian) has the gradient of H and no product form for Chin's schemes.
+  // A model given by H (general_hamiltonian) has the gradient of H and no product form for Chin's schemes; a
+  // comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
   const bool general = model.general;
   const bool gradient_of_h = general || model.hessians_and_third_derivatives;
   std::vector<AutoCandidate> usable;
-  for (auto& candidate : all) {
-    if (is_comparator(candidate.spec.scheme) ? !gradient_of_h : general) continue;
-    // A comparator's tangent map needs the plugin's directional derivative of grad H (hvp_H) besides.
-    if (run.analysis.tangent_vectors() > 0 &&
-        (!has_tangent_map(candidate.spec) || (is_comparator(candidate.spec.scheme) && !model.hessian_products)))
+  for (const auto& [scheme, order] : orders) {
+    const bool comparator = scheme->family == "comparator";
+    if (comparator ? !gradient_of_h : general) continue;
+    IntegratorSpec spec = spec_of_order(*scheme, order, form);
+    if (run.analysis.tangent_vectors() > 0 && (!has_tangent_map(spec) || (comparator && !model.hessian_products)))
       continue;
-    usable.push_back(std::move(candidate));
+    usable.push_back({scheme->name + " " + order.to_string(), std::move(spec)});
   }
   return usable;
 }
