@@ -119,7 +119,9 @@ std::vector<std::size_t> pilot_indices(const InitialStates& initial) {
   const std::size_t each = sets.empty() ? 0 : std::max<std::size_t>(1, auto_pilot_states / sets.size());
   for (const auto& [first, end] : sets) {
     const std::size_t size = end - first, count = std::min(size, each);
-    for (std::size_t k = 0; k < count; ++k) indices.push_back(first + k * size / count);
+    // The set's first and last states among them: on a grid the extremes are often the hardest (the largest
+    // amplitude, the parameter's end).
+    for (std::size_t k = 0; k < count; ++k) indices.push_back(first + (count == 1 ? 0 : k * (size - 1) / (count - 1)));
   }
   return indices;
 }
@@ -210,18 +212,37 @@ class Pilots {
       if (!round_off && !(ratio >= expected / asymptotic_within && ratio <= expected * asymptotic_within)) {
         last = "its error fell by " + format_number(ratio) + " from " + std::to_string(2 * n) + " to " +
                std::to_string(4 * n) + " pilot steps, not by 2^order = " + format_number(expected);
+        if (const auto least = least_run_seconds(order, energy ? 4 * n : 2 * n, fine, r2, r4, n);
+            bound && least && *least > *bound) {
+          result.excluded =
+              "its pilots' error, " + format_number(fine) + " at " + std::to_string(energy ? 4 * n : 2 * n) +
+              " steps, falling even at twice its order would need a run of at least " + format_number(*least) +
+              " s, longer than the predicted run of a candidate before it (" + format_number(*bound) + " s)";
+          return result;
+        }
         continue;
       }
       result.pilot_steps = n;
-      result.pilot_dt = choice_.pilot_horizon / static_cast<double>(4 * n);
       result.ratio = ratio;
+      // The pair whose difference is the error (energy: the run whose error it is) and where the prediction starts.
+      // When the finest run's error is round-off and the coarser pair's is not, that pair measures the error of its
+      // coarser run (phase: the n run's, within the 2n run's error, which is round-off; energy: the 2n run's own):
+      // the prediction starts there, at a measured error rather than at the round-off bound. The rate towards smaller
+      // steps is then the one observed down to round-off, which that round-off can only make slower (a larger
+      // predicted error).
+      const bool from_coarse = round_off && coarse > floor;
+      const PilotRun &pair_coarse = from_coarse ? r1 : r2, &pair_fine = from_coarse ? r2 : r4;
+      result.anchor_steps = from_coarse ? (energy ? 2 * n : n) : 4 * n;
+      result.pilot_dt = choice_.pilot_horizon / static_cast<double>(result.anchor_steps);
       // At round-off the difference bounds the error; in the asymptotic range Richardson gives it.
-      result.pilot_error = energy || round_off ? std::max(fine, floor) : fine / (expected - 1.0);
-      const double half =
-          energy ? r4.max_half : largest_distance(r2.marks[pilot_marks / 2 - 1], r4.marks[pilot_marks / 2 - 1], width);
-      const double raw = half > 0.0 && fine > 0.0 ? std::log2(fine / half) : 1.0;
+      result.pilot_error = from_coarse ? coarse : energy || round_off ? std::max(fine, floor) : fine / (expected - 1.0);
+      const double end = from_coarse ? coarse : fine;
+      const double half = energy ? pair_fine.max_half
+                                 : largest_distance(pair_coarse.marks[pilot_marks / 2 - 1],
+                                                    pair_fine.marks[pilot_marks / 2 - 1], width);
+      const double raw = half > 0.0 && end > 0.0 ? std::log2(end / half) : 1.0;
       result.growth = std::clamp(std::isfinite(raw) ? raw : 1.0, energy ? 0.0 : 1.0, max_growth_exponent);
-      if (!energy) result.envelope_growth = envelope_growth(r2, r4, width, floor);
+      if (!energy) result.envelope_growth = envelope_growth(pair_coarse, pair_fine, width, floor);
       result.seconds_per_step = r4.seconds > r1.seconds ? (r4.seconds - r1.seconds) / static_cast<double>(3 * n)
                                                         : r4.seconds / static_cast<double>(4 * n);
       predict(result, order);
@@ -232,6 +253,23 @@ class Pilots {
   }
 
  private:
+  // A lower bound on the run of a candidate whose ladder is not yet asymptotic, from its error `error` at `steps`
+  // pilot steps: its error falling like h^(2 order) from there (faster than any of its ladders has fallen in the
+  // catalogue's measurements), and growing no slower than the least exponent the prediction allows. Its seconds per
+  // step are those between the 2n and the 4n pilot (the pilot's fixed cost cancels); nothing when they are not
+  // measurable or the error already meets the tolerance.
+  std::optional<double> least_run_seconds(double order, std::uint64_t steps, double error, const PilotRun& r2,
+                                          const PilotRun& r4, std::uint64_t n) const {
+    const double per_step = (r4.seconds - r2.seconds) / static_cast<double>(2 * n);
+    const double horizons = std::abs(run_.time.t_end / choice_.pilot_horizon);
+    const double target =
+        choice_.tolerance / (auto_safety * (choice_.measure == AutoScheme::Measure::energy ? 1.0 : horizons));
+    if (!(per_step > 0.0) || !(error > target) || !std::isfinite(error)) return std::nullopt;
+    const double pilot_steps = static_cast<double>(steps) * std::pow(error / target, 1.0 / (2.0 * order));
+    return per_step * pilot_steps * horizons * static_cast<double>(loaded_.job.initial.count) /
+           static_cast<double>(choice_.pilot_states);
+  }
+
   // The largest step |time.dt| / m that meets tolerance / auto_safety by the prediction, and its cost.
   void predict(PilotResult& result, double order) const {
     const TimeGrid& time = run_.time;
@@ -248,6 +286,9 @@ class Pilots {
       h_max = std::max(h_pilot,
                        h_pilot * std::pow(choice_.tolerance / (auto_safety * result.pilot_error * growth), 1.0 / rate));
     }
+    // No larger than the coarsest pilot step the accepted ladder covers (t_p / n): above it the pilots showed no
+    // asymptotic fall (the ladder from n / 2 was not accepted), and the iteration of an implicit scheme may diverge.
+    h_max = std::min(h_max, std::abs(choice_.pilot_horizon) / static_cast<double>(result.pilot_steps));
     const double m = std::max(1.0, std::ceil(std::abs(time.dt) / h_max * (1.0 - 1e-12)));
     const double steps = static_cast<double>(time.steps) * m;
     if (!(steps <= static_cast<double>(max_steps))) {
@@ -456,7 +497,7 @@ json candidates_json(const std::vector<PilotResult>& pilots) {
                           {"scheme", pilot.candidate.spec.scheme},
                           {"order", Integrator::describe(pilot.candidate.spec).order.to_string()},
                           {"excluded", usable ? json(nullptr) : json(pilot.excluded)},
-                          {"pilot_steps", pilot.pilot_steps ? json(4 * pilot.pilot_steps) : json(nullptr)},
+                          {"pilot_steps", pilot.pilot_steps ? json(pilot.anchor_steps) : json(nullptr)},
                           {"pilot_dt", number_or_null(pilot.pilot_dt, pilot.pilot_steps > 0)},
                           {"pilot_error", number_or_null(pilot.pilot_error, pilot.pilot_steps > 0)},
                           {"error_ratio_per_halving", number_or_null(pilot.ratio, pilot.pilot_steps > 0)},

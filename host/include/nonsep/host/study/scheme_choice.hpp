@@ -9,23 +9,28 @@
 // only the schemes that have a tangent map (nonsep::has_tangent_map). A separable part K(p) + U(q) is solved by every
 // one of them.
 //
-// Pilots: up to auto_pilot_states of the job's states (evenly spread; with a sweep, as many of each parameter set's
-// states, at least one per set, each stepped with its set's parameters as the run steps it, so that the choice
-// meets the tolerance on every set), from t = 0 to the pilot horizon t_p, each
+// Pilots: up to auto_pilot_states of the job's states (evenly spread, the first and the last among them; with a
+// sweep, as many of each parameter set's states, at least one per set, each stepped with its set's parameters as
+// the run steps it, so that the choice meets the tolerance on every set), from t = 0 to the pilot horizon t_p, each
 // candidate at n, 2n and 4n steps (n = 4, doubled until the three are in the
 // scheme's asymptotic range: their differences fall by 2^order within a factor 2.5, or the finest is at round-off;
 // at most auto_pilot_max_steps steps). The error at t_p of the 4n run is, by Richardson extrapolation,
 //   phase:  |(q, p)_2n - (q, p)_4n| / (2^p - 1)          energy: max |dH/H0| over [0, t_p] of the 4n run
-// (the largest over the pilot states), and its growth from t_p / 2 to t_p gives an exponent a (phase: 1 to 3,
-// energy: 0 to 3), so that the error at t_end with step h is predicted as
+// (the largest over the pilot states). When that is round-off and the coarser pair's is not, the prediction starts
+// from the coarser pair's measured error instead: phase |(q, p)_n - (q, p)_2n|, the n run's error (the 2n run's is
+// round-off); energy the 2n run's. h_p is the step of the run whose error e_p is. Its growth from t_p / 2 to t_p
+// gives an exponent a (phase: 1 to 3, energy: 0 to 3), so that the error at t_end with step h is predicted as
 //   e(h) = e_p (h / h_p)^r (t_end / t_p)^a,
-// r the order, or the rate the pilots showed (log2 of their error ratio) where that predicts the larger error.
+// r the order, or the rate the pilots showed (log2 of their error ratio) where that predicts the larger error;
+// h at most t_p / n, the coarsest step the accepted ladder covers.
 // The pilot horizon is t_end itself (then a = 0 plays no part) unless no candidate is usable there (a long run, at
 // whose horizon even 2^14 steps are not asymptotic): then t_end / 8, then t_end / 64 (auto_pilot_fractions).
 // The step is the largest h = |time.dt| / m (m a whole number, so that the output grid of time.dt is kept) with
 // e(h) <= tolerance / auto_safety; the cost is the pilot's measured seconds per step times t_end / h. The candidate
 // with the least cost is chosen. The pilots' cost is bounded: a candidate whose pilots have taken longer than the
-// least predicted run so far is left out, so that they cost at most about that run per candidate. A candidate that
+// least predicted run so far is left out, so that they cost at most about that run per candidate; so is one whose
+// ladder is not yet asymptotic when its error falling at twice its order from its last pilot would still need a
+// longer run than that. A candidate that
 // diverges, fails, or does not reach its asymptotic range is left out with the reason. When none is left the choice
 // fails (ChoiceFailed).
 #include <cstdint>
@@ -71,12 +76,13 @@ std::vector<AutoCandidate> auto_candidates(const Job& job, const AutoModel& mode
 // What the pilots measured of one candidate.
 struct PilotResult {
   AutoCandidate candidate;
-  std::string excluded;           // why it was left out; "" when it can be chosen
-  std::uint64_t pilot_steps = 0;  // n of the accepted ladder (its runs: n, 2n, 4n steps to t_p)
-  double pilot_dt = 0.0;          // t_p / 4n
-  double pilot_error = 0.0;       // e_p: the 4n run's error at t_p
-  double ratio = 0.0;             // how much the error fell from 2n to 4n (2^order in the asymptotic range)
-  double growth = 0.0;            // a
+  std::string excluded;            // why it was left out; "" when it can be chosen
+  std::uint64_t pilot_steps = 0;   // n of the accepted ladder (its runs: n, 2n, 4n steps to t_p)
+  std::uint64_t anchor_steps = 0;  // the pilot run whose error e_p is: 4n, or n / 2n (phase / energy) at round-off
+  double pilot_dt = 0.0;           // t_p / anchor_steps
+  double pilot_error = 0.0;        // e_p: the anchor run's error at t_p
+  double ratio = 0.0;              // how much the error fell from 2n to 4n (2^order in the asymptotic range)
+  double growth = 0.0;             // a
   // Phase: log2 of the growth of the pilot pair's largest distance from t_p / 2 to t_p (largest over the marks up to
   // each); nothing for the energy, or when the distance is at round-off.
   std::optional<double> envelope_growth;
