@@ -1,0 +1,356 @@
+// Scheme "auto"'s pilots: the ladders of each candidate and the prediction from them (pilots.hpp).
+#include "pilots.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "nonsep/core/runtime/integrator.hpp"
+#include "nonsep/host/number_format.hpp"
+#include "nonsep/host/run/ensemble_driver.hpp"
+
+namespace nonsep::host {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Below this a pilot's error is round-off (relative to the state's length for the phase error).
+constexpr double pilot_round_off = 1e-13;
+// The asymptotic range: the error falls by 2^order per halving of the step, within this factor.
+constexpr double asymptotic_within = 2.5;
+// The pilots' states are kept at t_p k / pilot_marks (k = 1 .. pilot_marks), for the growth of the phase error.
+constexpr std::uint64_t pilot_marks = 8;
+
+// One pilot run: its states at t_p k / pilot_marks (k = 1 .. pilot_marks; those that fall on a step) and its largest
+// |dH/H0| up to t_p / 2 and t_p (energy evaluated at every step when the measure is the energy).
+class PilotObserver : public Observer {
+ public:
+  PilotObserver(std::size_t count, std::size_t dimension, std::uint64_t steps, bool energy)
+      : dimension_(dimension), steps_(steps), energy_(energy), width_(count * 2 * dimension), marks_(pilot_marks) {}
+
+  std::uint64_t next_event(std::uint64_t step) const override {
+    if (energy_) return step < steps_ ? step + 1 : no_event;
+    for (std::uint64_t k = 1; k <= pilot_marks; ++k)
+      if (const auto mark = mark_step(k); mark && *mark > step) return *mark;
+    return no_event;
+  }
+  bool needs_energy(std::uint64_t) const override { return energy_; }
+  void on_event(const Event& event) override {
+    for (const StateView& state : event.states) {
+      if (energy_ && state.energy && state.record->energy_initial && *state.record->energy_initial != 0.0) {
+        const double e = std::abs((*state.energy - *state.record->energy_initial) / *state.record->energy_initial);
+        max_end_ = std::max(max_end_, e);
+        if (event.step <= steps_ / 2) max_half_ = std::max(max_half_, e);
+      }
+      const std::uint64_t k = event.step * pilot_marks / steps_;
+      if (k == 0 || mark_step(k) != event.step) continue;
+      std::vector<double>& into = marks_[k - 1];
+      into.resize(width_);
+      std::copy(state.q.begin(), state.q.end(),
+                into.begin() + static_cast<std::ptrdiff_t>(state.trajectory * 2 * dimension_));
+      std::copy(state.p.begin(), state.p.end(),
+                into.begin() + static_cast<std::ptrdiff_t>(state.trajectory * 2 * dimension_ + dimension_));
+    }
+  }
+  void on_retire(std::size_t trajectory, const TrajectoryRecord& record) override {
+    if (stopped_early(record.status) && problem_.empty())
+      problem_ = std::string(to_string(record.status)) + " at step " + std::to_string(record.stop_step) +
+                 " (pilot state " + std::to_string(trajectory) + ")";
+  }
+
+  // The step of mark k, when t_p k / pilot_marks falls on one.
+  std::optional<std::uint64_t> mark_step(std::uint64_t k) const {
+    if (k * steps_ % pilot_marks != 0) return std::nullopt;
+    return k * steps_ / pilot_marks;
+  }
+
+  std::size_t dimension_;
+  std::uint64_t steps_;
+  bool energy_;
+  std::size_t width_;
+  std::vector<std::vector<double>> marks_;  // the states at mark k = 1 .. pilot_marks; empty where none falls
+  double max_half_ = 0.0, max_end_ = 0.0;
+  std::string problem_;
+};
+
+struct PilotRun {
+  std::string problem;                     // "" when every pilot state completed
+  std::vector<std::vector<double>> marks;  // PilotObserver::marks_
+  double max_half = 0.0, max_end = 0.0;
+  double seconds = 0.0;
+};
+
+// The largest distance between the pilot states of two runs, and the largest length of a state.
+double largest_distance(const std::vector<double>& a, const std::vector<double>& b, std::size_t width) {
+  double largest = 0.0;
+  for (std::size_t s = 0; s * width < a.size(); ++s) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < width; ++i)
+      sum += (a[s * width + i] - b[s * width + i]) * (a[s * width + i] - b[s * width + i]);
+    largest = std::max(largest, std::sqrt(sum));
+  }
+  return largest;
+}
+
+double largest_length(const std::vector<double>& a, std::size_t width) {
+  return largest_distance(a, std::vector<double>(a.size(), 0.0), width);
+}
+
+// How the phase error of the pilot pair (2n, 4n steps) grew over the second half of the pilot: log2 of the largest
+// distance between their states at the marks up to t_p over the largest up to t_p / 2. Nothing when that at t_p / 2
+// is within a factor 10 of round-off (`floor`): the ratio of two round-offs says nothing about the orbit.
+std::optional<double> envelope_growth(const PilotRun& coarse, const PilotRun& fine, std::size_t width, double floor) {
+  double largest = 0.0, at_half = 0.0;
+  for (std::size_t k = 0; k < pilot_marks; ++k) {
+    largest = std::max(largest, largest_distance(coarse.marks[k], fine.marks[k], width));
+    if (k + 1 == pilot_marks / 2) at_half = largest;
+  }
+  if (!(at_half > 10.0 * floor)) return std::nullopt;
+  return std::log2(largest / at_half);
+}
+
+class Pilots {
+ public:
+  Pilots(const LoadedJob& loaded, const RunOptions& options, SchemeChoice& choice, double fraction)
+      : loaded_(loaded), options_(options), choice_(choice), run_(loaded.job.run()) {
+    const InitialStates& initial = loaded.job.initial;
+    const std::size_t n = initial.dimension;
+    const std::vector<std::size_t> indices = pilot_indices(initial);
+    std::vector<std::size_t> set_of;  // each pilot state's parameter set (empty without a sweep)
+    for (const std::size_t index : indices) {
+      if (!initial.parameter_set.empty()) set_of.push_back(initial.parameter_set[index]);
+      q_.insert(q_.end(), initial.q.begin() + static_cast<std::ptrdiff_t>(index * n),
+                initial.q.begin() + static_cast<std::ptrdiff_t>(index * n + n));
+      p_.insert(p_.end(), initial.p.begin() + static_cast<std::ptrdiff_t>(index * n),
+                initial.p.begin() + static_cast<std::ptrdiff_t>(index * n + n));
+    }
+    // Each pilot state is stepped with its own set's parameters, as the run steps it.
+    sets_ = parameter_sets(loaded.job, set_of);
+    choice_.pilot_states = indices.size();
+    choice_.pilot_horizon = run_.time.t_end / fraction;
+  }
+
+  // `bound`: the least predicted cost of the candidates measured so far; a candidate whose pilots take longer is
+  // left out (its run could not be cheaper than that one's pilots and run together).
+  PilotResult measure(const AutoCandidate& candidate, std::optional<double> bound) {
+    const double spent_before = choice_.pilot_seconds;
+    PilotResult result;
+    result.candidate = candidate;
+    const double order = Integrator::describe(candidate.spec).order.value();
+    const bool energy = choice_.measure == AutoScheme::Measure::energy;
+    const std::size_t width = 2 * loaded_.job.initial.dimension;
+    std::map<std::uint64_t, PilotRun> runs;
+    const PilotRun over;  // a pilot not run: it would have taken the candidate's pilots over the bound
+    // Over the bound: what the pilots took, and what the next one would take at the last one's seconds per step.
+    double per_step = 0.0;
+    const auto over_bound = [&](std::uint64_t next_steps) {
+      return bound && choice_.pilot_seconds - spent_before + per_step * static_cast<double>(next_steps) > *bound;
+    };
+    const auto run = [&](std::uint64_t steps) -> const PilotRun& {
+      auto found = runs.find(steps);
+      if (found == runs.end() && !over_bound(steps)) {
+        found = runs.emplace(steps, pilot(candidate.spec, steps, energy)).first;
+        per_step = found->second.seconds / static_cast<double>(steps);
+      }
+      return found == runs.end() ? over : found->second;
+    };
+    std::string last;
+    for (std::uint64_t n = 4; 4 * n <= auto_pilot_max_steps; n *= 2) {
+      const PilotRun &r1 = run(n), &r2 = run(2 * n), &r4 = run(4 * n);
+      if (&r1 == &over || &r2 == &over || &r4 == &over) {
+        result.excluded = "its pilots took " + format_number(choice_.pilot_seconds - spent_before) +
+                          " s, and the next would take them past the predicted run of a candidate before it (" +
+                          format_number(*bound) + " s)";
+        return result;
+      }
+      if (!r1.problem.empty() || !r2.problem.empty() || !r4.problem.empty()) {
+        last = "its pilot with " +
+               std::to_string(!r1.problem.empty()   ? n
+                              : !r2.problem.empty() ? 2 * n
+                                                    : 4 * n) +
+               " steps " +
+               (!r1.problem.empty()   ? r1.problem
+                : !r2.problem.empty() ? r2.problem
+                                      : r4.problem);
+        continue;
+      }
+      const double coarse = energy ? r2.max_end : largest_distance(r1.marks.back(), r2.marks.back(), width);
+      const double fine = energy ? r4.max_end : largest_distance(r2.marks.back(), r4.marks.back(), width);
+      const double floor = pilot_round_off * (energy ? 1.0 : std::max(1.0, largest_length(r4.marks.back(), width)));
+      const double ratio = coarse / fine, expected = std::pow(2.0, order);
+      const bool round_off = fine <= floor;
+      if (!round_off && !(ratio >= expected / asymptotic_within && ratio <= expected * asymptotic_within)) {
+        last = "its error fell by " + format_number(ratio) + " from " + std::to_string(2 * n) + " to " +
+               std::to_string(4 * n) + " pilot steps, not by 2^order = " + format_number(expected);
+        if (const auto least = least_run_seconds(order, energy ? 4 * n : 2 * n, fine, r2, r4, n);
+            bound && least && *least > *bound) {
+          result.excluded =
+              "its pilots' error, " + format_number(fine) + " at " + std::to_string(energy ? 4 * n : 2 * n) +
+              " steps, falling even at twice its order would need a run of at least " + format_number(*least) +
+              " s, longer than the predicted run of a candidate before it (" + format_number(*bound) + " s)";
+          return result;
+        }
+        continue;
+      }
+      result.pilot_steps = n;
+      result.ratio = ratio;
+      // The pair whose difference is the error (energy: the run whose error it is) and where the prediction starts.
+      // When the finest run's error is round-off and the coarser pair's is not, that pair measures the error of its
+      // coarser run (phase: the n run's, within the 2n run's error, which is round-off; energy: the 2n run's own):
+      // the prediction starts there, at a measured error rather than at the round-off bound. The rate towards smaller
+      // steps is then the one observed down to round-off, which that round-off can only make slower (a larger
+      // predicted error).
+      const bool from_coarse = round_off && coarse > floor;
+      const PilotRun &pair_coarse = from_coarse ? r1 : r2, &pair_fine = from_coarse ? r2 : r4;
+      result.anchor_steps = from_coarse ? (energy ? 2 * n : n) : 4 * n;
+      result.pilot_dt = choice_.pilot_horizon / static_cast<double>(result.anchor_steps);
+      // At round-off the difference bounds the error; in the asymptotic range Richardson gives it.
+      result.pilot_error = from_coarse ? coarse : energy || round_off ? std::max(fine, floor) : fine / (expected - 1.0);
+      const double end = from_coarse ? coarse : fine;
+      const double half = energy ? pair_fine.max_half
+                                 : largest_distance(pair_coarse.marks[pilot_marks / 2 - 1],
+                                                    pair_fine.marks[pilot_marks / 2 - 1], width);
+      const double raw = half > 0.0 && end > 0.0 ? std::log2(end / half) : 1.0;
+      result.growth = std::clamp(std::isfinite(raw) ? raw : 1.0, energy ? 0.0 : 1.0, max_growth_exponent);
+      if (!energy) result.envelope_growth = envelope_growth(pair_coarse, pair_fine, width, floor);
+      result.seconds_per_step = r4.seconds > r1.seconds ? (r4.seconds - r1.seconds) / static_cast<double>(3 * n)
+                                                        : r4.seconds / static_cast<double>(4 * n);
+      predict(result, order);
+      return result;
+    }
+    result.excluded = "no usable pilot up to " + std::to_string(auto_pilot_max_steps) + " steps: " + last;
+    return result;
+  }
+
+ private:
+  // A lower bound on the run of a candidate whose ladder is not yet asymptotic, from its error `error` at `steps`
+  // pilot steps: its error falling like h^(2 order) from there (faster than any of its ladders has fallen in the
+  // catalogue's measurements), and growing no slower than the least exponent the prediction allows. Its seconds per
+  // step are those between the 2n and the 4n pilot (the pilot's fixed cost cancels); nothing when they are not
+  // measurable or the error already meets the tolerance.
+  std::optional<double> least_run_seconds(double order, std::uint64_t steps, double error, const PilotRun& r2,
+                                          const PilotRun& r4, std::uint64_t n) const {
+    const double per_step = (r4.seconds - r2.seconds) / static_cast<double>(2 * n);
+    const double horizons = std::abs(run_.time.t_end / choice_.pilot_horizon);
+    const double target =
+        choice_.tolerance / (auto_safety * (choice_.measure == AutoScheme::Measure::energy ? 1.0 : horizons));
+    if (!(per_step > 0.0) || !(error > target) || !std::isfinite(error)) return std::nullopt;
+    const double pilot_steps = static_cast<double>(steps) * std::pow(error / target, 1.0 / (2.0 * order));
+    return per_step * pilot_steps * horizons * static_cast<double>(loaded_.job.initial.count) /
+           static_cast<double>(choice_.pilot_states);
+  }
+
+  // The largest step |time.dt| / m that meets tolerance / auto_safety by the prediction, and its cost.
+  void predict(PilotResult& result, double order) const {
+    const TimeGrid& time = run_.time;
+    const double growth = std::pow(std::abs(time.t_end / choice_.pilot_horizon), result.growth);
+    const double h_pilot = std::abs(result.pilot_dt);
+    // Where the pilots' errors fell more slowly than 2^order per halving (not yet asymptotic), extrapolating to a
+    // smaller step uses the slower observed rate; to a larger step the order (either way the larger prediction).
+    const double observed = result.ratio > 1.0 ? std::log2(result.ratio) : order;
+    const double smaller = std::min(order, observed), larger = std::max(order, observed);
+    double rate = smaller;
+    double h_max = h_pilot * std::pow(choice_.tolerance / (auto_safety * result.pilot_error * growth), 1.0 / rate);
+    if (h_max > h_pilot) {
+      rate = larger;
+      h_max = std::max(h_pilot,
+                       h_pilot * std::pow(choice_.tolerance / (auto_safety * result.pilot_error * growth), 1.0 / rate));
+    }
+    // No larger than the coarsest pilot step the accepted ladder covers (t_p / n): above it the pilots showed no
+    // asymptotic fall (the ladder from n / 2 was not accepted), and the iteration of an implicit scheme may diverge.
+    h_max = std::min(h_max, std::abs(choice_.pilot_horizon) / static_cast<double>(result.pilot_steps));
+    const double m = std::max(1.0, std::ceil(std::abs(time.dt) / h_max * (1.0 - 1e-12)));
+    const double steps = static_cast<double>(time.steps) * m;
+    if (!(steps <= static_cast<double>(max_steps))) {
+      result.excluded = "it would need " + format_number(steps) + " steps, more than " + std::to_string(max_steps);
+      return;
+    }
+    result.steps = static_cast<std::uint64_t>(steps);
+    const double h = std::abs(time.dt) / m;
+    result.predicted_error = result.pilot_error * std::pow(h / h_pilot, h < h_pilot ? smaller : larger) * growth;
+    result.predicted_seconds = result.seconds_per_step * steps * static_cast<double>(loaded_.job.initial.count) /
+                               static_cast<double>(choice_.pilot_states);
+  }
+
+  PilotRun pilot(const IntegratorSpec& spec, std::uint64_t steps, bool energy) {
+    const std::size_t count = choice_.pilot_states;
+    const double t_p = choice_.pilot_horizon;
+    EnsembleSetup setup{spec,
+                        TimeGrid::to_end(t_p, t_p / static_cast<double>(steps), steps),
+                        loaded_.job.initial.dimension,
+                        q_,
+                        p_,
+                        options_.threads,
+                        options_.stop_requested};
+    setup.parameter_sets = sets_;
+    EnsembleDriver driver(loaded_.plugin, loaded_.model, setup);
+    PilotObserver observer(count, loaded_.job.initial.dimension, steps, energy);
+    driver.add_observer(observer);
+    const auto start = Clock::now();
+    const DriverEnd end = driver.run();
+    PilotRun result;
+    result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    choice_.pilot_seconds += result.seconds;
+    choice_.pilot_state_steps += steps * count;
+    const EvaluationCounts e = driver.evaluations();
+    EvaluationCounts& total = choice_.pilot_evaluations;
+    total.grad_T += e.grad_T;
+    total.grad_V += e.grad_V;
+    total.grad_H += e.grad_H;
+    total.grad_K += e.grad_K;
+    total.grad_U += e.grad_U;
+    if (end == DriverEnd::interrupted) throw PilotsInterrupted("interrupted during the pilot runs of scheme auto");
+    if (end == DriverEnd::failed) result.problem = "failed: " + driver.error();
+    if (result.problem.empty()) result.problem = observer.problem_;
+    result.marks = std::move(observer.marks_);
+    result.max_half = observer.max_half_;
+    result.max_end = observer.max_end_;
+    return result;
+  }
+
+  const LoadedJob& loaded_;
+  const RunOptions& options_;
+  SchemeChoice& choice_;
+  const SingleRun& run_;
+  std::vector<double> q_, p_;
+  std::vector<ParameterSet> sets_;  // of the pilot states; empty without a sweep
+};
+
+}  // namespace
+
+std::vector<std::size_t> pilot_indices(const InitialStates& initial) {
+  const std::vector<std::size_t>& set_of = initial.parameter_set;
+  std::vector<std::pair<std::size_t, std::size_t>> sets;  // each set's states: [first, end)
+  for (std::size_t b = 0; b < initial.count; ++b) {
+    if (b == 0 || (!set_of.empty() && set_of[b] != set_of[b - 1]))
+      sets.emplace_back(b, b + 1);
+    else
+      sets.back().second = b + 1;
+  }
+  std::vector<std::size_t> indices;
+  const std::size_t each = sets.empty() ? 0 : std::max<std::size_t>(1, auto_pilot_states / sets.size());
+  for (const auto& [first, end] : sets) {
+    const std::size_t size = end - first, count = std::min(size, each);
+    // The set's first and last states among them: on a grid the extremes are often the hardest (the largest
+    // amplitude, the parameter's end).
+    for (std::size_t k = 0; k < count; ++k) indices.push_back(first + (count == 1 ? 0 : k * (size - 1) / (count - 1)));
+  }
+  return indices;
+}
+
+void run_pilots(const LoadedJob& loaded, const RunOptions& options, SchemeChoice& choice, double fraction) {
+  choice.pilots.clear();
+  Pilots pilots(loaded, options, choice, fraction);
+  std::optional<double> bound;
+  for (const AutoCandidate& candidate : auto_candidates(loaded)) {
+    choice.pilots.push_back(pilots.measure(candidate, bound));
+    if (const PilotResult& last = choice.pilots.back(); last.excluded.empty())
+      bound = std::min(bound.value_or(last.predicted_seconds), last.predicted_seconds);
+  }
+}
+
+}  // namespace nonsep::host
