@@ -1,7 +1,10 @@
 #pragma once
 // The paper's one-dimensional model, eq. (algham): T(p) = p + p^3/6, V(q) = q^2/2 + q^4/12, so that
 //   H_TTV = T'(p)^2 V''(q) = (1 + p^2/2)^2 (1 + q^2)     (eq. h1d)    and    H_VVT = V'(q)^2 T''(p) = (q + q^3/3)^2 p.
-// Defined everywhere. Analytic gradients; Hessians by automatic differentiation.
+// Defined everywhere. Every derivative the comparators and the tangent maps use is written out (T''' = 1,
+// V''' = 2q): Gauss-Legendre's grad H needs T', the Hessian-vector products and the third derivative of V at every
+// stage point, which automatic differentiation (nested duals) made most of its cost; tests/plugins compares each
+// with automatic differentiation.
 #include <nonsep/plugin_sdk.hpp>
 
 struct Paper1D {
@@ -19,4 +22,18 @@ struct Paper1D {
 
   void grad_T(nonsep::sdk::Vector<double> p, std::span<double> out) const { out[0] = 1.0 + 0.5 * p[0] * p[0]; }
   void grad_V(nonsep::sdk::Vector<double> q, std::span<double> out) const { out[0] = q[0] * (1.0 + q[0] * q[0] / 3.0); }
+  void hessian_T(nonsep::sdk::Vector<double> p, std::span<double> out) const { out[0] = p[0]; }
+  void hessian_V(nonsep::sdk::Vector<double> q, std::span<double> out) const { out[0] = 1.0 + q[0] * q[0]; }
+  void hvp_T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> v, std::span<double> out) const {
+    out[0] = p[0] * v[0];
+  }
+  void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const {
+    out[0] = (1.0 + q[0] * q[0]) * v[0];
+  }
+  void d3T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> u, std::span<double> out) const {
+    out[0] = u[0] * u[0];
+  }
+  void d3V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> u, std::span<double> out) const {
+    out[0] = 2.0 * q[0] * u[0] * u[0];
+  }
 };

@@ -19,8 +19,12 @@
 // exponent decaying like log(t)/t) next to chaotic ones (<Y> growing like lambda t/2, lambda ~ 0.2) at the same
 // energy, e.g. q = (0.25, 0.3), p = (-1.5, 0.2) (regular, H = 6.75) and q = (-0.75, 0.3), p = (-1.5, 0.2)
 // (chaotic, H = 7.49); tests/core/test_chaos_against_reference.cpp checks both against an independent reference.
-// Defined everywhere. Analytic gradients and Hessians (the tangent maps of the Lyapunov and MEGNO diagnostics
-// evaluate the Hessians 8 times per basic step; automatic differentiation checks them in tests/plugins).
+// Defined everywhere. Analytic gradients, Hessians, Hessian-vector products and directional third derivatives
+// (the tangent maps of the Lyapunov and MEGNO diagnostics evaluate the Hessians 8 times per basic step, and
+// Gauss-Legendre's grad H the products and the third derivatives of V at every stage point; automatic
+// differentiation checks them in tests/plugins). With u^T Hess V u = (1 + |q|^2/3)|u|^2 + (2/3)(q.u)^2 +
+// coupling (2 q2^2 u1^2 + 8 q1 q2 u1 u2 + 2 q1^2 u2^2), d3V's entries are its derivatives in q1 and q2; T''' is 1 on
+// the diagonal.
 #include <nonsep/plugin_sdk.hpp>
 
 class Paper2D {
@@ -67,6 +71,25 @@ class Paper2D {
     out[0] = radial + 2.0 / 3.0 * x * x + 2.0 * coupling_ * y * y;
     out[1] = out[2] = (2.0 / 3.0 + 4.0 * coupling_) * x * y;
     out[3] = radial + 2.0 / 3.0 * y * y + 2.0 * coupling_ * x * x;
+  }
+  void hvp_T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> v, std::span<double> out) const {
+    out[0] = p[0] * v[0];
+    out[1] = p[1] * v[1];
+  }
+  void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const {
+    const double x = q[0], y = q[1], radial = 1.0 + (x * x + y * y) / 3.0;
+    const double off = (2.0 / 3.0 + 4.0 * coupling_) * x * y;
+    out[0] = (radial + 2.0 / 3.0 * x * x + 2.0 * coupling_ * y * y) * v[0] + off * v[1];
+    out[1] = off * v[0] + (radial + 2.0 / 3.0 * y * y + 2.0 * coupling_ * x * x) * v[1];
+  }
+  void d3T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> u, std::span<double> out) const {
+    out[0] = u[0] * u[0];
+    out[1] = u[1] * u[1];
+  }
+  void d3V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> u, std::span<double> out) const {
+    const double x = q[0], y = q[1], a = u[0], b = u[1], u2 = a * a + b * b, qu = x * a + y * b;
+    out[0] = 2.0 / 3.0 * x * u2 + 4.0 / 3.0 * qu * a + coupling_ * (8.0 * y * a * b + 4.0 * x * b * b);
+    out[1] = 2.0 / 3.0 * y * u2 + 4.0 / 3.0 * qu * b + coupling_ * (4.0 * y * a * a + 8.0 * x * a * b);
   }
 
  private:

@@ -74,6 +74,20 @@ void check_automatic_matches_analytic(const std::string& parameters = "{}") {
   automatic.hessian_V(x, ha, count);
   analytic.hessian_V(x, hb, count);
   check_agree(ha, hb, "hessian_V");
+  // Hessian-vector products and directional third derivatives, along random directions.
+  const auto u = random_points(count, n, 1.5, 9);
+  automatic.hvp_T(x, u, a, count);
+  analytic.hvp_T(x, u, b, count);
+  check_agree(a, b, "hvp_T");
+  automatic.hvp_V(x, u, a, count);
+  analytic.hvp_V(x, u, b, count);
+  check_agree(a, b, "hvp_V");
+  automatic.d3T(x, u, a, count);
+  analytic.d3T(x, u, b, count);
+  check_agree(a, b, "d3T");
+  automatic.d3V(x, u, a, count);
+  analytic.d3V(x, u, b, count);
+  check_agree(a, b, "d3V");
 }
 
 // H_TTV from the core's EnergyEvaluator (grad T . Hess V grad T) against the closed form, at random states.
