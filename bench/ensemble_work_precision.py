@@ -66,7 +66,7 @@ def main():
     args.work.mkdir(parents=True, exist_ok=True)
     results = {}
     lines = ["| problem | target | auto: scheme, steps | actual | auto CPU s | fastest peer meeting it | its error | "
-             "peer CPU s | auto / peer | Gauss 16, fewest steps meeting it | its CPU s |", "|" + "---|" * 11]
+             "peer CPU s | auto / peer | Gauss 16, cheapest run meeting it | its CPU s |", "|" + "---|" * 11]
     for name in args.problems.split(","):
         problem = PROBLEMS[name]
         n, t_end = problem["n"], problem["t_end"]
