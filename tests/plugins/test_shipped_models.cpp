@@ -62,32 +62,23 @@ void check_automatic_matches_analytic(const std::string& parameters = "{}") {
   const std::size_t n = automatic.dimension(), count = 64;
   const auto x = random_points(count, n, 2.0, 7);
   std::vector<double> a(n * count), b(n * count), ha(n * n * count), hb(n * n * count);
-  automatic.grad_T(x, a, count);
-  analytic.grad_T(x, b, count);
-  check_agree(a, b, "grad_T");
-  automatic.grad_V(x, a, count);
-  analytic.grad_V(x, b, count);
-  check_agree(a, b, "grad_V");
-  automatic.hessian_T(x, ha, count);
-  analytic.hessian_T(x, hb, count);
-  check_agree(ha, hb, "hessian_T");
-  automatic.hessian_V(x, ha, count);
-  analytic.hessian_V(x, hb, count);
-  check_agree(ha, hb, "hessian_V");
+  // Each function of both adapters into out_a, out_b, compared.
+  const auto same = [&](const char* what, std::vector<double>& out_a, std::vector<double>& out_b,
+                        const auto& evaluate) {
+    evaluate(automatic, out_a);
+    evaluate(analytic, out_b);
+    check_agree(out_a, out_b, what);
+  };
+  same("grad_T", a, b, [&](const auto& m, auto& out) { m.grad_T(x, out, count); });
+  same("grad_V", a, b, [&](const auto& m, auto& out) { m.grad_V(x, out, count); });
+  same("hessian_T", ha, hb, [&](const auto& m, auto& out) { m.hessian_T(x, out, count); });
+  same("hessian_V", ha, hb, [&](const auto& m, auto& out) { m.hessian_V(x, out, count); });
   // Hessian-vector products and directional third derivatives, along random directions.
   const auto u = random_points(count, n, 1.5, 9);
-  automatic.hvp_T(x, u, a, count);
-  analytic.hvp_T(x, u, b, count);
-  check_agree(a, b, "hvp_T");
-  automatic.hvp_V(x, u, a, count);
-  analytic.hvp_V(x, u, b, count);
-  check_agree(a, b, "hvp_V");
-  automatic.d3T(x, u, a, count);
-  analytic.d3T(x, u, b, count);
-  check_agree(a, b, "d3T");
-  automatic.d3V(x, u, a, count);
-  analytic.d3V(x, u, b, count);
-  check_agree(a, b, "d3V");
+  same("hvp_T", a, b, [&](const auto& m, auto& out) { m.hvp_T(x, u, out, count); });
+  same("hvp_V", a, b, [&](const auto& m, auto& out) { m.hvp_V(x, u, out, count); });
+  same("d3T", a, b, [&](const auto& m, auto& out) { m.d3T(x, u, out, count); });
+  same("d3V", a, b, [&](const auto& m, auto& out) { m.d3V(x, u, out, count); });
 }
 
 // H_TTV from the core's EnergyEvaluator (grad T . Hess V grad T) against the closed form, at random states.
