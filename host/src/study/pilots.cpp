@@ -216,7 +216,19 @@ class Pilots {
                                                     pair_fine.marks[pilot_marks / 2 - 1], width);
       const double raw = half > 0.0 && end > 0.0 ? std::log2(end / half) : 1.0;
       result.growth = std::clamp(std::isfinite(raw) ? raw : 1.0, energy ? 0.0 : 1.0, max_growth_exponent);
-      if (!energy) result.envelope_growth = envelope_growth(pair_coarse, pair_fine, width, floor);
+      // Where that pair is at round-off by t_p / 2, the next coarser pair of the candidate's pilots that is not (and
+      // had no problem) still sees how the error grows: a chaotic orbit is then found by this candidate alone,
+      // whichever others the pilots' time bound leaves out.
+      if (!energy) {
+        result.envelope_growth = envelope_growth(pair_coarse, pair_fine, width, floor);
+        for (std::uint64_t steps = from_coarse ? n : 2 * n; !result.envelope_growth && steps >= 8; steps /= 2) {
+          const auto coarser = runs.find(steps / 2), finer = runs.find(steps);
+          if (coarser == runs.end() || finer == runs.end() || !coarser->second.problem.empty() ||
+              !finer->second.problem.empty())
+            break;
+          result.envelope_growth = envelope_growth(coarser->second, finer->second, width, floor);
+        }
+      }
       result.seconds_per_step = r4.seconds > r1.seconds ? (r4.seconds - r1.seconds) / static_cast<double>(3 * n)
                                                         : r4.seconds / static_cast<double>(4 * n);
       predict(result, order);
