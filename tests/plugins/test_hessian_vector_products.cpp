@@ -73,9 +73,10 @@ TEST_CASE("every shipped plugin's Hessian-vector products are its dense Hessians
     CAPTURE(plugin_name);
     const PluginModel model = shipped(name, parameters);
     REQUIRE(model.plugin().has_hessian_vector_products());
-    // The lattice, paper1d and paper2d write their products out (test_shipped_models.cpp compares paper1d's and
-    // paper2d's with automatic differentiation, the next test the lattice's); the others' are automatic.
-    const bool written = plugin_name == "lattice_chain" || plugin_name == "paper1d" || plugin_name == "paper2d";
+    // The lattice, paper1d, paper2d and tao_product write their products out (test_shipped_models.cpp compares
+    // the three's with automatic differentiation, the next test the lattice's); the others' are automatic.
+    const bool written = plugin_name == "lattice_chain" || plugin_name == "paper1d" || plugin_name == "paper2d" ||
+                         plugin_name == "tao_product";
     const char* kind = written ? "analytic" : "automatic";
     CHECK(model.plugin().metadata()["derivatives"]["hvp_T"] == kind);
     CHECK(model.plugin().metadata()["derivatives"]["hvp_V"] == kind);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "mathews_lakshmanan/mathews_lakshmanan.hpp"
 #include "nonsep/core/analysis/energy.hpp"
 #include "nonsep/core/base/hamiltonian_gradient.hpp"
 #include "nonsep/core/schemes/chin_basic_step.hpp"
@@ -112,6 +113,9 @@ TEST_CASE("automatic and analytic derivatives of the shipped models agree to 1e-
   SUBCASE("radial, dimension 16") { check_automatic_matches_analytic<Radial>(R"({"dimension": 16})"); }
   SUBCASE("quadratic_kinetic") { check_automatic_matches_analytic<QuadraticKinetic>(R"({"lambda": 0.7})"); }
   SUBCASE("tao_product") { check_automatic_matches_analytic<TaoProduct>(); }
+  SUBCASE("mathews_lakshmanan") {
+    check_automatic_matches_analytic<MathewsLakshmanan>(R"({"lambda": 0.8, "alpha": 1.3})");
+  }
   SUBCASE("paper2d") { check_automatic_matches_analytic<Paper2D>(R"({"coupling": 0.3})"); }
 }
 
