@@ -56,7 +56,8 @@ class MathewsLakshmanan {
   }
   void hvp_T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> v, std::span<double> out) const { out[0] = v[0]; }
   void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const {
-    out[0] = 0.5 * (1.0 + lambda_ * q[0] * q[0]) * v[0];
+    hessian_V(q, out);
+    out[0] *= v[0];
   }
   void d3T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double>, std::span<double> out) const { out[0] = 0.0; }
   void d3V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> u, std::span<double> out) const {

@@ -25,10 +25,12 @@ struct Paper1D {
   void hessian_T(nonsep::sdk::Vector<double> p, std::span<double> out) const { out[0] = p[0]; }
   void hessian_V(nonsep::sdk::Vector<double> q, std::span<double> out) const { out[0] = 1.0 + q[0] * q[0]; }
   void hvp_T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> v, std::span<double> out) const {
-    out[0] = p[0] * v[0];
+    hessian_T(p, out);
+    out[0] *= v[0];
   }
   void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const {
-    out[0] = (1.0 + q[0] * q[0]) * v[0];
+    hessian_V(q, out);
+    out[0] *= v[0];
   }
   void d3T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> u, std::span<double> out) const {
     out[0] = u[0] * u[0];

@@ -73,14 +73,14 @@ class Paper2D {
     out[3] = radial + 2.0 / 3.0 * y * y + 2.0 * coupling_ * x * x;
   }
   void hvp_T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> v, std::span<double> out) const {
-    out[0] = p[0] * v[0];
+    out[0] = p[0] * v[0];  // Hess T is diagonal (p1, p2)
     out[1] = p[1] * v[1];
   }
   void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const {
-    const double x = q[0], y = q[1], radial = 1.0 + (x * x + y * y) / 3.0;
-    const double off = (2.0 / 3.0 + 4.0 * coupling_) * x * y;
-    out[0] = (radial + 2.0 / 3.0 * x * x + 2.0 * coupling_ * y * y) * v[0] + off * v[1];
-    out[1] = off * v[0] + (radial + 2.0 / 3.0 * y * y + 2.0 * coupling_ * x * x) * v[1];
+    double h[4];
+    hessian_V(q, h);
+    out[0] = h[0] * v[0] + h[1] * v[1];
+    out[1] = h[2] * v[0] + h[3] * v[1];
   }
   void d3T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> u, std::span<double> out) const {
     out[0] = u[0] * u[0];

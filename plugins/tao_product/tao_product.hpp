@@ -32,7 +32,8 @@ struct TaoProduct {
     out[0] = second_T(p[0]) * v[0];
   }
   void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const {
-    out[0] = (1.0 + q[0] * q[0]) * v[0];
+    hessian_V(q, out);
+    out[0] *= v[0];
   }
   void d3T(nonsep::sdk::Vector<double> p, nonsep::sdk::Vector<double> u, std::span<double> out) const {
     const double g = std::sqrt((1.0 + p[0] * p[0]) / 2.0);
