@@ -3,7 +3,8 @@
 // for every Chin scheme (mpe of 2 and 3 terms) and form, 1, 5 and 300 states, 1 and 2 threads, states that fail or
 // diverge partway, and a run killed and resumed; the tangent kernel likewise for Lyapunov exponents, MEGNO, SALI and
 // GALI (basic and triplet, 1 and 4 vectors); summary.json says which path ran; inspect shows and checks the kernels;
-// a plugin of another kernel version, and one without kernels, run through the evaluation path.
+// a plugin of another kernel version, and one without kernels, run through the evaluation path; Gauss-Legendre
+// through the plugins' gauss_steps likewise (both forms, a model given by H, a Lyapunov vector, a failing state).
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -187,6 +188,40 @@ TEST_CASE("kernel path: a plugin without kernels, or of another kernel version, 
   }
 }
 
+TEST_CASE("kernel path: Gauss-Legendre through the plugin's gauss_steps gives the evaluation path's files") {
+  TemporaryFolder folder;
+  // paper1d in both forms, 1, 5 and 300 states (blocks of 32 and a rest), 1 and 2 threads; with 3 stages also a
+  // Lyapunov vector (the tangent map linearises at the kernel's stage points) and a state whose iteration fails at
+  // its first step (the kernel's step is taken again through the evaluations, which retire that state alone).
+  for (const int stages : {1, 3, 8})
+    for (const char* form : {"TTV", "VVT"})
+      for (std::size_t count : {std::size_t{1}, std::size_t{5}, std::size_t{300}}) {
+        CAPTURE(stages);
+        CAPTURE(form);
+        CAPTURE(count);
+        json initial = states(count);
+        if (stages == 3 && count == 5) initial.push_back(state(3.0, 3.0));
+        json job = paper1d_job(initial, {{"dt", 0.05}, {"steps", 40}}, {{"scheme", "gauss"}, {"stages", stages}});
+        job["hamiltonian"] = form;
+        job["output"] = {{"every", 10}};
+        if (stages == 3) job["analysis"] = {{"lyapunov", {{"vectors", 1}}}};
+        const auto file = write_job(folder / "job.json", job);
+        const char* threads = count == 300 ? "2" : "1";
+        check_same_files(run_with("baseline", folder, "kernel", file, threads),
+                         run_with("evaluation", folder, "evaluation", file, threads));
+      }
+  // A model given by H (no Chin kernels, a Gauss-Legendre kernel).
+  json henon = json::array();
+  for (int i = 0; i < 40; ++i) henon.push_back({{"q", {0.02 * i - 0.4, 0.1}}, {"p", {0.1, 0.01 * i - 0.2}}});
+  json job = {{"model", {{"plugin", "henon_heiles"}}},
+              {"integrator", {{"scheme", "gauss"}, {"stages", 4}}},
+              {"initial", henon},
+              {"time", {{"dt", 0.1}, {"steps", 100}}},
+              {"output", {{"every", 25}}}};
+  const auto file = write_job(folder / "henon.json", job);
+  check_same_files(run_with("baseline", folder, "kernel", file), run_with("evaluation", folder, "evaluation", file));
+}
+
 TEST_CASE("inspect shows a plugin's kernels and --check compares them with the evaluation path") {
   TemporaryFolder folder;
   const auto shown = run_nonsep({"inspect", "paper1d"}, folder.path());
@@ -201,6 +236,14 @@ TEST_CASE("inspect shows a plugin's kernels and --check compares them with the e
         std::string::npos);
   CHECK(checked.out.find("tangent kernel x86-64 (basic, 2 vectors): identical to the evaluation path bit for bit") !=
         std::string::npos);
+  CHECK(checked.out.find("Gauss-Legendre kernel (8 steps of gauss 3 stages, dt 0.001, TTV and VVT, ") !=
+        std::string::npos);
+  CHECK(checked.out.find("states): identical to the evaluation path bit for bit") != std::string::npos);
+  const auto general = run_nonsep({"inspect", "henon_heiles", "--check"}, folder.path());
+  INFO(general.out);
+  CHECK(general.status == 0);
+  CHECK(general.out.find("Gauss-Legendre kernel (8 steps of gauss 3 stages, dt 0.001, ") != std::string::npos);
+  CHECK(general.out.find("states): identical to the evaluation path bit for bit") != std::string::npos);
   const auto none = run_nonsep({"inspect", "blowup", "--check"}, folder.path());
   CHECK(none.out.find("kernels: none (the evaluation path steps this plugin)") != std::string::npos);
 }

@@ -52,6 +52,8 @@ const char* status_name(nonsep_status status);
 // The kernel this process uses of the plugin of ABI version `abi_version` with checked metadata `metadata` and table
 // `api` (kernel_choice.cpp). Throws PluginError when NONSEP_INSTRUCTION_SET asks for one it cannot have.
 KernelChoice choose_kernel(const nlohmann::json& metadata, const nonsep_plugin_api& api, unsigned abi_version);
+// NONSEP_INSTRUCTION_SET as the kernel choice reads it ("x86-64" for "baseline"; "" when unset).
+std::string instruction_set_pin();
 
 // The metadata checks of plugin_abi.h on the parsed metadata `m` of the plugin at `path` whose table is `api`, of ABI
 // version `abi_version`, including the functions its kind of model requires (plugin_abi.h, check 3: grad_T and grad_V

@@ -35,12 +35,12 @@ const std::string rebuild_hint =
     "this nonsep's include/nonsep/plugin_abi.h)";
 
 // The versions this host loads, as its refusals name them, and the table sizes of each (plugin_abi.h; none for a
-// version it does not load). The first size is the version's own; version 4 also had a shorter first edition.
+// version it does not load). The first size is the version's own; versions 4 and 6 also load a shorter edition.
 const std::string accepted_versions = std::to_string(NONSEP_PLUGIN_ABI_VERSION) + ", 5, 4 or 3";
 std::vector<std::size_t> table_sizes(std::uint32_t version) {
   switch (version) {
     case NONSEP_PLUGIN_ABI_VERSION:
-      return {NONSEP_PLUGIN_V6_STRUCT_SIZE};
+      return {NONSEP_PLUGIN_V6_STRUCT_SIZE, NONSEP_PLUGIN_V6_EVALUATION_STRUCT_SIZE};
     case 5:
       return {NONSEP_PLUGIN_V5_STRUCT_SIZE};
     case 4:

@@ -136,7 +136,8 @@ void check_metadata(const json& m, const nonsep_plugin_api& api, unsigned abi_ve
                                                   {"hvp_H", api.hvp_H != nullptr},
                                                   {"chin_tangent_steps", api.chin_tangent_steps != nullptr},
                                                   {"value_H", api.value_H != nullptr},
-                                                  {"grad_H", api.grad_H != nullptr}};
+                                                  {"grad_H", api.grad_H != nullptr},
+                                                  {"gauss_steps", api.gauss_steps != nullptr}};
   for (const auto& [capability, in_table] : present) {
     const json claimed = m["capabilities"].value(capability, json(false));
     if (!claimed.is_boolean()) fail("gives capability \"" + std::string(capability) + "\" a non-boolean value");

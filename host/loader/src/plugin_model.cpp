@@ -186,7 +186,7 @@ PluginModel PluginModel::without_product_energy() const {
 
 PluginModel PluginModel::with_kernel() const {
   const auto chosen = plugin().kernels().chosen;
-  return chosen ? with_kernel(*chosen) : *this;
+  return with_kernel(chosen ? *chosen : plugin().kernels().usable.size());
 }
 
 PluginModel PluginModel::with_kernel(std::size_t instruction_set) const {
@@ -195,6 +195,7 @@ PluginModel PluginModel::with_kernel(std::size_t instruction_set) const {
   model.kernel_.reset();
   if (instruction_set < usable.size() && usable[instruction_set])
     model.kernel_ = static_cast<std::uint32_t>(instruction_set);
+  model.gauss_kernel_ = instance_->api->gauss_steps != nullptr && instruction_set_pin() != "evaluation";
   return model;
 }
 
@@ -256,6 +257,45 @@ bool PluginModel::chin_tangent_steps(const ChinTangentStepsCall& call) const {
   const nonsep_status status = api.chin_tangent_steps(instance_->handle, &args);
   if (status != NONSEP_OK) [[unlikely]]
     throw_failed(*this, instance_->handle, api, "chin_tangent_steps", status);
+  ++instance_->kernel_calls;
+  return true;
+}
+
+}  // namespace nonsep::host
+
+namespace nonsep::host {
+
+bool PluginModel::gauss_steps(const GaussStepsCall& call) const {
+  if (!gauss_kernel_) return false;
+  const std::size_t n = instance_->dimension, s = call.stages, size = call.count * n, stages = s * size,
+                    rows = call.count * gauss_memory_width(n, s);
+  if (s < 1 || s > gauss_max_stages || call.max_iterations < 1 || call.mu.size() != s * s || call.hb.size() != s ||
+      (!call.nu.empty() && call.nu.size() != s * s) || call.q.size() != size || call.p.size() != size ||
+      call.memory.size() != rows || call.next_memory.size() != rows || call.points_q.size() != stages ||
+      call.points_p.size() != stages || call.iterations.size() != call.count || call.outcome.size() != call.count)
+      [[unlikely]]
+    throw_bad_spans("gauss_steps", call.count, n, n, call.q.size(), call.p.size());
+  static_assert(sizeof(int) == sizeof(std::int32_t) && sizeof(GaussOutcome) == sizeof(std::uint8_t));
+  const std::uint32_t form = general_hamiltonian()               ? NONSEP_FORM_GENERAL
+                             : call.form == HamiltonianForm::TTV ? NONSEP_FORM_TTV
+                                                                 : NONSEP_FORM_VVT;
+  const nonsep_gauss_steps_args args{form,
+                                     static_cast<std::uint32_t>(s),
+                                     static_cast<std::uint32_t>(call.max_iterations),
+                                     call.dt,
+                                     call.mu.data(),
+                                     call.hb.data(),
+                                     call.nu.empty() ? nullptr : call.nu.data(),
+                                     call.count,
+                                     call.q.data(),
+                                     call.p.data(),
+                                     call.memory.data(),
+                                     call.next_memory.data(),
+                                     call.points_q.data(),
+                                     call.points_p.data(),
+                                     reinterpret_cast<std::int32_t*>(call.iterations.data()),
+                                     reinterpret_cast<std::uint8_t*>(call.outcome.data())};
+  if (instance_->api->gauss_steps(instance_->handle, &args) != NONSEP_OK) return false;
   ++instance_->kernel_calls;
   return true;
 }

@@ -3,6 +3,8 @@
 // size per state), both forms: the catalogue's Chin schemes with one order and those that are not symplectic (the
 // sums of substeps), each at its default options. The tangent kernel (chin_tangent_steps) likewise: the same steps of
 // the basic step with two tangent vectors per state, states and vectors against TangentIntegrator's evaluation path.
+// The Gauss-Legendre kernel (gauss_steps): a few steps of gauss 3 stages in each form the model has
+// (check_gauss_kernel).
 #include <algorithm>
 #include <string>
 
@@ -25,6 +27,34 @@ PhaseSpaceBatch run(const PluginModel& model, const IntegratorSpec& spec, std::s
   integrator.step_n(model, x, dt, steps);
   return x;
 }
+
+// `steps` steps of `spec` through the evaluation path (`model`) and through `kernel` from the same states: their
+// differences into `difference`, or the model's failure into `failure`.
+void compare_runs(const PluginModel& model, const PluginModel& kernel, const IntegratorSpec& spec,
+                  std::span<const double> q, std::span<const double> p, std::size_t count, double dt,
+                  std::uint64_t steps, PathDifference& difference, std::string& failure) {
+  try {
+    const PhaseSpaceBatch expected = run(model, spec, q, p, count, dt, steps);
+    const PhaseSpaceBatch found = run(kernel, spec, q, p, count, dt, steps);
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      difference.add(expected.q()[i], found.q()[i]);
+      difference.add(expected.p()[i], found.p()[i]);
+    }
+  } catch (const ModelError& error) {
+    failure = error.what();
+  }
+}
+
+// What a comparison with the evaluation path found, in words (judged by `result` against `tolerance`).
+std::string verdict(PathCheck& result, const PathDifference& difference, const std::string& failure, double tolerance,
+                    const char* rounding) {
+  if (!failure.empty()) return "not compared: the model failed at the sample points (" + failure + ")";
+  if (difference.identical) return "identical to the evaluation path bit for bit";
+  return result.judge(difference, tolerance, "the evaluation path", rounding);
+}
+
+constexpr const char* other_rounding =
+    "relative to max(1, |x|); fused multiply-add or other compiler flags round differently";
 
 // The numbers of `count` states and two tangent vectors each (the unit vectors of dq_0 and dp_0) after `steps` basic
 // steps of `form`, through the tangent kernel (`kernel` true; nothing when the plugin has none) or the evaluation path:
@@ -104,27 +134,10 @@ PathCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::spa
     for (IntegratorSpec spec : checked_schemes())
       for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT}) {
         spec.form = form;
-        try {
-          const PhaseSpaceBatch expected = run(model, spec, q, p, count, dt, steps);
-          const PhaseSpaceBatch found = run(kernel, spec, q, p, count, dt, steps);
-          for (std::size_t i = 0; i < expected.size(); ++i) {
-            difference.add(expected.q()[i], found.q()[i]);
-            difference.add(expected.p()[i], found.p()[i]);
-          }
-        } catch (const ModelError& error) {
-          failure = error.what();
-        }
+        compare_runs(model, kernel, spec, q, p, count, dt, steps, difference, failure);
       }
-    std::string line = "kernel " + name + ": ";
-    if (!failure.empty()) {
-      line += "not compared: the model failed at the sample points (" + failure + ")";
-    } else if (difference.identical) {
-      line += "identical to the evaluation path bit for bit";
-    } else {
-      line += result.judge(difference, tolerance, "the evaluation path",
-                           "relative to max(1, |x|); fused multiply-add or other compiler flags round differently");
-    }
-    result.text += line + (index == kernels.chosen ? " [used by runs]" : "") + "\n";
+    result.text += "kernel " + name + ": " + verdict(result, difference, failure, tolerance, other_rounding) +
+                   (index == kernels.chosen ? " [used by runs]" : "") + "\n";
     if (!model.has_hessian_vector_products()) continue;
     PathDifference tangent_difference;
     bool tangent_kernel = true;
@@ -138,19 +151,44 @@ PathCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::spa
         failure = error.what();
       }
     if (!tangent_kernel) continue;  // a plugin of ABI version 4, or one without chin_tangent_steps
-    line = "tangent kernel " + name + " (basic, 2 vectors): ";
-    if (!failure.empty())
-      line += "not compared: the model failed at the sample points (" + failure + ")";
-    else if (tangent_difference.identical)
-      line += "identical to the evaluation path bit for bit";
-    else
-      line += result.judge(tangent_difference, tolerance, "the evaluation path",
-                           "relative to max(1, |x|); fused multiply-add or other compiler flags round differently");
-    result.text += line + "\n";
+    result.text += "tangent kernel " + name +
+                   " (basic, 2 vectors): " + verdict(result, tangent_difference, failure, tolerance, other_rounding) +
+                   "\n";
   }
   result.text = "kernels (" + std::to_string(steps) + " steps of " + checked_schemes_text(checked_schemes()) + ", dt " +
                 std::to_string(dt).substr(0, 5) + ", TTV and VVT, " + std::to_string(count) + " states):\n" +
                 result.text;
+  return result;
+}
+
+PathCheck check_gauss_kernel(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                             std::span<const double> p, std::size_t count, double tolerance) {
+  PathCheck result;
+  const PluginModel kernel = model.with_kernel();
+  if (!kernel.has_gauss_kernel()) {
+    result.text = "Gauss-Legendre kernel: none (the evaluations step gauss and implicit_midpoint)\n";
+    return result;
+  }
+  constexpr double dt = 1e-3;
+  constexpr std::uint64_t steps = 8;
+  IntegratorSpec spec = spec_of_order(*find_scheme("gauss"), Fraction(6));
+  PathDifference difference;
+  std::string failure;
+  const std::uint64_t calls_before = kernel.kernel_calls();
+  for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT}) {
+    if (form == HamiltonianForm::VVT && plugin.general_hamiltonian()) continue;
+    spec.form = form;
+    compare_runs(model, kernel, spec, q, p, count, dt, steps, difference, failure);
+  }
+  result.text = "Gauss-Legendre kernel (" + std::to_string(steps) + " steps of gauss 3 stages, dt " +
+                std::to_string(dt).substr(0, 5) + (plugin.general_hamiltonian() ? "" : ", TTV and VVT") + ", " +
+                std::to_string(count) + " states): ";
+  if (failure.empty() && kernel.kernel_calls() == calls_before)
+    result.text += "not compared: every step went through the evaluations (an iteration did not converge)\n";
+  else
+    result.text += verdict(result, difference, failure, tolerance,
+                           "relative to max(1, |x|); the plugin was compiled with other flags than the host") +
+                   "\n";
   return result;
 }
 

@@ -409,9 +409,12 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
   const std::size_t states = std::min(samples.p.count, samples.q.count);
   const PathCheck kernels = check_kernels(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
   result.text += kernels.text;
+  const PathCheck gauss = check_gauss_kernel(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
+  result.text += gauss.text;
   const PathCheck energy = check_product_energy(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
   result.text += energy.text;
-  result.passed = report.passed() && difference.empty() && threads.empty() && kernels.passed && energy.passed;
+  result.passed =
+      report.passed() && difference.empty() && threads.empty() && kernels.passed && gauss.passed && energy.passed;
   if (!result.passed)
     result.text += "derivative check FAILED\n";
   else if (report.comparisons == 0)

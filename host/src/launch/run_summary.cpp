@@ -45,10 +45,19 @@ json energy_facts(const RunFacts& facts) {
           {"max_relative_error_bound", optional_number(run.analysis.max_relative_energy_error)}};
 }
 
-// Which path stepped the run: the plugin's kernel (and its instruction set) or the evaluation path.
-json stepping_facts(const RunFacts& facts) {
+// Which path stepped the run: the plugin's kernel (and its instruction set) or the evaluation path. Gauss-Legendre
+// (`gauss`, `implicit_midpoint`) has one kernel, gauss_steps, compiled with the plugin's own flags (the baseline).
+json stepping_facts(const RunFacts& facts, const std::string& scheme) {
   const KernelChoice& kernels = facts.loaded.plugin.kernels();
   const bool kernel = facts.driver.kernel_calls() > 0;
+  if (scheme == "gauss" || scheme == "implicit_midpoint")
+    return {{"path", kernel ? "kernel" : "evaluation"},
+            {"instruction_set", kernel ? json("x86-64") : json(nullptr)},
+            {"plugin_kernels", kernels.instruction_sets},
+            {"note", kernel ? "the plugin's Gauss-Legendre kernel (gauss_steps), compiled with the plugin's own flags: "
+                              "the evaluation path's numbers"
+                            : "the evaluations (the plugin has no Gauss-Legendre kernel, or "
+                              "NONSEP_INSTRUCTION_SET=evaluation)"}};
   return {{"path", kernel ? "kernel" : "evaluation"},
           {"instruction_set", kernel ? json(kernels.chosen_name()) : json(nullptr)},
           {"plugin_kernels", kernels.instruction_sets},
@@ -124,7 +133,7 @@ json run_summary(const RunFacts& facts) {
     summary["evaluations"]["grad_K"] = evaluations.grad_K;
     summary["evaluations"]["grad_U"] = evaluations.grad_U;
   }
-  summary["stepping"] = stepping_facts(facts);
+  summary["stepping"] = stepping_facts(facts, description.scheme);
   // What the scheme reports, under its family's name ("comparator": Tao's omega and largest copy distance).
   if (const std::vector<SchemeFigure> report = facts.driver.scheme_report(); !report.empty()) {
     json& figures = summary[find_scheme(run.integrator.scheme)->family];

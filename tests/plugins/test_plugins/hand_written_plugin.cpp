@@ -3,7 +3,7 @@
 //   0  none: a valid plugin "hand_written" (T = p^2/2, V = q^2/2), so the defects below are the only difference
 //   1  the exported symbol has another name
 //   2  abi_version is 2 (a plugin built for the previous ABI, which had integrate())
-//   3  struct_size is one pointer short (a table built against a shorter header: version 2's size)
+//   3  struct_size is two pointers short (a table built against another header: neither of version 6's sizes)
 //   4  the metadata is not valid JSON
 //   5  the metadata names another plugin than the file
 //   6  the required grad_V is null
@@ -24,6 +24,7 @@
 //  21  a model given by H whose table still has grad_T and grad_V
 //  22  a product-form model whose table has value_H and grad_H
 //  23  none: a valid model given by H, H = (p^2 + q^2)/2
+//  24  none: a valid version-6 table that ends before gauss_steps (the entries past it are not read)
 #include <cstddef>
 #include <cstring>
 
@@ -116,6 +117,11 @@ nonsep_status grad_H(nonsep_instance*, const double* q, const double* p, double*
   return NONSEP_OK;
 }
 #endif
+#if NONSEP_TEST_DEFECT == 24
+nonsep_status gauss_steps_past_the_end(nonsep_instance*, const nonsep_gauss_steps_args*) {
+  return NONSEP_INTERNAL_ERROR;
+}
+#endif
 #if NONSEP_TEST_DEFECT == 16
 nonsep_status energy_past_the_end(nonsep_instance*, const double*, const double*, double*, size_t) {
   return NONSEP_INTERNAL_ERROR;
@@ -140,7 +146,7 @@ nonsep_plugin_api make_table() {
   table.struct_size = static_cast<uint32_t>(NONSEP_PLUGIN_V4_STRUCT_SIZE);
   table.hvp_H = &hvp_H_past_the_end;  // past a version-4 table's end: never read
 #elif NONSEP_TEST_DEFECT == 3
-  table.struct_size = static_cast<uint32_t>(sizeof(nonsep_plugin_api) - sizeof(void*));
+  table.struct_size = static_cast<uint32_t>(sizeof(nonsep_plugin_api) - 2 * sizeof(void*));
 #elif NONSEP_TEST_DEFECT == 6
   table.grad_V = nullptr;
 #elif NONSEP_TEST_DEFECT == 11
@@ -165,6 +171,9 @@ nonsep_plugin_api make_table() {
   table.grad_T = table.grad_V = nullptr;
   table.value_H = &value_H;
   table.grad_H = &grad_H;
+#elif NONSEP_TEST_DEFECT == 24
+  table.struct_size = static_cast<uint32_t>(NONSEP_PLUGIN_V6_EVALUATION_STRUCT_SIZE);
+  table.gauss_steps = &gauss_steps_past_the_end;  // past the shorter table's end: never read
 #endif
   return table;
 }

@@ -23,6 +23,7 @@ const char* metadata() {
     metadata["kernels"]["version"] = 999;
     metadata["capabilities"]["hvp_H"] = false;  // past version 4's table
     metadata["capabilities"]["chin_tangent_steps"] = false;
+    metadata["capabilities"]["gauss_steps"] = false;
     return metadata.dump();
   }();
   return text.c_str();

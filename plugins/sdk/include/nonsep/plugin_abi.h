@@ -13,7 +13,9 @@
  *        chin_tangent_steps; chin_steps takes the arguments below and the metadata's "kernels" has no "version"
  *                                                                                  NONSEP_PLUGIN_V5_STRUCT_SIZE
  *   6  + models given by H(q, p) itself: value_H, grad_H, and hvp_H with the form NONSEP_FORM_GENERAL; the metadata's
- *        "hamiltonian_form" says which kind a plugin is                          NONSEP_PLUGIN_V6_STRUCT_SIZE
+ *        "hamiltonian_form" says which kind a plugin is; the Gauss-Legendre stepping kernel gauss_steps, of either
+ *        kind                                                                      NONSEP_PLUGIN_V6_STRUCT_SIZE
+ *        (a version-6 table without gauss_steps ends before it: NONSEP_PLUGIN_V6_EVALUATION_STRUCT_SIZE)
  * docs/plugin-abi.md lists the versions and their entries. Version 2 had a fused stepping function integrate() with
  * a stepper of its own; version 1 exported a function, nonsep_plugin_entry, returning the table instead of the
  * pointer below. Plugins of either are refused: rebuild them against the installed SDK.
@@ -66,7 +68,8 @@
  *     "capabilities": { "value_T": true, "value_V": true, "hessian_T": true, "hessian_V": true,
  *                       "d3T": true, "d3V": true, "grad_K": false, "grad_U": true, "value_U": true, ...,
  *                       "hvp_T": true, "hvp_V": true, "chin_steps": true,
- *                       "energy_TTV": false, "energy_VVT": false, "hvp_H": true, "chin_tangent_steps": true },
+ *                       "energy_TTV": false, "energy_VVT": false, "hvp_H": true, "chin_tangent_steps": true,
+ *                       "gauss_steps": true },
  *     "kernels": { "instruction_sets": ["x86-64", ...] }          exactly when chin_steps is non-null
  *                                                                  (chin_tangent_steps only with chin_steps)
  *   }
@@ -76,9 +79,10 @@
  * Two kinds of model (version 6). "product": H = T_i V_ij T_j (+ K + U) or its VVT form, given by T and V and
  * their derivatives (every entry up to version 5; grad_T and grad_V required, value_H and grad_H null); Chin's
  * schemes split it, and the schemes that integrate H itself take it too. "general": H(q, p) of any shape, given by
- * value_H and grad_H (both required) and optionally hvp_H with the form NONSEP_FORM_GENERAL; every entry of T, V, K,
- * U, the kernels and energy_TTV/VVT is null. Only the schemes that integrate H itself (Gauss-Legendre, implicit
- * midpoint, Tao's extended phase space) take it; the host refuses Chin's schemes for it before anything runs.
+ * value_H and grad_H (both required) and optionally hvp_H with the form NONSEP_FORM_GENERAL and gauss_steps; every
+ * entry of T, V, K, U, Chin's kernels and energy_TTV/VVT is null. Only the schemes that integrate H itself
+ * (Gauss-Legendre, implicit midpoint, Tao's extended phase space) take it; the host refuses Chin's schemes for it
+ * before anything runs.
  */
 #ifndef NONSEP_PLUGIN_ABI_H
 #define NONSEP_PLUGIN_ABI_H
@@ -150,6 +154,32 @@ typedef struct nonsep_chin_tangent_steps_args {
   double* tangent_q;            /* count*k*n, mapped in place */
   double* tangent_p;            /* count*k*n, mapped in place */
 } nonsep_chin_tangent_steps_args;
+
+/* The arguments of gauss_steps (below): one step of Gauss-Legendre collocation of `count` states, each iterated to
+ * convergence from its starting stages, in the arrangement, starting values, stopping rule and compensated sum of
+ * the core's gauss_stages.hpp (whose GaussStepsCall this is). Each state's last step is a row of 1 + 4n + 2sn
+ * numbers: dt (0: none), its end point q and p, the rounding errors of its compensated sum (q, p), and its stages' L
+ * (q parts, then p parts; stage j, component k at j*n + k). A state starts from its row when the row's dt and end
+ * point are this step's dt and its point, bit for bit, else from Z = 0 and no carried error. */
+typedef struct nonsep_gauss_steps_args {
+  uint32_t form;           /* NONSEP_FORM_TTV, NONSEP_FORM_VVT (product form) or NONSEP_FORM_GENERAL */
+  uint32_t stages;         /* s, 1 to 8 */
+  uint32_t max_iterations; /* >= 1 */
+  double dt;               /* the step */
+  const double* mu;        /* s*s, row-major: mu_ij = a_ij / b_j */
+  const double* hb;        /* s: fl(dt b_i) */
+  const double* nu;        /* s*s, row-major: the starting values' extrapolation; NULL: every step from Z = 0 */
+  size_t count;            /* states, in the batch layout */
+  double* q;               /* count*n: in, the states; out, the converged states advanced */
+  double* p;               /* count*n, as q */
+  const double* memory;    /* count rows (above): each state's last step */
+  double* next_memory;     /* count rows out: this step, for the converged states */
+  double* points_q;        /* s*count*n out (converged states): the stage points of the last evaluation, stage i,
+                              component k of state b at i*count*n + b*n + k */
+  double* points_p;        /* s*count*n out: the same, p */
+  int32_t* iterations;     /* count out: the iterations each state took */
+  uint8_t* outcome;        /* count out: 0 converged, 1 an iterate not finite, 2 no convergence in max_iterations */
+} nonsep_gauss_steps_args;
 
 typedef struct nonsep_plugin_api {
   uint32_t abi_version; /* NONSEP_PLUGIN_ABI_VERSION */
@@ -255,6 +285,15 @@ typedef struct nonsep_plugin_api {
   /* Its gradient: dH_dq[b*n + i] = dH/dq_i, dH_dp[b*n + i] = dH/dp_i at (q_b, p_b), the gradient layout. */
   nonsep_status (*grad_H)(nonsep_instance* instance, const double* q, const double* p, double* dH_dq, double* dH_dp,
                           size_t count);
+
+  /* ---- Version 6, optional, of either kind of model. ---- */
+
+  /* The Gauss-Legendre stepping kernel: one step of args->count states (args above), grad H evaluated inside the
+   * plugin with the model inlined, the same operations in the same order as the host's evaluation path, so that a
+   * plugin compiled with the host's flags gives its numbers bit for bit. The host takes a step through it when every
+   * state converged, and otherwise (or on a status other than NONSEP_OK) takes the step again through grad_T,
+   * grad_V and the Hessian-vector products (or grad_H), which say what failed. */
+  nonsep_status (*gauss_steps)(nonsep_instance* instance, const nonsep_gauss_steps_args* args);
 } nonsep_plugin_api;
 
 /* The size of a version-3 table: the entries before grad_K. */
@@ -267,6 +306,8 @@ typedef struct nonsep_plugin_api {
 #define NONSEP_PLUGIN_V5_STRUCT_SIZE offsetof(nonsep_plugin_api, value_H)
 /* The size of a version-6 table. */
 #define NONSEP_PLUGIN_V6_STRUCT_SIZE sizeof(nonsep_plugin_api)
+/* The size of a version-6 table that ends before gauss_steps: also loaded as version 6, without the kernel. */
+#define NONSEP_PLUGIN_V6_EVALUATION_STRUCT_SIZE offsetof(nonsep_plugin_api, gauss_steps)
 
 #ifdef __cplusplus
 }

@@ -51,6 +51,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "nonsep/core/kernel/gauss_stages.hpp"
 #include "nonsep/plugin_abi.h"
 #include "nonsep/sdk/dual.hpp"
 #include "nonsep/sdk/hamiltonian_adapter.hpp"
@@ -189,6 +190,48 @@ class PluginTableBase {
   static const char* last_error(const nonsep_instance* instance) noexcept {
     return instance == nullptr ? "no instance" : instance->last_error.c_str();
   }
+
+  // The Gauss-Legendre stepping kernel (plugin_abi.h gauss_steps): the core's gauss_kernel_steps with this model
+  // inlined, compiled with the plugin's own flags; its arguments checked (std::invalid_argument names what is wrong).
+  static nonsep_status gauss_steps(nonsep_instance* instance, const nonsep_gauss_steps_args* args) noexcept {
+    return guarded(instance, "gauss_steps", [&](const Instance& self) {
+      if (args == nullptr) throw std::invalid_argument("gauss_steps: no arguments");
+      constexpr bool general = !ModelWithThirdDerivatives<Adapter>;
+      const bool form_fits =
+          general ? args->form == NONSEP_FORM_GENERAL : args->form == NONSEP_FORM_TTV || args->form == NONSEP_FORM_VVT;
+      if (!form_fits) throw std::invalid_argument("gauss_steps: form " + std::to_string(args->form) + " of this model");
+      if (args->stages < 1 || args->stages > gauss_max_stages || args->max_iterations < 1)
+        throw std::invalid_argument("gauss_steps: " + std::to_string(args->stages) + " stages and " +
+                                    std::to_string(args->max_iterations) +
+                                    " iterations (expected 1 to 8 stages, at least one iteration)");
+      const std::size_t s = args->stages, n = self.adapter.dimension(), size = args->count * n, stages = s * size,
+                        rows = args->count * gauss_memory_width(n, s);
+      const auto in = [](const double* x, std::size_t length) { return std::span<const double>(x, length); };
+      const auto out = [](double* x, std::size_t length) { return std::span<double>(x, length); };
+      static_assert(sizeof(int) == sizeof(std::int32_t) && sizeof(GaussOutcome) == sizeof(std::uint8_t));
+      const GaussStepsCall call{args->form == NONSEP_FORM_VVT ? HamiltonianForm::VVT : HamiltonianForm::TTV,
+                                s,
+                                static_cast<int>(args->max_iterations),
+                                args->dt,
+                                in(args->mu, s * s),
+                                in(args->hb, s),
+                                args->nu == nullptr ? std::span<const double>() : in(args->nu, s * s),
+                                args->count,
+                                out(args->q, size),
+                                out(args->p, size),
+                                in(args->memory, rows),
+                                out(args->next_memory, rows),
+                                out(args->points_q, stages),
+                                out(args->points_p, stages),
+                                std::span<int>(reinterpret_cast<int*>(args->iterations), args->count),
+                                std::span<GaussOutcome>(reinterpret_cast<GaussOutcome*>(args->outcome), args->count)};
+      gauss_kernel(self.adapter, call);
+    });
+  }
+  // Flattened, so that the model's derivatives are inlined into the iteration.
+  [[gnu::flatten]] static void gauss_kernel(const Adapter& adapter, const GaussStepsCall& call) {
+    gauss_kernel_steps<HasFixedDimension<M> ? dimension_capacity<M>() : 0>(adapter, call);
+  }
 };
 
 // The constant function table exported for model class M. Identity is a type with a static constexpr
@@ -223,7 +266,8 @@ class PluginTable : PluginTableBase<ModelAdapter<M, policy>> {
                        {"energy_TTV", Adapter::analytic_energy_TTV},
                        {"energy_VVT", Adapter::analytic_energy_VVT},
                        {"hvp_H", Adapter::has_hamiltonian_hessian},
-                       {"chin_tangent_steps", NONSEP_SDK_TANGENT_KERNELS != 0}}},
+                       {"chin_tangent_steps", NONSEP_SDK_TANGENT_KERNELS != 0},
+                       {"gauss_steps", true}}},
                      {"derivatives",
                       {{"grad_T", kind(Adapter::analytic_grad_T)},
                        {"grad_V", kind(Adapter::analytic_grad_V)},
@@ -449,6 +493,7 @@ class PluginTable : PluginTableBase<ModelAdapter<M, policy>> {
       NONSEP_SDK_TANGENT_KERNELS ? &chin_tangent_steps : nullptr,
       nullptr,  // value_H: a product-form model
       nullptr,  // grad_H
+      &Base::gauss_steps,
   };
 };
 
@@ -472,7 +517,7 @@ class HamiltonianPluginTable : PluginTableBase<HamiltonianAdapter<M, policy>> {
     nlohmann::json metadata = Base::common_metadata(Identity::value);
     metadata.update(
         {{"hamiltonian_form", "general"},
-         {"capabilities", {{"value_H", true}, {"grad_H", true}, {"hvp_H", true}}},
+         {"capabilities", {{"value_H", true}, {"grad_H", true}, {"hvp_H", true}, {"gauss_steps", true}}},
          {"derivatives", {{"grad_H", kind(Adapter::analytic_grad_H)}, {"hvp_H", kind(Adapter::analytic_hvp_H)}}},
          {"automatic_differentiation", hamiltonian_differentiation_text<Adapter>()}});
     return metadata.dump();
@@ -546,6 +591,7 @@ class HamiltonianPluginTable : PluginTableBase<HamiltonianAdapter<M, policy>> {
       nullptr,  // chin_tangent_steps
       &value_H,
       &grad_H,
+      &Base::gauss_steps,
   };
 };
 

@@ -45,6 +45,12 @@
 // keeps it aligned with its states (compact, step_part) and checkpoints it (save_state, restore_state), so that a
 // state's numbers still depend on its own history alone, and a resumed run continues bit for bit.
 //
+// A model with a kernel (ModelWithGaussSteps: a plugin's gauss_steps, as the host presents it) takes the step itself,
+// blocks of states iterated to convergence with grad H inlined (kernel/gauss_stages.hpp, where the iteration, the
+// starting values, the stopping rule and the compensated sum are written once for both): the same numbers, counts
+// and private state. When a state of the batch fails there, the step is taken again through the evaluations below,
+// which say what failed.
+//
 // Failures: step() throws nonsep::ModelError naming every state that failed (its index in the batch, omitted for a
 // batch of one) and why, after advancing the states that converged and leaving the failed ones at their starting
 // point. This fits the host's failure model: a ModelError from a batch makes it redo the step state by state and
@@ -64,6 +70,7 @@
 
 #include "nonsep/core/base/hamiltonian_gradient.hpp"
 #include "nonsep/core/base/scheme_state.hpp"
+#include "nonsep/core/kernel/gauss_stages.hpp"
 #include "nonsep/core/schemes/chin_basic_step.hpp"
 #include "nonsep/core/schemes/comparator_description.hpp"
 
@@ -250,20 +257,28 @@ class GaussLegendre {
     const std::size_t size = count * n;
     start_q_.assign(x.q().begin(), x.q().end());
     start_p_.assign(x.p().begin(), x.p().end());
+    hb_.resize(s);
+    for (std::size_t i = 0; i < s; ++i) hb_[i] = dt * tableau_.b[i];
+    for (auto* v : {&final_q_, &final_p_}) v->resize(s * size);
+    iterations_.assign(count, 0);
+    fit_memory(count, n);
+    if constexpr (ModelWithGaussSteps<M>) {
+      if (step_by_kernel(model, x, dt)) return {};
+      // No kernel at hand, or a state the kernel could not take: the whole step again, through the evaluations
+      // (the same numbers), which say what failed and where.
+      std::copy(start_q_.begin(), start_q_.end(), x.q().begin());
+      std::copy(start_p_.begin(), start_p_.end(), x.p().begin());
+      iterations_.assign(count, 0);
+    }
     for (auto* v : {&stage_q_, &stage_p_}) v->assign(s * size, 0.0);
     start_from_last_step(x, dt);
     for (auto* v : {&next_q_, &next_p_, &L_q_, &L_p_, &dH_dq_, &dH_dp_}) v->resize(s * size);
-    hb_.resize(s);
-    for (std::size_t i = 0; i < s; ++i) hb_[i] = dt * tableau_.b[i];
     for (auto* v : {&change_, &scale_, &finite_probe_}) v->resize(size);
-    for (auto* v : {&final_q_, &final_p_}) v->resize(s * size);
     keep_points_.assign(size, 0);
-    iterations_.assign(count, 0);
     last_change_.assign(count, std::numeric_limits<double>::infinity());
     active_.resize(count);
     for (std::size_t b = 0; b < count; ++b) active_[b] = b;
     std::vector<StateFailure> failures;
-    const double eps = std::numeric_limits<double>::epsilon();
     for (int m = 0; m < max_iterations_ && !active_.empty(); ++m) {
       // While most states iterate, evaluate the whole batch (no gathering; the loops run over all of it); once
       // half of them have stopped, only those still iterating.
@@ -278,15 +293,9 @@ class GaussLegendre {
       still_.clear();
       for (std::size_t b : active_) {
         ++iterations_[b];
-        double change = 0.0, scale = 0.0, probe = 0.0;
-        for (std::size_t e = b * n; e < b * n + n; ++e) {
-          change = std::max(change, change_[e]);
-          scale = std::max(scale, scale_[e]);
-          probe += finite_probe_[e];
-        }
-        const double relative = scale > 0.0 ? change / scale : 0.0;
-        const bool finite = probe == 0.0;  // else NaN: an iterate is not finite
-        const bool converged = relative <= eps || (relative >= last_change_[b] && relative <= 64 * eps);
+        const auto [relative, finite] =
+            gauss_state_change(change_.data() + b * n, scale_.data() + b * n, finite_probe_.data() + b * n, n);
+        const bool converged = gauss_converged(relative, last_change_[b]);
         if (finite && !converged) {
           last_change_[b] = relative;
           still_.push_back(b);
@@ -369,56 +378,69 @@ class GaussLegendre {
   std::vector<SchemeFigure> report() const { return {}; }
 
  private:
-  std::size_t memory_width(std::size_t n) const { return 1 + 4 * n + 2 * static_cast<std::size_t>(stages()) * n; }
+  std::size_t memory_width(std::size_t n) const { return gauss_memory_width(n, static_cast<std::size_t>(stages())); }
+
+  // Sizes the memory to a batch of `count` states of dimension n, forgetting it when the batch is not the one it
+  // belongs to.
+  void fit_memory(std::size_t count, std::size_t n) {
+    if (memory_.size() != count * memory_width(n)) memory_.assign(count * memory_width(n), 0.0);
+  }
+
+  // The step through the model's kernel (gauss_stages.hpp, ModelWithGaussSteps): true when the kernel took it and
+  // every state converged (then counted, its memory and stage points kept as the evaluations' path would), false
+  // otherwise (x and the work arrays are then unspecified; the memory is as before).
+  template <HamiltonianModel M>
+  bool step_by_kernel(const M& model, PhaseSpaceBatch& x, double dt) {
+    const std::size_t count = x.count(), s = static_cast<std::size_t>(tableau_.stages);
+    outcomes_.assign(count, GaussOutcome::no_convergence);
+    next_memory_.resize(memory_.size());
+    const GaussStepsCall call{gradient_.form(),
+                              s,
+                              max_iterations_,
+                              dt,
+                              tableau_.mu,
+                              hb_,
+                              extrapolate_ ? std::span<const double>(tableau_.nu) : std::span<const double>(),
+                              count,
+                              x.q(),
+                              x.p(),
+                              memory_,
+                              next_memory_,
+                              final_q_,
+                              final_p_,
+                              iterations_,
+                              outcomes_};
+    if (!model.gauss_steps(call)) return false;
+    for (const GaussOutcome outcome : outcomes_)
+      if (outcome != GaussOutcome::converged) return false;
+    for (std::size_t b = 0; b < count; ++b) evaluations_.grad_H += s * static_cast<std::uint64_t>(iterations_[b]);
+    memory_.swap(next_memory_);
+    return true;
+  }
 
   // Z^0 (stage_q_, stage_p_, zero on entry) and the carried rounding errors from each state's last step where it
-  // continues it (see above), zero elsewhere; sizes the memory to the batch, forgetting it when the batch is not the
-  // one it belongs to.
+  // continues it (see above), zero elsewhere; the memory fits the batch (fit_memory).
   void start_from_last_step(const PhaseSpaceBatch& x, double dt) {
     const std::size_t count = x.count(), n = x.dimension(), s = static_cast<std::size_t>(stages()),
                       width = memory_width(n), size = count * n;
-    if (memory_.size() != count * width) memory_.assign(count * width, 0.0);
     compensation_q_.assign(size, 0.0);
     compensation_p_.assign(size, 0.0);
     for (std::size_t b = 0; b < count; ++b) {
       const double* row = memory_.data() + b * width;
-      if (row[0] != dt || std::memcmp(row + 1, x.q(b).data(), n * sizeof(double)) != 0 ||
-          std::memcmp(row + 1 + n, x.p(b).data(), n * sizeof(double)) != 0)
-        continue;
+      if (!gauss_continues(row, x.q(b).data(), x.p(b).data(), n, dt)) continue;
       std::copy_n(row + 1 + 2 * n, n, compensation_q_.begin() + static_cast<std::ptrdiff_t>(b * n));
       std::copy_n(row + 1 + 3 * n, n, compensation_p_.begin() + static_cast<std::ptrdiff_t>(b * n));
-      if (!extrapolate_) continue;
-      const double* L_q = row + 1 + 4 * n;
-      const double* L_p = L_q + s * n;
-      for (std::size_t i = 0; i < s; ++i)
-        for (std::size_t k = 0; k < n; ++k) {
-          double sum_q = 0.0, sum_p = 0.0;
-          for (std::size_t j = 0; j < s; ++j) {
-            sum_q += tableau_.nu[i * s + j] * L_q[j * n + k];
-            sum_p += tableau_.nu[i * s + j] * L_p[j * n + k];
-          }
-          stage_q_[i * size + b * n + k] = sum_q;
-          stage_p_[i * size + b * n + k] = sum_p;
-        }
+      if (extrapolate_)
+        gauss_extrapolate(row, tableau_.nu.data(), s, n, stage_q_.data() + b * n, stage_p_.data() + b * n, size);
     }
   }
 
   // State b's step, for the next: dt, its end point, the rounding errors of its sum and its L.
   void remember(const PhaseSpaceBatch& x, std::size_t b, double dt) {
-    const std::size_t n = x.dimension(), s = static_cast<std::size_t>(stages()), size = x.count() * n;
-    double* row = memory_.data() + b * memory_width(n);
-    row[0] = dt;
-    std::copy(x.q(b).begin(), x.q(b).end(), row + 1);
-    std::copy(x.p(b).begin(), x.p(b).end(), row + 1 + n);
-    std::copy_n(compensation_q_.begin() + static_cast<std::ptrdiff_t>(b * n), n, row + 1 + 2 * n);
-    std::copy_n(compensation_p_.begin() + static_cast<std::ptrdiff_t>(b * n), n, row + 1 + 3 * n);
-    double* L_q = row + 1 + 4 * n;
-    double* L_p = L_q + s * n;
-    for (std::size_t j = 0; j < s; ++j)
-      for (std::size_t k = 0; k < n; ++k) {
-        L_q[j * n + k] = L_q_[j * size + b * n + k];
-        L_p[j * n + k] = L_p_[j * size + b * n + k];
-      }
+    const std::size_t n = x.dimension(), size = x.count() * n;
+    gauss_remember(memory_.data() + b * memory_width(n), dt, x.q(b).data(), x.p(b).data(),
+                   compensation_q_.data() + b * n, compensation_p_.data() + b * n, L_q_.data() + b * n,
+                   L_p_.data() + b * n, size, static_cast<std::size_t>(stages()), n);
   }
 
   // Why state b's iterate is not finite: the first stage point of its last iteration where grad H is not finite
@@ -468,8 +490,9 @@ class GaussLegendre {
     gradient_.evaluate(model, q_, p_, dH_dq_, dH_dp_, s * count);
   }
 
-  // points[e] = start[e] + stage[e] where keep[e] is 0; where it is all ones, points[e] stays. A select on the bits,
-  // because GCC does not vectorize a conditional on a floating-point sum under -ftrapping-math (the default).
+  // points[e] = start[e] + stage[e] where keep[e] is 0; where it is all ones, points[e] stays (a state that stopped
+  // iterating keeps the points of its last evaluation). A select on the bits, because GCC does not vectorize a
+  // conditional on a floating-point sum under -ftrapping-math (the default).
   static void stage_points(const double* __restrict start, const double* __restrict stage,
                            const std::uint64_t* __restrict keep, double* __restrict points, std::size_t size) {
     for (std::size_t e = 0; e < size; ++e) {
@@ -509,62 +532,15 @@ class GaussLegendre {
   // finite (0 * inf and 0 * NaN are NaN). The stage count is a template argument so that the sums unroll and the
   // loop over components vectorizes.
   void next_iterate(std::size_t first, std::size_t last, std::size_t size) {
-    next_iterate_for(first, last, size, std::make_index_sequence<GaussLegendreTableau::max_stages>());
+    gauss_with_stages(static_cast<std::size_t>(tableau_.stages), [&]<std::size_t S>() {
+      double mu[S * S], hb[S];
+      std::copy_n(tableau_.mu.begin(), S * S, mu);
+      std::copy_n(hb_.begin(), S, hb);
+      gauss_next_iterate<S>(mu, hb, first, last, size, dH_dq_.data(), dH_dp_.data(), stage_q_.data(), stage_p_.data(),
+                            start_q_.data(), start_p_.data(), L_q_.data(), L_p_.data(), next_q_.data(), next_p_.data(),
+                            change_.data(), scale_.data(), finite_probe_.data());
+    });
   }
-  template <std::size_t... I>
-  void next_iterate_for(std::size_t first, std::size_t last, std::size_t size, std::index_sequence<I...>) {
-    (void)((tableau_.stages == static_cast<int>(I + 1) ? (next_iterate<I + 1>(first, last, size), true) : false) ||
-           ...);
-  }
-  template <std::size_t S>
-  void next_iterate(std::size_t first, std::size_t last, std::size_t size) {
-    double mu[S * S], hb[S];
-    std::copy_n(tableau_.mu.begin(), S * S, mu);
-    std::copy_n(hb_.begin(), S, hb);
-    next_iterate_kernel<S>(mu, hb, first, last, size, dH_dq_.data(), dH_dp_.data(), stage_q_.data(), stage_p_.data(),
-                           start_q_.data(), start_p_.data(), L_q_.data(), L_p_.data(), next_q_.data(), next_p_.data(),
-                           change_.data(), scale_.data(), finite_probe_.data());
-  }
-  // The arrays do not overlap (__restrict: without it GCC gives up on the many checks for overlap it would need).
-  template <std::size_t S>
-  static void next_iterate_kernel(const double* mu, const double* hb, std::size_t first, std::size_t last,
-                                  std::size_t size, const double* __restrict dH_dq, const double* __restrict dH_dp,
-                                  const double* __restrict z_q, const double* __restrict z_p,
-                                  const double* __restrict start_q, const double* __restrict start_p,
-                                  double* __restrict L_q, double* __restrict L_p, double* __restrict next_q,
-                                  double* __restrict next_p, double* __restrict change, double* __restrict scale,
-                                  double* __restrict probe) {
-    for (std::size_t e = first; e < last; ++e) {
-      double lq[S], lp[S];
-      for (std::size_t j = 0; j < S; ++j) {
-        lq[j] = hb[j] * dH_dp[j * size + e];
-        lp[j] = hb[j] * -dH_dq[j * size + e];
-        L_q[j * size + e] = lq[j];
-        L_p[j * size + e] = lp[j];
-      }
-      double largest_change = 0.0, largest = larger(std::abs(start_q[e]), std::abs(start_p[e])), nan = 0.0;
-      for (std::size_t i = 0; i < S; ++i) {
-        double sum_q = 0.0, sum_p = 0.0;
-        for (std::size_t j = 0; j < S; ++j) {
-          sum_q += mu[i * S + j] * lq[j];
-          sum_p += mu[i * S + j] * lp[j];
-        }
-        next_q[i * size + e] = sum_q;
-        next_p[i * size + e] = sum_p;
-        largest_change =
-            larger(largest_change, larger(std::abs(sum_q - z_q[i * size + e]), std::abs(sum_p - z_p[i * size + e])));
-        largest = larger(largest, larger(std::abs(sum_q), std::abs(sum_p)));
-        nan += 0.0 * sum_q + 0.0 * sum_p;
-      }
-      change[e] = largest_change;
-      scale[e] = largest;
-      probe[e] = nan;
-    }
-  }
-
-  // std::max by value: the same result (a < b ? b : a), but no reference to a temporary, which keeps GCC from
-  // vectorizing the loop.
-  static double larger(double a, double b) { return a < b ? b : a; }
 
   // The points z + Z^m_i of state b's last evaluation (the same sums as the evaluation's) into final_q_, final_p_.
   void keep_stage_points(std::size_t b, std::size_t n, std::size_t s, std::size_t size) {
@@ -579,20 +555,14 @@ class GaussLegendre {
   // step's rounding error, and this addition's own (TwoSum, exact) is kept for the next.
   void advance(PhaseSpaceBatch& x, std::size_t b, std::size_t s, std::size_t size) {
     const std::size_t n = x.dimension();
-    const auto add = [](double& z, double increment, double& error) {
-      increment += error;
-      const double sum = z + increment, increment_part = sum - z;
-      error = (z - (sum - increment_part)) + (increment - increment_part);
-      z = sum;
-    };
     for (std::size_t e = b * n; e < b * n + n; ++e) {
       double sum_q = 0.0, sum_p = 0.0;
       for (std::size_t i = 0; i < s; ++i) {
         sum_q += L_q_[i * size + e];
         sum_p += L_p_[i * size + e];
       }
-      add(x.q()[e], sum_q, compensation_q_[e]);
-      add(x.p()[e], sum_p, compensation_p_[e]);
+      gauss_compensated_add(x.q()[e], sum_q, compensation_q_[e]);
+      gauss_compensated_add(x.p()[e], sum_p, compensation_p_[e]);
     }
   }
 
@@ -600,7 +570,8 @@ class GaussLegendre {
   HamiltonianGradient gradient_;
   int max_iterations_;
   bool extrapolate_;
-  std::vector<double> memory_;  // per state: dt, end point, rounding errors and L of its last step (memory_width)
+  std::vector<double> memory_;       // per state: dt, end point, rounding errors and L of its last step (memory_width)
+  std::vector<double> next_memory_;  // the kernel's memory of this step, kept once every state converged
   std::vector<double> compensation_q_, compensation_p_;  // per component: the rounding error the step carries
   EvaluationCounts evaluations_;           // grad_H of the states iterating (not of those evaluated again for nothing)
   std::vector<double> start_q_, start_p_;  // z, the states at the start of the step
@@ -611,6 +582,7 @@ class GaussLegendre {
   std::vector<double> final_q_, final_p_;   // the stage points of each converged state's last evaluation
   std::vector<std::uint64_t> keep_points_;  // per component: 0 while its state iterates, then all ones
   std::vector<int> iterations_;
+  std::vector<GaussOutcome> outcomes_;       // per state, from the kernel
   std::vector<double> last_change_;          // per state: the relative change of its last iteration
   std::vector<std::size_t> active_, still_;  // the states iterating, and those that go on after this iteration
 };

@@ -83,6 +83,11 @@ struct PathCheck {
 PathCheck check_kernels(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
                         std::span<const double> p, std::size_t count, double tolerance);
 
+// The Gauss-Legendre kernel (plugin_abi.h gauss_steps; nothing when the plugin has none) against the evaluation path
+// on `count` states, a few steps of gauss 3 stages in each form the model has, judged as check_kernels.
+PathCheck check_gauss_kernel(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                             std::span<const double> p, std::size_t count, double tolerance);
+
 // The plugin's own product term of H (plugin_abi.h energy_TTV, energy_VVT; nothing when it has neither) against H
 // from its Hessian-vector products or Hessians at the count states (q, p): the largest difference relative to
 // max(1, |H|) is reported, and above `tolerance` (or non-finite on one side only) the check fails.

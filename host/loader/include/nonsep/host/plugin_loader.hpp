@@ -28,6 +28,7 @@
 #include "nonsep/core/base/error.hpp"
 #include "nonsep/core/kernel/chin_stages.hpp"
 #include "nonsep/core/kernel/chin_tangent_stages.hpp"
+#include "nonsep/core/kernel/gauss_stages.hpp"
 
 struct nonsep_plugin_api;
 struct nonsep_instance;
@@ -211,7 +212,14 @@ class PluginModel {
   // Advances `call` through the plugin's tangent kernel (plugin_abi.h chin_tangent_steps, ABI version 5) with the same
   // instruction set and returns true, or returns false without one at hand. Throws as chin_steps does.
   bool chin_tangent_steps(const ChinTangentStepsCall& call) const;
-  // Calls of chin_steps and chin_tangent_steps that ran a kernel, on this instance (every PluginModel sharing it).
+  // Takes `call`'s Gauss-Legendre step through the plugin's gauss_steps (plugin_abi.h, ABI version 6: compiled with
+  // the plugin's own flags) and returns true; false without it at hand (a plugin without the entry, a model not from
+  // with_kernel(), NONSEP_INSTRUCTION_SET=evaluation) or when it fails inside (the caller then takes the step through
+  // the evaluations, which say why). As a core model it is a nonsep::ModelWithGaussSteps (gauss_stages.hpp).
+  bool gauss_steps(const GaussStepsCall& call) const;
+  bool has_gauss_kernel() const { return gauss_kernel_; }
+  // Calls of chin_steps, chin_tangent_steps and gauss_steps that ran a kernel, on this instance (every PluginModel
+  // sharing it).
   std::uint64_t kernel_calls() const;
 
   const Plugin& plugin() const;
@@ -223,6 +231,7 @@ class PluginModel {
   struct Instance;
   std::shared_ptr<Instance> instance_;
   std::optional<std::uint32_t> kernel_;  // the instruction set chin_steps uses; empty: the evaluation path
+  bool gauss_kernel_ = false;            // whether gauss_steps uses the plugin's
   bool product_energy_ = true;           // false: has_product_energy says no
 };
 
