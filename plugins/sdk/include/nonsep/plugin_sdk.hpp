@@ -228,9 +228,25 @@ class PluginTableBase {
       gauss_kernel(self.adapter, call);
     });
   }
-  // Flattened, so that the model's derivatives are inlined into the iteration.
-  [[gnu::flatten]] static void gauss_kernel(const Adapter& adapter, const GaussStepsCall& call) {
-    gauss_kernel_steps<HasFixedDimension<M> ? dimension_capacity<M>() : 0>(adapter, call);
+  // A model that writes out every derivative grad H needs gets the iteration flattened (the derivatives inlined into
+  // it: 1.28x -> 1.2x a hand-written loop on paper1d); one differentiated automatically does not, since the inlined
+  // dual-number code multiplies the plugin's compile time (radial: 15 s -> 70 s).
+  static constexpr bool gradient_written_out = [] {
+    if constexpr (requires { Adapter::analytic_grad_H; })
+      return Adapter::analytic_grad_H;
+    else
+      return Adapter::analytic_grad_T && Adapter::analytic_grad_V && Adapter::analytic_hvp_T &&
+             Adapter::analytic_hvp_V && Adapter::analytic_d3T && Adapter::analytic_d3V;
+  }();
+  static constexpr std::size_t fixed_dimension = HasFixedDimension<M> ? dimension_capacity<M>() : 0;
+  static void gauss_kernel(const Adapter& adapter, const GaussStepsCall& call) {
+    if constexpr (gradient_written_out)
+      flat_gauss_kernel(adapter, call);
+    else
+      gauss_kernel_steps<fixed_dimension>(adapter, call);
+  }
+  [[gnu::flatten]] static void flat_gauss_kernel(const Adapter& adapter, const GaussStepsCall& call) {
+    gauss_kernel_steps<fixed_dimension>(adapter, call);
   }
 };
 
