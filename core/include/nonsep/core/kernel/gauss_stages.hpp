@@ -4,8 +4,8 @@
 //   - GaussLegendre, the host's stepper, iterates a whole batch together, grad H in one batched model call per
 //     iteration (a plugin's entries crossed a few times per iteration, not per state);
 //   - gauss_kernel_steps below, the stepping kernel a plugin carries (plugin_abi.h gauss_steps, compiled inside the
-//     plugin with the model inlined), iterates one state at a time to convergence, its stages in small arrays that
-//     stay in the first-level cache, grad H of its s stage points in one inlined call.
+//     plugin with the model), iterates blocks of 32 states to convergence, a block's stages in arrays that stay in
+//     the first-level cache, grad H of the states still iterating in one call per stage, no boundary crossed.
 // Both evaluate grad H at the same points, form the next iterate by gauss_next_iterate, stop by gauss_converged and
 // add the increment by gauss_compensated_add, in the same order per state: a kernel compiled with the host's flags
 // gives the host's numbers bit for bit (tests/core/test_gauss_kernel.cpp).
