@@ -1,4 +1,4 @@
-// Frequency map analysis (/analysis/frequencies, observers/frequency_map.hpp) through the `nonsep` executable on
+// Frequency map analysis (/analysis/frequencies, observers/sampled_indicator.hpp) through the `nonsep` executable on
 // paper2d: the diffusion index of a regular and a chaotic orbit (with FLI beside it), a run killed and resumed and a
 // run on two threads giving an uninterrupted one-thread run's files byte for byte, a signals file changed under a
 // checkpoint refused, and orbits that stop early. The frequencies against exact ones:

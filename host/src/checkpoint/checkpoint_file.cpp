@@ -135,14 +135,16 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   if (const auto& lyapunov = run.analysis.lyapunov)
     analysis += "|lyapunov " + std::to_string(lyapunov->vectors) + ' ' + std::to_string(lyapunov->renormalize_every) +
                 ' ' + std::to_string(lyapunov->every);
-  for (const auto& indicator : run.analysis.indicators) {
+  // The tangent map's indicators, then those that need samples (with the degrees of freedom they sample).
+  for (const auto& indicator : run.analysis.tangent_indicators()) {
     if (indicator->name() == "lyapunov") continue;  // above
     analysis += "|" + indicator->name();
     for (const auto& [name, value] : indicator->settings()) analysis += " " + std::to_string(value);
   }
-  if (const auto& frequencies = run.analysis.frequencies) {
-    analysis += "|frequencies " + std::to_string(frequencies->every) + ' ' + std::to_string(frequencies->spectra);
-    for (std::size_t k : frequencies->signals) analysis += ' ' + std::to_string(k);
+  for (const auto& indicator : run.analysis.sampled_indicators()) {
+    analysis += "|" + indicator->name();
+    for (const auto& [name, value] : indicator->settings()) analysis += " " + std::to_string(value);
+    for (std::size_t k : indicator->needs().samples.degrees) analysis += ' ' + std::to_string(k);
   }
   if (run.analysis.error_estimate) analysis += "|error_estimate";
   parts.emplace_back("analysis", std::move(analysis));
@@ -322,7 +324,7 @@ Checkpoint load_checkpoint(const std::filesystem::path& path, const LoadedJob& l
     state.lyapunov.push_back(record);
   }
   // Each indicator's state under its name, as the run's indicators size it.
-  const IndicatorList indicators = k > 0 ? job.run().analysis.indicators : IndicatorList();
+  const IndicatorList indicators = k > 0 ? job.run().analysis.tangent_indicators() : IndicatorList();
   const json& saved_indicators = read.member(active, "indicators");
   if (!saved_indicators.is_object() || saved_indicators.size() != indicators.size())
     read.damaged("active.indicators does not have the states of the job's indicators");

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "nonsep/core/analysis/frequency_map_indicator.hpp"
 #include "nonsep/host/exit_status.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/study/scheme_choice.hpp"
@@ -78,16 +79,24 @@ std::string sweep_text(const Job& job, bool loaded) {
 
 // What /analysis/frequencies will sample and write, or "" without it.
 std::string frequencies_text(const SingleRun& run, std::size_t dimension, std::size_t trajectories) {
-  const auto& map = run.analysis.frequencies;
-  if (!map) return "";
-  const std::size_t signals = map->signals.empty() ? dimension : map->signals.size();
-  const std::uint64_t samples = run.time.steps / map->every;
-  const double bytes =
-      static_cast<double>(trajectories) * static_cast<double>(signals) * static_cast<double>(samples) * 16.0;
-  return "  frequencies: " + counted(signals, "signal") + " q_k + i p_k, " + std::to_string(samples) +
-         " samples every " + counted(map->every, "step") + " (tau = " + format_number(run.time.dt * map->every) +
-         "), frequency_signals.npy " + format_number(std::round(bytes / 1e5) / 10.0) + " MB" +
-         (map->spectra > 0 ? ", frequency_spectra.csv with " + counted(map->spectra, "term") + " a signal" : "") + "\n";
+  std::string text;
+  for (const auto& indicator : run.analysis.sampled_indicators()) {
+    const auto* map = dynamic_cast<const FrequencyMapIndicator*>(indicator.get());
+    if (!map) continue;
+    const std::size_t signals = map->degrees().empty() ? dimension : map->degrees().size();
+    const std::uint64_t samples = run.time.steps / map->every();
+    const double bytes =
+        static_cast<double>(trajectories) * static_cast<double>(signals) * static_cast<double>(samples) * 16.0;
+    text += "  frequencies: " + counted(signals, "signal") + " q_k + i p_k, " + std::to_string(samples) +
+            " samples every " + counted(map->every(), "step") + " (tau = " + format_number(run.time.dt * map->every()) +
+            "), " + FrequencyMapIndicator::signals_file_name + " " + format_number(std::round(bytes / 1e5) / 10.0) +
+            " MB" +
+            (map->spectra() > 0 ? ", " + std::string(FrequencyMapIndicator::spectra_file_name) + " with " +
+                                      counted(map->spectra(), "term") + " a signal"
+                                : "") +
+            "\n";
+  }
+  return text;
 }
 
 int command_validate(const std::string& job_file) {

@@ -6,10 +6,10 @@
 #include <optional>
 
 #include "cluster/unit_seal.hpp"
+#include "nonsep/core/analysis/frequency_map_indicator.hpp"
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/cluster/merge_outputs.hpp"
 #include "nonsep/host/cluster/merge_results_h5.hpp"
-#include "nonsep/host/observers/frequency_map.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -156,10 +156,10 @@ RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const
   merge("lyapunov.csv", {"step", "trajectory"});
   merge("trajectories.csv", {"trajectory"});
   merge("frequency_spectra.csv", {"trajectory"});
-  if (std::filesystem::exists(parts.front().path / FrequencyMapObserver::signals_file_name)) {
+  if (std::filesystem::exists(parts.front().path / FrequencyMapIndicator::signals_file_name)) {
     std::vector<UnitFile> files = parts;
-    for (UnitFile& file : files) file.path /= FrequencyMapObserver::signals_file_name;
-    merge_signals(files, directory / FrequencyMapObserver::signals_file_name);
+    for (UnitFile& file : files) file.path /= FrequencyMapIndicator::signals_file_name;
+    merge_signals(files, directory / FrequencyMapIndicator::signals_file_name);
   }
   RunOutcome outcome;
   outcome.distributed = true;

@@ -12,7 +12,7 @@
 #include <tuple>
 
 #include "nonsep/host/launch/run_job.hpp"
-#include "nonsep/host/observers/frequency_map.hpp"
+#include "nonsep/host/observers/sampled_indicator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/csv_reader.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -138,7 +138,7 @@ void merge_signals(std::span<const UnitFile> parts, const std::filesystem::path&
       header.resize(10 + static_cast<unsigned char>(header[8]) + 256u * static_cast<unsigned char>(header[9]));
       const auto length = static_cast<ssize_t>(header.size() - 10);
       if (::pread(descriptor, header.data() + 10, header.size() - 10, 10) != length) refuse("a short header");
-      const auto shape = FrequencyMapObserver::signals_shape(header);
+      const auto shape = SampledIndicatorObserver::signals_shape(header);
       if (!shape) refuse("not an array of frequency map signals");
       if (first && ((*first)[1] != (*shape)[1] || (*first)[2] != (*shape)[2]))
         refuse("signals or samples other than the first unit's");
@@ -149,7 +149,7 @@ void merge_signals(std::span<const UnitFile> parts, const std::filesystem::path&
     }
     if (!first) throw OutputError(output.string() + ": no unit to merge");
     AtomicFile merged(output);
-    merged.write(FrequencyMapObserver::signals_header(trajectories, (*first)[1], (*first)[2]));
+    merged.write(SampledIndicatorObserver::signals_header(trajectories, (*first)[1], (*first)[2]));
     std::string buffer(std::size_t{1} << 20, '\0');
     for (std::size_t u = 0; u < units.size(); ++u)
       for (std::uint64_t done = 0; done < units[u].bytes;) {

@@ -1,5 +1,5 @@
-// /analysis/poincare, /analysis/frequencies and the chaos indicators (/analysis/lyapunov, /megno, /sali, /gali, /fli,
-// /ofli: the list of indicators.cpp): the dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the
+// /analysis/poincare and the indicators (/analysis/frequencies, /lyapunov, /megno, /sali, /gali, /fli, /ofli: the list
+// of indicators.cpp): the dynamics diagnostics of a run (docs/dynamics.md). Whether the plugin has the
 // Hessians the tangent map needs is checked when the job is loaded (load_job.cpp), where the plugin is known.
 #include <algorithm>
 #include <limits>
@@ -73,46 +73,11 @@ std::optional<PoincareSection> read_poincare(Checker& check, const json& value, 
   return section;
 }
 
-std::optional<FrequencyMap> read_frequencies(Checker& check, const json& value, std::size_t dimension) {
-  const std::string path = "/analysis/frequencies";
-  const std::size_t issues = check.issue_count();
-  const KeyReader keys(check, value, path, frequencies_keys(),
-                       "an object {\"every\": k, \"signals\": [degrees of freedom], \"spectra\": m}");
-  if (!keys.is_object()) return std::nullopt;
-  FrequencyMap frequencies;
-  if (const auto every = keys.integer("every")) frequencies.every = static_cast<std::uint64_t>(*every);
-  if (const auto spectra = keys.integer("spectra")) frequencies.spectra = static_cast<std::size_t>(*spectra);
-  const std::string degrees = dimension > 0 ? "from 0 to " + std::to_string(dimension - 1) : "below the dimension";
-  if (const json* signals = keys.value("signals")) {
-    const std::string what =
-        "a non-empty list of distinct degrees of freedom k (" + degrees + "): the signals q_k + i p_k, numbered from 0";
-    if (!signals->is_array() || signals->empty()) check.issue(keys.path("signals"), describe(*signals), what);
-    for (std::size_t i = 0; signals->is_array() && i < signals->size(); ++i) {
-      const std::string at = child(keys.path("signals"), i);
-      const auto k = check.integer((*signals)[i], at, 0, std::numeric_limits<std::int64_t>::max(), what);
-      if (!k) continue;
-      const auto degree = static_cast<std::size_t>(*k);
-      if (dimension > 0 && degree >= dimension)
-        check.issue(at, std::to_string(degree), "a degree of freedom " + degrees + " (numbered from 0)");
-      else if (std::find(frequencies.signals.begin(), frequencies.signals.end(), degree) != frequencies.signals.end())
-        check.issue(at, std::to_string(degree) + " again", "each degree of freedom once");
-      else
-        frequencies.signals.push_back(degree);
-    }
-  } else if (!keys.given("signals")) {
-    for (std::size_t k = 0; k < dimension; ++k) frequencies.signals.push_back(k);
-  }
-  if (check.issue_count() != issues) return std::nullopt;
-  return frequencies;
-}
-
 }  // namespace
 
 void read_dynamics(Checker& check, const KeyReader& analysis_keys, std::size_t dimension, Analysis& analysis) {
   if (const json* poincare = analysis_keys.value("poincare"))
     analysis.poincare = read_poincare(check, *poincare, dimension);
-  if (const json* frequencies = analysis_keys.value("frequencies"))
-    analysis.frequencies = read_frequencies(check, *frequencies, dimension);
   for (const IndicatorEntry& entry : indicator_entries())
     if (const json* member = analysis_keys.value(entry.rule.name))
       if (auto indicator = entry.read(check, *member, analysis_keys.path(entry.rule.name), dimension, analysis))

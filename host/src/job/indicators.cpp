@@ -2,9 +2,11 @@
 #include "indicators.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "nonsep/core/analysis/alignment_indices.hpp"
 #include "nonsep/core/analysis/fast_lyapunov_indicator.hpp"
+#include "nonsep/core/analysis/frequency_map_indicator.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
 #include "nonsep/core/analysis/megno.hpp"
 #include "nonsep/core/analysis/orthogonal_fast_lyapunov_indicator.hpp"
@@ -49,6 +51,42 @@ std::shared_ptr<const Indicator> read_lyapunov(Checker& check, const json& value
   return std::make_shared<LyapunovIndicator>(lyapunov.vectors);
 }
 
+// /analysis/frequencies: a frequency map of the signals it names (every degree of freedom when it names none).
+std::shared_ptr<const Indicator> read_frequencies(Checker& check, const json& value, const std::string& path,
+                                                  std::size_t dimension, Analysis&) {
+  const std::size_t issues = check.issue_count();
+  const KeyReader keys(check, value, path, frequencies_keys(),
+                       "an object {\"every\": k, \"signals\": [degrees of freedom], \"spectra\": m}");
+  if (!keys.is_object()) return nullptr;
+  std::uint64_t every = 1;
+  std::size_t spectra = 0;
+  std::vector<std::size_t> chosen;  // the degrees of freedom, in column order
+  if (const auto k = keys.integer("every")) every = static_cast<std::uint64_t>(*k);
+  if (const auto m = keys.integer("spectra")) spectra = static_cast<std::size_t>(*m);
+  const std::string degrees = dimension > 0 ? "from 0 to " + std::to_string(dimension - 1) : "below the dimension";
+  if (const json* signals = keys.value("signals")) {
+    const std::string what =
+        "a non-empty list of distinct degrees of freedom k (" + degrees + "): the signals q_k + i p_k, numbered from 0";
+    if (!signals->is_array() || signals->empty()) check.issue(keys.path("signals"), describe(*signals), what);
+    for (std::size_t i = 0; signals->is_array() && i < signals->size(); ++i) {
+      const std::string at = child(keys.path("signals"), i);
+      const auto k = check.integer((*signals)[i], at, 0, std::numeric_limits<std::int64_t>::max(), what);
+      if (!k) continue;
+      const auto degree = static_cast<std::size_t>(*k);
+      if (dimension > 0 && degree >= dimension)
+        check.issue(at, std::to_string(degree), "a degree of freedom " + degrees + " (numbered from 0)");
+      else if (std::find(chosen.begin(), chosen.end(), degree) != chosen.end())
+        check.issue(at, std::to_string(degree) + " again", "each degree of freedom once");
+      else
+        chosen.push_back(degree);
+    }
+  } else if (!keys.given("signals")) {
+    for (std::size_t k = 0; k < dimension; ++k) chosen.push_back(k);
+  }
+  if (check.issue_count() != issues) return nullptr;
+  return std::make_shared<const FrequencyMapIndicator>(every, std::move(chosen), spectra);
+}
+
 // A boolean key (its value checked by /analysis's table): `make` the indicator it asks for when true.
 template <class Made>
 std::shared_ptr<const Indicator> when_true(const json& value, Made&& make) {
@@ -59,6 +97,17 @@ std::shared_ptr<const Indicator> when_true(const json& value, Made&& make) {
 
 const std::vector<IndicatorEntry>& indicator_entries() {
   static const std::vector<IndicatorEntry> entries{
+      {KeyRule{.name = "frequencies",
+               .type = ValueType::object,
+               .description =
+                   "Frequency map analysis (Laskar): the fundamental frequency of each signal q_k + i p_k, sampled "
+                   "every `every` steps, by NAFF (Hann window) over the whole run and over its first and second "
+                   "half, and the diffusion index log10 |nu_second - nu_first| / max(|nu_first|, |nu_second|): "
+                   "trajectories.csv columns frequency<k>, frequency<k>_first, frequency<k>_second (radians per unit "
+                   "time) and diffusion; the sampled signals in frequency_signals.npy; with spectra, the strongest "
+                   "terms in frequency_spectra.csv. Needs at least 32 samples. Any model: no Hessians needed.",
+               .keys = frequencies_keys},
+       read_frequencies},
       {KeyRule{.name = "lyapunov",
                .type = ValueType::object,
                .description =

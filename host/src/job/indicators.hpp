@@ -1,7 +1,8 @@
 #pragma once
-// The one list of chaos indicators a job's /analysis can ask for (nonsep/core/analysis/indicator.hpp), in the order
-// of their columns in trajectories.csv and lyapunov.csv: each with its key's rule (the schema, docs/job-file.md and
-// the known keys of /analysis take it from here) and its reading. Adding an indicator is its class in
+// The one list of indicators a job's /analysis can ask for (nonsep/core/analysis/indicator.hpp), in the order of
+// their columns in trajectories.csv and lyapunov.csv: frequency map analysis (which needs samples of the state), then
+// the chaos indicators of the tangent map; each with its key's rule (the schema, docs/job-file.md and the known keys
+// of /analysis take it from here) and its reading. Adding an indicator is its class in
 // core/include/nonsep/core/analysis/ and its entry here.
 #include <cstddef>
 #include <memory>

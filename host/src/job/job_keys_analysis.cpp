@@ -10,7 +10,7 @@
 namespace nonsep::host::job_reader {
 
 const KeyTable& analysis_keys() {
-  // The chaos indicators' keys (indicators.cpp) come before error_estimate.
+  // The indicators' keys (indicators.cpp: frequencies, then the chaos indicators) come before error_estimate.
   static const KeyTable table = [] {
     KeyTable t{{
         {.name = "closest_return_after",
@@ -33,16 +33,6 @@ const KeyTable& analysis_keys() {
                         "a fractional step of the run's integrator (|normal . (q, p) - value| at round-off). Exactly "
                         "one of component and normal.",
          .keys = poincare_keys},
-        {.name = "frequencies",
-         .type = ValueType::object,
-         .description = "Frequency map analysis (Laskar): the fundamental frequency of each signal q_k + i p_k, "
-                        "sampled every `every` steps, by NAFF (Hann window) over the whole run and over its first and "
-                        "second half, and the diffusion index log10 |nu_second - nu_first| / max(|nu_first|, "
-                        "|nu_second|): trajectories.csv columns frequency<k>, frequency<k>_first, frequency<k>_second "
-                        "(radians per unit time) and diffusion; the sampled signals in frequency_signals.npy; with "
-                        "spectra, the strongest terms in frequency_spectra.csv. Needs at least 32 samples. Any model: "
-                        "no Hessians needed.",
-         .keys = frequencies_keys},
     }};
     for (const IndicatorEntry& entry : indicator_entries()) t.rules.push_back(entry.rule);
     t.rules.push_back(

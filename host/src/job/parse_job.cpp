@@ -1,12 +1,39 @@
 // Pass 2 of the job reader: the whole document, section by section (sections.hpp), and the rules that join
 // sections: a study has no /integrator, /analysis or /checkpoint, one initial state, and a reference of its
 // dimension.
+#include "nonsep/core/analysis/frequency_map_indicator.hpp"
 #include "nonsep/host/platform/installation.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host {
 
 using namespace job_reader;
+
+namespace {
+
+// What the run's steps leave an indicator that needs samples: at least the fewest it analyses; for a frequency map,
+// at most a quarter of them as spectral terms.
+void check_samples(Checker& check, const SingleRun& run) {
+  const std::uint64_t steps = run.time.steps;
+  for (const auto& indicator : run.analysis.sampled_indicators()) {
+    const SampleNeeds needs = indicator->needs().samples;
+    const std::string path = "/analysis/" + indicator->name();
+    const std::uint64_t samples = steps / needs.every, least = needs.minimum;
+    const auto* map = dynamic_cast<const FrequencyMapIndicator*>(indicator.get());
+    if (samples < least)
+      check.issue(path + "/every",
+                  std::to_string(needs.every) + " (" + std::to_string(samples) + " samples of " +
+                      std::to_string(steps) + " steps)",
+                  "at most steps / " + std::to_string(least) + " = " + std::to_string(steps / least) + ": at least " +
+                      std::to_string(least) + " samples, " + std::to_string(least / 2) + " in each half of the run");
+    else if (map && map->spectra() > samples / 4)
+      check.issue(path + "/spectra", std::to_string(map->spectra()) + " (of " + std::to_string(samples) + " samples)",
+                  "at most samples / 4 = " + std::to_string(samples / 4) +
+                      ": the window's main lobe is 4 frequency bins wide, so no more terms can be told apart");
+  }
+}
+
+}  // namespace
 
 Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_file, std::vector<JobIssue>& issues) {
   Checker check(issues);
@@ -43,21 +70,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
     run.time = read_time(check, keys);
     if (const json* analysis = keys.value("analysis"))
       run.analysis = read_analysis(check, *analysis, job.initial.dimension);
-    if (const auto& frequencies = run.analysis.frequencies; frequencies && run.time.steps > 0) {
-      if (run.time.steps / frequencies->every < minimum_frequency_samples)
-        check.issue("/analysis/frequencies/every",
-                    std::to_string(frequencies->every) + " (" + std::to_string(run.time.steps / frequencies->every) +
-                        " samples of " + std::to_string(run.time.steps) + " steps)",
-                    "at most steps / " + std::to_string(minimum_frequency_samples) + " = " +
-                        std::to_string(run.time.steps / minimum_frequency_samples) + ": at least " +
-                        std::to_string(minimum_frequency_samples) + " samples, 16 in each half of the run");
-      else if (frequencies->spectra > run.time.steps / frequencies->every / 4)
-        check.issue("/analysis/frequencies/spectra",
-                    std::to_string(frequencies->spectra) + " (of " +
-                        std::to_string(run.time.steps / frequencies->every) + " samples)",
-                    "at most samples / 4 = " + std::to_string(run.time.steps / frequencies->every / 4) +
-                        ": the window's main lobe is 4 frequency bins wide, so no more terms can be told apart");
-    }
+    if (run.time.steps > 0) check_samples(check, run);
     check_sweep_size(check, job);
   }
   read_output(check, keys, job);

@@ -83,8 +83,8 @@ Study read_study(Checker& check, const json& study, HamiltonianForm form, double
 void read_output(Checker& check, const KeyReader& document, Job& job);
 // read_analysis needs the dimension of the initial states (0 when unknown) for /analysis/poincare and /lyapunov.
 Analysis read_analysis(Checker& check, const json& value, std::size_t dimension);
-// /analysis/poincare, /analysis/frequencies and the chaos indicators (dynamics.cpp, indicators.hpp) of /analysis as
-// its KeyReader checked it, into `analysis`.
+// /analysis/poincare and the indicators (/analysis/frequencies and the chaos indicators: dynamics.cpp, indicators.hpp)
+// of /analysis as its KeyReader checked it, into `analysis`.
 void read_dynamics(Checker& check, const KeyReader& analysis_keys, std::size_t dimension, Analysis& analysis);
 CheckpointPolicy read_checkpoint(Checker& check, const json& value);
 

@@ -6,6 +6,7 @@
 
 #include "launch/run_plan.hpp"
 #include "launch/run_summary.hpp"
+#include "nonsep/core/analysis/frequency_map_indicator.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
@@ -48,23 +49,36 @@ nlohmann::ordered_json poincare_facts(const PoincareSection& section, const Poin
            "found by TOMS 748 (core/include/nonsep/core/analysis/poincare_crossing.hpp)"}};
 }
 
-nlohmann::ordered_json frequency_facts(const FrequencyMap& map, const FrequencyMapObserver& observer) {
+// The summary of an indicator that needs samples: what its sample store (sampled_indicator.hpp) sampled and
+// analysed, its settings and files; a frequency map's with the method, window and units of its columns.
+nlohmann::ordered_json sampled_facts(const SampledIndicatorObserver& observer) {
   std::vector<std::string> columns;
   observer.columns(columns);
-  return {{"signals", observer.signals()},
-          {"signal", "q_k + i p_k of each degree of freedom k listed"},
-          {"every", map.every},
-          {"samples", observer.samples()},
-          {"tau", observer.tau()},
-          {"window", "Hann (Laskar's window of order 1)"},
-          {"method", "NAFF (core/include/nonsep/core/analysis/frequency_analysis.hpp)"},
-          {"columns", columns},
-          {"units", "radians per unit time, signed"},
-          {"analysed", observer.analysed()},
-          {"signals_file", FrequencyMapObserver::signals_file_name},
-          {"spectra", map.spectra},
-          {"spectra_file", map.spectra > 0 ? nlohmann::ordered_json(FrequencyMapObserver::spectra_file_name)
-                                           : nlohmann::ordered_json(nullptr)}};
+  const SampleNeeds needs = observer.indicator().needs().samples;
+  const auto spectra_file =
+      needs.spectra_file.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(needs.spectra_file);
+  nlohmann::ordered_json facts = {{"signals", observer.signals()},
+                                  {"signal", "q_k + i p_k of each degree of freedom k listed"},
+                                  {"every", needs.every},
+                                  {"samples", observer.samples()},
+                                  {"tau", observer.tau()}};
+  if (const auto* map = dynamic_cast<const FrequencyMapIndicator*>(&observer.indicator())) {
+    facts["window"] = "Hann (Laskar's window of order 1)";
+    facts["method"] = "NAFF (core/include/nonsep/core/analysis/frequency_analysis.hpp)";
+    facts["columns"] = columns;
+    facts["units"] = "radians per unit time, signed";
+    facts["analysed"] = observer.analysed();
+    facts["signals_file"] = needs.file;
+    facts["spectra"] = map->spectra();
+    facts["spectra_file"] = spectra_file;
+    return facts;
+  }
+  facts["columns"] = columns;
+  facts["analysed"] = observer.analysed();
+  facts["signals_file"] = needs.file;
+  for (const auto& [name, value] : observer.indicator().settings()) facts[name] = value;
+  facts["spectra_file"] = spectra_file;
+  return facts;
 }
 
 nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
@@ -75,7 +89,8 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
        "component j (run/tangent_block.hpp)"},
       {"method",
        "the exact tangent map of the run's integrator (core/include/nonsep/core/runtime/tangent_integrator.hpp)"}};
-  for (const auto& indicator : analysis.indicators) {
+  const IndicatorList indicators = analysis.tangent_indicators();
+  for (const auto& indicator : indicators) {
     if (indicator->name() == "lyapunov") {
       const LyapunovAnalysis& l = *analysis.lyapunov;
       facts["lyapunov"] = {{"exponents", l.vectors},
@@ -91,7 +106,7 @@ nlohmann::ordered_json tangent_facts(const Analysis& analysis) {
     facts[indicator->name()] = std::move(entry);
   }
   const auto with_factors = [](const auto& indicator) { return indicator->needs().orthonormalization_factors; };
-  if (std::ranges::any_of(analysis.indicators, with_factors))
+  if (std::ranges::any_of(indicators, with_factors))
     facts["alignment_indices"] =
         "the vectors of the Lyapunov exponents, with the triangular factors of their orthonormalisations "
         "(core/include/nonsep/core/analysis/alignment_indices.hpp), at the last orthonormalisation";
@@ -213,8 +228,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
   outcome.summary = run_summary(facts);
   if (plan.poincare) outcome.summary["analysis"]["poincare"] = poincare_facts(*run.analysis.poincare, *plan.poincare);
   if (plan.chaos) outcome.summary["analysis"]["tangent_map"] = tangent_facts(run.analysis);
-  if (plan.frequencies)
-    outcome.summary["analysis"]["frequencies"] = frequency_facts(*run.analysis.frequencies, *plan.frequencies);
+  for (const auto& sampled : plan.sampled) outcome.summary["analysis"][sampled->name()] = sampled_facts(*sampled);
   if (!choice.is_null()) outcome.summary["scheme_choice"] = std::move(choice);
   if (plan.estimate)
     outcome.summary["analysis"]["error_estimate"] =
@@ -235,7 +249,7 @@ RunOutcome run_job(const LoadedJob& loaded, const RunOptions& options) {
     std::vector<const TrajectoryColumns*> columns{&plan.energy};
     if (plan.closest) columns.push_back(&*plan.closest);
     if (plan.poincare) columns.push_back(&*plan.poincare);
-    if (plan.frequencies) columns.push_back(&*plan.frequencies);
+    for (const auto& sampled : plan.sampled) columns.push_back(sampled.get());
     if (plan.chaos) columns.push_back(&*plan.chaos);
     if (plan.estimate) columns.push_back(&*plan.estimate);
     write_trajectories_csv(directory / trajectories_file_name, facts, columns);

@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "nonsep/core/analysis/frequency_map_indicator.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/run_files.hpp"
 
@@ -33,7 +34,7 @@ EnsembleSetup driver_setup(const LoadedJob& loaded, const RunOptions& options) {
           run.analysis.lyapunov ? run.analysis.lyapunov->renormalize_every : 1,
           run_block_size_for(options.whole_ensemble > 0 ? options.whole_ensemble : job.initial.count),
           parameter_sets(job, job.initial.parameter_set),
-          run.analysis.indicators,
+          run.analysis.tangent_indicators(),
           options.chunk_seconds};
 }
 
@@ -98,17 +99,18 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
                      driver.time(), job.initial.dimension, count, driver.energy_available(), options.resume);
   else
     remove_stale(directory / PoincareSectionObserver::file_name);
-  if (const auto& map = run.analysis.frequencies) {
-    frequencies.emplace(directory, *map, driver.time(), job.initial.dimension, count, options.resume);
-    if (map->spectra == 0) remove_stale(directory / FrequencyMapObserver::spectra_file_name);
-  } else {
-    remove_stale(directory / FrequencyMapObserver::signals_file_name);
-    remove_stale(directory / FrequencyMapObserver::spectra_file_name);
-  }
+  for (const auto& indicator : run.analysis.sampled_indicators())
+    sampled.emplace_back(std::make_unique<SampledIndicatorObserver>(directory, indicator, driver.time(),
+                                                                    job.initial.dimension, count, options.resume));
+  // An earlier run's files of a frequency map this run does not make, or does not make whole.
+  const SampledIndicatorObserver* frequencies = sampled_indicator("frequencies");
+  if (!frequencies) remove_stale(directory / FrequencyMapIndicator::signals_file_name);
+  if (!frequencies || frequencies->indicator().needs().samples.spectra_file.empty())
+    remove_stale(directory / FrequencyMapIndicator::spectra_file_name);
   const std::uint64_t series_every = run.analysis.lyapunov ? run.analysis.lyapunov->every : 0;
   if (run.analysis.tangent_vectors() > 0)
-    chaos.emplace(directory / IndicatorColumns::file_name, run.analysis.indicators, series_every, driver.records(),
-                  options.resume);
+    chaos.emplace(directory / IndicatorColumns::file_name, run.analysis.tangent_indicators(), series_every,
+                  driver.records(), options.resume);
   if (!chaos || series_every == 0) remove_stale(directory / IndicatorColumns::file_name);
   if (run.analysis.error_estimate)
     estimate.emplace(directory / ErrorEstimateObserver::file_name, run_finer(loaded, options),
@@ -124,7 +126,7 @@ RunPlan::RunPlan(const LoadedJob& loaded, const RunOptions& options)
   if (hdf5_samples) watch(*hdf5_samples);
 #endif
   if (poincare) watch(*poincare);
-  if (frequencies) watch(*frequencies);
+  for (const auto& observer : sampled) watch(*observer);
   if (estimate) watch(*estimate);
   saver.emplace(directory / checkpoint_file_name, identity_, run.checkpoint, driver, checkpointed);
   progress.emplace(options.progress, options.progress_interval, driver, &energy, options.progress_label,

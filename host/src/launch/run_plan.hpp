@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -20,12 +21,12 @@
 #include "nonsep/host/observers/closest_return.hpp"
 #include "nonsep/host/observers/energy_error.hpp"
 #include "nonsep/host/observers/error_estimate.hpp"
-#include "nonsep/host/observers/frequency_map.hpp"
 #include "nonsep/host/observers/indicator_columns.hpp"
 #include "nonsep/host/observers/poincare_section.hpp"
 #include "nonsep/host/observers/progress.hpp"
 #include "nonsep/host/observers/runaway.hpp"
 #include "nonsep/host/observers/sample_writer.hpp"
+#include "nonsep/host/observers/sampled_indicator.hpp"
 #include "nonsep/host/output/run_folder.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 #include "nonsep/host/run/observer.hpp"
@@ -59,7 +60,7 @@ class RunPlan {
   std::optional<Hdf5SampleWriter> hdf5_samples;
 #endif
   std::optional<PoincareSectionObserver> poincare;
-  std::optional<FrequencyMapObserver> frequencies;
+  std::vector<std::unique_ptr<SampledIndicatorObserver>> sampled;  // one per indicator that needs samples, in order
   std::optional<IndicatorColumns> chaos;
   std::optional<ErrorEstimateObserver> estimate;  // /analysis/error_estimate: its finer run is done by the plan
   // The observers above that the driver tells, in the order it tells them; the saver and the progress bar follow.
@@ -76,6 +77,14 @@ class RunPlan {
     if constexpr (std::is_base_of_v<CheckpointedObserver, O>) checkpointed.push_back(&observer);
   }
   void resume(Checkpoint checkpoint);
+
+ public:
+  // The sample store of the indicator named `name`, or null when the job has none.
+  const SampledIndicatorObserver* sampled_indicator(const std::string& name) const {
+    for (const auto& observer : sampled)
+      if (observer->name() == name) return observer.get();
+    return nullptr;
+  }
 };
 
 }  // namespace nonsep::host

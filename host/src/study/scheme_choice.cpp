@@ -118,7 +118,8 @@ void apply_choice(Job& job, const SchemeChoice& choice) {
     run.analysis.lyapunov->every *= m;
     run.analysis.lyapunov->renormalize_every *= m;
   }
-  if (run.analysis.frequencies) run.analysis.frequencies->every *= m;  // the same sampling times
+  for (auto& indicator : run.analysis.indicators)  // the same sampling times
+    if (needs_samples(*indicator)) indicator = indicator->sampling_every(indicator->needs().samples.every * m);
 }
 
 void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& recorded,

@@ -123,27 +123,22 @@ struct LyapunovAnalysis {
   std::uint64_t every = 0;              // lyapunov.csv every this many steps; 0: no time series
 };
 
-// /analysis/frequencies: frequency map analysis (observers/frequency_map.hpp): the fundamental frequencies of the
-// signals z_k = q_k + i p_k of the degrees of freedom `signals`, sampled every `every` steps, by NAFF over the whole
-// run and over its two halves, and Laskar's diffusion index.
-// The fewest samples a frequency map takes: 16 in each half (nonsep::FrequencyAnalysis::minimum_samples).
-inline constexpr std::uint64_t minimum_frequency_samples = 32;
-// Samples of one signal a trajectory keeps in memory before they are written to frequency_signals.npy (16 kB).
-inline constexpr std::size_t frequency_samples_in_memory = 1024;
-struct FrequencyMap {
-  std::uint64_t every = 1;           // steps between samples
-  std::vector<std::size_t> signals;  // degrees of freedom, in column order (all of them when the job gives none)
-  std::size_t spectra = 0;           // terms per signal in frequency_spectra.csv; 0: no such file
-};
+// Samples of one signal a trajectory keeps in memory before they are written to its indicator's sample file
+// (observers/sampled_indicator.hpp; 16 kB).
+inline constexpr std::size_t samples_in_memory = 1024;
 
 // Per-trajectory analysis of a single run (/analysis).
 struct Analysis {
   std::optional<PoincareSection> poincare;   // /analysis/poincare
-  std::optional<FrequencyMap> frequencies;   // /analysis/frequencies
   std::optional<LyapunovAnalysis> lyapunov;  // /analysis/lyapunov
-  // The chaos indicators asked for (/analysis/lyapunov, /megno, /sali, /gali, /fli, /ofli), in the order of their
-  // columns (host/src/job/indicators.cpp: the one list).
+  // The indicators asked for (/analysis/frequencies, /lyapunov, /megno, /sali, /gali, /fli, /ofli), in the order of
+  // their columns (host/src/job/indicators.cpp: the one list): those that follow tangent vectors and those that need
+  // samples of the state (nonsep::needs_samples).
   IndicatorList indicators;
+  // The ones that follow tangent vectors, in order.
+  IndicatorList tangent_indicators() const { return select(false); }
+  // The ones that need samples of the state, in order.
+  IndicatorList sampled_indicators() const { return select(true); }
   // Tangent vectors per trajectory the run must follow, shared by every indicator: the most any of them needs; 0
   // for none.
   std::size_t tangent_vectors() const {
@@ -151,8 +146,11 @@ struct Analysis {
     for (const auto& indicator : indicators) k = std::max(k, indicator->needs().tangent_vectors);
     return k;
   }
-  // The job file's key of the first indicator, for messages ("" for none).
-  std::string tangent_key() const { return indicators.empty() ? "" : "/analysis/" + indicators.front()->name(); }
+  // The job file's key of the first indicator that follows tangent vectors, for messages ("" for none).
+  std::string tangent_key() const {
+    const IndicatorList tangent = tangent_indicators();
+    return tangent.empty() ? "" : "/analysis/" + tangent.front()->name();
+  }
   // /analysis/closest_return_after: from this time on, the smallest Euclidean phase-space distance
   // |(q, p) - (q0, p0)| to the trajectory's initial state is tracked at every step (summary: closest_return).
   std::optional<double> closest_return_after;
@@ -162,6 +160,14 @@ struct Analysis {
   // /analysis/error_estimate: a second run with half the step estimates every trajectory's global error
   // (observers/error_estimate.hpp).
   bool error_estimate = false;
+
+ private:
+  IndicatorList select(bool sampled) const {
+    IndicatorList chosen;
+    for (const auto& indicator : indicators)
+      if (needs_samples(*indicator) == sampled) chosen.push_back(indicator);
+    return chosen;
+  }
 };
 
 // When a run saves checkpoint.json (host/include/nonsep/host/checkpoint/checkpoint_file.hpp) so that `nonsep run

@@ -21,17 +21,43 @@
 //                                    indicator needs), with its triangular factor R (k x k, row-major:
 //                                    orthonormalize_state; needs().orthonormalization_factors);
 //   values(state, lyapunov, out)     its columns' values now (out.size() == columns().size()).
+//
+// An indicator can instead need samples of the state (needs().samples.every > 0; frequency map analysis is one): the
+// signals z = q_k + i p_k of the degrees of freedom needs().samples.degrees at every every-th step. The caller keeps
+// them (the host's sample store, observers/sampled_indicator.hpp: in needs().samples.file, checkpointed there) and
+// calls, once a trajectory has all of them (or retires early with at least needs().samples.minimum),
+//   from_samples(signals, tau)       its columns' values and its spectra from one span per signal, tau = every dt;
+// such an indicator follows no tangent vector and keeps no state_size numbers.
 // The list of the indicators a job file can ask for is host/src/job/indicators.cpp.
+#include <complex>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "nonsep/core/analysis/frequency_analysis.hpp"
 #include "nonsep/core/analysis/lyapunov_record.hpp"
 
 namespace nonsep {
+
+// Samples of the state an indicator needs (none when every == 0).
+struct SampleNeeds {
+  std::uint64_t every = 0;           // steps between samples: steps every, 2 every, ..., N every
+  std::vector<std::size_t> degrees;  // the signals q_k + i p_k, in column order
+  std::uint64_t minimum = 0;         // the fewest samples it can analyse
+  std::string file;                  // the output file that keeps them (a NumPy array)
+  std::string spectra_file;          // its spectra's CSV file, "" for none
+};
+
+// What an indicator computes from a trajectory's samples: its columns' values (none: it could not, e.g. a sample
+// that is not finite) and, per signal, the strongest terms for its spectra file (none without one).
+struct SampleAnalysis {
+  std::vector<double> values;
+  std::vector<std::vector<FrequencyTerm>> spectra;
+};
 
 struct IndicatorNeeds {
   std::size_t tangent_vectors = 0;          // the first k vectors of the shared ones (the run follows the most asked)
@@ -40,6 +66,7 @@ struct IndicatorNeeds {
   bool across_flow = false;                 // the first vector's share across the flow at time 0 and every step
                                             // (one gradient of H per state and step: the model needs grad H)
   std::size_t state_size = 0;               // numbers per trajectory
+  SampleNeeds samples{};                    // samples of the state instead of tangent vectors
 };
 
 class Indicator {
@@ -61,8 +88,21 @@ class Indicator {
   virtual void across_flow(std::span<double> /*state*/, double /*a*/, bool /*at_start*/) const {}
   virtual void after_orthonormalization(std::span<double> /*state*/, std::span<const double> /*r*/,
                                         std::size_t /*k*/) const {}
-  virtual void values(std::span<const double> state, const LyapunovRecord& lyapunov, std::span<double> out) const = 0;
+  virtual void values(std::span<const double> /*state*/, const LyapunovRecord& /*lyapunov*/,
+                      std::span<double> /*out*/) const {}
+
+  // For an indicator that needs samples: its analysis of `signals` (one span per needs().samples.degrees entry, all
+  // of one length, at least needs().samples.minimum), sampled every `tau`; and the same indicator sampling every
+  // `every` steps instead (scheme auto's step divides the job's: the same sampling times).
+  virtual SampleAnalysis from_samples(std::span<const std::span<const std::complex<double>>> /*signals*/,
+                                      double /*tau*/) const {
+    return {};
+  }
+  virtual std::shared_ptr<const Indicator> sampling_every(std::uint64_t /*every*/) const { return nullptr; }
 };
+
+// Whether it follows tangent vectors (the tangent map's indicators) or needs samples of the state.
+inline bool needs_samples(const Indicator& indicator) { return indicator.needs().samples.every > 0; }
 
 // The indicators of a run, in the order of their columns.
 using IndicatorList = std::vector<std::shared_ptr<const Indicator>>;

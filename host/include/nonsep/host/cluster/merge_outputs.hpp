@@ -26,7 +26,7 @@ struct UnitFile {
 // OutputError naming the file that cannot be read or does not fit.
 void merge_csv(std::span<const UnitFile> parts, const std::filesystem::path& output, std::span<const std::string> keys);
 
-// frequency_signals.npy of the whole run (observers/frequency_map.hpp) from the units' (in trajectory order): their
+// frequency_signals.npy of the whole run (observers/sampled_indicator.hpp) from the units' (in trajectory order): their
 // arrays, which must agree in signals and samples, one after the other. Written atomically. Throws OutputError
 // naming the unit file that cannot be read or does not fit.
 void merge_signals(std::span<const UnitFile> parts, const std::filesystem::path& output);

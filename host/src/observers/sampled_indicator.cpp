@@ -1,4 +1,4 @@
-#include "nonsep/host/observers/frequency_map.hpp"
+#include "nonsep/host/observers/sampled_indicator.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -35,12 +35,13 @@ std::uint64_t checksum(std::span<const std::complex<double>> samples, std::uint6
   return hash;
 }
 
-// The job's signals, or every degree of freedom when it names none (the reader fills them in when it knows the
+// The indicator's signals, or every degree of freedom when it names none (the reader fills them in when it knows the
 // dimension).
-std::vector<std::size_t> all_signals(const std::vector<std::size_t>& signals, std::size_t dimension) {
+std::vector<std::size_t> all_signals(const Indicator& indicator, std::size_t dimension) {
+  const std::vector<std::size_t>& signals = indicator.needs().samples.degrees;
   for (std::size_t k : signals)
     if (k >= dimension)
-      throw InvalidArgument("frequency map: the signal of degree of freedom " + std::to_string(k) +
+      throw InvalidArgument(indicator.name() + ": the signal of degree of freedom " + std::to_string(k) +
                             " of a state of dimension " + std::to_string(dimension));
   if (!signals.empty()) return signals;
   std::vector<std::size_t> all(dimension);
@@ -50,31 +51,33 @@ std::vector<std::size_t> all_signals(const std::vector<std::size_t>& signals, st
 
 }  // namespace
 
-FrequencyMapObserver::FrequencyMapObserver(const std::filesystem::path& directory, const FrequencyMap& settings,
-                                           const TimeGrid& time, std::size_t dimension, std::size_t trajectories,
-                                           bool resuming)
-    : every_(settings.every),
-      signals_(all_signals(settings.signals, dimension)),
-      spectra_(settings.spectra),
-      tau_(static_cast<double>(settings.every) * time.dt),
+SampledIndicatorObserver::SampledIndicatorObserver(const std::filesystem::path& directory,
+                                                   std::shared_ptr<const Indicator> indicator, const TimeGrid& time,
+                                                   std::size_t dimension, std::size_t trajectories, bool resuming)
+    : indicator_(std::move(indicator)),
+      every_(indicator_->needs().samples.every),
+      signals_(all_signals(*indicator_, dimension)),
+      columns_(indicator_->columns().size()),
+      tau_(static_cast<double>(every_) * time.dt),
       dimension_(dimension),
       trajectories_(trajectories),
-      samples_(time.steps / settings.every),
-      signals_path_(directory / signals_file_name),
-      spectra_path_(directory / spectra_file_name),
+      samples_(time.steps / every_),
+      signals_path_(directory / indicator_->needs().samples.file),
       written_(trajectories, 0),
       checksums_(trajectories * signals_.size(), content_hash_start),
       pending_(trajectories * signals_.size()),
       chunk_start_(trajectories, 0),
       results_(trajectories) {
+  if (const std::string spectra = indicator_->needs().samples.spectra_file; !spectra.empty())
+    spectra_path_ = directory / spectra;
   const std::string header = signals_header(trajectories, signals_.size(), samples_);
   data_offset_ = header.size();
   const std::uint64_t rows = static_cast<std::uint64_t>(trajectories) * signals_.size();
   if (rows > 0 && samples_ > (std::numeric_limits<std::int64_t>::max() / sample_bytes - data_offset_) / rows)
     throw OutputError("cannot create " + signals_path_.string() + ": " + std::to_string(rows) + " signals of " +
                       std::to_string(samples_) +
-                      " samples are more than a file can hold; sample less often "
-                      "(/analysis/frequencies/every)");
+                      " samples are more than a file can hold; sample less often (/analysis/" + indicator_->name() +
+                      "/every)");
   const std::uint64_t size = data_offset_ + rows * samples_ * sample_bytes;
   const std::string verb = resuming ? "cannot resume " : "cannot create ";
   descriptor_ = open_regular_file_for_writing(signals_path_, O_RDWR | (resuming ? 0 : O_CREAT | O_TRUNC), verb);
@@ -99,8 +102,8 @@ FrequencyMapObserver::FrequencyMapObserver(const std::filesystem::path& director
     refuse(std::strerror(errno));
 }
 
-std::string FrequencyMapObserver::signals_header(std::uint64_t trajectories, std::uint64_t signals,
-                                                 std::uint64_t samples) {
+std::string SampledIndicatorObserver::signals_header(std::uint64_t trajectories, std::uint64_t signals,
+                                                     std::uint64_t samples) {
   std::string dictionary = "{'descr': '<c16', 'fortran_order': False, 'shape': (" + std::to_string(trajectories) +
                            ", " + std::to_string(signals) + ", " + std::to_string(samples) + "), }";
   const std::size_t unpadded = 10 + dictionary.size() + 1;
@@ -112,7 +115,7 @@ std::string FrequencyMapObserver::signals_header(std::uint64_t trajectories, std
   return header + dictionary;
 }
 
-std::optional<std::array<std::uint64_t, 3>> FrequencyMapObserver::signals_shape(const std::string& header) {
+std::optional<std::array<std::uint64_t, 3>> SampledIndicatorObserver::signals_shape(const std::string& header) {
   static const std::regex form(
       "\\{'descr': '<c16', 'fortran_order': False, 'shape': \\(([0-9]{1,19}), ([0-9]{1,19}), "
       "([0-9]{1,19})\\), \\} *\n");
@@ -129,20 +132,20 @@ std::optional<std::array<std::uint64_t, 3>> FrequencyMapObserver::signals_shape(
   return shape;
 }
 
-FrequencyMapObserver::~FrequencyMapObserver() {
+SampledIndicatorObserver::~SampledIndicatorObserver() {
   if (descriptor_ >= 0) ::close(descriptor_);
 }
 
-std::uint64_t FrequencyMapObserver::offset(std::size_t trajectory, std::size_t signal, std::uint64_t sample) const {
+std::uint64_t SampledIndicatorObserver::offset(std::size_t trajectory, std::size_t signal, std::uint64_t sample) const {
   return data_offset_ +
          ((static_cast<std::uint64_t>(trajectory) * signals_.size() + signal) * samples_ + sample) * sample_bytes;
 }
 
-std::uint64_t FrequencyMapObserver::count(std::size_t trajectory) const {
+std::uint64_t SampledIndicatorObserver::count(std::size_t trajectory) const {
   return written_[trajectory] + pending_[trajectory * signals_.size()].size();
 }
 
-void FrequencyMapObserver::flush(std::size_t trajectory) {
+void SampledIndicatorObserver::flush(std::size_t trajectory) {
   const std::size_t m = signals_.size();
   const std::uint64_t added = pending_[trajectory * m].size();
   if (added == 0) return;
@@ -163,12 +166,12 @@ void FrequencyMapObserver::flush(std::size_t trajectory) {
   written_[trajectory] += added;
 }
 
-void FrequencyMapObserver::flush_all() {
+void SampledIndicatorObserver::flush_all() {
   for (std::size_t trajectory = 0; trajectory < trajectories_; ++trajectory) flush(trajectory);
 }
 
-void FrequencyMapObserver::read(std::size_t trajectory, std::size_t signal, std::uint64_t count,
-                                std::vector<std::complex<double>>& samples) const {
+void SampledIndicatorObserver::read(std::size_t trajectory, std::size_t signal, std::uint64_t count,
+                                    std::vector<std::complex<double>>& samples) const {
   samples.resize(count);
   const std::uint64_t from_file = std::min(count, written_[trajectory]);
   char* bytes = reinterpret_cast<char*>(samples.data());
@@ -186,37 +189,25 @@ void FrequencyMapObserver::read(std::size_t trajectory, std::size_t signal, std:
   std::copy_n(pending.begin(), count - from_file, samples.begin() + static_cast<std::ptrdiff_t>(from_file));
 }
 
-FrequencyMapObserver::Result FrequencyMapObserver::analyse(std::size_t trajectory, std::uint64_t count,
-                                                           BlockState& state) const {
+SampledIndicatorObserver::Result SampledIndicatorObserver::analyse(std::size_t trajectory, std::uint64_t count,
+                                                                   BlockState& state) const {
   Result result;
   result.samples = count;
-  if (count < minimum_frequency_samples) return result;
-  const std::size_t m = signals_.size(), half = static_cast<std::size_t>(count / 2);
-  std::vector<double> whole(m), first(m), second(m);
-  std::vector<std::vector<FrequencyTerm>> spectra;
-  try {
-    for (std::size_t j = 0; j < m; ++j) {
-      read(trajectory, j, count, state.samples);
-      const std::span<const std::complex<double>> z = state.samples;
-      // The column is the strongest term alone: the amplitudes of several terms found together are their joint
-      // projection, which can rank a later term first.
-      whole[j] = state.analysis.fundamental_frequency(z, tau_);
-      if (spectra_ > 0) spectra.push_back(state.analysis.terms(z, tau_, spectra_));
-      first[j] = state.analysis.fundamental_frequency(z.first(half), tau_);
-      second[j] = state.analysis.fundamental_frequency(z.subspan(half, half), tau_);
-    }
-  } catch (const InvalidArgument&) {
-    return result;  // a sample that is not finite: no analysis
+  if (count < indicator_->needs().samples.minimum) return result;
+  const std::size_t m = signals_.size();
+  state.samples.resize(m);
+  std::vector<std::span<const std::complex<double>>> signals(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    read(trajectory, j, count, state.samples[j]);
+    signals[j] = state.samples[j];
   }
-  for (std::size_t j = 0; j < m; ++j) result.values.insert(result.values.end(), {whole[j], first[j], second[j]});
-  result.values.push_back(diffusion_index(first, second));
-  result.spectra = std::move(spectra);
+  result.analysis = indicator_->from_samples(signals, tau_);
   return result;
 }
 
-void FrequencyMapObserver::prepare_blocks(std::size_t blocks) { blocks_.resize(blocks); }
+void SampledIndicatorObserver::prepare_blocks(std::size_t blocks) { blocks_.resize(blocks); }
 
-void FrequencyMapObserver::on_step(std::uint64_t step, double, const BlockView& block) {
+void SampledIndicatorObserver::on_step(std::uint64_t step, double, const BlockView& block) {
   const std::uint64_t sample = step / every_;  // 1-based
   if (step % every_ != 0 || sample == 0 || sample > samples_) return;
   const std::size_t n = dimension_, m = signals_.size();
@@ -231,11 +222,11 @@ void FrequencyMapObserver::on_step(std::uint64_t step, double, const BlockView& 
   }
 }
 
-void FrequencyMapObserver::save_block(const BlockView& block) {
+void SampledIndicatorObserver::save_block(const BlockView& block) {
   for (std::size_t trajectory : block.trajectories) chunk_start_[trajectory] = count(trajectory);
 }
 
-void FrequencyMapObserver::restore_block(const BlockView& block) {
+void SampledIndicatorObserver::restore_block(const BlockView& block) {
   const std::size_t m = signals_.size();
   for (std::size_t trajectory : block.trajectories) {
     const std::uint64_t kept = chunk_start_[trajectory] - written_[trajectory];  // pending before the chunk
@@ -244,14 +235,14 @@ void FrequencyMapObserver::restore_block(const BlockView& block) {
   }
 }
 
-void FrequencyMapObserver::after_chunk(std::uint64_t) {
+void SampledIndicatorObserver::after_chunk(std::uint64_t) {
   // A write per trajectory and signal once it has some 16 kB: a write per chunk each would cost some 3% of a run
   // that samples every step.
   for (std::size_t trajectory = 0; trajectory < trajectories_; ++trajectory)
-    if (pending_[trajectory * signals_.size()].size() >= frequency_samples_in_memory) flush(trajectory);
+    if (pending_[trajectory * signals_.size()].size() >= samples_in_memory) flush(trajectory);
 }
 
-void FrequencyMapObserver::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
+void SampledIndicatorObserver::on_retire(std::size_t trajectory, const TrajectoryRecord& record) {
   flush(trajectory);
   if (record.status != TrajectoryStatus::completed) {
     results_[trajectory] = {};  // stopped by its numbers or interrupted: no analysis
@@ -261,21 +252,21 @@ void FrequencyMapObserver::on_retire(std::size_t trajectory, const TrajectoryRec
     results_[trajectory] = analyse(trajectory, written_[trajectory], own_);
 }
 
-void FrequencyMapObserver::on_end() {
+void SampledIndicatorObserver::on_end() {
   flush_all();
-  if (spectra_ > 0) write_spectra();
+  if (!spectra_path_.empty()) write_spectra();
 }
 
-std::size_t FrequencyMapObserver::analysed() const {
+std::size_t SampledIndicatorObserver::analysed() const {
   return static_cast<std::size_t>(
-      std::count_if(results_.begin(), results_.end(), [](const Result& r) { return !r.values.empty(); }));
+      std::count_if(results_.begin(), results_.end(), [](const Result& r) { return !r.analysis.values.empty(); }));
 }
 
-void FrequencyMapObserver::write_spectra() const {
+void SampledIndicatorObserver::write_spectra() const {
   std::string text = "trajectory,signal,term,frequency,amplitude_re,amplitude_im\n";
   for (std::size_t trajectory = 0; trajectory < trajectories_; ++trajectory)
-    for (std::size_t j = 0; j < results_[trajectory].spectra.size(); ++j) {
-      const auto& terms = results_[trajectory].spectra[j];
+    for (std::size_t j = 0; j < results_[trajectory].analysis.spectra.size(); ++j) {
+      const auto& terms = results_[trajectory].analysis.spectra[j];
       for (std::size_t term = 0; term < terms.size(); ++term) {
         text += std::to_string(trajectory) + ',' + std::to_string(signals_[j]) + ',' + std::to_string(term) + ',';
         append_number(text, terms[term].frequency);
@@ -289,7 +280,7 @@ void FrequencyMapObserver::write_spectra() const {
   write_file_atomically(spectra_path_, text);
 }
 
-nlohmann::json FrequencyMapObserver::save() {
+nlohmann::json SampledIndicatorObserver::save() {
   flush_all();
   nlohmann::json checksums = nlohmann::json::array(), results = nlohmann::json::array();
   for (std::uint64_t hash : checksums_) checksums.push_back(content_hash_hex(hash));
@@ -297,8 +288,8 @@ nlohmann::json FrequencyMapObserver::save() {
     const Result& result = results_[trajectory];
     if (result.samples == 0) continue;
     nlohmann::json values = nlohmann::json::array(), spectra = nlohmann::json::array();
-    for (double x : result.values) values.push_back(format_number(x));
-    for (const auto& terms : result.spectra) {
+    for (double x : result.analysis.values) values.push_back(format_number(x));
+    for (const auto& terms : result.analysis.spectra) {
       nlohmann::json numbers = nlohmann::json::array();
       for (const FrequencyTerm& term : terms)
         for (double x : {term.frequency, term.amplitude.real(), term.amplitude.imag()})
@@ -311,7 +302,7 @@ nlohmann::json FrequencyMapObserver::save() {
   return {{"samples", written_}, {"checksums", checksums}, {"results", results}};
 }
 
-void FrequencyMapObserver::restore(const nlohmann::json& state) {
+void SampledIndicatorObserver::restore(const nlohmann::json& state) {
   const SavedState saved = SavedState::of_observer(name(), state);
   const std::size_t m = signals_.size();
   const nlohmann::json& counts = saved.list(saved.member(state, "samples"), trajectories_, "samples");
@@ -322,20 +313,19 @@ void FrequencyMapObserver::restore(const nlohmann::json& state) {
     if (!sums[i].is_string() || sums[i].get<std::string>().size() != 16) saved.damaged("a checksum");
   const nlohmann::json& results = saved.member(state, "results");
   if (!results.is_array()) saved.damaged("results that are not a list");
-  const std::size_t columns = 3 * m + 1;
   for (const nlohmann::json& entry : results) {
     const std::size_t trajectory = saved.count(saved.member(entry, "trajectory"), "a trajectory", trajectories_ - 1);
     Result& result = results_[trajectory];
     result.samples = saved.count(saved.member(entry, "samples"), "a sample count", written_[trajectory]);
     const nlohmann::json& values = saved.member(entry, "values");
-    result.values = saved.numbers(values, values.is_array() && values.empty() ? 0 : columns, "values");
+    result.analysis.values = saved.numbers(values, values.is_array() && values.empty() ? 0 : columns_, "values");
     const nlohmann::json& spectra = saved.member(entry, "spectra");
     const nlohmann::json& lists = saved.list(spectra, spectra.is_array() && spectra.empty() ? 0 : m, "spectra");
-    result.spectra.clear();
+    result.analysis.spectra.clear();
     for (const nlohmann::json& list : lists) {
       const std::size_t terms = list.is_array() ? list.size() / 3 : 0;
       const std::vector<double> numbers = saved.numbers(list, 3 * terms, "a spectrum");
-      auto& out = result.spectra.emplace_back();
+      auto& out = result.analysis.spectra.emplace_back();
       for (std::size_t t = 0; t < terms; ++t) out.push_back({numbers[3 * t], {numbers[3 * t + 1], numbers[3 * t + 2]}});
     }
   }
@@ -354,15 +344,13 @@ void FrequencyMapObserver::restore(const nlohmann::json& state) {
     }
 }
 
-void FrequencyMapObserver::columns(std::vector<std::string>& names) const {
-  for (std::size_t k : signals_)
-    for (const char* part : {"", "_first", "_second"}) names.push_back("frequency" + std::to_string(k) + part);
-  names.push_back("diffusion");
+void SampledIndicatorObserver::columns(std::vector<std::string>& names) const {
+  for (std::string& column : indicator_->columns()) names.push_back(std::move(column));
 }
 
-void FrequencyMapObserver::cells(std::size_t trajectory, std::string& row) const {
-  const std::vector<double>& values = results_[trajectory].values;
-  for (std::size_t j = 0; j < 3 * signals_.size() + 1; ++j) {
+void SampledIndicatorObserver::cells(std::size_t trajectory, std::string& row) const {
+  const std::vector<double>& values = results_[trajectory].analysis.values;
+  for (std::size_t j = 0; j < columns_; ++j) {
     row += ',';
     if (j < values.size()) append_number(row, values[j]);
   }
