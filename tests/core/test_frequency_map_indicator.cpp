@@ -48,7 +48,7 @@ TEST_CASE("frequency map indicator: it asks for samples, not tangent vectors, an
   CHECK(map.name() == "frequencies");
   CHECK(map.settings() == std::vector<std::pair<std::string, std::size_t>>{{"every", 3}, {"spectra", 2}});
 
-  // Sampling every 5 steps instead: the same signals and spectra.
+  // Sampling every 15 steps instead (scheme auto's step a fifth of the job's): the same signals and spectra.
   const auto resampled = map.sampling_every(15);
   REQUIRE(resampled);
   CHECK(resampled->needs().samples.every == 15);
@@ -88,11 +88,38 @@ TEST_CASE("frequency map indicator: the whole run, both halves and the diffusion
   CHECK(result.values[6] > -4.0);  // log10(0.5e-3 * 2.1 / |(-1.3, 2.1)|) = -3.37
   CHECK(result.values[6] < -2.5);
 
-  // The spectra: the strongest term of each signal over the whole run.
+  // The spectra: the strongest term of each signal over the whole run; none without spectra.
   REQUIRE(result.spectra.size() == 2);
   REQUIRE(result.spectra[0].size() == 1);
   CHECK(result.spectra[0][0].frequency == doctest::Approx(-1.3).epsilon(1e-10));
   CHECK(std::abs(result.spectra[0][0].amplitude - Complex(0.7, 0.2)) < 1e-8);
+  const SampleAnalysis without = FrequencyMapIndicator(1, {0, 1}, 0).from_samples(signals, tau);
+  CHECK(without.spectra.empty());
+  CHECK(without.values == result.values);
+
+  // The columns follow the order of the signals: the same two signals the other way round.
+  const std::vector<std::span<const Complex>> swapped{drifting, torus};
+  const SampleAnalysis reversed = FrequencyMapIndicator(1, {1, 0}, 0).from_samples(swapped, tau);
+  REQUIRE(reversed.values.size() == 7);
+  for (std::size_t column = 0; column < 3; ++column) {
+    CHECK(reversed.values[column] == result.values[3 + column]);
+    CHECK(reversed.values[3 + column] == result.values[column]);
+  }
+}
+
+TEST_CASE("frequency map indicator: an odd number of samples leaves the last one out of the halves") {
+  const double tau = 0.07;
+  const std::size_t n = 1001;
+  const auto z = signal(0.8, {1.0, 0.0}, 0.0, tau, n);
+  const std::vector<std::span<const Complex>> signals{z};
+  const SampleAnalysis result = FrequencyMapIndicator(1, {0}, 0).from_samples(signals, tau);
+  REQUIRE(result.values.size() == 4);
+  FrequencyAnalysis direct;
+  const std::span<const Complex> all = z;
+  CHECK(result.values[0] == direct.fundamental_frequency(all, tau));
+  CHECK(result.values[1] == direct.fundamental_frequency(all.first(500), tau));
+  CHECK(result.values[2] == direct.fundamental_frequency(all.subspan(500, 500), tau));
+  for (std::size_t column : {0, 1, 2}) CHECK(std::abs(result.values[column] - 0.8) < 1e-10);
 }
 
 TEST_CASE("frequency map indicator: a signal with a sample that is not finite gives no values") {

@@ -142,7 +142,9 @@ double wrap(double u) {  // into [-pi, pi)
 struct FrequencyAnalysis::Workspace {
   Eigen::FFT<double> fft;
   std::vector<std::complex<double>> padded, spectrum;
-  // The window of each length seen, kept: a frequency map alternates between a run's samples and its halves.
+  // The window of each length seen, kept: a frequency map alternates between a run's samples and its halves. At most
+  // kept_windows lengths (an object that lives long, one per thread, sees the lengths of early-retired trajectories).
+  static constexpr std::size_t kept_windows = 4;
   struct Window {
     std::vector<double> chi;  // chi_k
     double sum = 0.0;         // sum_k chi_k
@@ -157,6 +159,7 @@ struct FrequencyAnalysis::Workspace {
   void prepare(std::span<const std::complex<double>> z) {
     const std::size_t n = z.size();
     if (window.size() != n) {
+      if (!windows.contains(n) && windows.size() >= kept_windows) windows.clear();
       const auto found = windows.try_emplace(n);
       Window& known = found.first->second;
       if (found.second) {

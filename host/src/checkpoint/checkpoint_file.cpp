@@ -144,7 +144,8 @@ std::string job_fingerprint(const LoadedJob& loaded) {
   for (const auto& indicator : run.analysis.sampled_indicators()) {
     analysis += "|" + indicator->name();
     for (const auto& [name, value] : indicator->settings()) analysis += " " + std::to_string(value);
-    for (std::size_t k : indicator->needs().samples.degrees) analysis += ' ' + std::to_string(k);
+    const SampleNeeds needs = indicator->needs().samples;
+    for (std::size_t k : needs.degrees) analysis += ' ' + std::to_string(k);
   }
   if (run.analysis.error_estimate) analysis += "|error_estimate";
   parts.emplace_back("analysis", std::move(analysis));

@@ -6,7 +6,6 @@
 #include <optional>
 
 #include "cluster/unit_seal.hpp"
-#include "nonsep/core/analysis/frequency_map_indicator.hpp"
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/cluster/merge_outputs.hpp"
 #include "nonsep/host/cluster/merge_results_h5.hpp"
@@ -155,11 +154,13 @@ RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const
   merge("poincare.csv", {"step", "trajectory"});
   merge("lyapunov.csv", {"step", "trajectory"});
   merge("trajectories.csv", {"trajectory"});
-  merge("frequency_spectra.csv", {"trajectory"});
-  if (std::filesystem::exists(parts.front().path / FrequencyMapIndicator::signals_file_name)) {
+  for (const auto& indicator : loaded.job.run().analysis.sampled_indicators()) {
+    const SampleNeeds needs = indicator->needs().samples;
+    if (!needs.spectra_file.empty()) merge(needs.spectra_file.c_str(), {"trajectory"});
+    if (!std::filesystem::exists(parts.front().path / needs.file)) continue;
     std::vector<UnitFile> files = parts;
-    for (UnitFile& file : files) file.path /= FrequencyMapIndicator::signals_file_name;
-    merge_signals(files, directory / FrequencyMapIndicator::signals_file_name);
+    for (UnitFile& file : files) file.path /= needs.file;
+    merge_signals(files, directory / needs.file);
   }
   RunOutcome outcome;
   outcome.distributed = true;

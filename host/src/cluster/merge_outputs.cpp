@@ -225,10 +225,12 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
     if (merged.contains("analysis") && merged["analysis"].contains("poincare"))
       merged["analysis"]["poincare"]["crossings"] = merged["analysis"]["poincare"]["crossings"].get<std::uint64_t>() +
                                                     unit["analysis"]["poincare"]["crossings"].get<std::uint64_t>();
-    if (merged.contains("analysis") && merged["analysis"].contains("frequencies"))
-      merged["analysis"]["frequencies"]["analysed"] =
-          merged["analysis"]["frequencies"]["analysed"].get<std::uint64_t>() +
-          unit["analysis"]["frequencies"]["analysed"].get<std::uint64_t>();
+    // The trajectories an indicator that needs samples analysed (launch/run_job.cpp: sampled_facts) add up.
+    if (merged.contains("analysis"))
+      for (auto entry = merged["analysis"].begin(); entry != merged["analysis"].end(); ++entry)
+        if (entry->is_object() && entry->contains("analysed"))
+          (*entry)["analysed"] = (*entry)["analysed"].get<std::uint64_t>() +
+                                 unit["analysis"][entry.key()]["analysed"].get<std::uint64_t>();
   }
   // The largest energy error: strictly larger wins, as one process scans the trajectories in order.
   json largest = nullptr;

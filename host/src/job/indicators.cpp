@@ -1,4 +1,5 @@
-// The one list of a job's chaos indicators (indicators.hpp): each key's rule and reading.
+// The one list of a job's indicators (indicators.hpp): the frequency map, then the chaos indicators of the tangent
+// map; each key's rule and reading.
 #include "indicators.hpp"
 
 #include <algorithm>

@@ -87,14 +87,15 @@ MemoryEstimate estimate_run_memory(const LoadedJob& loaded, std::size_t trajecto
     if (analysis.poincare) add("/analysis/poincare", "the state before each step", stepped * state);
     for (const auto& indicator : analysis.sampled_indicators()) {
       // Per trajectory and signal the samples not yet written, and per block (at most 8 + stepped / 2) one
-      // analysis's signals, its FFT and the transforms' tables: some 6 copies of N complex numbers.
+      // trajectory's m signals and an analysis's FFT, window and transforms' tables: some m + 5 copies of N complex
+      // numbers.
       const SampleNeeds needs = indicator->needs().samples;
       const double samples = static_cast<double>(run.time.steps / needs.every);
       const double blocks = std::min(stepped, 8.0 + stepped / 2.0);
       add("/analysis/" + indicator->name(), "the samples not yet in " + needs.file + " and the blocks' analyses",
           stepped * static_cast<double>(std::max<std::size_t>(needs.degrees.size(), 1)) *
                   static_cast<double>(samples_in_memory) * 2 * number +
-              blocks * 6 * samples * 2 * number);
+              blocks * (static_cast<double>(needs.degrees.size()) + 5) * samples * 2 * number);
     }
     if (analysis.closest_return_after)
       add("/analysis/closest_return_after", "the initial states compared with", stepped * state);

@@ -50,34 +50,29 @@ nlohmann::ordered_json poincare_facts(const PoincareSection& section, const Poin
 }
 
 // The summary of an indicator that needs samples: what its sample store (sampled_indicator.hpp) sampled and
-// analysed, its settings and files; a frequency map's with the method, window and units of its columns.
+// analysed, its columns, settings and files; a frequency map's with its method, window and units.
 nlohmann::ordered_json sampled_facts(const SampledIndicatorObserver& observer) {
   std::vector<std::string> columns;
   observer.columns(columns);
   const SampleNeeds needs = observer.indicator().needs().samples;
-  const auto spectra_file =
-      needs.spectra_file.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(needs.spectra_file);
+  const bool map = dynamic_cast<const FrequencyMapIndicator*>(&observer.indicator()) != nullptr;
   nlohmann::ordered_json facts = {{"signals", observer.signals()},
                                   {"signal", "q_k + i p_k of each degree of freedom k listed"},
                                   {"every", needs.every},
                                   {"samples", observer.samples()},
                                   {"tau", observer.tau()}};
-  if (const auto* map = dynamic_cast<const FrequencyMapIndicator*>(&observer.indicator())) {
+  if (map) {
     facts["window"] = "Hann (Laskar's window of order 1)";
     facts["method"] = "NAFF (core/include/nonsep/core/analysis/frequency_analysis.hpp)";
-    facts["columns"] = columns;
-    facts["units"] = "radians per unit time, signed";
-    facts["analysed"] = observer.analysed();
-    facts["signals_file"] = needs.file;
-    facts["spectra"] = map->spectra();
-    facts["spectra_file"] = spectra_file;
-    return facts;
   }
   facts["columns"] = columns;
+  if (map) facts["units"] = "radians per unit time, signed";
   facts["analysed"] = observer.analysed();
   facts["signals_file"] = needs.file;
-  for (const auto& [name, value] : observer.indicator().settings()) facts[name] = value;
-  facts["spectra_file"] = spectra_file;
+  for (const auto& [name, value] : observer.indicator().settings())
+    if (!facts.contains(name)) facts[name] = value;
+  facts["spectra_file"] =
+      needs.spectra_file.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(needs.spectra_file);
   return facts;
 }
 

@@ -77,8 +77,6 @@ class RunPlan {
     if constexpr (std::is_base_of_v<CheckpointedObserver, O>) checkpointed.push_back(&observer);
   }
   void resume(Checkpoint checkpoint);
-
- public:
   // The sample store of the indicator named `name`, or null when the job has none.
   const SampledIndicatorObserver* sampled_indicator(const std::string& name) const {
     for (const auto& observer : sampled)

@@ -35,18 +35,16 @@ std::uint64_t checksum(std::span<const std::complex<double>> samples, std::uint6
   return hash;
 }
 
-// The indicator's signals, or every degree of freedom when it names none (the reader fills them in when it knows the
-// dimension).
-std::vector<std::size_t> all_signals(const Indicator& indicator, std::size_t dimension) {
-  const std::vector<std::size_t>& signals = indicator.needs().samples.degrees;
+// The indicator's signals, each a degree of freedom of the states (the job reader names them all when the job names
+// none), at least one.
+std::vector<std::size_t> checked_signals(const Indicator& indicator, std::size_t dimension) {
+  std::vector<std::size_t> signals = indicator.needs().samples.degrees;
+  if (signals.empty()) throw InvalidArgument(indicator.name() + ": no signal to sample");
   for (std::size_t k : signals)
     if (k >= dimension)
       throw InvalidArgument(indicator.name() + ": the signal of degree of freedom " + std::to_string(k) +
                             " of a state of dimension " + std::to_string(dimension));
-  if (!signals.empty()) return signals;
-  std::vector<std::size_t> all(dimension);
-  for (std::size_t k = 0; k < dimension; ++k) all[k] = k;
-  return all;
+  return signals;
 }
 
 }  // namespace
@@ -56,7 +54,7 @@ SampledIndicatorObserver::SampledIndicatorObserver(const std::filesystem::path& 
                                                    std::size_t dimension, std::size_t trajectories, bool resuming)
     : indicator_(std::move(indicator)),
       every_(indicator_->needs().samples.every),
-      signals_(all_signals(*indicator_, dimension)),
+      signals_(checked_signals(*indicator_, dimension)),
       columns_(indicator_->columns().size()),
       tau_(static_cast<double>(every_) * time.dt),
       dimension_(dimension),

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -119,7 +120,11 @@ void apply_choice(Job& job, const SchemeChoice& choice) {
     run.analysis.lyapunov->renormalize_every *= m;
   }
   for (auto& indicator : run.analysis.indicators)  // the same sampling times
-    if (needs_samples(*indicator)) indicator = indicator->sampling_every(indicator->needs().samples.every * m);
+    if (needs_samples(*indicator)) {
+      auto resampled = indicator->sampling_every(indicator->needs().samples.every * m);
+      if (!resampled) throw std::logic_error(indicator->name() + " cannot sample at scheme auto's step");
+      indicator = std::move(resampled);
+    }
 }
 
 void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& recorded,

@@ -36,6 +36,7 @@ class FrequencyMapIndicator final : public Indicator {
   IndicatorNeeds needs() const override;
   std::vector<std::string> columns() const override;
   std::string description() const override;
+  // In this order: a checkpoint's fingerprint lists them so (host/src/checkpoint/checkpoint_file.cpp).
   std::vector<std::pair<std::string, std::size_t>> settings() const override {
     return {{"every", static_cast<std::size_t>(every_)}, {"spectra", spectra_}};
   }

@@ -1,7 +1,7 @@
 #pragma once
-// The results of the run's chaos indicators (nonsep/core/analysis/indicator.hpp; the list of a job's is
-// job/indicators.cpp), which the ensemble driver computes with the tangent vectors it follows (run/tangent_block.hpp,
-// EnsembleSetup::indicators):
+// The results of the run's chaos indicators (nonsep/core/analysis/indicator.hpp: those of the job's list,
+// job/indicators.cpp, that follow tangent vectors, Analysis::tangent_indicators), which the ensemble driver computes
+// with the tangent vectors it follows (run/tangent_block.hpp, EnsembleSetup::indicators):
 //   trajectories.csv  each indicator's columns, in the list's order: lyapunov0 .. lyapunov<k-1> (Benettin's
 //                     finite-time exponents at the last re-orthonormalisation), megno, mean_megno (Y and <Y> of the
 //                     first tangent vector: <Y> -> 2 on a quasi-periodic orbit, ~ lambda t / 2 on a chaotic one, 0 on
