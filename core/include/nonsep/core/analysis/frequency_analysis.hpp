@@ -42,7 +42,7 @@
 // Cost. Per term one FFT of the padded length M (about half the time of a fundamental frequency) and two or three
 // passes of some 20 flops per sample, plus the projection, O(N m^2) for m terms. The FrequencyAnalysis object keeps
 // the FFT's tables for each length it has seen and its buffers: keep one object per thread and reuse it. One
-// fundamental frequency of 2^14 samples takes some 0.4 ms on one core (bench/frequency_analysis.cpp measures it;
+// fundamental frequency of 2^14 samples takes some 0.35 ms on one core (bench/frequency_analysis.cpp measures it;
 // docs/dynamics.md has the figures).
 //
 // Errors: InvalidArgument for fewer than minimum_samples samples, a non-finite sample, tau not finite and
