@@ -23,7 +23,7 @@
 // linear drift) and the long run's seconds. Methods run in parallel on the available threads, each single-threaded.
 //
 // Exit status 1 when a method has no setting in its ladder that meets a target, or its long run's energy error is not
-// finite.
+// finite; 2 for a bad argument (named).
 //
 // Usage: nonsep_bench_drift_at_equal_accuracy [--out FILE.csv] [--periods P] [--target E]...   (--periods 30: smoke)
 #include <algorithm>
@@ -212,21 +212,40 @@ int main(int argc, char** argv) {
   std::string out = "drift_at_equal_accuracy.csv";
   std::size_t periods = 100000;
   std::vector<double> targets;
+  const auto usage = [](const std::string& problem) {
+    std::fprintf(stderr,
+                 "nonsep_bench_drift_at_equal_accuracy: %s\nusage: nonsep_bench_drift_at_equal_accuracy [--out "
+                 "FILE.csv] [--periods P >= 1] [--target E > 0]...\n",
+                 problem.c_str());
+    return 2;
+  };
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (arg == "--periods" && i + 1 < argc) {
-      periods = std::stoul(argv[++i]);
-    } else if (arg == "--target" && i + 1 < argc) {
-      targets.push_back(std::stod(argv[++i]));
-    } else {
-      std::fprintf(stderr,
-                   "usage: nonsep_bench_drift_at_equal_accuracy [--out FILE.csv] [--periods P] [--target E]...\n");
-      return 2;
+    const std::string value = i + 1 < argc ? argv[i + 1] : "";
+    std::size_t used = 0;
+    try {
+      if (arg == "--out" && i + 1 < argc) {
+        out = value;
+      } else if (arg == "--periods" && i + 1 < argc) {
+        const long long p = std::stoll(value, &used);
+        if (used != value.size() || p < 1) return usage("--periods " + value + ": a whole number >= 1 needed");
+        periods = static_cast<std::size_t>(p);
+      } else if (arg == "--target" && i + 1 < argc) {
+        const double e = std::stod(value, &used);
+        if (used != value.size() || !std::isfinite(e) || !(e > 0.0))
+          return usage("--target " + value + ": a finite number > 0 needed");
+        targets.push_back(e);
+      } else {
+        return usage("unknown or incomplete argument " + arg);
+      }
+    } catch (const std::exception&) {  // std::stoll, std::stod: not a number, or out of range
+      return usage(arg + " " + value + ": not a number");
     }
+    ++i;
   }
   if (targets.empty()) targets = {1e-8, 1e-10};
+  std::ofstream csv(out);  // opened before the runs: a path that cannot be written fails at once
+  if (!csv) return usage("--out " + out + ": cannot be written");
   if (const auto failures = check_derivatives<Paper1D>(); !failures.empty()) {
     std::fprintf(stderr, "%s\n", failures.front().c_str());
     return 1;
@@ -274,7 +293,6 @@ int main(int argc, char** argv) {
   for (unsigned t = 0; t < std::max(1u, std::thread::hardware_concurrency()); ++t) pool.emplace_back(worker);
   for (auto& thread : pool) thread.join();
 
-  std::ofstream csv(out);
   csv.precision(6);
   csv << "target,method,family,setting,calls_per_period,ensemble_error,block_first_period,block_last_period,"
          "max_relative_energy_error\n";
@@ -308,5 +326,6 @@ int main(int argc, char** argv) {
            std::all_of(r.envelope.begin(), r.envelope.end(), [](const auto& b) { return std::isfinite(b.max_error); });
   });
   if (!complete) std::fprintf(stderr, "some method met no target or lost its energy: see the table\n");
+  if (!csv) std::fprintf(stderr, "nonsep_bench_drift_at_equal_accuracy: writing %s failed\n", out.c_str());
   return csv && complete ? 0 : 1;
 }
