@@ -44,6 +44,7 @@
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "odeint_methods.hpp"
+#include "period_blocks.hpp"
 
 using namespace nonsep;
 using namespace nonsep::bench;
@@ -64,14 +65,8 @@ std::vector<OdeintState> ensemble() {
 // Sees a run's states after every step: the largest relative energy error per block of periods.
 class Envelope {
  public:
-  Envelope(double energy, double period, std::size_t periods) : energy_(energy), period_(period) {
-    std::size_t first = 0;
-    for (int k = 1; first < periods; ++k) {
-      const auto last = std::min(periods, static_cast<std::size_t>(std::llround(std::pow(10.0, k / 10.0))));
-      if (last > first) blocks_.push_back({first, last});
-      first = std::max(first, last);
-    }
-  }
+  Envelope(double energy, double period, std::size_t periods)
+      : energy_(energy), period_(period), blocks_(period_blocks(periods)) {}
   void see(const OdeintState& x, double t) {
     const auto period = static_cast<std::size_t>(t / period_);
     while (b_ < blocks_.size() && blocks_[b_].last <= period) ++b_;
@@ -79,15 +74,11 @@ class Envelope {
     const double error = std::abs(energy(x) - energy_) / energy_;
     blocks_[b_].max_error = std::isfinite(error) ? std::max(blocks_[b_].max_error, error) : INFINITY;
   }
-  struct Block {
-    std::size_t first, last;  // periods first .. last - 1
-    double max_error = 0.0;
-  };
-  const std::vector<Block>& blocks() const { return blocks_; }
+  const std::vector<PeriodBlock>& blocks() const { return blocks_; }
 
  private:
   double energy_, period_;
-  std::vector<Block> blocks_;
+  std::vector<PeriodBlock> blocks_;
   std::size_t b_ = 0;
 };
 
@@ -193,18 +184,8 @@ double largest_error(const Runner& run, const std::vector<OdeintState>& start, c
 struct Result {
   std::string method, family, setting = "none in the ladder";
   double ensemble_error = NAN, calls_per_period = NAN, seconds = NAN;
-  std::vector<Envelope::Block> envelope;
+  std::vector<PeriodBlock> envelope;
 };
-
-double slope_of_last_two_decades(const std::vector<Envelope::Block>& blocks, std::size_t periods) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0, m = 0;
-  for (const auto& b : blocks)
-    if (b.first * 100 >= periods && b.max_error > 0.0) {
-      const double x = std::log10(0.5 * static_cast<double>(b.first + b.last)), y = std::log10(b.max_error);
-      sx += x, sy += y, sxx += x * x, sxy += x * y, m += 1;
-    }
-  return m >= 3 ? (m * sxy - sx * sy) / (m * sxx - sx * sx) : NAN;
-}
 
 }  // namespace
 

@@ -41,6 +41,7 @@
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "odeint_methods.hpp"
+#include "period_blocks.hpp"
 #ifdef NONSEP_BENCH_HAVE_GSL
 #include "gsl_gauss_methods.hpp"
 #endif
@@ -135,33 +136,17 @@ std::vector<Contender> contenders() {
   return list;
 }
 
-struct Block {
-  std::size_t first, last;  // periods first .. last - 1 (period k runs from time k T to (k + 1) T)
-  double max_error = 0.0;
-};
-
-std::vector<Block> blocks(std::size_t periods) {
-  std::vector<Block> out;
-  std::size_t first = 0;
-  for (int k = 1; first < periods; ++k) {
-    const auto last = std::min(periods, static_cast<std::size_t>(std::llround(std::pow(10.0, k / 10.0))));
-    if (last > first) out.push_back({first, last});
-    first = std::max(first, last);
-  }
-  return out;
-}
-
 struct Result {
   std::string name, family, note;
   std::size_t steps_per_period = 0;
   double calls_per_period = 0.0, seconds = 0.0;
   std::size_t failed_in_period = 0;  // 0: did not fail; else 1 + the period
-  std::vector<Block> envelope;
+  std::vector<PeriodBlock> envelope;
 };
 
 // Runs `periods` periods at N steps per period; returns the calls per period, or -1 when the scheme failed.
 double run(const TrajectoryFactory& make, std::size_t n, std::size_t periods, double period,
-           std::vector<Block>* envelope = nullptr, std::size_t* failed_in = nullptr) {
+           std::vector<PeriodBlock>* envelope = nullptr, std::size_t* failed_in = nullptr) {
   Trajectory t = make();
   const double dt = period / static_cast<double>(n), energy = Paper1D::H(q0, p0);
   std::size_t b = 0;
@@ -202,16 +187,6 @@ std::size_t calibrate(const TrajectoryFactory& make, double budget, double perio
     n = next;
   }
   return n;
-}
-
-double slope_of_last_two_decades(const std::vector<Block>& envelope, std::size_t periods) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0, m = 0;
-  for (const Block& b : envelope)
-    if (b.first * 100 >= periods && b.max_error > 0.0) {
-      const double x = std::log10(0.5 * static_cast<double>(b.first + b.last)), y = std::log10(b.max_error);
-      sx += x, sy += y, sxx += x * x, sxy += x * y, m += 1;
-    }
-  return m >= 3 ? (m * sxy - sx * sy) / (m * sxx - sx * sx) : std::nan("");
 }
 
 }  // namespace
@@ -270,7 +245,7 @@ int main(int argc, char** argv) {
 #endif
       r.steps_per_period = calibrate(make, budget, period);
       if (r.steps_per_period == 0) continue;
-      r.envelope = blocks(periods);
+      r.envelope = period_blocks(periods);
       const auto start = std::chrono::steady_clock::now();
       r.calls_per_period = run(make, r.steps_per_period, periods, period, &r.envelope, &r.failed_in_period);
       r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -304,7 +279,7 @@ int main(int argc, char** argv) {
       continue;
     }
     double early = 0.0, late = 0.0;
-    for (const Block& b : r.envelope) {
+    for (const PeriodBlock& b : r.envelope) {
       if (b.first < 10) early = std::max(early, b.max_error);
       if (b.first * 10 >= periods) late = std::max(late, b.max_error);
       csv << jobs[j].budget << ',' << r.name << ',' << r.family << ',' << r.note << ',' << r.steps_per_period << ','
