@@ -168,7 +168,10 @@ class Reference:
         for key, needed in node.get("dependentRequired", {}).items():
             rules.append(f"`{key}` needs " + ", ".join(f"`{k}`" for k in needed))
         for key, schema in node.get("dependentSchemas", {}).items():
-            rules.append(f"with `{key}`: {self.negation_text(schema['not'])}")
+            if set(schema) == {"not"} and set(schema["not"]) == {"required"} and len(schema["not"]["required"]) == 1:
+                rules.append(f"not `{schema['not']['required'][0]}` and `{key}` together")
+            else:
+                rules.append(f"with `{key}`: {self.negation_text(schema['not'])}")
         return rules
 
     def condition_text(self, node, negated=False):

@@ -289,7 +289,7 @@ TEST_CASE("formula cache: run checks what validate checks before compiling anyth
   const std::vector<std::pair<json, std::string>> cases = {{wrong_dimension, "/initial/q"},
                                                            {unknown_parameter, "/model/parameters/alpha"},
                                                            {string_parameter, "/model/parameters/k"},
-                                                           {both, "/model"}};
+                                                           {both, "/model/formula"}};
   for (std::size_t i = 0; i < cases.size(); ++i) {
     CAPTURE(i);
     const auto file = write_job(folder / ("bad" + std::to_string(i) + ".json"), cases[i].first);

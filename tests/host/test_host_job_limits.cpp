@@ -149,8 +149,8 @@ TEST_CASE("max_initial_values applies to every kind of initial state, not only g
   std::vector<JobIssue> issues;
   Job job = parse_job(document, "/jobs/test.json", issues);
   REQUIRE(paths(issues) == std::vector<std::string>{"/initial/q"});
-  CHECK(issues[0].found == "16777217 components");
-  CHECK(issues[0].allowed == "at most 16777216 numbers in q (states times dimension)");
+  CHECK(issues[0].found == "16777217 numbers");
+  CHECK(issues[0].allowed == "at most 16777216 numbers");
   CHECK(job.initial.q.empty());
 
   // A list: the first state is read, the second would go over the limit.

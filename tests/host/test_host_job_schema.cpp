@@ -5,6 +5,8 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -271,4 +273,111 @@ TEST_CASE("a value its key table refuses is reported once, with the rule's text,
   REQUIRE(missing.size() == 1);
   CHECK(missing[0].path == "/initial/grid/q/0/count");
   CHECK(missing[0].allowed.find("the number of values, an integer from 1 to ") == 0);
+}
+
+TEST_CASE("pairs of keys and lists of numbers are checked by their key tables: one issue each, at the key") {
+  // A pair (key_reader.hpp): the second key of two that may not go together, the first of two of which one is
+  // needed, the missing one of two that go together; a list: the item that is refused, or the whole list.
+  struct Case {
+    std::string path, found, allowed;
+    std::function<void(json&)> change;
+  };
+  const json study = {{"model", {{"plugin", "paper1d"}}},
+                      {"initial", {{"q", {0.5}}, {"p", {0.0}}}},
+                      {"time", {{"t_end", 1.0}}},
+                      {"study", {{"integrators", {{{"scheme", "basic"}, {"steps", {4, 8}}}}}}}};
+  const std::vector<Case> cases{
+      {"/time/steps", "10 together with /time/t_end", "either \"t_end\" (the time to end at) or \"steps\"",
+       [](json& job) { job["time"]["t_end"] = 1.0; }},
+      {"/time/t_end", "nothing (neither \"t_end\" nor \"steps\" is given)", "either \"t_end\"",
+       [](json& job) { job["time"].erase("steps"); }},
+      {"/model/formula", "{\"T\":\"p0^2/2\",\"V\":\"q0^2/2\"} together with /model/plugin", "exactly one of \"plugin\"",
+       [](json& job) {
+         job["model"]["formula"] = {{"T", "p0^2/2"}, {"V", "q0^2/2"}};
+       }},
+      {"/analysis/poincare/offset", "1 together with /analysis/poincare/value", "one of them",
+       [](json& job) {
+         job["analysis"]["poincare"] = {{"component", "q0"}, {"value", 0.0}, {"offset", 1}};
+       }},
+      {"/analysis/poincare/component", "nothing (neither \"component\" nor \"normal\" is given)", "exactly one of",
+       [](json& job) {
+         job["analysis"]["poincare"] = {{"value", 0.0}};
+       }},
+      {"/initial/grid/q/0/values/1", "\"x\"", "a finite number",
+       [](json& job) {
+         job["initial"] = {{"grid", {{"q", {{{"values", {0.1, "x"}}}}}, {"p", {0.0}}}}};
+       }},
+      {"/initial/solve_for", "nothing, while \"energy\" is given", "\"energy\" and \"solve_for\" together",
+       [](json& job) {
+         job["initial"] = {{"grid", {{"q", {0.1}}, {"p", {0.0}}}}, {"energy", 1.0}};
+       }},
+      {"/analysis/frequencies/signals/1", "0, given before", "an integer >= 0, not given before",
+       [](json& job) {
+         job["analysis"]["frequencies"] = {{"signals", {0, 0}}};
+       }},
+      {"/analysis/poincare/normal", "[]", "a non-empty array of finite numbers",
+       [](json& job) {
+         job["analysis"]["poincare"] = {{"normal", json::array()}};
+       }},
+  };
+  const auto check_cases = [](const json& base, const std::vector<Case>& list) {
+    for (const auto& c : list) {
+      CAPTURE(c.path);
+      json job = base;
+      c.change(job);
+      const auto issues = issues_of(job);
+      REQUIRE(issues.size() == 1);
+      CHECK(issues[0].path == c.path);
+      CHECK(issues[0].found == c.found);
+      CHECK(issues[0].allowed.find(c.allowed) == 0);
+    }
+  };
+  check_cases(full_run(), cases);
+  const std::vector<Case> study_cases{
+      {"/study/dt", "[0.5] together with /study/steps", "either \"steps\" (step counts over t_end) or \"dt\"",
+       [](json& job) { job["study"]["steps"] = {2}, job["study"]["dt"] = {0.5}; }},
+      {"/study/integrators/0/dt", "[0.5] together with /study/integrators/0/steps", "either \"steps\"",
+       [](json& job) { job["study"]["integrators"][0]["dt"] = {0.5}; }},
+      {"/study/reference_run", "{\"scheme\":\"basic\",\"steps\":[64]} together with /study/reference",
+       "either \"reference\" (the state at t_end) or \"reference_run\"",
+       [](json& job) {
+         job["study"]["reference"] = {{"q", {0.5}}, {"p", {0.0}}};
+         job["study"]["reference_run"] = {{"scheme", "basic"}, {"steps", {64}}};
+       }},
+      {"/study/integrators/0/steps/1", "4, given before", "a step count, an integer from 1 to ",
+       [](json& job) {
+         job["study"]["integrators"][0]["steps"] = {4, 4};
+       }},
+      {"/study/integrators/0/label", "\"\"", "a non-empty string naming the integrator",
+       [](json& job) { job["study"]["integrators"][0]["label"] = ""; }},
+      {"/study/integrators/0/order", "\"x\"", "an exact fraction as a string (\"4/3\") or an integer (2): ",
+       [](json& job) {
+         job["study"]["integrators"][0] = {{"scheme", "triplet"}, {"order", "x"}, {"steps", {4}}};
+       }},
+  };
+  check_cases(study, study_cases);
+}
+
+TEST_CASE("scheme auto's tolerance range is its key table's, in the schema and in the reader") {
+  const json schema = job_schema();
+  json tolerance;
+  for (const json& branch : schema["$defs"]["integrator"]["allOf"])
+    if (branch["if"]["properties"]["scheme"]["const"] == "auto") tolerance = branch["then"]["properties"]["tolerance"];
+  REQUIRE(tolerance.is_object());
+  const double low = tolerance["minimum"].get<double>(), high = tolerance["maximum"].get<double>();
+  CHECK(low == auto_tolerance_min);
+  CHECK(high == auto_tolerance_max);
+  for (const double value : {low, high, std::nextafter(low, 0.0), std::nextafter(high, 1.0)}) {
+    CAPTURE(value);
+    json job = full_run();
+    job["integrator"] = {{"scheme", "auto"}, {"tolerance", value}};
+    const auto issues = issues_of(job);
+    const bool inside = value >= low && value <= high;
+    CHECK(issues.empty() == inside);
+    if (!inside) {
+      REQUIRE(issues.size() == 1);
+      CHECK(issues[0].path == "/integrator/tolerance");
+      CHECK(issues[0].allowed.find("a number from 1e-14 to 0.1") == 0);
+    }
+  }
 }

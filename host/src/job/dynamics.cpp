@@ -33,35 +33,29 @@ std::optional<PoincareSection> read_poincare(Checker& check, const json& value, 
                        "\"+\", \"max_crossings\": N}");
   if (!keys.is_object()) return std::nullopt;
   PoincareSection section;
-  const bool has_component = keys.given("component"), has_normal = keys.given("normal");
   const std::string components = dimension > 0 ? "\"q0\" .. \"q" + std::to_string(dimension - 1) +
                                                      "\" or \"p0\" .. \"p" + std::to_string(dimension - 1) + "\""
                                                : "\"q<i>\" or \"p<i>\"";
-  if (has_component == has_normal) {
-    check.issue(path, has_component ? "both \"component\" and \"normal\"" : "neither \"component\" nor \"normal\"",
-                "exactly one of \"component\" (" + components + ") and \"normal\" (2n numbers, n for q then n for p)");
-  } else if (const auto component = keys.string("component")) {
+  // Exactly one of component and normal (the table's pair says so when not).
+  const bool one = keys.given("component") != keys.given("normal");
+  if (const auto component = keys.string("component"); component && one) {
     if (const auto index = component_index(*component, dimension)) {
       section.normal.assign(2 * dimension, 0.0);
       section.normal[*index] = 1.0;
     } else {
       check.issue(keys.path("component"), describe(value["component"]), components + ", a component of the state");
     }
-  } else if (const json* given = keys.value("normal")) {
-    if (auto normal = check.vector(*given, keys.path("normal"))) {
-      double squared = 0.0;
-      for (double x : *normal) squared += x * x;
-      if (normal->size() != 2 * dimension && dimension > 0)
-        check.issue(keys.path("normal"), std::to_string(normal->size()) + " numbers",
-                    std::to_string(2 * dimension) + " numbers (2n: n for q, then n for p)");
-      else if (!(squared > 0.0) || !std::isfinite(squared))
-        check.issue(keys.path("normal"), describe(*given), "a normal vector that is not zero");
-      else
-        section.normal = std::move(*normal);
-    }
+  } else if (auto normal = keys.numbers("normal"); normal && one) {
+    double squared = 0.0;
+    for (double x : *normal) squared += x * x;
+    if (normal->size() != 2 * dimension && dimension > 0)
+      check.issue(keys.path("normal"), std::to_string(normal->size()) + " numbers",
+                  std::to_string(2 * dimension) + " numbers (2n: n for q, then n for p)");
+    else if (!(squared > 0.0) || !std::isfinite(squared))
+      check.issue(keys.path("normal"), describe(value["normal"]), "a normal vector that is not zero");
+    else
+      section.normal = std::move(*normal);
   }
-  if (keys.given("value") && keys.given("offset"))
-    check.issue(path, "both \"value\" and \"offset\"", "one of them: the plane is normal . (q, p) = value");
   for (const char* key : {"value", "offset"})
     if (const auto offset = keys.number(key)) section.offset = *offset;
   if (const auto direction = keys.string("direction"))

@@ -15,13 +15,8 @@ namespace nonsep::host {
 namespace job_reader {
 
 void read_energy_shell(Checker& check, const KeyReader& initial, InitialStates& states) {
-  const bool has_energy = initial.given("energy"), has_solve = initial.given("solve_for");
-  if (!has_energy && !has_solve) return;
-  if (has_energy != has_solve) {
-    check.issue(has_energy ? "/initial/solve_for" : "/initial/energy", "nothing",
-                "\"energy\" and \"solve_for\" together: the component p_i solved for so that H = energy");
-    return;
-  }
+  // Both or neither (the table's pair).
+  if (!initial.given("energy") || !initial.pairs_hold()) return;
   EnergyShell shell;
   const auto energy = initial.number("energy");
   const auto solve = initial.string("solve_for");

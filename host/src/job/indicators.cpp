@@ -65,19 +65,12 @@ std::shared_ptr<const Indicator> read_frequencies(Checker& check, const json& va
   if (const auto k = keys.integer("every")) every = static_cast<std::uint64_t>(*k);
   if (const auto m = keys.integer("spectra")) spectra = static_cast<std::size_t>(*m);
   const std::string degrees = dimension > 0 ? "from 0 to " + std::to_string(dimension - 1) : "below the dimension";
-  if (const json* signals = keys.value("signals")) {
-    const std::string what =
-        "a non-empty list of distinct degrees of freedom k (" + degrees + "): the signals q_k + i p_k, numbered from 0";
-    if (!signals->is_array() || signals->empty()) check.issue(keys.path("signals"), describe(*signals), what);
-    for (std::size_t i = 0; signals->is_array() && i < signals->size(); ++i) {
-      const std::string at = child(keys.path("signals"), i);
-      const auto k = check.integer((*signals)[i], at, 0, std::numeric_limits<std::int64_t>::max(), what);
-      if (!k) continue;
-      const auto degree = static_cast<std::size_t>(*k);
+  if (const auto signals = keys.integers("signals")) {  // distinct integers >= 0 by the table
+    for (std::size_t i = 0; i < signals->size(); ++i) {
+      const auto degree = static_cast<std::size_t>((*signals)[i]);
       if (dimension > 0 && degree >= dimension)
-        check.issue(at, std::to_string(degree), "a degree of freedom " + degrees + " (numbered from 0)");
-      else if (std::find(chosen.begin(), chosen.end(), degree) != chosen.end())
-        check.issue(at, std::to_string(degree) + " again", "each degree of freedom once");
+        check.issue(child(keys.path("signals"), i), std::to_string(degree),
+                    "a degree of freedom " + degrees + " (numbered from 0)");
       else
         chosen.push_back(degree);
     }

@@ -123,13 +123,13 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
   }
   if (value.contains("values")) {
     const KeyReader keys(check, value, path, values_axis_keys(), what);
-    const json* values = keys.value("values");
-    if (values->is_array() && values->size() > max_initial_states) {
+    auto values = keys.numbers("values");
+    if (values && values->size() > max_initial_states) {
       check.issue(keys.path("values"), std::to_string(values->size()) + " values",
                   "at most " + std::to_string(max_initial_states) + " values");
       return std::nullopt;
     }
-    return check.vector(*values, keys.path("values"));
+    return values;
   }
   const KeyReader keys(check, value, path, range_axis_keys(), what);
   const auto from = keys.number("from"), to = keys.number("to");
@@ -217,24 +217,10 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
 }  // namespace
 
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
-                const std::string& first_path) {
-  const KeyReader keys(check, value, path, state_keys(), "a state {\"q\": [...], \"p\": [...]}");
-  const json* q_value = keys.value("q");
-  const json* p_value = keys.value("p");
-  // Sizes first, so that an array over the limit is not copied.
-  const std::size_t q_size = q_value && q_value->is_array() ? q_value->size() : 0;
-  if (q_size > max_initial_values) {
-    check.issue(child(path, "q"), std::to_string(q_size) + " components", values_limit);
-    return;
-  }
-  if (p_value && p_value->is_array() && p_value->size() > max_initial_values) {
-    check.issue(child(path, "p"), std::to_string(p_value->size()) + " components",
-                q_size != 0 ? std::to_string(q_size) + ", as many as q has" : values_limit);
-    return;
-  }
-  std::optional<std::vector<double>> q, p;
-  if (q_value) q = check.vector(*q_value, child(path, "q"));
-  if (p_value) p = check.vector(*p_value, child(path, "p"));
+                const std::string& first_path, const std::string& what) {
+  // The table refuses an array over max_initial_values from its size, before any number is read.
+  const KeyReader keys(check, value, path, state_keys(), what);
+  const auto q = keys.numbers("q"), p = keys.numbers("p");
   if (!q || !p) return;
   if (q->size() != p->size()) {
     check.issue(child(path, "p"), std::to_string(p->size()) + " components",

@@ -21,26 +21,6 @@ std::string scheme_names() {
   return list;
 }
 
-// The value of one catalogue parameter, as the job wrote it or as its default: a Fraction for the order, a double
-// otherwise (nonsep::set_option).
-
-std::optional<OptionValue> read_option(Checker& check, const ParameterDescription& parameter, const json& value,
-                                       const std::string& path) {
-  if (parameter.kind == ParameterDescription::Kind::Number) {
-    const auto x = check.finite_number(value, path, "a finite number: " + parameter.description);
-    if (!x) return std::nullopt;
-    return OptionValue(*x);
-  }
-  try {
-    if (value.is_string()) return OptionValue(Fraction::parse(value.get<std::string>()));
-    if (const auto integral = integral_value(value)) return OptionValue(Fraction(*integral));
-  } catch (const InvalidArgument&) {
-  }
-  check.issue(path, describe(value),
-              "an exact fraction as a string (\"4/3\") or an integer (2): " + parameter.description);
-  return std::nullopt;
-}
-
 // The options of the scheme, or with an unknown scheme the options of every scheme (so that their problems are
 // reported too).
 std::vector<ParameterDescription> options_of(const Scheme* scheme) {
@@ -54,62 +34,81 @@ std::vector<ParameterDescription> options_of(const Scheme* scheme) {
   return parameters;
 }
 
+// The scheme an integrator object names, if the catalogue has it.
+const Scheme* named_scheme(const json& integrator) {
+  if (!integrator.is_object() || !integrator.contains("scheme") || !integrator["scheme"].is_string()) return nullptr;
+  return find_scheme(integrator["scheme"].get<std::string>());
+}
+
+// The key table of an integrator object: "scheme", the options the catalogue gives it (an order, or a number whose
+// range the core checks), then `extra`'s keys and pairs.
+KeyTable integrator_keys(const Scheme* scheme, const KeyTable* extra) {
+  KeyTable table;
+  KeyRule name{.name = "scheme", .type = ValueType::choice, .required = true, .allowed = "one of " + scheme_names()};
+  for (const auto& entry : scheme_catalogue()) name.choices.push_back(entry.name);
+  table.rules.push_back(std::move(name));
+  for (const auto& parameter : options_of(scheme)) {
+    const bool order = parameter.kind == ParameterDescription::Kind::Order;
+    table.rules.push_back(
+        {.name = parameter.name,
+         .type = order ? ValueType::order : ValueType::finite,
+         .required = parameter.default_text.empty(),
+         .allowed = (order ? "an exact fraction as a string (\"4/3\") or an integer (2): " : "a finite number: ") +
+                    parameter.description});
+  }
+  if (extra) {
+    table.rules.insert(table.rules.end(), extra->rules.begin(), extra->rules.end());
+    table.pairs = extra->pairs;
+  }
+  return table;
+}
+
+// The value of one catalogue option as the table checked it: a Fraction for the order, a double otherwise
+// (nonsep::set_option).
+OptionValue option_value(const ParameterDescription& parameter, const json& value) {
+  if (parameter.kind == ParameterDescription::Kind::Number) return OptionValue(value.get<double>());
+  return OptionValue(*order_value(value));
+}
+
 }  // namespace
+
+IntegratorReader::IntegratorReader(Checker& check, const json& integrator, const std::string& path,
+                                   HamiltonianForm form, const KeyTable* extra, const std::string& what)
+    : scheme_(named_scheme(integrator)),
+      table_(integrator_keys(scheme_, extra)),
+      keys_(check, integrator, path, table_, what) {
+  spec_.form = form;
+  if (!scheme_ || !keys_.is_object()) return;
+  spec_.scheme = scheme_->name;
+  const std::vector<ParameterDescription>& parameters = scheme_->parameters;
+  // Every option starts at the scheme's default, so that a refused value leaves a spec the scheme can build (a
+  // comparator refuses IntegratorSpec's own default order 2/3).
+  for (const auto& parameter : parameters)
+    if (!parameter.default_text.empty()) set_option(spec_, parameter, default_option_value(parameter));
+  for (const auto& parameter : parameters) {
+    const json* given = keys_.value(parameter.name);
+    if (!given) continue;
+    const OptionValue value = option_value(parameter, *given);
+    // The core decides what is valid: the scheme described with this one option set and the others at their
+    // defaults (setting an integer option refuses a number that is not whole).
+    IntegratorSpec probe{scheme_->name, {}, spec_.form};
+    for (const auto& other : parameters)
+      if (!other.default_text.empty()) set_option(probe, other, default_option_value(other));
+    try {
+      set_option(probe, parameter, value);
+      Integrator::describe(probe);
+      set_option(spec_, parameter, value);
+    } catch (const InvalidArgument& error) {
+      check.issue(keys_.path(parameter.name), describe(*given), error.what());
+    }
+  }
+}
 
 HamiltonianForm read_hamiltonian(const KeyReader& document) {
   if (const auto form = document.string("hamiltonian"))
     for (const auto& [name, value] : hamiltonian_forms())
       if (*form == name) return value;
   return HamiltonianForm::TTV;
-}
-
-IntegratorSpec read_integrator_object(Checker& check, const json& integrator, const std::string& path,
-                                      HamiltonianForm form, const std::vector<std::string>& extra_keys) {
-  IntegratorSpec spec;
-  spec.form = form;
-  const Scheme* scheme = nullptr;
-  if (const json* name = check.member(integrator, path, "scheme", true, "one of " + scheme_names())) {
-    if (name->is_string()) scheme = find_scheme(name->get<std::string>());
-    if (scheme)
-      spec.scheme = scheme->name;
-    else
-      check.issue(child(path, "scheme"), describe(*name), "one of " + scheme_names());
-  }
-  const std::vector<ParameterDescription> parameters = options_of(scheme);
-  std::vector<std::string> keys{"scheme"};
-  for (const auto& parameter : parameters) keys.push_back(parameter.name);
-  keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
-  check.known_keys(integrator, path, keys);
-
-  // Every option starts at the scheme's default, so that a refused value leaves a spec the scheme can build (a
-  // comparator refuses IntegratorSpec's own default order 2/3).
-  if (scheme)
-    for (const auto& parameter : parameters)
-      if (!parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
-  for (const auto& parameter : parameters) {
-    const std::string option_path = child(path, parameter.name);
-    const json* given =
-        check.member(integrator, path, parameter.name, parameter.default_text.empty(), parameter.description);
-    if (!given) {
-      if (scheme && !parameter.default_text.empty()) set_option(spec, parameter, default_option_value(parameter));
-      continue;
-    }
-    const auto value = read_option(check, parameter, *given, option_path);
-    if (!value || !scheme) continue;
-    // The core decides what is valid: the scheme described with this one option set and the others at their
-    // defaults (setting an integer option refuses a number that is not whole).
-    IntegratorSpec probe{scheme->name, {}, spec.form};
-    for (const auto& other : parameters)
-      if (!other.default_text.empty()) set_option(probe, other, default_option_value(other));
-    try {
-      set_option(probe, parameter, *value);
-      Integrator::describe(probe);
-      set_option(spec, parameter, *value);
-    } catch (const InvalidArgument& error) {
-      check.issue(option_path, describe(*given), error.what());
-    }
-  }
-  return spec;
 }
 
 IntegratorSpec read_integrator(Checker& check, const KeyReader& document, HamiltonianForm form,
@@ -119,37 +118,19 @@ IntegratorSpec read_integrator(Checker& check, const KeyReader& document, Hamilt
   if (!integrator)
     check.member(document.object(), "", "integrator", true,
                  "an object with \"scheme\" (" + scheme_names() + " or \"auto\") and options");
-  IntegratorSpec spec;
-  spec.form = form;
-  if (!integrator || !check.object(*integrator, "/integrator", "an object with \"scheme\" and the scheme's options"))
-    return spec;
-  if (!integrator->contains("scheme") || (*integrator)["scheme"] != "auto")
-    return read_integrator_object(check, *integrator, "/integrator", form);
-  const KeyTable& keys = auto_integrator_keys();
-  std::vector<std::string> names{"scheme"};
-  for (const auto& name : keys.names()) names.push_back(name);
-  check.known_keys(*integrator, "/integrator", names);
+  const std::string what = "an object with \"scheme\" and the scheme's options";
+  if (!integrator || !integrator->is_object() || !integrator->contains("scheme") || (*integrator)["scheme"] != "auto")
+    return integrator ? IntegratorReader(check, *integrator, "/integrator", form, nullptr, what).spec()
+                      : IntegratorSpec{.form = form};
+  KeyTable keys = auto_integrator_keys();
+  keys.rules.insert(keys.rules.begin(), {.name = "scheme", .type = ValueType::choice, .choices = {"auto"}});
+  const KeyReader reader(check, *integrator, "/integrator", keys, what);
   AutoScheme chosen;
-  const std::string range = "a number from " + format_number(auto_tolerance_min) + " to " +
-                            format_number(auto_tolerance_max) + ": " + keys["tolerance"].description;
-  if (const json* value = check.member(*integrator, "/integrator", "tolerance", true, range))
-    if (const auto x = check.finite_number(*value, "/integrator/tolerance", range)) {
-      if (*x < auto_tolerance_min || *x > auto_tolerance_max)
-        check.issue("/integrator/tolerance", describe(*value), range);
-      else
-        chosen.tolerance = *x;
-    }
-  if (const json* value = check.member(*integrator, "/integrator", "measure", false, "")) {
-    if (*value == "energy")
-      chosen.measure = AutoScheme::Measure::energy;
-    else if (*value != "phase")
-      check.issue("/integrator/measure", describe(*value),
-                  "\"phase\" (the phase-space error at t_end, the default) or \"energy\" (the largest |dH/H0|)");
-  }
+  if (const auto tolerance = reader.number("tolerance")) chosen.tolerance = *tolerance;
+  if (reader.string("measure") == "energy") chosen.measure = AutoScheme::Measure::energy;
   auto_scheme = chosen;
-  spec.scheme = "triplet";  // a valid spec until the choice replaces it
-  spec.options = ChinOptions{Fraction(4, 3)};
-  return spec;
+  // A valid spec until the choice replaces it.
+  return IntegratorSpec{.scheme = "triplet", .options = ChinOptions{Fraction(4, 3)}, .form = form};
 }
 
 }  // namespace nonsep::host::job_reader

@@ -118,28 +118,33 @@ const KeyTable& model_keys() {
                           "plugin's defaults.",
            .definition = "parameters"},
       },
-      {{"oneOf", {{{"required", {"plugin"}}}, {{"required", {"formula"}}}}}}};
+      {{KeyPair::Kind::exactly_one, "plugin", "formula",
+        "exactly one of \"plugin\" (a compiled model) and \"formula\" (T and V as formulas, "
+        "docs/formula-models.md)"}}};
   return table;
 }
 
 const KeyTable& run_time_keys() {
-  static const KeyTable table{{
-      {.name = "dt",
-       .type = ValueType::nonzero,
-       .required = true,
-       .description = "Time step; negative integrates backwards (t_end must then be negative too).",
-       .allowed = "the time step, a finite non-zero number (negative integrates backwards in time)"},
-      {.name = "t_end",
-       .type = ValueType::nonzero,
-       .description = "End time, same sign as dt. steps = ceil((t_end/dt)(1 - 1e-9)), and the step actually used "
-                      "is t_end/steps, so the run ends exactly at t_end.",
-       .allowed = "the end time, a finite non-zero number of the same sign as dt"},
-      {.name = "steps",
-       .type = ValueType::integer,
-       .minimum = 1,
-       .maximum = steps_limit,
-       .description = "Number of steps of exactly dt."},
-  }};
+  static const KeyTable table{
+      {
+          {.name = "dt",
+           .type = ValueType::nonzero,
+           .required = true,
+           .description = "Time step; negative integrates backwards (t_end must then be negative too).",
+           .allowed = "the time step, a finite non-zero number (negative integrates backwards in time)"},
+          {.name = "t_end",
+           .type = ValueType::nonzero,
+           .description = "End time, same sign as dt. steps = ceil((t_end/dt)(1 - 1e-9)), and the step actually used "
+                          "is t_end/steps, so the run ends exactly at t_end.",
+           .allowed = "the end time, a finite non-zero number of the same sign as dt"},
+          {.name = "steps",
+           .type = ValueType::integer,
+           .minimum = 1,
+           .maximum = steps_limit,
+           .description = "Number of steps of exactly dt."},
+      },
+      {{KeyPair::Kind::exactly_one, "t_end", "steps",
+        "either \"t_end\" (the time to end at) or \"steps\" (the number of steps of dt), not both"}}};
   return table;
 }
 
@@ -243,131 +248,26 @@ const KeyTable& study_keys() {
                           "every repeat computes the same numbers).",
            .allowed = "a whole number of repeats from 1 to 1000"},
       },
-      {{"dependentSchemas", {{"reference_run", {{"not", {{"required", {"reference"}}}}}}}}}};
+      {{KeyPair::Kind::at_most_one, "steps", "dt",
+        "either \"steps\" (step counts over t_end) or \"dt\" (step sizes), not both"},
+       {KeyPair::Kind::at_most_one, "reference", "reference_run",
+        "either \"reference\" (the state at t_end) or \"reference_run\" (an integrator that computes it)"}}};
   return table;
 }
 
 const KeyTable& study_integrator_keys() {
-  static const KeyTable table{{
-      {.name = "label",
-       .type = ValueType::string,
-       .description = "The integrator's name in convergence.csv and the fits; default \"<scheme> <order>\" "
-                      "(\"basic\" for the basic step); distinct per integrator."},
-      {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
-      {.name = "dt", .type = ValueType::defined, .definition = "step_sizes"},
-  }};
-  return table;
-}
-
-const KeyTable& state_keys() {
-  static const KeyTable table{{
-      {.name = "q",
-       .type = ValueType::defined,
-       .required = true,
-       .description = "Positions, one per degree of freedom.",
-       .allowed = "the positions, an array of finite numbers",
-       .definition = "vector"},
-      {.name = "p",
-       .type = ValueType::defined,
-       .required = true,
-       .description = "Momenta, as many as q.",
-       .allowed = "the momenta, an array of finite numbers",
-       .definition = "vector"},
-  }};
-  return table;
-}
-
-const KeyTable& initial_grid_keys() {
   static const KeyTable table{
       {
-          {.name = "grid",
-           .type = ValueType::object,
-           .required = true,
-           .description = "One axis per component of q and of p; the states are every combination, in row-major order "
-                          "over q0, q1, ..., p0, p1, ... (the last axis varies fastest). At most " +
-                          std::to_string(max_initial_states) + " states, and at most " +
-                          std::to_string(max_initial_values) + " numbers in q (states times dimension).",
-           .keys = grid_keys},
-          {.name = "energy",
-           .type = ValueType::finite,
-           .description = "Put every state of the grid on the energy shell H = energy by solving for the momentum "
-                          "component solve_for names (the grid's value of it is ignored); states that cannot reach the "
-                          "shell are left out (summary.json energy_shell.left_out).",
-           .allowed = "a finite number: the energy H of every state"},
-          {.name = "solve_for",
+          {.name = "label",
            .type = ValueType::string,
-           .description = "\"p<i>\": the root p_i >= 0 nearest to 0; \"-p<i>\": the root p_i <= 0.",
-           .allowed = "\"p<i>\" (the root p_i >= 0) or \"-p<i>\" (the root p_i <= 0), i from 0 below the dimension",
-           .pattern = "^-?p(0|[1-9][0-9]*)$"},
+           .description = "The integrator's name in convergence.csv and the fits; default \"<scheme> <order>\" "
+                          "(\"basic\" for the basic step); distinct per integrator.",
+           .allowed = "a non-empty string naming the integrator"},
+          {.name = "steps", .type = ValueType::defined, .definition = "step_counts"},
+          {.name = "dt", .type = ValueType::defined, .definition = "step_sizes"},
       },
-      {{"dependentRequired", {{"energy", {"solve_for"}}, {"solve_for", {"energy"}}}}}};
-  return table;
-}
-
-const KeyTable& initial_file_keys() {
-  static const KeyTable table{{
-      {.name = "file",
-       .type = ValueType::path,
-       .required = true,
-       .description = "The states in a file, relative to the job file's folder, one state per row, q0..q(n-1) then "
-                      "p0..p(n-1): a NumPy .npy file of a little-endian float64 array of shape (states, 2n) or (2n,) "
-                      "(numpy.save), or a .csv file with the header q0,...,q(n-1),p0,...,p(n-1). At most " +
-                      std::to_string(max_initial_states) + " states and " + std::to_string(max_initial_values) +
-                      " numbers in q, every number finite.",
-       .allowed = "the path of a .npy or .csv file of initial states, relative to the job file's folder"},
-  }};
-  return table;
-}
-
-const KeyTable& grid_keys() {
-  static const KeyTable table{{
-      {.name = "q",
-       .type = ValueType::defined,
-       .required = true,
-       .description = "The axes of q0, q1, ...",
-       .allowed = "an array of axes, one per component",
-       .definition = "axes"},
-      {.name = "p",
-       .type = ValueType::defined,
-       .required = true,
-       .description = "The axes of p0, p1, ...",
-       .allowed = "an array of axes, one per component",
-       .definition = "axes"},
-  }};
-  return table;
-}
-
-const KeyTable& range_axis_keys() {
-  static const KeyTable table{{
-      {.name = "from",
-       .type = ValueType::finite,
-       .required = true,
-       .description = "The first value.",
-       .allowed = "the first value, a finite number"},
-      {.name = "to",
-       .type = ValueType::finite,
-       .required = true,
-       .description = "The last value.",
-       .allowed = "the last value, a finite number"},
-      {.name = "count",
-       .type = ValueType::integer,
-       .required = true,
-       .minimum = 1,
-       .maximum = states_limit,
-       .description = "The number of values.",
-       .allowed = "the number of values, an integer from 1 to " + std::to_string(states_limit)},
-  }};
-  return table;
-}
-
-const KeyTable& values_axis_keys() {
-  static const KeyTable table{{
-      {.name = "values",
-       .type = ValueType::defined,
-       .required = true,
-       .description = "The values listed.",
-       .definition = "vector"},
-  }};
+      {{KeyPair::Kind::at_most_one, "steps", "dt",
+        "either \"steps\" (step counts over t_end) or \"dt\" (step sizes), not both"}}};
   return table;
 }
 

@@ -4,7 +4,9 @@
 // (KeyReader, key_reader.hpp: known keys, required keys, each value's type, range and choices, with the rule's
 // `allowed` text as the message), and `nonsep schema` (job_schema.cpp) writes schemas/job.schema.json from the same
 // tables and the scheme catalogue, so the schema cannot drift from the reader; tests/host/test_host_job_schema.cpp
-// holds the readers to the types written here. What relates keys to each other stays with the readers.
+// holds the readers to the types written here. Two keys of one object that relate are a pair of the table (exactly
+// one of them, not both, both or neither); what relates a value to anything else (the state's dimension, t_end, the
+// scheme's own verdict on an option) stays with the readers.
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -31,7 +33,9 @@ enum class ValueType {
   form,         // one of hamiltonian_forms()
   boolean,      // true or false
   choice,       // one of the strings `choices`
-  defined,      // a shape of its own, $defs/<definition> of the schema (states, axes, integrators, step lists)
+  order,        // a scheme's order: an exact fraction as a string ("4/3") or a positive integer
+  defined,      // a shape of its own, $defs/<definition> of the schema (states, axes, integrators); the lists of
+                // numbers among them (number_list) are checked by the table too
 };
 
 // The integer ranges the tables share: step counts up to the time grid's limit, ensembles up to the reader's.
@@ -45,7 +49,9 @@ struct KeyRule {
   std::string name = {};
   ValueType type = ValueType::finite;
   bool required = false;
-  std::int64_t minimum = 0, maximum = 0;           // ValueType::integer
+  std::int64_t minimum = 0, maximum = 0;  // ValueType::integer
+  // ValueType::finite: the closed range [at_least, at_most] (unbounded by default).
+  double at_least = -std::numeric_limits<double>::infinity(), at_most = std::numeric_limits<double>::infinity();
   nlohmann::ordered_json default_value = nullptr;  // as a job file would write it; null: no default
   std::string description = {};                    // for the schema
   // What a message for a refused value says is allowed (key_reader.hpp); empty: one built from the type and range.
@@ -59,17 +65,44 @@ struct KeyRule {
   std::string in_study_found = {}, in_study_allowed = {};
 };
 
-// The keys of one kind of object, in the order messages list them ("only the keys ...").
+// Two keys of one object that relate: the reader checks the pair (KeyReader) and the schema writes it (oneOf,
+// dependentSchemas, dependentRequired), from this one line.
+struct KeyPair {
+  enum class Kind {
+    exactly_one,  // one of the two, not both
+    at_most_one,  // not both
+    together,     // both or neither
+  };
+  Kind kind;
+  std::string first, second;
+  std::string allowed;  // what a message says is allowed
+};
+
+// The keys of one kind of object, in the order messages list them ("only the keys ..."), and how they pair.
 struct KeyTable {
   std::vector<KeyRule> rules;
-  // What the table cannot say key by key (exactly one of two keys, two keys that go together), as JSON Schema
-  // keywords added to the object's schema; the reader checks the same with its own messages.
-  nlohmann::ordered_json constraints = nlohmann::ordered_json::object();
+  std::vector<KeyPair> pairs = {};
   std::vector<std::string> names() const;
   std::vector<std::string> required() const;
   // The rule named `name`; a name without a rule is a programming error (std::logic_error).
   const KeyRule& operator[](std::string_view name) const;
 };
+
+// A list of numbers of a job file (the ValueType::defined rules of these definitions: "vector", "indices",
+// "step_counts", "step_sizes"): the reader checks each item and the schema writes it under $defs, from here.
+struct NumberList {
+  std::string definition;
+  ValueType item = ValueType::finite;     // finite, nonzero or integer
+  std::int64_t minimum = 0, maximum = 0;  // integer items
+  std::size_t max_items = 0;              // more is refused before the items are read
+  bool distinct = false;                  // each value once
+  std::string description = {};           // for the schema
+  std::string allowed = {};               // the list as a whole, for messages
+  std::string item_allowed = {};          // one item, for messages
+};
+// The list described for `definition`, or nullptr when that definition is not a list of numbers.
+const NumberList* number_list(std::string_view definition);
+const std::vector<NumberList>& number_lists();
 
 // The document and its sections.
 const KeyTable& document_keys();

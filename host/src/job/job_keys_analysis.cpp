@@ -6,6 +6,7 @@
 #include "indicators.hpp"
 #include "job_keys.hpp"
 #include "nonsep/core/analysis/lyapunov_exponents.hpp"
+#include "nonsep/host/number_format.hpp"
 
 namespace nonsep::host::job_reader {
 
@@ -55,17 +56,22 @@ const KeyTable& analysis_keys() {
 const KeyTable& auto_integrator_keys() {
   static const KeyTable table{{
       {.name = "tolerance",
-       .type = ValueType::positive,
+       .type = ValueType::finite,
        .required = true,
+       .at_least = auto_tolerance_min,
+       .at_most = auto_tolerance_max,
        .description = "The accuracy asked for: the global error at the end of the run (phase), or the largest "
                       "relative energy error |dH/H0| over the run (energy), between 1e-14 and 0.1. Pilot runs on "
                       "the job's own model and states choose the scheme and the step that meet it at the least "
-                      "predicted cost; time.dt is then the output grid, which the chosen step divides."},
+                      "predicted cost; time.dt is then the output grid, which the chosen step divides.",
+       .allowed = "a number from " + format_number(auto_tolerance_min) + " to " + format_number(auto_tolerance_max) +
+                  ": the global error at t_end (phase) or the largest |dH/H0| over the run (energy)"},
       {.name = "measure",
        .type = ValueType::choice,
        .default_value = "phase",
        .description = "\"phase\": the phase-space error |(q, p) - (q, p)_exact| at t_end; \"energy\": the largest "
                       "|dH/H0| over the run (needs the plugin's Hessians).",
+       .allowed = "\"phase\" (the phase-space error at t_end, the default) or \"energy\" (the largest |dH/H0|)",
        .choices = {"phase", "energy"}},
   }};
   return table;
@@ -109,8 +115,10 @@ const KeyTable& poincare_keys() {
            .allowed = "an integer >= 1: a trajectory stops (status \"completed\", with a message) at the step of its "
                       "N-th crossing"},
       },
-      {{"oneOf", {{{"required", {"component"}}}, {{"required", {"normal"}}}}},
-       {"not", {{"required", {"value", "offset"}}}}}};
+      {{KeyPair::Kind::exactly_one, "component", "normal",
+        "exactly one of \"component\" (\"q<i>\" or \"p<i>\", i from 0 below the dimension) and \"normal\" (2n "
+        "numbers, n for q then n for p)"},
+       {KeyPair::Kind::at_most_one, "value", "offset", "one of them: the plane is normal . (q, p) = value"}}};
   return table;
 }
 
@@ -128,6 +136,7 @@ const KeyTable& frequencies_keys() {
        .type = ValueType::defined,
        .description = "The degrees of freedom k whose signals q_k + i p_k are analysed, in column order (0-based, "
                       "below the dimension, each once). Absent: every degree of freedom.",
+       .allowed = "a non-empty list of distinct degrees of freedom k (numbered from 0): the signals q_k + i p_k",
        .definition = "indices"},
       {.name = "spectra",
        .type = ValueType::integer,

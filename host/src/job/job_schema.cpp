@@ -37,6 +37,38 @@ schema_json forms() {
 
 schema_json object_schema(const KeyTable& table, const std::string& description = "");
 
+// A table's pairs of keys: exactly one of two (oneOf, one per object), not both (dependentSchemas), both or neither
+// (dependentRequired).
+void add_pairs(schema_json& schema, const std::vector<KeyPair>& pairs) {
+  for (const KeyPair& pair : pairs) switch (pair.kind) {
+      case KeyPair::Kind::exactly_one:
+        if (schema.contains("oneOf")) throw std::logic_error("two exactly-one pairs in one key table");
+        schema["oneOf"] = {{{"required", {pair.first}}}, {{"required", {pair.second}}}};
+        break;
+      case KeyPair::Kind::at_most_one:
+        schema["dependentSchemas"][pair.second] = {{"not", {{"required", {pair.first}}}}};
+        break;
+      case KeyPair::Kind::together:
+        schema["dependentRequired"][pair.first] = {pair.second};
+        schema["dependentRequired"][pair.second] = {pair.first};
+        break;
+    }
+}
+
+// A list of numbers (number_list), under $defs.
+schema_json list_schema(const NumberList& list) {
+  schema_json item;
+  if (list.item == ValueType::integer)
+    item = {{"type", "integer"}, {"minimum", list.minimum}, {"maximum", list.maximum}};
+  else
+    item = ref(list.item == ValueType::nonzero ? "nonzero" : "finite");
+  schema_json schema = {{"type", "array"}, {"minItems", 1}, {"maxItems", list.max_items}};
+  if (list.distinct) schema["uniqueItems"] = true;
+  schema["items"] = std::move(item);
+  if (!list.description.empty()) schema["description"] = list.description;
+  return schema;
+}
+
 schema_json value_schema(const KeyRule& rule) {
   schema_json schema;
   switch (rule.type) {
@@ -62,6 +94,11 @@ schema_json value_schema(const KeyRule& rule) {
       break;
     case ValueType::finite:
       schema = ref("finite");
+      if (std::isfinite(rule.at_least)) schema["minimum"] = rule.at_least;
+      if (std::isfinite(rule.at_most)) schema["maximum"] = rule.at_most;
+      break;
+    case ValueType::order:
+      schema = ref("order");
       break;
     case ValueType::nonzero:
       schema = ref("nonzero");
@@ -97,11 +134,9 @@ schema_json object_schema(const KeyTable& table, const std::string& description)
   schema_json properties = schema_json::object();
   for (const auto& rule : table.rules) properties[rule.name] = value_schema(rule);
   schema["properties"] = std::move(properties);
-  for (const auto& [keyword, value] : table.constraints.items()) schema[keyword] = value;
+  add_pairs(schema, table.pairs);
   return schema;
 }
-
-schema_json not_both(const char* a, const char* b) { return {{"required", {a, b}}}; }
 
 double number_from_text(const std::string& text) {
   double value = 0.0;
@@ -178,7 +213,7 @@ schema_json integrator_schema(const KeyTable* extra, const std::string& descript
         {"description",
          "The scheme, by its name in the core's catalogue (`nonsep --help` lists each with its family and options); "
          "the other keys are that scheme's options."}}}};
-  if (extra) schema["not"] = not_both("steps", "dt");
+  if (extra) add_pairs(schema, extra->pairs);
   schema["allOf"] = std::move(branches);
   return schema;
 }
@@ -203,19 +238,8 @@ schema_json definitions() {
                                                "An integrator as /integrator of a run, with an optional label and "
                                                "its own steps or dt (which override the study's).");
   defs["run_time"] = object_schema(run_time_keys());
-  defs["run_time"]["oneOf"] = {{{"required", {"t_end"}}}, {{"required", {"steps"}}}};
   defs["study_time"] = object_schema(study_time_keys());
-  defs["step_counts"] = {{"type", "array"},
-                         {"minItems", 1},
-                         {"uniqueItems", true},
-                         {"items", {{"type", "integer"}, {"minimum", 1}, {"maximum", max_steps}}},
-                         {"description", "Step counts over t_end: dt = t_end / steps exactly."}};
-  defs["step_sizes"] = {{"type", "array"},
-                        {"minItems", 1},
-                        {"items", ref("nonzero")},
-                        {"description",
-                         "Step sizes of the sign of t_end; each becomes steps = ceil((t_end/dt)(1 - "
-                         "1e-9)) as in a run."}};
+  for (const NumberList& list : number_lists()) defs[list.definition] = list_schema(list);
   defs["formula"] = formula::formula_schema();
   defs["parameters"] = {
       {"type", "object"},
@@ -237,9 +261,6 @@ schema_json definitions() {
          "\"count\"}) make a sweep: the run takes every parameter set of the product of the swept parameters with "
          "every initial state (docs/dynamics.md). Every set must give the model the same dimension: a sweep of a "
          "parameter that sets it (lattice_chain's sites) is refused."}}}};
-  defs["vector"] = {{"type", "array"}, {"minItems", 1}, {"items", ref("finite")}};
-  defs["indices"] = {
-      {"type", "array"}, {"minItems", 1}, {"uniqueItems", true}, {"items", {{"type", "integer"}, {"minimum", 0}}}};
   defs["state"] = object_schema(state_keys());
   defs["initial"] = {{"oneOf",
                       {ref("state"),
@@ -289,7 +310,6 @@ schema_json job_schema() {
        {"else",
         {{"required", {"integrator"}},
          {"properties", {{"time", described(ref("run_time"), "A run's time grid: dt, and t_end or steps.")}}}}}}};
-  schema["properties"]["study"]["not"] = not_both("steps", "dt");
   schema["$defs"] = definitions();
   return schema;
 }

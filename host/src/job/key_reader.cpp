@@ -3,6 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
+
+#include "nonsep/core/base/error.hpp"
+#include "nonsep/core/base/fraction.hpp"
+#include "nonsep/host/number_format.hpp"
 
 namespace nonsep::host::job_reader {
 
@@ -10,7 +15,11 @@ std::string allowed_text(const KeyRule& rule) {
   if (!rule.allowed.empty()) return rule.allowed;
   switch (rule.type) {
     case ValueType::finite:
+      if (std::isfinite(rule.at_least) || std::isfinite(rule.at_most))
+        return "a number from " + format_number(rule.at_least) + " to " + format_number(rule.at_most);
       return "a finite number";
+    case ValueType::order:
+      return "an exact fraction as a string (\"4/3\") or an integer (2)";
     case ValueType::nonzero:
       return "a finite non-zero number";
     case ValueType::positive:
@@ -58,6 +67,24 @@ KeyReader::KeyReader(Checker& check, const json& object, std::string path, const
       refused_.push_back(rule.name);
     }
   }
+  for (const KeyPair& pair : table.pairs) check_pair(pair);
+}
+
+void KeyReader::check_pair(const KeyPair& pair) {
+  const bool first = object_->contains(pair.first), second = object_->contains(pair.second);
+  if (first && second && pair.kind != KeyPair::Kind::together) {
+    check_.issue(path(pair.second), describe((*object_)[pair.second]) + " together with " + path(pair.first),
+                 pair.allowed);
+    pairs_hold_ = false;
+  } else if (!first && !second && pair.kind == KeyPair::Kind::exactly_one) {
+    check_.issue(path(pair.first), "nothing (neither \"" + pair.first + "\" nor \"" + pair.second + "\" is given)",
+                 pair.allowed);
+    pairs_hold_ = false;
+  } else if (first != second && pair.kind == KeyPair::Kind::together) {
+    const std::string& given = first ? pair.first : pair.second;
+    check_.issue(path(first ? pair.second : pair.first), "nothing, while \"" + given + "\" is given", pair.allowed);
+    pairs_hold_ = false;
+  }
 }
 
 namespace {
@@ -72,7 +99,7 @@ bool accepted(const json& value, const KeyRule& rule) {
   };
   switch (rule.type) {
     case ValueType::finite:
-      return number([](double) { return true; });
+      return number([&](double x) { return x >= rule.at_least && x <= rule.at_most; });
     case ValueType::nonzero:
       return number([](double x) { return x != 0.0; });
     case ValueType::positive:
@@ -96,21 +123,71 @@ bool accepted(const json& value, const KeyRule& rule) {
       return value.is_string() && std::ranges::any_of(hamiltonian_forms(), [&](const FormName& form) {
                return form.name == value.get<std::string>();
              });
+    case ValueType::order:
+      return order_value(value).has_value();
     case ValueType::object:
     case ValueType::defined:
-      return true;  // the section reader reads what is inside
+      return true;  // the section reader reads what is inside (a list of numbers: KeyReader::valid_list)
   }
   return true;
 }
 
+// One item of a list of numbers.
+bool accepted_item(const json& item, const NumberList& list) {
+  if (list.item == ValueType::integer) {
+    const auto x = integral_value(item);
+    return x && *x >= list.minimum && *x <= list.maximum;
+  }
+  if (!item.is_number()) return false;
+  const double x = item.get<double>();
+  return std::isfinite(x) && (list.item != ValueType::nonzero || x != 0.0);
+}
+
 }  // namespace
 
+std::optional<Fraction> order_value(const json& value) {
+  try {
+    if (value.is_string()) return Fraction::parse(value.get<std::string>());
+    if (const auto integral = integral_value(value)) return Fraction(*integral);
+  } catch (const InvalidArgument&) {
+  }
+  return std::nullopt;
+}
+
+bool KeyReader::valid_list(const json& value, const KeyRule& rule, const NumberList& list) {
+  const std::string at = child(path_, rule.name);
+  if (!value.is_array() || value.empty()) {
+    check_.issue(at, describe(value), rule.allowed.empty() ? list.allowed : rule.allowed);
+    return false;
+  }
+  if (value.size() > list.max_items) {  // refused from its size, before any item is read
+    check_.issue(at, std::to_string(value.size()) + " numbers",
+                 "at most " + std::to_string(list.max_items) + " numbers");
+    return false;
+  }
+  bool ok = true;
+  std::unordered_set<std::int64_t> seen;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const json& item = value[i];
+    if (!accepted_item(item, list)) {
+      check_.issue(child(at, i), describe(item), list.item_allowed);
+      ok = false;
+    } else if (list.distinct && !seen.insert(*integral_value(item)).second) {
+      check_.issue(child(at, i), describe(item) + ", given before", list.item_allowed);
+      ok = false;
+    }
+  }
+  return ok;
+}
+
 bool KeyReader::valid(const json& value, const KeyRule& rule) {
+  if (rule.type == ValueType::defined)
+    if (const NumberList* list = number_list(rule.definition)) return valid_list(value, rule, *list);
   if (!accepted(value, rule)) {
     check_.issue(child(path_, rule.name), describe(value), allowed_text(rule));
     return false;
   }
-  // A path the file system cannot take: said as Checker::path_string says it.
+  // A path the file system cannot take.
   if (rule.type == ValueType::path && value.get_ref<const std::string&>().find('\0') != std::string::npos) {
     check_.issue(child(path_, rule.name), describe(value) + ", which contains NUL (\\u0000)",
                  allowed_text(rule) + ", without NUL characters");
@@ -146,6 +223,24 @@ std::optional<bool> KeyReader::boolean(std::string_view key) const {
 std::optional<std::string> KeyReader::string(std::string_view key) const {
   const json* v = value(key);
   return v ? std::optional<std::string>(v->get<std::string>()) : std::nullopt;
+}
+
+std::optional<std::vector<double>> KeyReader::numbers(std::string_view key) const {
+  const json* v = value(key);
+  if (!v) return std::nullopt;
+  std::vector<double> items;
+  items.reserve(v->size());
+  for (const json& item : *v) items.push_back(item.get<double>());
+  return items;
+}
+
+std::optional<std::vector<std::int64_t>> KeyReader::integers(std::string_view key) const {
+  const json* v = value(key);
+  if (!v) return std::nullopt;
+  std::vector<std::int64_t> items;
+  items.reserve(v->size());
+  for (const json& item : *v) items.push_back(*integral_value(item));
+  return items;
 }
 
 }  // namespace nonsep::host::job_reader

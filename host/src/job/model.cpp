@@ -13,11 +13,6 @@ void read_model(Checker& check, const KeyReader& document, Job& job) {
   if (!model) return;
   const KeyReader keys(check, *model, "/model", model_keys(), allowed_text(document_keys()["model"]));
   if (!keys.is_object()) return;
-  if (keys.given("plugin") == keys.given("formula"))
-    check.issue("/model",
-                keys.given("plugin") ? "both \"plugin\" and \"formula\"" : "neither \"plugin\" nor \"formula\"",
-                "exactly one of \"plugin\" (a compiled model) and \"formula\" (T and V as formulas, "
-                "docs/formula-models.md)");
   if (const auto plugin = keys.string("plugin")) job.plugin = *plugin;
   if (const json* formula = keys.value("formula"))
     job.formula = formula::read_formula_model(*formula, "/model/formula", job.directory, check.issues());

@@ -13,6 +13,7 @@
 
 #include "job_keys.hpp"
 #include "key_reader.hpp"
+#include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/json/checker.hpp"
 #include "nonsep/host/json/parameter_check.hpp"
@@ -32,14 +33,29 @@ std::optional<SweptParameter> read_swept_parameter(Checker& check, const std::st
 // max_initial_values (sweep.cpp); an issue at /model/parameters otherwise.
 void check_sweep_size(Checker& check, const Job& job);
 
-// /hamiltonian and /integrator (integrator.cpp). read_integrator_object reads one integrator object at `path`
-// (a run's /integrator or a study's /study/integrators/<i>); `extra_keys` are keys its caller reads itself.
+// /hamiltonian and /integrator (integrator.cpp).
 HamiltonianForm read_hamiltonian(const KeyReader& document);
 // /integrator of a run; with "scheme": "auto", also its tolerance and measure into `auto_scheme`.
 IntegratorSpec read_integrator(Checker& check, const KeyReader& document, HamiltonianForm form,
                                std::optional<AutoScheme>& auto_scheme);
-IntegratorSpec read_integrator_object(Checker& check, const json& integrator, const std::string& path,
-                                      HamiltonianForm form, const std::vector<std::string>& extra_keys = {});
+// One integrator object at `path` (a run's /integrator, an entry of /study/integrators, /study/reference_run) read
+// by its table: "scheme", that scheme's options from the catalogue and `extra`'s keys (which the caller reads through
+// keys()); `what` is the message for a value that is not an object.
+class IntegratorReader {
+ public:
+  IntegratorReader(Checker& check, const json& integrator, const std::string& path, HamiltonianForm form,
+                   const KeyTable* extra, const std::string& what);
+  IntegratorReader(const IntegratorReader&) = delete;  // its KeyReader refers to its table
+  IntegratorReader& operator=(const IntegratorReader&) = delete;
+  const IntegratorSpec& spec() const { return spec_; }
+  const KeyReader& keys() const { return keys_; }
+
+ private:
+  const Scheme* scheme_;
+  KeyTable table_;
+  KeyReader keys_;
+  IntegratorSpec spec_;
+};
 
 // /time (time.cpp): a run's {"dt", "t_end" or "steps"}, a study's {"t_end"}.
 TimeGrid read_time(Checker& check, const KeyReader& document);
@@ -72,7 +88,7 @@ void read_initial_file(Checker& check, const json& initial, const std::filesyste
 // /initial/energy and /initial/solve_for of a grid (energy_shell.cpp), into states.shell.
 void read_energy_shell(Checker& check, const KeyReader& initial, InitialStates& states);
 void read_state(Checker& check, const json& value, const std::string& path, InitialStates& states,
-                const std::string& first_path);
+                const std::string& first_path, const std::string& what = "a state {\"q\": [...], \"p\": [...]}");
 
 // /study (study/convergence_study.cpp), with the study's end time (0 when /time/t_end is invalid: the step sizes are
 // then only checked, not turned into counts).

@@ -30,16 +30,7 @@ TimeGrid read_time(Checker& check, const KeyReader& document) {
   if (!keys.is_object()) return grid;
   // NaN marks a value that is missing or invalid (and already reported).
   const double dt = keys.number("dt").value_or(std::nan(""));
-  if (keys.given("t_end") && keys.given("steps")) {
-    check.issue("/time/steps", describe((*time)["steps"]) + " together with /time/t_end",
-                "either \"t_end\" or \"steps\", not both");
-    return grid;
-  }
-  if (!keys.given("t_end") && !keys.given("steps")) {
-    check.issue("/time/t_end", "nothing (neither \"t_end\" nor \"steps\" is given)",
-                "either \"t_end\" (the time to end at) or \"steps\" (the number of steps of dt)");
-    return grid;
-  }
+  if (!keys.pairs_hold()) return grid;  // exactly one of t_end and steps
   if (keys.given("t_end")) {
     const auto t_end = keys.number("t_end");
     if (!t_end || std::isnan(dt)) return grid;

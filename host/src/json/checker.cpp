@@ -125,53 +125,11 @@ std::optional<double> Checker::finite_number(const json& value, const std::strin
   return std::nullopt;
 }
 
-std::optional<double> Checker::positive_number(const json& value, const std::string& path, const std::string& what) {
-  if (value.is_number()) {
-    const double x = value.get<double>();
-    if (std::isfinite(x) && x > 0.0) return x;
-  }
-  issue(path, describe(value), what);
-  return std::nullopt;
-}
-
 std::optional<std::int64_t> Checker::integer(const json& value, const std::string& path, std::int64_t minimum,
                                              std::int64_t maximum, const std::string& what) {
   if (const auto x = integral_value(value); x && *x >= minimum && *x <= maximum) return x;
   issue(path, describe(value), what);
   return std::nullopt;
-}
-
-std::optional<std::string> Checker::string(const json& value, const std::string& path, const std::string& what) {
-  if (value.is_string() && !value.get<std::string>().empty()) return value.get<std::string>();
-  issue(path, describe(value), what);
-  return std::nullopt;
-}
-
-std::optional<std::string> Checker::path_string(const json& value, const std::string& path, const std::string& what) {
-  auto text = string(value, path, what);
-  if (text && text->find('\0') != std::string::npos) {
-    issue(path, describe(value) + ", which contains NUL (\\u0000)", what + ", without NUL characters");
-    return std::nullopt;
-  }
-  return text;
-}
-
-std::optional<std::vector<double>> Checker::vector(const json& value, const std::string& path) {
-  if (!value.is_array() || value.empty()) {
-    issue(path, describe(value), "a non-empty array of finite numbers, one per degree of freedom");
-    return std::nullopt;
-  }
-  std::vector<double> result;
-  result.reserve(value.size());
-  bool ok = true;
-  for (std::size_t i = 0; i < value.size(); ++i) {
-    if (const auto x = finite_number(value[i], child(path, i), "a finite number"))
-      result.push_back(*x);
-    else
-      ok = false;
-  }
-  if (!ok) return std::nullopt;
-  return result;
 }
 
 }  // namespace nonsep::host::job_reader

@@ -46,18 +46,9 @@ class Checker {
                      const std::string& what);
 
   std::optional<double> finite_number(const json& value, const std::string& path, const std::string& what);
-  // A finite number > 0.
-  std::optional<double> positive_number(const json& value, const std::string& path, const std::string& what);
   // An integral_value within [minimum, maximum].
   std::optional<std::int64_t> integer(const json& value, const std::string& path, std::int64_t minimum,
                                       std::int64_t maximum, const std::string& what);
-  // A non-empty string.
-  std::optional<std::string> string(const json& value, const std::string& path, const std::string& what);
-  // A non-empty string without NUL (U+0000), which no file system accepts in a path: /model/plugin,
-  // /output/directory.
-  std::optional<std::string> path_string(const json& value, const std::string& path, const std::string& what);
-  // A non-empty array of finite numbers.
-  std::optional<std::vector<double>> vector(const json& value, const std::string& path);
 
  private:
   std::vector<JobIssue>& issues_;
