@@ -287,9 +287,9 @@ TEST_CASE("pairs of keys and lists of numbers are checked by their key tables: o
                       {"time", {{"t_end", 1.0}}},
                       {"study", {{"integrators", {{{"scheme", "basic"}, {"steps", {4, 8}}}}}}}};
   const std::vector<Case> cases{
-      {"/time/steps", "10 together with /time/t_end", "either \"t_end\" (the time to end at) or \"steps\"",
+      {"/time/steps", "10 together with /time/t_end", "exactly one of \"t_end\" (the time to end at) and \"steps\"",
        [](json& job) { job["time"]["t_end"] = 1.0; }},
-      {"/time/t_end", "nothing (neither \"t_end\" nor \"steps\" is given)", "either \"t_end\"",
+      {"/time/t_end", "nothing (neither \"t_end\" nor \"steps\" is given)", "exactly one of \"t_end\"",
        [](json& job) { job["time"].erase("steps"); }},
       {"/model/formula", "{\"T\":\"p0^2/2\",\"V\":\"q0^2/2\"} together with /model/plugin", "exactly one of \"plugin\"",
        [](json& job) {
@@ -311,7 +311,7 @@ TEST_CASE("pairs of keys and lists of numbers are checked by their key tables: o
        [](json& job) {
          job["initial"] = {{"grid", {{"q", {0.1}}, {"p", {0.0}}}}, {"energy", 1.0}};
        }},
-      {"/analysis/frequencies/signals/1", "0, given before", "an integer >= 0, not given before",
+      {"/analysis/frequencies/signals/1", "0, given before", "a non-empty list of distinct degrees of freedom",
        [](json& job) {
          job["analysis"]["frequencies"] = {{"signals", {0, 0}}};
        }},
@@ -344,7 +344,7 @@ TEST_CASE("pairs of keys and lists of numbers are checked by their key tables: o
          job["study"]["reference"] = {{"q", {0.5}}, {"p", {0.0}}};
          job["study"]["reference_run"] = {{"scheme", "basic"}, {"steps", {64}}};
        }},
-      {"/study/integrators/0/steps/1", "4, given before", "a step count, an integer from 1 to ",
+      {"/study/integrators/0/steps/1", "4, given before", "a non-empty array of distinct step counts",
        [](json& job) {
          job["study"]["integrators"][0]["steps"] = {4, 4};
        }},
@@ -356,6 +356,39 @@ TEST_CASE("pairs of keys and lists of numbers are checked by their key tables: o
        }},
   };
   check_cases(study, study_cases);
+
+  // Every problem at once: the items a list's rule accepts still meet the reader's own checks.
+  json job = full_run();
+  job["analysis"]["frequencies"] = {{"signals", {-1, 5}}};  // paper1d: one degree of freedom
+  auto issues = issues_of(job);
+  REQUIRE(issues.size() == 2);
+  CHECK(issues[0].path == "/analysis/frequencies/signals/0");
+  CHECK(issues[1].path == "/analysis/frequencies/signals/1");
+  CHECK(issues[1].allowed.find("a degree of freedom from 0 to 0") == 0);
+  job = study;
+  job["study"]["integrators"][0] = {{"scheme", "basic"}, {"dt", {0, -0.1, 0.1}}};
+  issues = issues_of(job);
+  REQUIRE(issues.size() == 2);
+  CHECK(issues[0].path == "/study/integrators/0/dt/0");
+  CHECK(issues[1].path == "/study/integrators/0/dt/1");
+  CHECK(issues[1].allowed == "a non-zero step size of the same sign as /time/t_end");
+  // A broken pair elsewhere in the object does not hide the steps' problems.
+  job = study;
+  job["study"]["dt"] = {-0.1};
+  job["study"]["reference"] = {{"q", {0.5}}, {"p", {0.0}}};
+  job["study"]["reference_run"] = {{"scheme", "basic"}, {"steps", {64}}};
+  job["study"]["integrators"][0].erase("steps");
+  issues = issues_of(job);
+  CHECK(names(issues, "/study/dt/0"));
+  CHECK(names(issues, "/study/reference_run"));
+  // A list over its limit is refused from its size, in one issue, before any item is read.
+  job = full_run();
+  job["initial"] = {{"grid", {{"q", {{{"values", json::array_t(max_initial_states + 1, json("a"))}}}}, {"p", {0.0}}}}};
+  issues = issues_of(job);
+  REQUIRE(issues.size() == 1);
+  CHECK(issues[0].path == "/initial/grid/q/0/values");
+  CHECK(issues[0].found == "1000001 numbers");
+  CHECK(issues[0].allowed == "at most 1000000 numbers");
 }
 
 TEST_CASE("scheme auto's tolerance range is its key table's, in the schema and in the reader") {

@@ -65,9 +65,9 @@ std::shared_ptr<const Indicator> read_frequencies(Checker& check, const json& va
   if (const auto k = keys.integer("every")) every = static_cast<std::uint64_t>(*k);
   if (const auto m = keys.integer("spectra")) spectra = static_cast<std::size_t>(*m);
   const std::string degrees = dimension > 0 ? "from 0 to " + std::to_string(dimension - 1) : "below the dimension";
-  if (const auto signals = keys.integers("signals")) {  // distinct integers >= 0 by the table
-    for (std::size_t i = 0; i < signals->size(); ++i) {
-      const auto degree = static_cast<std::size_t>((*signals)[i]);
+  if (keys.given("signals")) {  // distinct integers >= 0 by the table; each below the dimension here
+    for (const auto& [i, item] : keys.accepted_items("signals")) {
+      const auto degree = static_cast<std::size_t>(*integral_value(*item));
       if (dimension > 0 && degree >= dimension)
         check.issue(child(keys.path("signals"), i), std::to_string(degree),
                     "a degree of freedom " + degrees + " (numbered from 0)");

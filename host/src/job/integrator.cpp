@@ -8,7 +8,6 @@
 
 #include "job_keys.hpp"
 #include "nonsep/core/base/error.hpp"
-#include "nonsep/host/number_format.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {

@@ -144,7 +144,7 @@ const KeyTable& run_time_keys() {
            .description = "Number of steps of exactly dt."},
       },
       {{KeyPair::Kind::exactly_one, "t_end", "steps",
-        "either \"t_end\" (the time to end at) or \"steps\" (the number of steps of dt), not both"}}};
+        "exactly one of \"t_end\" (the time to end at) and \"steps\" (the number of steps of dt)"}}};
   return table;
 }
 

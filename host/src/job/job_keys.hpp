@@ -33,9 +33,9 @@ enum class ValueType {
   form,         // one of hamiltonian_forms()
   boolean,      // true or false
   choice,       // one of the strings `choices`
-  order,        // a scheme's order: an exact fraction as a string ("4/3") or a positive integer
-  defined,      // a shape of its own, $defs/<definition> of the schema (states, axes, integrators); the lists of
-                // numbers among them (number_list) are checked by the table too
+  order,    // a scheme's order: an exact fraction as a string ("4/3") or an integer (the scheme refuses one it lacks)
+  defined,  // a shape of its own, $defs/<definition> of the schema (states, axes, integrators); the lists of
+            // numbers among them (number_list) are checked by the table too
 };
 
 // The integer ranges the tables share: step counts up to the time grid's limit, ensembles up to the reader's.
@@ -88,8 +88,9 @@ struct KeyTable {
   const KeyRule& operator[](std::string_view name) const;
 };
 
-// A list of numbers of a job file (the ValueType::defined rules of these definitions: "vector", "indices",
-// "step_counts", "step_sizes"): the reader checks each item and the schema writes it under $defs, from here.
+// A list of numbers of a job file (the ValueType::defined rules of these definitions: "vector", "normal", "values",
+// "indices", "step_counts", "step_sizes"): the reader checks its size, each item and distinctness, and the schema
+// writes it under $defs, from here.
 struct NumberList {
   std::string definition;
   ValueType item = ValueType::finite;     // finite, nonzero or integer

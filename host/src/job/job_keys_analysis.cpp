@@ -88,7 +88,7 @@ const KeyTable& poincare_keys() {
           {.name = "normal",
            .type = ValueType::defined,
            .description = "2n numbers, n for q then n for p, not all zero.",
-           .definition = "vector"},
+           .definition = "normal"},
           {.name = "value",
            .type = ValueType::finite,
            .default_value = 0,

@@ -173,7 +173,7 @@ bool KeyReader::valid_list(const json& value, const KeyRule& rule, const NumberL
       check_.issue(child(at, i), describe(item), list.item_allowed);
       ok = false;
     } else if (list.distinct && !seen.insert(*integral_value(item)).second) {
-      check_.issue(child(at, i), describe(item) + ", given before", list.item_allowed);
+      check_.issue(child(at, i), describe(item) + ", given before", rule.allowed.empty() ? list.allowed : rule.allowed);
       ok = false;
     }
   }
@@ -223,6 +223,18 @@ std::optional<bool> KeyReader::boolean(std::string_view key) const {
 std::optional<std::string> KeyReader::string(std::string_view key) const {
   const json* v = value(key);
   return v ? std::optional<std::string>(v->get<std::string>()) : std::nullopt;
+}
+
+std::vector<std::pair<std::size_t, const json*>> KeyReader::accepted_items(std::string_view key) const {
+  const KeyRule& rule = table_[key];
+  const NumberList* list = number_list(rule.definition);
+  std::vector<std::pair<std::size_t, const json*>> items;
+  if (!object_ || !list || !object_->contains(rule.name)) return items;
+  const json& value = (*object_)[rule.name];
+  if (!value.is_array() || value.size() > list->max_items) return items;
+  for (std::size_t i = 0; i < value.size(); ++i)
+    if (accepted_item(value[i], *list)) items.emplace_back(i, &value[i]);
+  return items;
 }
 
 std::optional<std::vector<double>> KeyReader::numbers(std::string_view key) const {

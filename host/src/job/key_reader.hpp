@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "job_keys.hpp"
@@ -38,6 +39,9 @@ class KeyReader {
   // The checked items of a list of numbers (number_list): every item, or nothing when absent or refused.
   std::optional<std::vector<double>> numbers(std::string_view key) const;
   std::optional<std::vector<std::int64_t>> integers(std::string_view key) const;  // integer items
+  // The items of a list of numbers that its item rule accepts, with their index, whether or not the list as a whole
+  // was (for the checks a reader adds on each item: every problem at once); none when absent or not a list.
+  std::vector<std::pair<std::size_t, const json*>> accepted_items(std::string_view key) const;
   // Whether the table's pairs of keys held (each broken pair is an issue).
   bool pairs_hold() const { return pairs_hold_; }
   // The JSON Pointer of `key`.

@@ -15,23 +15,24 @@ namespace {
 // given or a value is refused. The table allows at most one of them. `from` is set to `from_prefix` + the key used.
 std::optional<std::vector<std::uint64_t>> read_steps_or_dt(Checker& check, const KeyReader& keys, double t_end,
                                                            std::string& from, const std::string& from_prefix) {
-  if (!keys.pairs_hold()) return std::nullopt;
+  if (keys.given("steps") && keys.given("dt")) return std::nullopt;  // the table's pair says so
   std::vector<std::uint64_t> result;
   if (const auto counts = keys.integers("steps")) {
     for (const std::int64_t n : *counts) result.push_back(static_cast<std::uint64_t>(n));
     from = from_prefix + "steps";
-  } else if (const auto sizes = keys.numbers("dt")) {
+  } else if (keys.given("dt")) {
+    // Each size the table accepts is held to t_end's sign and turned into a count, whether or not another was
+    // refused (every problem at once).
     from = from_prefix + "dt";
-    bool ok = true;
-    for (std::size_t i = 0; i < sizes->size(); ++i) {
-      const std::string item = child(keys.path("dt"), i);
-      const double dt = (*sizes)[i];
-      const std::string found = describe(keys.object()["dt"][i]);
+    bool ok = keys.value("dt") != nullptr;
+    for (const auto& [i, item] : keys.accepted_items("dt")) {
+      const std::string at = child(keys.path("dt"), i), found = describe(*item);
+      const double dt = item->get<double>();
       if (t_end != 0.0 && !(t_end / dt > 0.0)) {
-        check.issue(item, found, "a non-zero step size of the same sign as /time/t_end");
+        check.issue(at, found, "a non-zero step size of the same sign as /time/t_end");
         ok = false;
       } else if (t_end != 0.0) {
-        const auto steps = step_count(check, t_end, dt, item, found + " to /time/t_end");
+        const auto steps = step_count(check, t_end, dt, at, found + " to /time/t_end");
         if (steps) result.push_back(*steps);
         ok = ok && steps.has_value();
       }
