@@ -1,8 +1,8 @@
 // Formula models through the `nonsep` executable: malformed formulas exit 2 with a column pointer from
 // `nonsep validate` (which compiles nothing); a formula model compiled by the real compiler gives the states of the
-// hand-written paper1d plugin (the one real compile of these tests); the cache's mechanics with a stand-in compiler
-// that copies the shipped paper1d.so (reuse, two runs compiling at once, a damaged entry, an unwritable cache,
-// no compiler, a failing compiler); `nonsep model compile`.
+// hand-written paper1d plugin; a cached plugin's kernel sets, unpinned and pinned; the cache's mechanics with a
+// stand-in compiler that copies the shipped paper1d.so (reuse, two runs compiling at once, a damaged entry, an
+// unwritable cache, no compiler, a failing compiler); `nonsep model compile`.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -253,6 +253,38 @@ TEST_CASE("formula commands: paper1d written as one H gives the product-form plu
   INFO("inspect: " << check.out << check.err);
   CHECK(check.status == 0);
   CHECK(contains(check.out, "derivative check passed"));
+}
+
+TEST_CASE(
+    "formula commands: a cached plugin has the kernel set the host uses here, and pinned to x86-64 one of its own") {
+  TemporaryFolder folder;
+  Environment cache("NONSEP_CACHE_DIR", (folder / "cache").string());
+  const auto file = write_job(folder / "job.json", job_with({{"formula", paper1d_formula("paper1d_k")}}));
+  const auto run = [&](const std::string& name, const std::string& pin) {
+    Environment set("NONSEP_INSTRUCTION_SET", pin);  // "" as unset
+    // Compiles take seconds on an idle machine and minutes on a loaded one: a generous limit, not a timing.
+    const auto ran =
+        finish(start_nonsep({"run", "--quiet", "-o", (folder / name).string(), file.string()}, folder.path()),
+               std::chrono::seconds(900));
+    INFO(name << " stderr: " << ran.err);
+    REQUIRE(ran.status == 0);
+    return json::parse(read_text(folder / name / "summary.json"));
+  };
+  // Unpinned: the plugin carries the set its runs use and, when that is a wider one, not the baseline, which the
+  // host would never take on this machine.
+  const json chosen = run("chosen", "")["stepping"];
+  REQUIRE(chosen["path"] == "kernel");
+  CHECK(chosen["plugin_kernels"] == json::array({chosen["instruction_set"]}));
+  // Pinned to the baseline: another cache entry (the flags are part of its key), with the baseline kernel, whose
+  // steps are the evaluation path's bit for bit.
+  const json baseline = run("baseline", "x86-64")["stepping"];
+  CHECK(baseline["instruction_set"] == "x86-64");
+  CHECK(baseline["plugin_kernels"][0] == "x86-64");
+  run("evaluation", "evaluation");
+  CHECK(read_text(folder / "baseline" / "trajectories.csv") == read_text(folder / "evaluation" / "trajectories.csv"));
+  std::size_t entries = 0;
+  for (const auto& entry : fs::directory_iterator(folder / "cache" / "formula")) entries += entry.is_directory();
+  CHECK(entries == (chosen["instruction_set"] == "x86-64" ? 1u : 2u));
 }
 
 TEST_CASE("formula commands: every function compiles, and the gradients written from the trees pass the check") {

@@ -33,7 +33,7 @@ int command_model_compile(const ModelCompileArguments& arguments) {
     return to_int(ExitStatus::success);
   }
   try {
-    const auto toolchain = formula::find_toolchain();
+    const auto toolchain = formula::find_toolchain(formula::PluginUse::share);
     const auto start = std::chrono::steady_clock::now();
     formula::compile_plugin(formula::cpp_source(*model), toolchain, output);
     char seconds[32];

@@ -159,7 +159,7 @@ std::string cache_key(const std::string& source, const Toolchain& toolchain) {
 }
 
 CachedPlugin cached_plugin(const FormulaModel& model, const std::function<void(const std::string&)>& say) {
-  const Toolchain toolchain = find_toolchain();
+  const Toolchain toolchain = find_toolchain(PluginUse::cache);
   const std::string source = cpp_source(model);
   CachedPlugin result;
   result.key = cache_key(source, toolchain);

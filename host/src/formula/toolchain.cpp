@@ -74,7 +74,7 @@ std::string header_hash(const std::vector<fs::path>& folders) {
 
 }  // namespace
 
-Toolchain find_toolchain() {
+Toolchain find_toolchain(PluginUse use) {
   const auto data = data_directory();
   const fs::path file = data ? *data / "formula" / "toolchain.json" : fs::path();
   std::error_code error;
@@ -114,14 +114,16 @@ Toolchain find_toolchain() {
   const fs::path resolved = fs::canonical(*compiler, error);
   toolchain.identity = (error ? compiler->string() : resolved.string()) + "\n" + version.output;
   toolchain.header_hash = header_hash(toolchain.include_directories);
-  for (const auto& flag : kernel_flags()) toolchain.flags.push_back(flag);
+  for (const auto& flag : kernel_flags(use)) toolchain.flags.push_back(flag);
   return toolchain;
 }
 
-std::vector<std::string> kernel_flags() {
+std::vector<std::string> kernel_flags(PluginUse use) {
   const std::string set = instruction_set_to_use({"x86-64", "x86-64-v3", "x86-64-v4"});
   const int bits = set == "x86-64-v3" ? 1 : set == "x86-64-v4" ? 2 : 0;
-  return {"-DNONSEP_SDK_WIDE_KERNEL_SETS=" + std::to_string(bits)};
+  std::vector<std::string> flags{"-DNONSEP_SDK_WIDE_KERNEL_SETS=" + std::to_string(bits)};
+  if (use == PluginUse::cache && bits != 0) flags.push_back("-DNONSEP_SDK_BASELINE_KERNELS=0");
+  return flags;
 }
 
 }  // namespace nonsep::host::formula

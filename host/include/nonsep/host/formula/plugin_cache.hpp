@@ -44,11 +44,18 @@ struct Toolchain {
   std::string header_hash;  // the content hash of the nonsep headers a formula plugin includes, part of the key
 };
 
-// The toolchain of this executable; throws FormulaCompileError when there is no compiler or no SDK headers.
-Toolchain find_toolchain();
+// Where a formula plugin will run: `cache`, on this machine only (the formula cache, whose key holds the flags);
+// `share`, anywhere (`nonsep model compile -o`).
+enum class PluginUse { cache, share };
 
-// The flags choosing the formula plugin's kernels (-DNONSEP_SDK_WIDE_KERNEL_SETS=...).
-std::vector<std::string> kernel_flags();
+// The toolchain of this executable for plugins of that use; throws FormulaCompileError when there is no compiler or
+// no SDK headers.
+Toolchain find_toolchain(PluginUse use);
+
+// The flags choosing the formula plugin's kernels: the set the host uses here (-DNONSEP_SDK_WIDE_KERNEL_SETS=...),
+// beside the baseline, which a cached plugin leaves out when that set is a wider one
+// (-DNONSEP_SDK_BASELINE_KERNELS=0: the host would never run it here).
+std::vector<std::string> kernel_flags(PluginUse use);
 
 // Compiles `source` into the plugin `output`: in a fresh folder .nonsep-compile-<unique> beside it (removed
 // afterwards, and by the compiler's guard when nonsep dies, with the folders `abandon`), then renamed to `output`.

@@ -18,7 +18,10 @@
 // defined): its baseline uses that processor's vectors, and GCC inlines nothing compiled for one processor into a
 // function of another arch, so a wider kernel there would call the model's gradients out of line.
 // NONSEP_SDK_WIDE_KERNEL_SETS (default 3) chooses the wider sets compiled, as bits: 1 for x86-64-v3, 2 for x86-64-v4, 0
-// for none (each costs compile time; formula models compile the one the host uses).
+// for none (each costs compile time; formula models compile the one the host uses). NONSEP_SDK_BASELINE_KERNELS 0
+// leaves the baseline kernels out when a wider set is compiled (a formula model's cached plugin, which runs only on
+// the machine that compiled it, where the host takes the wider set: about a sixth of its compile time); the
+// metadata then names the wider set alone, and NONSEP_INSTRUCTION_SET=x86-64 compiles a plugin of its own.
 //
 // Kernel units: the wider sets' kernels may be compiled in translation units of their own, in parallel with the rest
 // of the plugin (nonsep_add_model does so for a one-file plugin; the plugin is the same, built in about half the wall
@@ -63,6 +66,11 @@ namespace nonsep::sdk {
 #define NONSEP_SDK_KERNEL_V3 0
 #define NONSEP_SDK_KERNEL_V4 0
 #endif
+#ifndef NONSEP_SDK_BASELINE_KERNELS
+#define NONSEP_SDK_BASELINE_KERNELS 1
+#endif
+// Whether the plugin has the baseline kernels: unless left out, and always when it has no wider set.
+#define NONSEP_SDK_KERNEL_BASELINE (NONSEP_SDK_BASELINE_KERNELS || !(NONSEP_SDK_KERNEL_V3 || NONSEP_SDK_KERNEL_V4))
 // Whether this unit compiles the kernel bodies of v3 (v4), or calls another unit's.
 #define NONSEP_SDK_KERNEL_V3_HERE (NONSEP_SDK_KERNEL_V3 && !(NONSEP_SDK_SEPARATE_KERNEL_UNITS & 1))
 #define NONSEP_SDK_KERNEL_V4_HERE (NONSEP_SDK_KERNEL_V4 && !(NONSEP_SDK_SEPARATE_KERNEL_UNITS & 2))
@@ -72,7 +80,9 @@ void kernel_unit_2(const void* adapter, const ChinStepsCall& call);
 void tangent_kernel_unit_1(const void* adapter, const ChinTangentStepsCall& call);
 void tangent_kernel_unit_2(const void* adapter, const ChinTangentStepsCall& call);
 inline constexpr std::string_view kernel_instruction_sets[] = {
+#if NONSEP_SDK_KERNEL_BASELINE
     "x86-64",
+#endif
 #if NONSEP_SDK_KERNEL_V3
     "x86-64-v3",
 #endif
@@ -135,10 +145,12 @@ struct ChinKernels {
     return false;
 #else
     std::size_t set = 0;
+#if NONSEP_SDK_KERNEL_BASELINE
     if (index == set++) {
       tangent_baseline(adapter, call);
       return true;
     }
+#endif
 #if NONSEP_SDK_KERNEL_V3
     if (index == set++) {
 #if NONSEP_SDK_KERNEL_V3_HERE
@@ -166,10 +178,12 @@ struct ChinKernels {
   static bool run(std::size_t index, const Adapter& adapter, const ChinStepsCall& call) {
     const bool expansion = !call.weights.empty();
     std::size_t set = 0;
+#if NONSEP_SDK_KERNEL_BASELINE
     if (index == set++) {
       expansion ? baseline<true>(adapter, call) : baseline<false>(adapter, call);
       return true;
     }
+#endif
 #if NONSEP_SDK_KERNEL_V3
     if (index == set++) {
 #if NONSEP_SDK_KERNEL_V3_HERE
