@@ -381,6 +381,21 @@ TEST_CASE("pairs of keys and lists of numbers are checked by their key tables: o
   issues = issues_of(job);
   CHECK(names(issues, "/study/dt/0"));
   CHECK(names(issues, "/study/reference_run"));
+  // An unknown scheme is one issue per entry: no default label to clash, no steps asked for.
+  job = study;
+  job["study"]["integrators"] = {{{"scheme", "rk4"}, {"steps", {10}}}, {{"scheme", "rk45"}}};
+  issues = issues_of(job);
+  REQUIRE(issues.size() == 2);
+  CHECK(issues[0].path == "/study/integrators/0/scheme");
+  CHECK(issues[1].path == "/study/integrators/1/scheme");
+  CHECK(issues[0].allowed.find("auto") == std::string::npos);  // a study's integrators cannot be chosen
+  // A run's integrator may be "auto": its message says so.
+  job = full_run();
+  job["integrator"] = {{"scheme", "rk4"}};
+  issues = issues_of(job);
+  REQUIRE(issues.size() == 1);
+  CHECK(issues[0].path == "/integrator/scheme");
+  CHECK(issues[0].allowed.ends_with("\"gauss\" or \"auto\""));
   // A list over its limit is refused from its size, in one issue, before any item is read.
   job = full_run();
   job["initial"] = {{"grid", {{"q", {{{"values", json::array_t(max_initial_states + 1, json("a"))}}}}, {"p", {0.0}}}}};

@@ -43,7 +43,11 @@ const Scheme* named_scheme(const json& integrator) {
 // range the core checks), then `extra`'s keys and pairs.
 KeyTable integrator_keys(const Scheme* scheme, const KeyTable* extra) {
   KeyTable table;
-  KeyRule name{.name = "scheme", .type = ValueType::choice, .required = true, .allowed = "one of " + scheme_names()};
+  // A run's integrator (no extra keys) may also be "auto" (read before this table: read_integrator).
+  KeyRule name{.name = "scheme",
+               .type = ValueType::choice,
+               .required = true,
+               .allowed = "one of " + scheme_names() + (extra ? "" : " or \"auto\"")};
   for (const auto& entry : scheme_catalogue()) name.choices.push_back(entry.name);
   table.rules.push_back(std::move(name));
   for (const auto& parameter : options_of(scheme)) {

@@ -48,6 +48,8 @@ class IntegratorReader {
   IntegratorReader(const IntegratorReader&) = delete;  // its KeyReader refers to its table
   IntegratorReader& operator=(const IntegratorReader&) = delete;
   const IntegratorSpec& spec() const { return spec_; }
+  // Whether the object names a scheme of the catalogue (else spec() is no scheme's, and an issue says so).
+  bool scheme_known() const { return scheme_ != nullptr; }
   const KeyReader& keys() const { return keys_; }
 
  private:

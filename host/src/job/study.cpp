@@ -88,7 +88,9 @@ Study read_study(Checker& check, const json& study_value, HamiltonianForm form, 
     const IntegratorReader reader(check, (*list)[i], item, form, &study_integrator_keys(),
                                   "an integrator {\"scheme\": ..., options, \"label\", \"steps\" or \"dt\"}");
     const KeyReader& entry = reader.keys();
-    if (!entry.is_object()) continue;
+    // An entry that is no object or names no scheme of the catalogue has its issue; its label and steps would only
+    // repeat it (an unknown scheme's spec is no scheme's: two of them would share a default label).
+    if (!entry.is_object() || !reader.scheme_known()) continue;
     StudyIntegrator integrator;
     integrator.spec = reader.spec();
     integrator.label = entry.string("label").value_or(default_label(integrator.spec));
