@@ -93,13 +93,11 @@ struct KeyTable {
 // writes it under $defs, from here.
 struct NumberList {
   std::string definition;
-  ValueType item = ValueType::finite;     // finite, nonzero or integer
-  std::int64_t minimum = 0, maximum = 0;  // integer items
-  std::size_t max_items = 0;              // more is refused before the items are read
-  bool distinct = false;                  // each value once
-  std::string description = {};           // for the schema
-  std::string allowed = {};               // the list as a whole, for messages
-  std::string item_allowed = {};          // one item, for messages
+  KeyRule item;                  // one item: its type (finite, nonzero or integer), range and message
+  std::size_t max_items = 0;     // more is refused before the items are read
+  bool distinct = false;         // each value once
+  std::string description = {};  // for the schema
+  std::string allowed = {};      // the list as a whole, for messages
 };
 // The list described for `definition`, or nullptr when that definition is not a list of numbers.
 const NumberList* number_list(std::string_view definition);

@@ -36,6 +36,7 @@ schema_json forms() {
 }
 
 schema_json object_schema(const KeyTable& table, const std::string& description = "");
+schema_json value_schema(const KeyRule& rule);
 
 // A table's pairs of keys: exactly one of two (oneOf, one per object), not both (dependentSchemas), both or neither
 // (dependentRequired).
@@ -57,14 +58,9 @@ void add_pairs(schema_json& schema, const std::vector<KeyPair>& pairs) {
 
 // A list of numbers (number_list), under $defs.
 schema_json list_schema(const NumberList& list) {
-  schema_json item;
-  if (list.item == ValueType::integer)
-    item = {{"type", "integer"}, {"minimum", list.minimum}, {"maximum", list.maximum}};
-  else
-    item = ref(list.item == ValueType::nonzero ? "nonzero" : "finite");
   schema_json schema = {{"type", "array"}, {"minItems", 1}, {"maxItems", list.max_items}};
   if (list.distinct) schema["uniqueItems"] = true;
-  schema["items"] = std::move(item);
+  schema["items"] = value_schema(list.item);
   if (!list.description.empty()) schema["description"] = list.description;
   return schema;
 }

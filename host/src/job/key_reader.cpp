@@ -132,17 +132,6 @@ bool accepted(const json& value, const KeyRule& rule) {
   return true;
 }
 
-// One item of a list of numbers.
-bool accepted_item(const json& item, const NumberList& list) {
-  if (list.item == ValueType::integer) {
-    const auto x = integral_value(item);
-    return x && *x >= list.minimum && *x <= list.maximum;
-  }
-  if (!item.is_number()) return false;
-  const double x = item.get<double>();
-  return std::isfinite(x) && (list.item != ValueType::nonzero || x != 0.0);
-}
-
 }  // namespace
 
 std::optional<Fraction> order_value(const json& value) {
@@ -169,8 +158,8 @@ bool KeyReader::valid_list(const json& value, const KeyRule& rule, const NumberL
   std::unordered_set<std::int64_t> seen;
   for (std::size_t i = 0; i < value.size(); ++i) {
     const json& item = value[i];
-    if (!accepted_item(item, list)) {
-      check_.issue(child(at, i), describe(item), list.item_allowed);
+    if (!accepted(item, list.item)) {
+      check_.issue(child(at, i), describe(item), allowed_text(list.item));
       ok = false;
     } else if (list.distinct && !seen.insert(*integral_value(item)).second) {
       check_.issue(child(at, i), describe(item) + ", given before", rule.allowed.empty() ? list.allowed : rule.allowed);
@@ -233,7 +222,7 @@ std::vector<std::pair<std::size_t, const json*>> KeyReader::accepted_items(std::
   const json& value = (*object_)[rule.name];
   if (!value.is_array() || value.size() > list->max_items) return items;
   for (std::size_t i = 0; i < value.size(); ++i)
-    if (accepted_item(value[i], *list)) items.emplace_back(i, &value[i]);
+    if (accepted(value[i], list->item)) items.emplace_back(i, &value[i]);
   return items;
 }
 
