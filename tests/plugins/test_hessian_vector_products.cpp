@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,24 +19,19 @@
 #include "nonsep/derivative_checker.hpp"
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/reference/hamiltonian_flow.hpp"
+#include "support/random_points.hpp"
 
 using nonsep::host::load_plugin;
 using nonsep::host::PluginModel;
 using nonsep::sdk::Derivatives;
 using nonsep::sdk::ModelAdapter;
 
+using nonsep::testing::random_points;
+
 namespace {
 
 PluginModel shipped(const std::string& name, const nlohmann::json& parameters = nlohmann::json::object()) {
   return load_plugin(std::string(NONSEP_BUILD_PLUGIN_DIR) + "/" + name + ".so", "").create(parameters);
-}
-
-std::vector<double> random_points(std::size_t size, double box, unsigned seed) {
-  std::mt19937_64 engine(seed);
-  std::uniform_real_distribution<double> uniform(-box, box);
-  std::vector<double> x(size);
-  for (double& xi : x) xi = uniform(engine);
-  return x;
 }
 
 // |a - b| <= tolerance max(1, |b|) for every entry.

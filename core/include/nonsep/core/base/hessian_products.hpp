@@ -13,6 +13,9 @@
 //   TTV: g = grad T(p), w = Hess V(q) g:   H = g . w,   dH/dp = 2 Hess T(p) w,   dH/dq = d3V(q, g)
 //   VVT: g = grad V(q), w = Hess T(p) g:   H = g . w,   dH/dq = 2 Hess V(q) w,   dH/dp = d3T(p, g)
 // (the same formulas as energy.hpp and hamiltonian_gradient.hpp, with each matrix met only as its product).
+// A model may also give the inner product w with the third derivatives along the same g, in one call whose numbers
+// are those of the two apart (nonsep::ModelWithThirdAndProduct: the SDK's automatic derivatives compute both in one
+// pass); the gradient of H then takes it.
 #include <algorithm>
 #include <concepts>
 #include <cstddef>
@@ -29,6 +32,16 @@ concept ModelWithHessianProducts = Model<M> &&
              std::size_t count) {
   m.hvp_T(x, v, out, count);
   m.hvp_V(x, v, out, count);
+};
+
+// For spans x, u (size count*n, read) and out, product (size count*n, written):
+//   m.d3V_with_product(q, u, out, product, count)   out = d3V(q, u), product = Hess V(q) u, at each position
+//   m.d3T_with_product(p, u, out, product, count)   the same for T at each momentum
+template <class M>
+concept ModelWithThirdAndProduct = requires(const M& m, std::span<const double> x, std::span<const double> u,
+                                            std::span<double> out, std::size_t count) {
+  m.d3V_with_product(x, u, out, out, count);
+  m.d3T_with_product(x, u, out, out, count);
 };
 
 // Whether `model` evaluates Hessian-vector products (its type has them and, where it says, the object too).
@@ -90,6 +103,23 @@ requires ModelWithHessianProducts<M> && ModelWithThirdDerivatives<M>
 void hamiltonian_gradient_by_products(const M& model, HamiltonianForm form, std::span<const double> q,
                                       std::span<const double> p, std::span<double> dH_dq, std::span<double> dH_dp,
                                       std::size_t count, HessianProductScratch& scratch) {
+  if constexpr (ModelWithThirdAndProduct<M>) {
+    const std::size_t size = count * static_cast<std::size_t>(model.dimension());
+    scratch.resize(size);
+    const std::span<double> g(scratch.gradient.data(), size), w(scratch.product.data(), size);
+    if (form == HamiltonianForm::TTV) {
+      model.grad_T(p, g, count);
+      model.d3V_with_product(q, g, dH_dq, w, count);
+      model.hvp_T(p, w, dH_dp, count);
+      for (double& x : dH_dp) x *= 2.0;
+    } else {
+      model.grad_V(q, g, count);
+      model.d3T_with_product(p, g, dH_dp, w, count);
+      model.hvp_V(q, w, dH_dq, count);
+      for (double& x : dH_dq) x *= 2.0;
+    }
+    return;
+  }
   inner_hessian_product(model, form, q, p, count, scratch);
   const std::span<const double> g(scratch.gradient), w(scratch.product);
   if (form == HamiltonianForm::TTV) {

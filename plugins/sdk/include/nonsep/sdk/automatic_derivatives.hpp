@@ -11,11 +11,14 @@
 //                               d^2/ds dt f(x + (s + t) u) with its gradient in x inside. 4 (K+1) doubles per
 //                               number: cheaper than differencing n Hessian passes, and no Hessian is formed.
 //   hessian_vector_by_dual      out = H(x) v, one column pass of hessian_by_dual with the outer slot seeded with v
-//                               instead of e_j: the cost of a single Hessian column.
+//                               instead of e_j: the cost of a single Hessian column (and grad f alongside, on
+//                               request).
 //   mixed_third_by_dual         out_k = sum_ij f_kij(x) a_i b_j, one pass of ThirdDerivativeDual<K> with the outer
 //                               slots seeded with a and b
 //   mixed_fourth_by_dual        out_k = sum_ijl f_kijl(x) a_i b_j c_l, one pass of FourthDerivativeDual<K> with the
 //                               three outer slots seeded with a, b and c: 8 (K+1) doubles per number
+// The mixed passes also give, on request, the lower derivatives they compute alongside and take a seed of their
+// second-order slots (MixedPassExtras, below): hvp_H forms its sums of third and fourth derivatives that way.
 // Each returns f(x) (the value computed alongside). The adapter's gradients drop it, so that once inlined the work
 // only the value needs is dead code (dual.hpp's derivative rules carry the domains); the other passes give it to
 // poison_if_not_finite.
@@ -30,6 +33,7 @@
 //   mixed_third_by_gradient         out_k = sum_ij f_kij a_i b_j, the same pass with the slots seeded with a and b
 //   mixed_fourth_by_gradient        out_k = sum_ijl f_kijl a_i b_j c_l, one pass of g on
 //                                   Dual<Dual<Dual<double, 1>, 1>, 1> seeded with a, b and c: O(n) for a sparse g
+//                                   (both mixed passes with MixedPassExtras as above)
 // These return nothing (g gives no value); the callers poison their results by the value of f where they need to.
 #include <array>
 #include <cmath>
@@ -66,8 +70,21 @@ inline void poison_if_not_finite(double value, double* out, std::size_t size) {
   for (std::size_t i = 0; i < size; ++i) out[i] = finite ? out[i] : std::numeric_limits<double>::quiet_NaN();
 }
 
+// What a mixed pass (mixed_third_*, mixed_fourth_*) takes and gives beyond its main result, so that hvp_H
+// (model_adapter.hpp) gets several derivatives from one pass; a null pointer is a zero seed or a result not wanted.
+//   seed      s in the second-order slots: e1 e2 of a third-derivative pass, which adds f'' s to its result; e1 e3
+//             and e2 e3 of a fourth, which adds f'''[a, s] + f'''[b, s]
+//   along_a   f'' a (either pass);  along_b   f'' b (a third-derivative pass)
+//   lower     f'''[b, c] + f'' s (a fourth-derivative pass: its e2 e3 part)
+struct MixedPassExtras {
+  const double* seed = nullptr;
+  double* along_a = nullptr;
+  double* along_b = nullptr;
+  double* lower = nullptr;
+};
+
 template <std::size_t K, class F>
-double gradient_by_dual(const F& f, const double* x, std::size_t n, double* out) {
+NONSEP_SDK_DUAL_INLINE double gradient_by_dual(const F& f, const double* x, std::size_t n, double* out) {
   using D = GradientDual<K>;
   std::array<D, K> xs;
   for (std::size_t i = 0; i < n; ++i) xs[i] = D::variable(x[i], i);
@@ -93,7 +110,8 @@ double hessian_by_dual(const F& f, const double* x, std::size_t n, double* out) 
 }
 
 template <std::size_t K, class F>
-double mixed_third_by_dual(const F& f, const double* x, const double* a, const double* b, std::size_t n, double* out) {
+NONSEP_SDK_DUAL_INLINE double mixed_third_by_dual(const F& f, const double* x, const double* a, const double* b,
+                                                  std::size_t n, double* out, const MixedPassExtras& extras = {}) {
   using Inner = Dual<double, K>;
   using Middle = Dual<Inner, 1>;
   using D = ThirdDerivativeDual<K>;
@@ -102,9 +120,14 @@ double mixed_third_by_dual(const F& f, const double* x, const double* a, const d
     xs[i].value.value = Inner::variable(x[i], i);
     xs[i].value.derivative[0] = Inner(a[i]);
     xs[i].derivative[0] = Middle(b[i]);
+    if (extras.seed != nullptr) xs[i].derivative[0].derivative[0] = Inner(extras.seed[i]);  // e1 e2
   }
   const D y = f(Vector<D>(xs.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[k];
+  if (extras.along_a != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.along_a[k] = y.value.derivative[0].derivative[k];
+  if (extras.along_b != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.along_b[k] = y.derivative[0].value.derivative[k];
   return y.value.value.value;
 }
 
@@ -114,8 +137,9 @@ double directional_third_by_dual(const F& f, const double* x, const double* u, s
 }
 
 template <std::size_t K, class F>
-double mixed_fourth_by_dual(const F& f, const double* x, const double* a, const double* b, const double* c,
-                            std::size_t n, double* out) {
+NONSEP_SDK_DUAL_INLINE double mixed_fourth_by_dual(const F& f, const double* x, const double* a, const double* b,
+                                                   const double* c, std::size_t n, double* out,
+                                                   const MixedPassExtras& extras = {}) {
   using Inner = Dual<double, K>;
   using Second = Dual<Inner, 1>;
   using Third = ThirdDerivativeDual<K>;
@@ -126,14 +150,23 @@ double mixed_fourth_by_dual(const F& f, const double* x, const double* a, const 
     xs[i].value.value.derivative[0] = Inner(a[i]);
     xs[i].value.derivative[0] = Second(b[i]);
     xs[i].derivative[0] = Third(c[i]);
+    if (extras.seed != nullptr) {
+      xs[i].derivative[0].value.derivative[0] = Inner(extras.seed[i]);  // e1 e3
+      xs[i].derivative[0].derivative[0].value = Inner(extras.seed[i]);  // e2 e3
+    }
   }
   const D y = f(Vector<D>(xs.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = y.derivative[0].derivative[0].derivative[0].derivative[k];
+  if (extras.along_a != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.along_a[k] = y.value.value.derivative[0].derivative[k];
+  if (extras.lower != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.lower[k] = y.derivative[0].derivative[0].value.derivative[k];
   return y.value.value.value.value;
 }
 
 template <std::size_t K, class F>
-double hessian_vector_by_dual(const F& f, const double* x, const double* v, std::size_t n, double* out) {
+NONSEP_SDK_DUAL_INLINE double hessian_vector_by_dual(const F& f, const double* x, const double* v, std::size_t n,
+                                                     double* out, double* gradient = nullptr) {
   using Inner = Dual<double, K>;
   using D = HessianDual<K>;
   std::array<D, K> xs;
@@ -143,6 +176,8 @@ double hessian_vector_by_dual(const F& f, const double* x, const double* v, std:
   }
   const D y = f(Vector<D>(xs.data(), n));
   for (std::size_t i = 0; i < n; ++i) out[i] = y.derivative[0].derivative[i];
+  if (gradient != nullptr)  // grad f, computed alongside
+    for (std::size_t i = 0; i < n; ++i) gradient[i] = y.value.derivative[i];
   return y.value.value;
 }
 
@@ -161,7 +196,8 @@ struct GradientScratch {
 };
 
 template <class G>
-void hessian_vector_by_gradient(const G& gradient, const double* x, const double* v, std::size_t n, double* out) {
+NONSEP_SDK_DUAL_INLINE void hessian_vector_by_gradient(const G& gradient, const double* x, const double* v,
+                                                       std::size_t n, double* out) {
   using D = Dual<double, 1>;
   auto& scratch = GradientScratch<D>::of_size(n);
   for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(x[i], {v[i]});
@@ -181,7 +217,8 @@ void hessian_by_gradient(const G& gradient, const double* x, std::size_t n, doub
 }
 
 template <class G>
-void directional_third_by_gradient(const G& gradient, const double* x, const double* u, std::size_t n, double* out) {
+NONSEP_SDK_DUAL_INLINE void directional_third_by_gradient(const G& gradient, const double* x, const double* u,
+                                                          std::size_t n, double* out) {
   using Inner = Dual<double, 1>;
   using D = Dual<Inner, 1>;
   auto& scratch = GradientScratch<D>::of_size(n);
@@ -191,26 +228,40 @@ void directional_third_by_gradient(const G& gradient, const double* x, const dou
 }
 
 template <class G>
-void mixed_third_by_gradient(const G& gradient, const double* x, const double* a, const double* b, std::size_t n,
-                             double* out) {
+NONSEP_SDK_DUAL_INLINE void mixed_third_by_gradient(const G& gradient, const double* x, const double* a,
+                                                    const double* b, std::size_t n, double* out,
+                                                    const MixedPassExtras& extras = {}) {
   using Inner = Dual<double, 1>;
   using D = Dual<Inner, 1>;
   auto& scratch = GradientScratch<D>::of_size(n);
-  for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(Inner(x[i], {a[i]}), {Inner(b[i])});
+  for (std::size_t i = 0; i < n; ++i)  // the e1 e2 slot seeded with s
+    scratch.x[i] = D(Inner(x[i], {a[i]}), {Inner(b[i], {extras.seed != nullptr ? extras.seed[i] : 0.0})});
   gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = scratch.g[k].derivative[0].derivative[0];
+  if (extras.along_a != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.along_a[k] = scratch.g[k].value.derivative[0];
+  if (extras.along_b != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.along_b[k] = scratch.g[k].derivative[0].value;
 }
 
 template <class G>
-void mixed_fourth_by_gradient(const G& gradient, const double* x, const double* a, const double* b, const double* c,
-                              std::size_t n, double* out) {
+NONSEP_SDK_DUAL_INLINE void mixed_fourth_by_gradient(const G& gradient, const double* x, const double* a,
+                                                     const double* b, const double* c, std::size_t n, double* out,
+                                                     const MixedPassExtras& extras = {}) {
   using Inner = Dual<double, 1>;
   using Second = Dual<Inner, 1>;
   using D = Dual<Second, 1>;
   auto& scratch = GradientScratch<D>::of_size(n);
-  for (std::size_t i = 0; i < n; ++i) scratch.x[i] = D(Second(Inner(x[i], {a[i]}), {Inner(b[i])}), {Second(c[i])});
+  for (std::size_t i = 0; i < n; ++i) {
+    const double s = extras.seed != nullptr ? extras.seed[i] : 0.0;  // the e1 e3 and e2 e3 slots
+    scratch.x[i] = D(Second(Inner(x[i], {a[i]}), {Inner(b[i])}), {Second(Inner(c[i], {s}), {Inner(s)})});
+  }
   gradient(Vector<D>(scratch.x.data(), n), std::span<D>(scratch.g.data(), n));
   for (std::size_t k = 0; k < n; ++k) out[k] = scratch.g[k].derivative[0].derivative[0].derivative[0];
+  if (extras.along_a != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.along_a[k] = scratch.g[k].value.value.derivative[0];
+  if (extras.lower != nullptr)
+    for (std::size_t k = 0; k < n; ++k) extras.lower[k] = scratch.g[k].derivative[0].derivative[0].value;
 }
 
 }  // namespace detail

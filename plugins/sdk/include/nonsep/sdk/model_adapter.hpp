@@ -516,6 +516,18 @@ class ModelAdapter {
     }
   }
 
+  // d3T (d3V) and the Hessian-vector product along the same u, from one pass where both are automatic (the pass of
+  // the third derivatives computes the product alongside, with the numbers of hvp_T's own pass): grad H's inner
+  // product and third derivatives (core hessian_products.hpp, ModelWithThirdAndProduct).
+  void d3T_with_product(std::span<const double> p, std::span<const double> u, std::span<double> out,
+                        std::span<double> product, std::size_t count) const requires(!analytic_d3T && !analytic_hvp_T) {
+    third_with_product<true>(p, u, out, product, count);
+  }
+  void d3V_with_product(std::span<const double> q, std::span<const double> u, std::span<double> out,
+                        std::span<double> product, std::size_t count) const requires(!analytic_d3V && !analytic_hvp_V) {
+    third_with_product<false>(q, u, out, product, count);
+  }
+
   // Hessian-vector products, out[b*n + i] = sum_j T_ij(p_b) v[b*n + j] (hvp_T), the same for V in q (hvp_V); v has
   // the layout of p. The model's own product, or one directional pass over the gradient template, or one
   // Hessian-column pass over T or V.
@@ -532,10 +544,11 @@ class ModelAdapter {
 
   // The directional derivative of grad H (plugin_abi.h hvp_H, which writes out the formula): the Hessian of the
   // solved H, K + U included, times the tangent (dq, dp) of each state, into out_q = d(dH/dq), out_p = d(dH/dp); all
-  // six spans in the gradient layout. Per state: the gradient and two Hessian-vector products of the outer function
-  // (T in TTV), two of the inner, one mixed third derivative of each and one mixed fourth of the inner, each one
-  // pass over the gradient templates (O(n) for a sparse model) or over T and V (fewer when dq or dp is zero); plus
-  // K'' dp and U'' dq.
+  // six spans in the gradient layout. Per state three passes, over the gradient templates (O(n) for a sparse model)
+  // or over T and V, each seeded so that it also forms what the formula adds to its result (MixedPassExtras,
+  // automatic_derivatives.hpp): the gradient and a Hessian-vector product of the outer function (T in TTV) in one
+  // pass where it is differentiated automatically, the inner's mixed fourth derivative (third when dq or dp is
+  // zero) with its lower derivatives, the outer's mixed third derivative; plus K'' dp and U'' dq.
   void hvp_H(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<const double> dq,
              std::span<const double> dp, std::span<double> out_q, std::span<double> out_p,
              std::size_t count) const requires has_hamiltonian_hessian {
@@ -544,51 +557,13 @@ class ModelAdapter {
       if (found < size) [[unlikely]]
         throw_bad_batch_sizes(count, dimension_, std::min({q.size(), p.size(), dq.size(), dp.size()}),
                               std::min(out_q.size(), out_p.size()));
+    if (form == HamiltonianForm::TTV)
+      hamiltonian_products<true>(q.data(), p.data(), dq.data(), dp.data(), out_q.data(), out_p.data(), count);
+    else
+      hamiltonian_products<false>(p.data(), q.data(), dp.data(), dq.data(), out_p.data(), out_q.data(), count);
     const std::size_t n = batch_dimension();
-    auto& scratch = detail::GradientScratch<double>::of_size(3 * n);
-    double* g = scratch.x.data();
-    double* dg = g + n;
-    double* w = dg + n;
-    double* third = scratch.g.data();
-    double* sum = third + n;
-    const bool ttv = form == HamiltonianForm::TTV;
     for (std::size_t b = 0; b < count; ++b) {
       const std::size_t at = b * n;
-      // X the outer function (T at p in TTV), Y the inner (V at q), each with its point, tangent and output.
-      const double* x = (ttv ? p : q).data() + at;
-      const double* dx = (ttv ? dp : dq).data() + at;
-      const double* y = (ttv ? q : p).data() + at;
-      const double* dy = (ttv ? dq : dp).data() + at;
-      double* out_x = (ttv ? out_p : out_q).data() + at;
-      double* out_y = (ttv ? out_q : out_p).data() + at;
-      // out_y = Y''''[g, g, dy] + 2 Y'''[g, dg],  out_x = 2 X'''[dx, w] + 2 X'' (Y'''[g, dy] + Y'' dg),  dg = X'' dx,
-      // w = Y'' g. A tangent without an x part (dx = 0: dg = 0) or without a y part skips the passes whose terms
-      // are then zero, with the same numbers: the unit directions Gauss's tangent map forms its Jacobians from
-      // (tangent_gauss_legendre.hpp) take 4 or 7 passes instead of 9.
-      const bool moves_x = std::any_of(dx, dx + n, [](double v) { return v != 0.0; });
-      const bool moves_y = std::any_of(dy, dy + n, [](double v) { return v != 0.0; });
-      gradient_of(ttv, x, g, n);
-      std::fill(out_y, out_y + n, 0.0);
-      std::fill(sum, sum + n, 0.0);
-      if (moves_y) {
-        mixed_fourth_of(!ttv, y, g, g, dy, out_y, n);
-        mixed_third_of(!ttv, y, g, dy, sum, n);
-      }
-      if (moves_x) {
-        product_of(ttv, x, dx, dg, n);
-        mixed_third_of(!ttv, y, g, dg, third, n);
-        for (std::size_t i = 0; i < n; ++i) out_y[i] += 2.0 * third[i];
-        product_of(!ttv, y, dg, third, n);
-        for (std::size_t i = 0; i < n; ++i) sum[i] += third[i];
-      }
-      product_of(ttv, x, sum, out_x, n);
-      if (moves_x) {
-        product_of(!ttv, y, g, w, n);
-        mixed_third_of(ttv, x, dx, w, third, n);
-        for (std::size_t i = 0; i < n; ++i) out_x[i] = 2.0 * (third[i] + out_x[i]);
-      } else {
-        for (std::size_t i = 0; i < n; ++i) out_x[i] = 2.0 * out_x[i];
-      }
       if constexpr (HasK<M>) add_separable_product<true>(p.data() + at, dp.data() + at, out_p.data() + at, n);
       if constexpr (HasU<M>) add_separable_product<false>(q.data() + at, dq.data() + at, out_q.data() + at, n);
     }
@@ -617,47 +592,137 @@ class ModelAdapter {
   }
 
  private:
+  // hvp_H's product term, ttv saying which form: Y the inner function (V at y = q in TTV), X the outer (T at x = p),
+  // each with its tangent and output (out_y = d(dH/dy)); spans of count states in the gradient layout.
+  template <bool ttv>
+  void hamiltonian_products(const double* ys, const double* xs, const double* dys, const double* dxs, double* out_ys,
+                            double* out_xs, std::size_t count) const requires has_hamiltonian_hessian {
+    const std::size_t n = batch_dimension();
+    auto& scratch = detail::GradientScratch<double>::of_size(3 * n);
+    double* g = scratch.x.data();
+    double* dg = g + n;
+    double* w = dg + n;
+    double* sum = scratch.g.data();
+    for (std::size_t b = 0; b < count; ++b) {
+      const std::size_t at = b * n;
+      const double *x = xs + at, *dx = dxs + at, *y = ys + at, *dy = dys + at;
+      double *out_x = out_xs + at, *out_y = out_ys + at;
+      // out_y = Y''''[g, g, dy] + 2 Y'''[g, dg],  out_x = 2 (X'''[dx, w] + X'' sum),  with g = X', dg = X'' dx,
+      // w = Y'' g and sum = Y'''[g, dy] + Y'' dg. A tangent without an x part (dx = 0: dg = 0) takes X'' sum by a
+      // product; one without a y part, Y's third derivatives instead of its fourth (the unit directions Gauss's
+      // tangent map forms its Jacobians from, tangent_gauss_legendre.hpp, are of these two kinds).
+      const bool moves_x = std::any_of(dx, dx + n, [](double v) { return v != 0.0; });
+      const bool moves_y = std::any_of(dy, dy + n, [](double v) { return v != 0.0; });
+      if (!moves_x && !moves_y) {
+        std::fill(out_x, out_x + n, 0.0);
+        std::fill(out_y, out_y + n, 0.0);
+        continue;
+      }
+      gradient_and_product_of<ttv>(x, moves_x ? dx : nullptr, g, dg, n);
+      if (moves_y) {
+        mixed_fourth_of<!ttv>(y, g, g, dy, out_y, n,
+                              {.seed = moves_x ? dg : nullptr, .along_a = w, .along_b = nullptr, .lower = sum});
+      } else {
+        mixed_third_of<!ttv>(y, g, dg, out_y, n, {.seed = nullptr, .along_a = w, .along_b = sum});
+        for (std::size_t i = 0; i < n; ++i) out_y[i] *= 2.0;
+      }
+      if (moves_x)
+        mixed_third_of<ttv>(x, dx, w, out_x, n, {.seed = sum});
+      else
+        product_of<ttv>(x, sum, out_x, n);
+      for (std::size_t i = 0; i < n; ++i) out_x[i] *= 2.0;
+    }
+  }
+  // T (kinetic) or V, for any number type, and its gradient template (where the model has them).
+  template <bool kinetic>
+  auto function_of() const {
+    return [this](auto v) {
+      if constexpr (kinetic)
+        return model_.T(v);
+      else
+        return model_.V(v);
+    };
+  }
+  template <bool kinetic>
+  auto gradient_template_of() const {
+    return [this](auto v, auto g) {
+      if constexpr (kinetic)
+        model_.grad_T(v, g);
+      else
+        model_.grad_V(v, g);
+    };
+  }
   // One state's derivatives of T (kinetic) or V, for hvp_H: the gradient and the Hessian-vector product as grad_T and
   // hvp_T compute them, the mixed third and fourth derivatives by automatic differentiation.
-  void gradient_of(bool kinetic, const double* x, double* out, std::size_t n) const {
-    if (kinetic)
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void gradient_of(const double* x, double* out, std::size_t n) const {
+    if constexpr (kinetic)
       grad_T(std::span<const double>(x, n), std::span<double>(out, n), 1);
     else
       grad_V(std::span<const double>(x, n), std::span<double>(out, n), 1);
   }
-  void product_of(bool kinetic, const double* x, const double* v, double* out, std::size_t n) const {
-    if (kinetic)
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void product_of(const double* x, const double* v, double* out, std::size_t n) const {
+    if constexpr (kinetic)
       hvp_T(std::span<const double>(x, n), std::span<const double>(v, n), std::span<double>(out, n), 1);
     else
       hvp_V(std::span<const double>(x, n), std::span<const double>(v, n), std::span<double>(out, n), 1);
   }
-  void mixed_third_of(bool kinetic, const double* x, const double* a, const double* b, double* out,
-                      std::size_t n) const {
-    if constexpr (differentiates_gradients) {
-      if (kinetic)
-        detail::mixed_third_by_gradient([this](auto v, auto g) { model_.grad_T(v, g); }, x, a, b, n, out);
-      else
-        detail::mixed_third_by_gradient([this](auto v, auto g) { model_.grad_V(v, g); }, x, a, b, n, out);
+  // g = grad X at x and, with a direction dx, dg = X'' dx (else 0): one Hessian-column pass, which gives the
+  // gradient alongside, where X is differentiated over X itself; else the gradient and the product as computed alone.
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void gradient_and_product_of(const double* x, const double* dx, double* g, double* dg,
+                                                      std::size_t n) const {
+    constexpr bool automatic = kinetic ? !analytic_grad_T && !analytic_hvp_T : !analytic_grad_V && !analytic_hvp_V;
+    if (dx == nullptr) {
+      gradient_of<kinetic>(x, g, n);
+      std::fill(dg, dg + n, 0.0);
+    } else if constexpr (automatic && !differentiates_gradients) {
+      detail::poison_if_not_finite(detail::hessian_vector_by_dual<capacity>(function_of<kinetic>(), x, dx, n, dg, g),
+                                   dg, n);
     } else {
-      const double value =
-          kinetic ? detail::mixed_third_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, a, b, n, out)
-                  : detail::mixed_third_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, a, b, n, out);
-      detail::poison_if_not_finite(value, out, n);
+      gradient_of<kinetic>(x, g, n);
+      product_of<kinetic>(x, dx, dg, n);
     }
   }
-  void mixed_fourth_of(bool kinetic, const double* x, const double* a, const double* b, const double* c, double* out,
-                       std::size_t n) const requires has_hamiltonian_hessian {
-    if constexpr (fourth_by_gradients) {
-      if (kinetic)
-        detail::mixed_fourth_by_gradient([this](auto v, auto g) { model_.grad_T(v, g); }, x, a, b, c, n, out);
-      else
-        detail::mixed_fourth_by_gradient([this](auto v, auto g) { model_.grad_V(v, g); }, x, a, b, c, n, out);
-    } else {
-      const double value =
-          kinetic ? detail::mixed_fourth_by_dual<capacity>([this](auto v) { return model_.T(v); }, x, a, b, c, n, out)
-                  : detail::mixed_fourth_by_dual<capacity>([this](auto v) { return model_.V(v); }, x, a, b, c, n, out);
-      detail::poison_if_not_finite(value, out, n);
+  // d3T_with_product (kinetic) or d3V_with_product: the pass of d3T (d3V) with the product taken alongside.
+  template <bool kinetic>
+  void third_with_product(std::span<const double> x, std::span<const double> u, std::span<double> out,
+                          std::span<double> product, std::size_t count) const {
+    check_sizes(x, out, count, dimension_);
+    check_sizes(u, product, count, dimension_);
+    const std::size_t n = batch_dimension();
+    for (std::size_t b = 0; b < count; ++b) {
+      const double* v = u.data() + b * n;
+      mixed_third_of<kinetic>(x.data() + b * n, v, v, out.data() + b * n, n,
+                              {.seed = nullptr, .along_a = product.data() + b * n});
     }
+  }
+  // The mixed passes of hvp_H (automatic_derivatives.hpp, with its extras), of the gradient templates where they
+  // compile for the pass's numbers, else of T (kinetic) or V; their lower results poisoned with the main one.
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void mixed_third_of(const double* x, const double* a, const double* b, double* out,
+                                             std::size_t n, const detail::MixedPassExtras& extras) const {
+    if constexpr (differentiates_gradients)
+      detail::mixed_third_by_gradient(gradient_template_of<kinetic>(), x, a, b, n, out, extras);
+    else
+      poison_pass(detail::mixed_third_by_dual<capacity>(function_of<kinetic>(), x, a, b, n, out, extras), out, extras,
+                  n);
+  }
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void mixed_fourth_of(
+      const double* x, const double* a, const double* b, const double* c, double* out, std::size_t n,
+      const detail::MixedPassExtras& extras) const requires has_hamiltonian_hessian {
+    if constexpr (fourth_by_gradients)
+      detail::mixed_fourth_by_gradient(gradient_template_of<kinetic>(), x, a, b, c, n, out, extras);
+    else
+      poison_pass(detail::mixed_fourth_by_dual<capacity>(function_of<kinetic>(), x, a, b, c, n, out, extras), out,
+                  extras, n);
+  }
+  static void poison_pass(double value, double* out, const detail::MixedPassExtras& extras, std::size_t n) {
+    detail::poison_if_not_finite(value, out, n);
+    for (double* lower : {extras.along_a, extras.along_b, extras.lower})
+      if (lower != nullptr) detail::poison_if_not_finite(value, lower, n);
   }
   // out += K''(x) v (kinetic) or U''(x) v: one directional pass over grad_K (grad_U) where it is a template, else
   // one Hessian-column pass over K (U).
