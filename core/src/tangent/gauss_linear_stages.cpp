@@ -91,7 +91,8 @@ template <std::size_t... M>
 bool dispatch(std::size_t m, std::index_sequence<M...>, const GaussLegendreTableau& tableau, double dt,
               std::span<const double> jacobians, std::size_t d, std::span<double> vectors, std::size_t k) {
   bool finite = true;  // m = 0: nothing to solve
-  ((m == M + 1 && (finite = map_by_linear_stages_of<M + 1>(tableau, dt, jacobians, d, vectors, k), true)) || ...);
+  static_cast<void>(
+      ((m == M + 1 && (finite = map_by_linear_stages_of<M + 1>(tableau, dt, jacobians, d, vectors, k), true)) || ...));
   return finite;
 }
 

@@ -41,8 +41,20 @@
 // The arithmetic of the dual numbers, and the passes of automatic_derivatives.hpp that drive it, are always inlined:
 // left to the compiler, a nested dual's operator*= stayed a call in the model's T and V, and a pass a call from its
 // loop (with its seeds and wanted results unknown inside), which made an AD plugin's MEGNO with Gauss-Legendre 1.4x
-// slower and its build slower too (bench/autodiff_megno.py).
+// slower and its build slower too (bench/autodiff_megno.py). Not forced where nothing is optimised (-O0) or under
+// AddressSanitizer: there the forced inlining buys no speed and made clang's builds of the SDK plugins 20-60% slower
+// (CI's sanitized build).
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define NONSEP_SDK_SANITIZED_ADDRESSES
+#endif
+#endif
+#if defined(__OPTIMIZE__) && !defined(__SANITIZE_ADDRESS__) && !defined(NONSEP_SDK_SANITIZED_ADDRESSES)
 #define NONSEP_SDK_DUAL_INLINE [[gnu::always_inline]] inline
+#else
+#define NONSEP_SDK_DUAL_INLINE inline
+#endif
+#undef NONSEP_SDK_SANITIZED_ADDRESSES
 
 namespace nonsep::sdk {
 
