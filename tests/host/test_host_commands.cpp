@@ -71,7 +71,7 @@ TEST_CASE("validate checks without running, errors go to stderr with exit 2") {
   write_job(file, job);
   result = run_nonsep({"validate", file.string()}, folder.path());
   CHECK(result.status == 2);
-  CHECK(result.err.find("/initial/q: found 1 components") != std::string::npos);
+  CHECK(result.err.find("/initial/q: found 1 component;") != std::string::npos);
 }
 
 TEST_CASE("usage: --version, --help with the schemes, options and exit statuses, usage errors exit 2") {

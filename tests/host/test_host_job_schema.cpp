@@ -237,6 +237,74 @@ TEST_CASE("a misspelt key is named as such, both where it is unknown and where t
   CHECK(issues_of(job).front().found == "the unknown key \"colour\"");
 }
 
+TEST_CASE("a misspelt choice names the value it likely means, a value like none of them no guess") {
+  const auto scheme_found = [](const json& scheme) {
+    json job = host_testing::quickstart_job();
+    job["integrator"] = {{"scheme", scheme}};
+    const auto issues = issues_of(job);
+    REQUIRE(issues.size() == 1);
+    CHECK(issues.front().path == "/integrator/scheme");
+    return issues.front().found;
+  };
+  CHECK(scheme_found("gaus") == "\"gaus\" (did you mean \"gauss\"?)");
+  CHECK(scheme_found("Triplet") == "\"Triplet\" (did you mean \"triplet\"?)");
+  CHECK(scheme_found("rk4") == "\"rk4\"");
+  CHECK(scheme_found(4) == "4");
+}
+
+TEST_CASE("a study refuses a run's strides and time step, saying where a study's step sizes go") {
+  json job = {{"model", {{"plugin", "paper1d"}}},
+              {"initial", {{"q", {2.0}}, {"p", {0.0}}}},
+              {"time", {{"t_end", 0.4}}},
+              {"study", {{"steps", {10, 20}}, {"integrators", {{{"scheme", "basic"}}}}}}};
+  CHECK(issues_of(job).empty());
+  job["time"]["dt"] = 0.01;
+  job["output"] = {{"every", 5}, {"energy_every", 0}, {"directory", "out"}};
+  const auto issues = issues_of(job);
+  REQUIRE(issues.size() == 3);
+  CHECK(issues[0].path == "/time/dt");
+  CHECK(issues[0].found == "0.01 in a study's /time");
+  CHECK(issues[0].allowed.find("each integrator's \"steps\" or \"dt\"") != std::string::npos);
+  CHECK(issues[1].path == "/output/every");
+  CHECK(issues[1].found == "5 together with /study");
+  CHECK(issues[1].allowed.find("convergence.csv") != std::string::npos);
+  CHECK(issues[2].path == "/output/energy_every");
+  job["output"] = {{"every", -1}};  // refused by the table's own rule, once
+  job["time"].erase("dt");
+  const auto refused = issues_of(job);
+  REQUIRE(refused.size() == 1);
+  CHECK(refused.front().path == "/output/every");
+  CHECK(refused.front().found == "-1");
+}
+
+TEST_CASE("q and p of different lengths: the first state is named with both, a later one at the list that differs") {
+  json job = host_testing::quickstart_job();
+  job["initial"] = {{"q", {0.5}}, {"p", {0.0, 1.0}}};
+  auto issues = issues_of(job);
+  REQUIRE(issues.size() == 1);  // which of the two is wrong only the model's dimension can tell: neither is blamed
+  CHECK(issues.front().path == "/initial");
+  CHECK(issues.front().found == "q of 1 component and p of 2");
+  CHECK(issues.front().allowed == "q and p of as many components, the dimension of the model");
+  job["initial"] = json::array({{{"q", {0.5}}, {"p", {0.0}}}, {{"q", {0.5}}, {"p", {0.0, 1.0}}}});
+  issues = issues_of(job);
+  REQUIRE(issues.size() == 1);
+  CHECK(issues.front().path == "/initial/1/p");
+  CHECK(issues.front().found == "2 components");
+  CHECK(issues.front().allowed == "1, as many as the first state (/initial/0) has");
+  job["initial"] = json::array({{{"q", {0.5, 0.1}}, {"p", {0.0, 0.0}}}, {{"q", {0.5}}, {"p", {0.0, 1.0, 2.0}}}});
+  issues = issues_of(job);
+  REQUIRE(issues.size() == 2);
+  CHECK(issues[0].path == "/initial/1/q");
+  CHECK(issues[0].found == "1 component");
+  CHECK(issues[1].path == "/initial/1/p");
+  CHECK(issues[1].found == "3 components");
+  job["initial"] = {{"grid", {{"q", {1.0}}, {"p", {0.0, 0.0}}}}};
+  issues = issues_of(job);
+  REQUIRE(issues.size() == 1);
+  CHECK(issues.front().path == "/initial/grid");
+  CHECK(issues.front().found == "q of 1 axis and p of 2");
+}
+
 TEST_CASE("a value its key table refuses is reported once, with the rule's text, and read no further") {
   // Each of these is checked by its object's key table alone (key_reader.hpp): one issue at the key's path, whose
   // text says what the table allows, and nothing else about it (no second message from the section's reader).

@@ -56,11 +56,6 @@ std::string parameters_text(nlohmann::json parameters, const Job& job) {
   return parameters.dump();
 }
 
-// "1 value", "2 values": a count with its noun (`plural` where it is not the noun and an s).
-std::string counted(std::size_t count, const std::string& noun, const std::string& plural = "") {
-  return std::to_string(count) + " " + (count == 1 ? noun : plural.empty() ? noun + "s" : plural);
-}
-
 std::string sweep_text(const Job& job, bool loaded) {
   if (job.sweep.empty()) return "";
   std::string text = "  sweep:       ";

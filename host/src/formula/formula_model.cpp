@@ -259,7 +259,7 @@ std::shared_ptr<const FormulaModel> read_object(const json& object, const std::s
       model.dimension = static_cast<std::size_t>(*n);
   for (const auto& [key, gradient] : {std::pair{"dT", &model.t_gradient}, std::pair{"dV", &model.v_gradient}})
     if (!gradient->empty() && gradient->size() != model.dimension)
-      check.issue(job_reader::child(pointer, key), std::to_string(gradient->size()) + " components",
+      check.issue(job_reader::child(pointer, key), counted(gradient->size(), "component"),
                   "one component per variable: " + std::to_string(model.dimension) +
                       " (the model's dimension: the largest variable index used plus one, or \"dimension\")");
   if (check.issue_count() != before) return nullptr;

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 
+#include "nonsep/host/number_format.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host::job_reader {
@@ -196,7 +198,8 @@ void read_grid(Checker& check, const json& grid, InitialStates& states) {
     }
   }
   if (sizes[0] && sizes[1] && sizes[0] != sizes[1]) {
-    check.issue(child(path, "p"), std::to_string(sizes[1]) + " axes", std::to_string(sizes[0]) + ", as many as q has");
+    check.issue(path, "q of " + counted(sizes[0], "axis", "axes") + " and p of " + std::to_string(sizes[1]),
+                "q and p of as many axes, the dimension of the model");
     ok = false;
   }
   if (!ok) return;
@@ -216,18 +219,22 @@ void read_state(Checker& check, const json& value, const std::string& path, Init
   const KeyReader keys(check, value, path, state_keys(), what);
   const auto q = keys.numbers("q"), p = keys.numbers("p");
   if (!q || !p) return;
-  if (q->size() != p->size()) {
-    check.issue(child(path, "p"), std::to_string(p->size()) + " components",
-                std::to_string(q->size()) + ", as many as q has");
+  // The length every state has: the first state's; in the first, q's and p's where they agree. When they do not, the
+  // reader cannot tell which is wrong (the model's dimension comes later): the state is named, with both lengths.
+  const std::string first = ", as many as the first state (" + first_path + ") has";
+  if (q->size() != p->size() && states.dimension == 0) {
+    check.issue(path, "q of " + counted(q->size(), "component") + " and p of " + std::to_string(p->size()),
+                "q and p of as many components, the dimension of the model");
     return;
   }
-  if (states.dimension == 0) {
-    states.dimension = q->size();
-  } else if (q->size() != states.dimension) {
-    check.issue(child(path, "q"), std::to_string(q->size()) + " components",
-                std::to_string(states.dimension) + ", as many as the first state (" + first_path + ") has");
-    return;
-  }
+  if (states.dimension == 0) states.dimension = q->size();
+  bool ok = true;
+  for (const auto& [key, numbers] : {std::pair{"q", &*q}, std::pair{"p", &*p}})
+    if (numbers->size() != states.dimension) {
+      check.issue(child(path, key), counted(numbers->size(), "component"), std::to_string(states.dimension) + first);
+      ok = false;
+    }
+  if (!ok) return;
   states.q.insert(states.q.end(), q->begin(), q->end());
   states.p.insert(states.p.end(), p->begin(), p->end());
   ++states.count;
@@ -287,7 +294,8 @@ void check_dimension(const InitialStates& initial, std::size_t model_dimension, 
                                                      : "/initial/q";
   issues.push_back(
       {path,
-       std::to_string(initial.dimension) + (initial.shape == "grid" ? " axes" : " components") +
+       (initial.shape == "grid" ? counted(initial.dimension, "axis", "axes")
+                                : counted(initial.dimension, "component")) +
            (initial.shape == "list" && initial.count > 1 ? " (in every state)" : ""),
        std::to_string(model_dimension) + ", the dimension of the model (for q and p alike" +
            (formula ? "; the largest index its formulas use plus one, or its \"dimension\"" : "") +

@@ -68,7 +68,8 @@ const KeyTable& document_keys() {
       {.name = "time",
        .type = ValueType::object,
        .required = true,
-       .description = "The time grid: {dt, t_end or steps} for a run, {t_end} for a study.",
+       .description = "The time grid: {dt, t_end or steps} for a run, {t_end} for a study (whose step sizes are its "
+                      "integrators').",
        .allowed = "an object with \"dt\" and either \"t_end\" or \"steps\" (a run), or {\"t_end\": T} (a study: every "
                   "integrator runs to T with its own step counts)"},
       {.name = "output", .type = ValueType::object, .description = "Where results go.", .keys = output_keys},
@@ -172,7 +173,7 @@ const KeyTable& output_keys() {
        .maximum = int64_limit,
        .default_value = 1,
        .description = "trajectory.csv gets steps 0, every, 2 every, ... and the final step; 0 writes no "
-                      "trajectory.csv.",
+                      "trajectory.csv. Not in a study (it writes no samples).",
        .allowed = "an integer >= 0: write every n-th step to trajectory.csv (0: no trajectory)"},
       {.name = "energy_every",
        .type = ValueType::integer,
@@ -180,7 +181,8 @@ const KeyTable& output_keys() {
        .maximum = int64_limit,
        .default_value = 0,
        .description = "H is evaluated at step 0, at every written sample and at the end; energy_every > 0 also "
-                      "evaluates it every energy_every-th step. Costs about a step's work per evaluation.",
+                      "evaluates it every energy_every-th step. Costs about a step's work per evaluation. Not in a "
+                      "study (it measures the energy error at every step).",
        .allowed = "an integer >= 0: also evaluate H every n-th step (0: only at the written samples, the start and "
                   "the end)"},
       {.name = "format",

@@ -173,7 +173,14 @@ bool KeyReader::valid(const json& value, const KeyRule& rule) {
   if (rule.type == ValueType::defined)
     if (const NumberList* list = number_list(rule.definition)) return valid_list(value, rule, *list);
   if (!accepted(value, rule)) {
-    check_.issue(child(path_, rule.name), describe(value), allowed_text(rule));
+    std::string found = describe(value);
+    if (rule.type == ValueType::choice && value.is_string())  // "gaus": did you mean "gauss"?
+      if (const auto meant = std::ranges::find_if(
+              rule.choices,
+              [&](const std::string& name) { return looks_like_misspelling(value.get<std::string>(), name); });
+          meant != rule.choices.end())
+        found += " (did you mean \"" + *meant + "\"?)";
+    check_.issue(child(path_, rule.name), found, allowed_text(rule));
     return false;
   }
   // A path the file system cannot take.

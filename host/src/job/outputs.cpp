@@ -26,11 +26,17 @@ OutputFormat read_format(Checker& check, const std::string& format, bool study) 
 }  // namespace
 
 void read_output(Checker& check, const KeyReader& document, Job& job) {
-  SingleRun study_strides;  // a study's /output/every and /output/energy_every are checked but not used
+  SingleRun study_strides;  // a study has no strides: refused below, after the table has checked them
   SingleRun& run = job.is_study() ? study_strides : std::get<SingleRun>(job.plan);
   std::filesystem::path output = job.file.stem().string() + ".out";
   if (const json* section = document.value("output")) {
     const KeyReader keys(check, *section, "/output", output_keys(), "an object {\"directory\": ..., \"every\": ...}");
+    if (job.is_study())  // a study writes convergence.csv only: a stride would be taken and do nothing
+      for (const char* key : {"every", "energy_every"})
+        if (keys.value(key))  // given and of the table's type
+          check.issue(child("/output", key), describe((*section)[key]) + " together with /study",
+                      "no stride in a study: it writes convergence.csv (one row per integrator and step count) and no "
+                      "samples; its energy error is measured at every step");
     if (const auto directory = keys.string("directory")) output = *directory;
     if (const auto every = keys.integer("every")) run.every = static_cast<std::uint64_t>(*every);
     if (const auto every = keys.integer("energy_every")) run.energy_every = static_cast<std::uint64_t>(*every);

@@ -2,6 +2,7 @@
 // sections: a study has no /integrator, /analysis or /checkpoint, one initial state, and a reference of its
 // dimension.
 #include "nonsep/core/analysis/frequency_map_indicator.hpp"
+#include "nonsep/host/number_format.hpp"
 #include "nonsep/host/platform/installation.hpp"
 #include "sections.hpp"
 
@@ -62,7 +63,7 @@ Job parse_job(const nlohmann::json& document, const std::filesystem::path& job_f
       check.issue("/initial", std::to_string(job.initial.count) + " states",
                   "one state: a study runs every integrator from the same initial state");
     if (!study.reference_q.empty() && job.initial.dimension != 0 && study.reference_q.size() != job.initial.dimension)
-      check.issue("/study/reference/q", std::to_string(study.reference_q.size()) + " components",
+      check.issue("/study/reference/q", counted(study.reference_q.size(), "component"),
                   std::to_string(job.initial.dimension) + ", as many as the initial state has");
   } else {
     SingleRun& run = job.plan.emplace<SingleRun>();

@@ -57,7 +57,15 @@ TimeGrid read_study_time(Checker& check, const KeyReader& document) {
   const std::string what = "an object {\"t_end\": T}: a study runs every integrator to T with its own step counts";
   const json* time = document.value("time");
   if (!time) return grid;
-  const KeyReader keys(check, *time, "/time", study_time_keys(), what);
+  // A run's time grid written in a study: said so, rather than as unknown keys.
+  json rest = *time;
+  if (rest.is_object())
+    for (const char* key : {"dt", "steps"})
+      if (rest.erase(key))
+        check.issue(child("/time", key), describe((*time)[key]) + " in a study's /time",
+                    "only \"t_end\" in a study's /time: the step sizes are each integrator's \"steps\" or \"dt\" in "
+                    "/study/integrators, or /study's for every integrator");
+  const KeyReader keys(check, rest, "/time", study_time_keys(), what);
   if (const auto t_end = keys.number("t_end")) grid.t_end = *t_end;
   return grid;
 }

@@ -2,6 +2,7 @@
 // Shortest round-trip decimal text of a double (std::to_chars): reading the text back gives the same double bit
 // for bit. Used for every number nonsep writes to CSV.
 #include <charconv>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -34,6 +35,11 @@ inline std::string ordinal(unsigned long long n) {
                        : units == 3             ? "rd"
                                                 : "th";
   return std::to_string(n) + suffix;
+}
+
+// A count with its noun: "1 value", "2 values" (`plural` where it is not the noun and an s: "2 trajectories").
+inline std::string counted(std::size_t count, const std::string& noun, const std::string& plural = "") {
+  return std::to_string(count) + " " + (count == 1 ? noun : plural.empty() ? noun + "s" : plural);
 }
 
 // The double written by append_number (the whole of `text`, nothing else), or nothing.
