@@ -17,7 +17,7 @@ namespace nonsep {
 
 // jacobians: s matrices J_i of d x d, column-major, J_i's column e at jacobians[(i*d + e)*d]. vectors: k vectors
 // of d numbers (dq then dp), dz on entry and dz' on return. Returns false when a number of dz' is not finite (a
-// Jacobian that is not, or a singular system): vectors are then unspecified. Throws InvalidArgument unless
+// Jacobian that is not, or a singular system): vectors are then unspecified. Throws InvalidArgument unless d is even,
 // 2ns <= 32 and k <= 32 (the sizes TangentGaussLegendre solves directly); allocates nothing.
 bool map_by_linear_stages(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
                           std::size_t d, std::span<double> vectors, std::size_t k);
