@@ -81,8 +81,7 @@ bool map_by_linear_stages_of(const GaussLegendreTableau& tableau, double dt, std
       for (std::size_t c = col + 1; c < M; ++c) sum -= system[col * M + c] * right[c];
       right[col] = sum / system[col * M + col];
     }
-    // dz' = dz + dt sum_i b_i (J_i dz + J_i dZ_i)
-    std::array<double, D> next;
+    // dz' = dz + dt sum_i b_i (J_i dz + J_i dZ_i): in place, dz being read no more (products holds J_i dz)
     for (std::size_t r = 0; r < D; ++r) {
       double sum = 0.0;
       for (std::size_t i = 0; i < S; ++i) {
@@ -90,10 +89,7 @@ bool map_by_linear_stages_of(const GaussLegendreTableau& tableau, double dt, std
         for (std::size_t c = 0; c < D; ++c) stage += J(i, r, c) * right[i * D + c];
         sum += dt * tableau.b[i] * stage;
       }
-      next[r] = z[r] + sum;
-    }
-    for (std::size_t r = 0; r < D; ++r) {
-      z[r] = next[r];
+      z[r] += sum;
       finite = finite && std::isfinite(z[r]);
     }
   }

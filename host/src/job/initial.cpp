@@ -221,7 +221,6 @@ void read_state(Checker& check, const json& value, const std::string& path, Init
   if (!q || !p) return;
   // The length every state has: the first state's; in the first, q's and p's where they agree. When they do not, the
   // reader cannot tell which is wrong (the model's dimension comes later): the state is named, with both lengths.
-  const std::string first = ", as many as the first state (" + first_path + ") has";
   if (q->size() != p->size() && states.dimension == 0) {
     check.issue(path, "q of " + counted(q->size(), "component") + " and p of " + std::to_string(p->size()),
                 "q and p of as many components, the dimension of the model");
@@ -231,7 +230,8 @@ void read_state(Checker& check, const json& value, const std::string& path, Init
   bool ok = true;
   for (const auto& [key, numbers] : {std::pair{"q", &*q}, std::pair{"p", &*p}})
     if (numbers->size() != states.dimension) {
-      check.issue(child(path, key), counted(numbers->size(), "component"), std::to_string(states.dimension) + first);
+      check.issue(child(path, key), counted(numbers->size(), "component"),
+                  std::to_string(states.dimension) + ", as many as the first state (" + first_path + ") has");
       ok = false;
     }
   if (!ok) return;
