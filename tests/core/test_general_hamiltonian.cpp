@@ -297,3 +297,32 @@ TEST_CASE("general H: a Gauss step that reaches a point where grad H is not fini
   CHECK(x.q()[0] == -0.5);  // the failed state keeps its starting point
   CHECK(x.q()[1] != 1.0);
 }
+
+namespace {
+// H = p^2/2 + q^4/4: defined and smooth everywhere; a step far too large for its time scale makes the fixed-point
+// iteration diverge until grad H overflows.
+struct QuarticWell {
+  static constexpr std::size_t dimension = 1;
+  template <class S>
+  S H(sdk::Vector<S> q, sdk::Vector<S> p) const {
+    return p[0] * p[0] / 2.0 + q[0] * q[0] * q[0] * q[0] / 4.0;
+  }
+};
+}  // namespace
+
+TEST_CASE("general H: a Gauss step whose iteration diverges to where grad H overflows names dt, not H") {
+  const sdk::HamiltonianAdapter<QuarticWell> model;
+  GaussLegendre gauss(HamiltonianForm::TTV, 4);
+  PhaseSpaceBatch x(1, 1);
+  x.q()[0] = 1.0;
+  const auto failures = gauss.try_step(model, x, 5.0);
+  REQUIRE(failures.size() == 1);
+  INFO(failures[0].reason);
+  CHECK(failures[0].reason.find("grad H is not finite at stage ") == 0);
+  CHECK(failures[0].reason.find("far from the step's start q = (1), p = (0)") != std::string::npos);
+  CHECK(failures[0].reason.find("the fixed-point iteration diverged, which a smaller dt prevents") !=
+        std::string::npos);
+  CHECK(x.q()[0] == 1.0);
+  // The same state with a step the iteration takes: no failure.
+  CHECK(gauss.try_step(model, x, 0.05).empty());
+}

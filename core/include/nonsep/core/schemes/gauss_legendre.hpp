@@ -60,7 +60,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <limits>
 #include <span>
 #include <string>
@@ -72,6 +71,7 @@
 #include "nonsep/core/kernel/gauss_stages.hpp"
 #include "nonsep/core/schemes/chin_basic_step.hpp"
 #include "nonsep/core/schemes/comparator_description.hpp"
+#include "nonsep/core/schemes/gauss_failure.hpp"
 #include "nonsep/core/schemes/gauss_legendre_tableau.hpp"
 
 namespace nonsep {
@@ -219,7 +219,10 @@ class GaussLegendre {
           advance(x, b, s, size);
           remember(x, b, dt);
         } else {
-          failures.push_back({b, not_finite_reason(b, n, s, size)});
+          failures.push_back(
+              {b, gauss_not_finite_reason(start_q_.data() + b * n, start_p_.data() + b * n, stage_q_.data() + b * n,
+                                          stage_p_.data() + b * n, dH_dq_.data() + b * n, dH_dp_.data() + b * n, n, s,
+                                          size, iterations_[b])});
         }
       }
       active_.swap(still_);
@@ -229,12 +232,7 @@ class GaussLegendre {
     for (const StateFailure& failure : failures) memory_[failure.state * memory_width(n)] = 0.0;
     for (std::size_t b : active_) {
       memory_[b * memory_width(n)] = 0.0;
-      char change[32];
-      std::snprintf(change, sizeof change, "%.3g", last_change_[b]);
-      failures.push_back({b, "no convergence in " + std::to_string(max_iterations_) +
-                                 " iterations, last relative change " + change +
-                                 ": a smaller dt makes the iteration contract, unless the orbit runs off where grad H "
-                                 "grows without bound (a non-compact energy shell)"});
+      failures.push_back({b, gauss_no_convergence_reason(max_iterations_, last_change_[b])});
     }
     std::sort(failures.begin(), failures.end(), [](const auto& l, const auto& r) { return l.state < r.state; });
     return failures;
@@ -353,30 +351,6 @@ class GaussLegendre {
     gauss_remember(memory_.data() + b * memory_width(n), dt, x.q(b).data(), x.p(b).data(),
                    compensation_q_.data() + b * n, compensation_p_.data() + b * n, L_q_.data() + b * n,
                    L_p_.data() + b * n, size, static_cast<std::size_t>(stages()), n);
-  }
-
-  // Why state b's iterate is not finite: the first stage point of its last iteration where grad H is not finite
-  // (named, with the stage), or else the iterate itself overflowing.
-  std::string not_finite_reason(std::size_t b, std::size_t n, std::size_t s, std::size_t size) const {
-    const auto vector_text = [&](const std::vector<double>& start, const std::vector<double>& stage, std::size_t i) {
-      std::string text = "(";
-      char number[32];
-      for (std::size_t e = b * n; e < b * n + n; ++e) {
-        std::snprintf(number, sizeof number, "%.17g", start[e] + stage[i * size + e]);
-        text += (e == b * n ? "" : ", ") + std::string(number);
-      }
-      return text + ")";
-    };
-    for (std::size_t i = 0; i < s; ++i)
-      for (std::size_t e = b * n; e < b * n + n; ++e)
-        if (!std::isfinite(dH_dq_[i * size + e]) || !std::isfinite(dH_dp_[i * size + e]))
-          return "grad H is not finite at stage " + std::to_string(i + 1) + " of iteration " +
-                 std::to_string(iterations_[b]) + ", q = " + vector_text(start_q_, stage_q_, i) +
-                 ", p = " + vector_text(start_p_, stage_p_, i) +
-                 ": H is not defined or not differentiable there, or the orbit ran off to where it overflows (on a "
-                 "non-compact energy shell it can run off without bound)";
-    return "an iterate is not finite after " + std::to_string(iterations_[b]) +
-           " iterations: the stages overflowed; a smaller dt makes the iteration contract";
   }
 
   // The work arrays are stage-major, so that the loops over the batch run over contiguous memory: stage i, component
