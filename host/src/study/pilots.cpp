@@ -20,6 +20,12 @@ using Clock = std::chrono::steady_clock;
 
 // Below this a pilot's error is round-off (relative to the state's length for the phase error).
 constexpr double pilot_round_off = 1e-13;
+// The round-off of the phase error as an orbit amplifies it: measured (twins_round_off) where the error falls more
+// slowly than the order and is below this, relative to the state's length.
+constexpr double measure_round_off_below = 1e-8;
+// A pilot pair at round-off differs by up to about twice the larger of the twins' distances (paper2d's regular
+// orbits to t = 100 with Gauss 16, 2048 to 32768 steps); this factor keeps a margin.
+constexpr double round_off_twin_factor = 4.0;
 // The asymptotic range: the error falls by 2^order per halving of the step, within this factor.
 constexpr double asymptotic_within = 2.5;
 // The pilots' states are kept at t_p k / pilot_marks (k = 1 .. pilot_marks), for the growth of the phase error.
@@ -143,20 +149,31 @@ class Pilots {
     const double order = Integrator::describe(candidate.spec).order.value();
     const bool energy = choice_.measure == AutoScheme::Measure::energy;
     const std::size_t width = 2 * loaded_.job.initial.dimension;
-    std::map<std::uint64_t, PilotRun> runs;
+    std::map<std::uint64_t, PilotRun> runs, twins;
     const PilotRun over;  // a pilot not run: it would have taken the candidate's pilots over the bound
     // Over the bound: what the pilots took, and what the next one would take at the last one's seconds per step.
     double per_step = 0.0;
     const auto over_bound = [&](std::uint64_t next_steps) {
       return bound && choice_.pilot_seconds - spent_before + per_step * static_cast<double>(next_steps) > *bound;
     };
-    const auto run = [&](std::uint64_t steps) -> const PilotRun& {
-      auto found = runs.find(steps);
-      if (found == runs.end() && !over_bound(steps)) {
-        found = runs.emplace(steps, pilot(candidate.spec, steps, energy)).first;
+    const auto run = [&](std::uint64_t steps, bool twin = false) -> const PilotRun& {
+      std::map<std::uint64_t, PilotRun>& into = twin ? twins : runs;
+      auto found = into.find(steps);
+      if (found == into.end() && !over_bound(steps)) {
+        found = into.emplace(steps, pilot(candidate.spec, steps, energy, twin)).first;
         per_step = found->second.seconds / static_cast<double>(steps);
       }
-      return found == runs.end() ? over : found->second;
+      return found == into.end() ? over : found->second;
+    };
+    // The round-off of the pilots r2 and r4 (2n and 4n steps) at t_p as the orbit amplifies it: their distances from
+    // their twins (the same runs with a step one ulp larger: every step rounds differently, the truncation error is
+    // the same to a relative 1e-16), the larger times round_off_twin_factor. Nothing when a twin was not run (over
+    // the bound) or had a problem.
+    const auto twins_round_off = [&](std::uint64_t n, const PilotRun& r2, const PilotRun& r4) -> std::optional<double> {
+      const PilotRun &t2 = run(2 * n, true), &t4 = run(4 * n, true);
+      if (&t2 == &over || &t4 == &over || !t2.problem.empty() || !t4.problem.empty()) return std::nullopt;
+      return round_off_twin_factor * std::max(largest_distance(r2.marks.back(), t2.marks.back(), width),
+                                              largest_distance(r4.marks.back(), t4.marks.back(), width));
     };
     std::string last;
     for (std::uint64_t n = 4; 4 * n <= auto_pilot_max_steps; n *= 2) {
@@ -180,8 +197,14 @@ class Pilots {
       }
       const double coarse = energy ? r2.max_end : largest_distance(r1.marks.back(), r2.marks.back(), width);
       const double fine = energy ? r4.max_end : largest_distance(r2.marks.back(), r4.marks.back(), width);
-      const double floor = pilot_round_off * (energy ? 1.0 : std::max(1.0, largest_length(r4.marks.back(), width)));
+      const double length = energy ? 1.0 : std::max(1.0, largest_length(r4.marks.back(), width));
       const double ratio = coarse / fine, expected = std::pow(2.0, order);
+      // The phase error's round-off grows with the orbit's sensitivity, not only with the state's length (paper2d's
+      // regular orbit q = (0, 0), p = (0.5, 2) to t = 100: 1e-12 to 4e-12 by Gauss 16 at 2^11 to 2^15 steps, 5 to 20
+      // times the fixed bound): where a small error falls more slowly than the order, the twins measure it.
+      double floor = pilot_round_off * length;
+      if (!energy && fine > floor && fine <= measure_round_off_below * length && ratio < expected / asymptotic_within)
+        if (const auto measured = twins_round_off(n, r2, r4)) floor = std::max(floor, *measured);
       const bool round_off = fine <= floor;
       if (!round_off && !(ratio >= expected / asymptotic_within && ratio <= expected * asymptotic_within)) {
         last = "its error fell by " + format_number(ratio) + " from " + std::to_string(2 * n) + " to " +
@@ -198,18 +221,20 @@ class Pilots {
       }
       result.pilot_steps = n;
       result.ratio = ratio;
+      result.round_off = floor;
       // The pair whose difference is the error (energy: the run whose error it is) and where the prediction starts.
-      // When the finest run's error is round-off and the coarser pair's is not, that pair measures the error of its
-      // coarser run (phase: the n run's, within the 2n run's error, which is round-off; energy: the 2n run's own):
-      // the prediction starts there, at a measured error rather than at the round-off bound. The rate towards smaller
-      // steps is then the one observed down to round-off, which that round-off can only make slower (a larger
-      // predicted error).
-      const bool from_coarse = round_off && coarse > floor;
+      // When the finest run's error is round-off, the coarser pair measures the error of its coarser run (phase: the
+      // n run's, within the 2n run's error, which is round-off; energy: the 2n run's own): the prediction starts
+      // there, at a measured error, or at the round-off bound when that pair is within it too (the first ladder
+      // without a problem, all of it at round-off), rather than at the 4n run's round-off bound. The rate towards
+      // smaller steps is then the one observed down to round-off, which that round-off can only make slower (a
+      // larger predicted error).
+      const bool from_coarse = round_off;
       const PilotRun &pair_coarse = from_coarse ? r1 : r2, &pair_fine = from_coarse ? r2 : r4;
       result.anchor_steps = from_coarse ? (energy ? 2 * n : n) : 4 * n;
       result.pilot_dt = choice_.pilot_horizon / static_cast<double>(result.anchor_steps);
       // At round-off the difference bounds the error; in the asymptotic range Richardson gives it.
-      result.pilot_error = from_coarse ? coarse : energy || round_off ? std::max(fine, floor) : fine / (expected - 1.0);
+      result.pilot_error = from_coarse ? std::max(coarse, floor) : energy ? fine : fine / (expected - 1.0);
       const double end = from_coarse ? coarse : fine;
       const double half = energy ? pair_fine.max_half
                                  : largest_distance(pair_coarse.marks[pilot_marks / 2 - 1],
@@ -288,16 +313,19 @@ class Pilots {
                                static_cast<double>(choice_.pilot_states);
   }
 
-  PilotRun pilot(const IntegratorSpec& spec, std::uint64_t steps, bool energy) {
+  // A pilot of `steps` steps to t_p; a twin's step is one ulp larger (it ends later by `steps` ulps of the step,
+  // about 1e-16 t_p, which moves its end point by that times the speed: far below the round-off it measures).
+  PilotRun pilot(const IntegratorSpec& spec, std::uint64_t steps, bool energy, bool twin = false) {
     const std::size_t count = choice_.pilot_states;
-    const double t_p = choice_.pilot_horizon;
-    EnsembleSetup setup{spec,
-                        TimeGrid::to_end(t_p, t_p / static_cast<double>(steps), steps),
-                        loaded_.job.initial.dimension,
-                        q_,
-                        p_,
-                        options_.threads,
-                        options_.stop_requested};
+    const double t_p = choice_.pilot_horizon, dt = t_p / static_cast<double>(steps);
+    EnsembleSetup setup{
+        spec,
+        twin ? TimeGrid::of_steps(steps, std::nextafter(dt, 2.0 * dt)) : TimeGrid::to_end(t_p, dt, steps),
+        loaded_.job.initial.dimension,
+        q_,
+        p_,
+        options_.threads,
+        options_.stop_requested};
     setup.parameter_sets = sets_;
     EnsembleDriver driver(loaded_.plugin, loaded_.model, setup);
     PilotObserver observer(count, loaded_.job.initial.dimension, steps, energy);

@@ -167,6 +167,7 @@ json candidates_json(const std::vector<PilotResult>& pilots) {
                           {"pilot_dt", number_or_null(pilot.pilot_dt, pilot.pilot_steps > 0)},
                           {"pilot_error", number_or_null(pilot.pilot_error, pilot.pilot_steps > 0)},
                           {"error_ratio_per_halving", number_or_null(pilot.ratio, pilot.pilot_steps > 0)},
+                          {"round_off", number_or_null(pilot.round_off, pilot.pilot_steps > 0)},
                           {"expected_ratio", std::pow(2.0, order)},
                           {"growth_exponent", number_or_null(pilot.growth, pilot.pilot_steps > 0)},
                           {"envelope_growth_exponent",

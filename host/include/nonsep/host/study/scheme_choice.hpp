@@ -82,6 +82,7 @@ struct PilotResult {
   double pilot_dt = 0.0;           // t_p / anchor_steps
   double pilot_error = 0.0;        // e_p: the anchor run's error at t_p
   double ratio = 0.0;              // how much the error fell from 2n to 4n (2^order in the asymptotic range)
+  double round_off = 0.0;          // the 4n pilot's error is round-off at or below this (pilots.cpp)
   double growth = 0.0;             // a
   // Phase: log2 of the growth of the pilot pair's largest distance from t_p / 2 to t_p (largest over the marks up to
   // each); nothing for the energy, or when the distance is at round-off.
