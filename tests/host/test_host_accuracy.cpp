@@ -330,6 +330,14 @@ TEST_CASE("scheme auto: a phase error at the round-off the orbit amplifies is me
     squares += std::pow(number(row, column) - number(exact, column), 2);
   CAPTURE(std::sqrt(squares));
   CHECK(std::sqrt(squares) <= 1e-10);
+  // Below that round-off no step meets a tolerance, and the prediction does not claim it: the run warns.
+  const auto below =
+      run_job(folder, "below", run_of(model, {{"scheme", "auto"}, {"tolerance", 1e-12}}, initial, 100.0, 100.0, 0));
+  REQUIRE(below.status == 0);
+  const json below_choice = read_json(below.folder / "summary.json")["scheme_choice"];
+  CHECK(below_choice["estimated_error"].get<double>() >= gauss16["round_off"].get<double>());
+  CHECK(below_choice["tolerance_met"] == false);
+  CHECK(below.err.find("warning: scheme auto did not meet the tolerance 1e-12") != std::string::npos);
 }
 
 TEST_CASE("scheme auto: a phase tolerance on a chaotic orbit is not promised, the step is chosen by the energy") {

@@ -222,6 +222,7 @@ class Pilots {
       result.pilot_steps = n;
       result.ratio = ratio;
       result.round_off = floor;
+      if (floor > pilot_round_off * length) amplified_round_off_ = std::max(amplified_round_off_, floor);
       // The pair whose difference is the error (energy: the run whose error it is) and where the prediction starts.
       // When the finest run's error is round-off, the coarser pair measures the error of its coarser run (phase: the
       // n run's, within the 2n run's error, which is round-off; energy: the 2n run's own): the prediction starts
@@ -257,6 +258,7 @@ class Pilots {
       result.seconds_per_step = r4.seconds > r1.seconds ? (r4.seconds - r1.seconds) / static_cast<double>(3 * n)
                                                         : r4.seconds / static_cast<double>(4 * n);
       predict(result, order);
+      apply_round_off(result);
       return result;
     }
     result.excluded = "no usable pilot up to " + std::to_string(auto_pilot_max_steps) + " steps: " + last;
@@ -313,6 +315,21 @@ class Pilots {
                                static_cast<double>(choice_.pilot_states);
   }
 
+ public:
+  // The round-off the pilots measured (twins_round_off, above the fixed bound: the orbit amplifies each step's
+  // rounding; the largest over the candidates so far, for it is the orbit's more than the scheme's) does not fall
+  // with the step: no prediction of a usable candidate goes below it, grown to t_end as its error grows. A
+  // tolerance below it is not met by any step, and the prediction says so (the run warns; the candidate stays, the
+  // best double precision gives). run_pilots applies it again once every candidate is measured, to those measured
+  // before it was known.
+  void apply_round_off(PilotResult& result) const {
+    if (!result.excluded.empty() || amplified_round_off_ == 0.0) return;
+    const double at_end =
+        amplified_round_off_ * std::pow(std::abs(run_.time.t_end / choice_.pilot_horizon), result.growth);
+    result.predicted_error = std::max(result.predicted_error, at_end);
+  }
+
+ private:
   // A pilot of `steps` steps to t_p; a twin's step is one ulp larger (it ends later by `steps` ulps of the step,
   // about 1e-16 t_p, which moves its end point by that times the speed: far below the round-off it measures).
   PilotRun pilot(const IntegratorSpec& spec, std::uint64_t steps, bool energy, bool twin = false) {
@@ -357,7 +374,8 @@ class Pilots {
   SchemeChoice& choice_;
   const SingleRun& run_;
   std::vector<double> q_, p_;
-  std::vector<ParameterSet> sets_;  // of the pilot states; empty without a sweep
+  std::vector<ParameterSet> sets_;    // of the pilot states; empty without a sweep
+  double amplified_round_off_ = 0.0;  // apply_round_off
 };
 
 }  // namespace
@@ -391,6 +409,7 @@ void run_pilots(const LoadedJob& loaded, const RunOptions& options, SchemeChoice
     if (const PilotResult& last = choice.pilots.back(); last.excluded.empty())
       bound = std::min(bound.value_or(last.predicted_seconds), last.predicted_seconds);
   }
+  for (PilotResult& result : choice.pilots) pilots.apply_round_off(result);
 }
 
 }  // namespace nonsep::host
