@@ -338,6 +338,10 @@ TEST_CASE("scheme auto: a phase error at the round-off the orbit amplifies is me
   CHECK(below_choice["estimated_error"].get<double>() >= gauss16["round_off"].get<double>());
   CHECK(below_choice["tolerance_met"] == false);
   CHECK(below.err.find("warning: scheme auto did not meet the tolerance 1e-12") != std::string::npos);
+  CHECK(below.err.find("which no smaller step reduces") != std::string::npos);
+  CHECK(below_choice["amplified_round_off"].get<double>() >= gauss16["round_off"].get<double>());
+  // Steps smaller than those that reach the round-off gain nothing: the same step as for 1e-10.
+  CHECK(below_choice["subdivision"] == choice["subdivision"]);
 }
 
 TEST_CASE("scheme auto: a phase tolerance on a chaotic orbit is not promised, the step is chosen by the energy") {

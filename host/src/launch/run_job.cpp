@@ -162,7 +162,13 @@ nlohmann::ordered_json checked_choice(nlohmann::ordered_json choice, const RunOu
                     (measured ? how + " is " + format_number(*measured) : std::string()) +
                     (measured && has_prediction ? ", " : "") +
                     (has_prediction ? "the prediction " + std::string(measured ? "" : "is ") + format_number(predicted)
-                                    : std::string()));
+                                    : std::string()) +
+                    (choice["amplified_round_off"].is_number()
+                         ? "; the pilots measured a round-off of " +
+                               format_number(choice["amplified_round_off"].get<double>()) +
+                               " at the pilot horizon on these orbits (they amplify each step's rounding), which no "
+                               "smaller step reduces"
+                         : std::string()));
   return choice;
 }
 

@@ -222,7 +222,7 @@ class Pilots {
       result.pilot_steps = n;
       result.ratio = ratio;
       result.round_off = floor;
-      if (floor > pilot_round_off * length) amplified_round_off_ = std::max(amplified_round_off_, floor);
+      if (floor > pilot_round_off * length) choice_.amplified_round_off = std::max(choice_.amplified_round_off, floor);
       // The pair whose difference is the error (energy: the run whose error it is) and where the prediction starts.
       // When the finest run's error is round-off, the coarser pair measures the error of its coarser run (phase: the
       // n run's, within the 2n run's error, which is round-off; energy: the 2n run's own): the prediction starts
@@ -292,12 +292,14 @@ class Pilots {
     // smaller step uses the slower observed rate; to a larger step the order (either way the larger prediction).
     const double observed = result.ratio > 1.0 ? std::log2(result.ratio) : order;
     const double smaller = std::min(order, observed), larger = std::max(order, observed);
+    // The aim: a third of the tolerance, or the measured round-off where that is larger (apply_round_off: smaller
+    // steps than those that reach it gain nothing).
+    const double aim = std::max(choice_.tolerance / auto_safety, choice_.amplified_round_off * growth);
     double rate = smaller;
-    double h_max = h_pilot * std::pow(choice_.tolerance / (auto_safety * result.pilot_error * growth), 1.0 / rate);
+    double h_max = h_pilot * std::pow(aim / (result.pilot_error * growth), 1.0 / rate);
     if (h_max > h_pilot) {
       rate = larger;
-      h_max = std::max(h_pilot,
-                       h_pilot * std::pow(choice_.tolerance / (auto_safety * result.pilot_error * growth), 1.0 / rate));
+      h_max = std::max(h_pilot, h_pilot * std::pow(aim / (result.pilot_error * growth), 1.0 / rate));
     }
     // No larger than the coarsest pilot step the accepted ladder covers (t_p / n): above it the pilots showed no
     // asymptotic fall (the ladder from n / 2 was not accepted), and the iteration of an implicit scheme may diverge.
@@ -323,9 +325,9 @@ class Pilots {
   // best double precision gives). run_pilots applies it again once every candidate is measured, to those measured
   // before it was known.
   void apply_round_off(PilotResult& result) const {
-    if (!result.excluded.empty() || amplified_round_off_ == 0.0) return;
+    if (!result.excluded.empty() || choice_.amplified_round_off == 0.0) return;
     const double at_end =
-        amplified_round_off_ * std::pow(std::abs(run_.time.t_end / choice_.pilot_horizon), result.growth);
+        choice_.amplified_round_off * std::pow(std::abs(run_.time.t_end / choice_.pilot_horizon), result.growth);
     result.predicted_error = std::max(result.predicted_error, at_end);
   }
 
@@ -374,8 +376,7 @@ class Pilots {
   SchemeChoice& choice_;
   const SingleRun& run_;
   std::vector<double> q_, p_;
-  std::vector<ParameterSet> sets_;    // of the pilot states; empty without a sweep
-  double amplified_round_off_ = 0.0;  // apply_round_off
+  std::vector<ParameterSet> sets_;  // of the pilot states; empty without a sweep
 };
 
 }  // namespace
@@ -402,6 +403,7 @@ std::vector<std::size_t> pilot_indices(const InitialStates& initial) {
 
 void run_pilots(const LoadedJob& loaded, const RunOptions& options, SchemeChoice& choice, double fraction) {
   choice.pilots.clear();
+  choice.amplified_round_off = 0.0;
   Pilots pilots(loaded, options, choice, fraction);
   std::optional<double> bound;
   for (const AutoCandidate& candidate : auto_candidates(loaded)) {

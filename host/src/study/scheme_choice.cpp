@@ -206,6 +206,7 @@ json to_json(const SchemeChoice& choice) {
            format_number(auto_safety)},
       {"pilot_horizon", choice.pilot_horizon},
       {"pilot_states", choice.pilot_states},
+      {"amplified_round_off", number_or_null(choice.amplified_round_off, choice.amplified_round_off > 0.0)},
       {"candidates", candidates_json(choice.pilots)},
       {"phase_candidates", asked ? json(nullptr) : candidates_json(choice.phase_pilots)},
       {"phase_pilot_horizon", asked ? json(nullptr) : json(choice.phase_pilot_horizon)},

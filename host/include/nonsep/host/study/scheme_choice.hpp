@@ -107,6 +107,9 @@ struct SchemeChoice {
   std::vector<PilotResult> phase_pilots;  // the phase pilots, when chosen by the energy
   double phase_pilot_horizon = 0.0;       // and their horizon
   double pilot_horizon = 0.0;
+  // The largest round-off the phase pilots measured above the fixed bound (pilots.cpp: the orbits amplify each
+  // step's rounding); 0 when none. No prediction goes below it.
+  double amplified_round_off = 0.0;
   std::size_t pilot_states = 0;
   std::vector<PilotResult> pilots;  // one per candidate
   std::size_t chosen = 0;           // index into pilots
