@@ -11,6 +11,7 @@
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
+#include "pilot_run.hpp"
 
 namespace nonsep::host {
 
@@ -28,97 +29,6 @@ constexpr double measure_round_off_below = 1e-8;
 constexpr double round_off_twin_factor = 4.0;
 // The asymptotic range: the error falls by 2^order per halving of the step, within this factor.
 constexpr double asymptotic_within = 2.5;
-// The pilots' states are kept at t_p k / pilot_marks (k = 1 .. pilot_marks), for the growth of the phase error.
-constexpr std::uint64_t pilot_marks = 8;
-
-// One pilot run: its states at t_p k / pilot_marks (k = 1 .. pilot_marks; those that fall on a step) and its largest
-// |dH/H0| up to t_p / 2 and t_p (energy evaluated at every step when the measure is the energy).
-class PilotObserver : public Observer {
- public:
-  PilotObserver(std::size_t count, std::size_t dimension, std::uint64_t steps, bool energy)
-      : dimension_(dimension), steps_(steps), energy_(energy), width_(count * 2 * dimension), marks_(pilot_marks) {}
-
-  std::uint64_t next_event(std::uint64_t step) const override {
-    if (energy_) return step < steps_ ? step + 1 : no_event;
-    for (std::uint64_t k = 1; k <= pilot_marks; ++k)
-      if (const auto mark = mark_step(k); mark && *mark > step) return *mark;
-    return no_event;
-  }
-  bool needs_energy(std::uint64_t) const override { return energy_; }
-  void on_event(const Event& event) override {
-    for (const StateView& state : event.states) {
-      if (energy_ && state.energy && state.record->energy_initial && *state.record->energy_initial != 0.0) {
-        const double e = std::abs((*state.energy - *state.record->energy_initial) / *state.record->energy_initial);
-        max_end_ = std::max(max_end_, e);
-        if (event.step <= steps_ / 2) max_half_ = std::max(max_half_, e);
-      }
-      const std::uint64_t k = event.step * pilot_marks / steps_;
-      if (k == 0 || mark_step(k) != event.step) continue;
-      std::vector<double>& into = marks_[k - 1];
-      into.resize(width_);
-      std::copy(state.q.begin(), state.q.end(),
-                into.begin() + static_cast<std::ptrdiff_t>(state.trajectory * 2 * dimension_));
-      std::copy(state.p.begin(), state.p.end(),
-                into.begin() + static_cast<std::ptrdiff_t>(state.trajectory * 2 * dimension_ + dimension_));
-    }
-  }
-  void on_retire(std::size_t trajectory, const TrajectoryRecord& record) override {
-    if (stopped_early(record.status) && problem_.empty())
-      problem_ = std::string(to_string(record.status)) + " at step " + std::to_string(record.stop_step) +
-                 " (pilot state " + std::to_string(trajectory) + ")";
-  }
-
-  // The step of mark k, when t_p k / pilot_marks falls on one.
-  std::optional<std::uint64_t> mark_step(std::uint64_t k) const {
-    if (k * steps_ % pilot_marks != 0) return std::nullopt;
-    return k * steps_ / pilot_marks;
-  }
-
-  std::size_t dimension_;
-  std::uint64_t steps_;
-  bool energy_;
-  std::size_t width_;
-  std::vector<std::vector<double>> marks_;  // the states at mark k = 1 .. pilot_marks; empty where none falls
-  double max_half_ = 0.0, max_end_ = 0.0;
-  std::string problem_;
-};
-
-struct PilotRun {
-  std::string problem;                     // "" when every pilot state completed
-  std::vector<std::vector<double>> marks;  // PilotObserver::marks_
-  double max_half = 0.0, max_end = 0.0;
-  double seconds = 0.0;
-};
-
-// The largest distance between the pilot states of two runs, and the largest length of a state.
-double largest_distance(const std::vector<double>& a, const std::vector<double>& b, std::size_t width) {
-  double largest = 0.0;
-  for (std::size_t s = 0; s * width < a.size(); ++s) {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < width; ++i)
-      sum += (a[s * width + i] - b[s * width + i]) * (a[s * width + i] - b[s * width + i]);
-    largest = std::max(largest, std::sqrt(sum));
-  }
-  return largest;
-}
-
-double largest_length(const std::vector<double>& a, std::size_t width) {
-  return largest_distance(a, std::vector<double>(a.size(), 0.0), width);
-}
-
-// How the phase error of the pilot pair (2n, 4n steps) grew over the second half of the pilot: log2 of the largest
-// distance between their states at the marks up to t_p over the largest up to t_p / 2. Nothing when that at t_p / 2
-// is within a factor 10 of round-off (`floor`): the ratio of two round-offs says nothing about the orbit.
-std::optional<double> envelope_growth(const PilotRun& coarse, const PilotRun& fine, std::size_t width, double floor) {
-  double largest = 0.0, at_half = 0.0;
-  for (std::size_t k = 0; k < pilot_marks; ++k) {
-    largest = std::max(largest, largest_distance(coarse.marks[k], fine.marks[k], width));
-    if (k + 1 == pilot_marks / 2) at_half = largest;
-  }
-  if (!(at_half > 10.0 * floor)) return std::nullopt;
-  return std::log2(largest / at_half);
-}
-
 class Pilots {
  public:
   Pilots(const LoadedJob& loaded, const RunOptions& options, SchemeChoice& choice, double fraction)
@@ -230,13 +140,12 @@ class Pilots {
       // without a problem, all of it at round-off), rather than at the 4n run's round-off bound. The rate towards
       // smaller steps is then the one observed down to round-off, which that round-off can only make slower (a
       // larger predicted error).
-      const bool from_coarse = round_off;
-      const PilotRun &pair_coarse = from_coarse ? r1 : r2, &pair_fine = from_coarse ? r2 : r4;
-      result.anchor_steps = from_coarse ? (energy ? 2 * n : n) : 4 * n;
+      const PilotRun &pair_coarse = round_off ? r1 : r2, &pair_fine = round_off ? r2 : r4;
+      result.anchor_steps = round_off ? (energy ? 2 * n : n) : 4 * n;
       result.pilot_dt = choice_.pilot_horizon / static_cast<double>(result.anchor_steps);
       // At round-off the difference bounds the error; in the asymptotic range Richardson gives it.
-      result.pilot_error = from_coarse ? std::max(coarse, floor) : energy ? fine : fine / (expected - 1.0);
-      const double end = from_coarse ? coarse : fine;
+      result.pilot_error = round_off ? std::max(coarse, floor) : energy ? fine : fine / (expected - 1.0);
+      const double end = round_off ? coarse : fine;
       const double half = energy ? pair_fine.max_half
                                  : largest_distance(pair_coarse.marks[pilot_marks / 2 - 1],
                                                     pair_fine.marks[pilot_marks / 2 - 1], width);
@@ -247,7 +156,7 @@ class Pilots {
       // whichever others the pilots' time bound leaves out.
       if (!energy) {
         result.envelope_growth = envelope_growth(pair_coarse, pair_fine, width, floor);
-        for (std::uint64_t steps = from_coarse ? n : 2 * n; !result.envelope_growth && steps >= 8; steps /= 2) {
+        for (std::uint64_t steps = round_off ? n : 2 * n; !result.envelope_growth && steps >= 8; steps /= 2) {
           const auto coarser = runs.find(steps / 2), finer = runs.find(steps);
           if (coarser == runs.end() || finer == runs.end() || !coarser->second.problem.empty() ||
               !finer->second.problem.empty())
