@@ -67,3 +67,14 @@ function(nonsep_precompile_headers target)
     target_precompile_headers(${target} PRIVATE ${ARGN})
   endif()
 endfunction()
+
+# The host library's and the test suites' files also share what they instantiate and optimise (the JSON library's
+# and the core's templates), once per file: each such target is compiled as a few translation units that include
+# its files (CMake's unity build), which takes a fraction of the CPU time. Off: one translation unit per file, for
+# incremental work on one file.
+option(NONSEP_UNITY_BUILD "Compile the host library and the test suites as a few translation units each" ON)
+function(nonsep_unity_build target files_per_unit)
+  if(NONSEP_UNITY_BUILD)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE ${files_per_unit})
+  endif()
+endfunction()

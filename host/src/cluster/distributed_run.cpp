@@ -20,7 +20,7 @@ namespace nonsep::host {
 
 namespace {
 
-using json = nlohmann::ordered_json;
+using nlohmann::ordered_json;
 constexpr const char* plan_name = "plan.json";
 constexpr int plan_format = 2;            // 2: "stepping"
 constexpr std::size_t target_units = 64;  // enough to balance a few dozen ranks; each unit costs a folder and a merge
@@ -45,7 +45,7 @@ struct Plan {
 
 // With how the ranks step (stepping_identity, checkpoint_file.hpp): a unit started on a resume computes its numbers
 // as the finished ones did.
-json plan_json(const Plan& plan, const std::string& fingerprint, const std::string& stepping) {
+ordered_json plan_json(const Plan& plan, const std::string& fingerprint, const std::string& stepping) {
   return {{"format", plan_format}, {"trajectories", plan.trajectories}, {"unit_size", plan.unit_size},
           {"units", plan.units},   {"job_fingerprint", fingerprint},    {"stepping", stepping}};
 }
@@ -82,9 +82,9 @@ void prepare_folder(const LoadedJob& loaded, const RunOptions& options, const Pl
   const auto path = directory / units_folder / plan_name;
   if (options.resume) {
     check_real_folder(directory / units_folder, false);
-    json saved;
+    ordered_json saved;
     try {
-      saved = json::parse(read_regular_file(path, 1 << 16).value_or(""));
+      saved = ordered_json::parse(read_regular_file(path, 1 << 16).value_or(""));
     } catch (const std::exception&) {
       throw CheckpointError(path.string() + " is missing or damaged: there is no distributed run to resume here");
     }
@@ -131,7 +131,7 @@ RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const
   const std::filesystem::path& directory = options.output_directory;
   check_real_folder(directory / units_folder, false);
   std::vector<UnitFile> parts;
-  std::vector<json> summaries;
+  std::vector<ordered_json> summaries;
   std::vector<std::size_t> firsts;
   for (std::size_t u = 0; u < plan.units; ++u) {
     parts.push_back({unit_folder(directory, u), plan.first(u)});
@@ -139,8 +139,8 @@ RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const
     check_real_folder(parts.back().path, false);
     verify_unit(parts.back().path, unit_identity(loaded, plan, u));
     try {
-      summaries.push_back(json::parse(read_regular_file(parts.back().path / "summary.json").value_or("")));
-    } catch (const json::exception& error) {
+      summaries.push_back(ordered_json::parse(read_regular_file(parts.back().path / "summary.json").value_or("")));
+    } catch (const ordered_json::exception& error) {
       throw OutputError((parts.back().path / "summary.json").string() + " cannot be read: " + error.what());
     }
   }
@@ -166,7 +166,7 @@ RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const
   outcome.distributed = true;
   outcome.summary = merge_summaries(summaries, firsts, plan.trajectories, directory, wall_seconds);
   write_file_atomically(directory / "summary.json", outcome.summary.dump(2) + "\n");
-  const json& summary = outcome.summary;
+  const ordered_json& summary = outcome.summary;
   outcome.status =
       trajectory_status_from_string(summary["status"].get<std::string>()).value_or(TrajectoryStatus::failed);
   outcome.exit_status = exit_status_of(outcome.status);
@@ -175,7 +175,7 @@ RunOutcome merge_units(const LoadedJob& loaded, const RunOptions& options, const
   for (TrajectoryStatus status : {TrajectoryStatus::completed, TrajectoryStatus::diverged, TrajectoryStatus::failed,
                                   TrajectoryStatus::inaccurate, TrajectoryStatus::interrupted})
     outcome.counts[status] = summary["counts"][to_string(status)].get<std::size_t>();
-  if (const json& largest = summary["energy"]["largest_relative_error"]; largest.is_object())
+  if (const ordered_json& largest = summary["energy"]["largest_relative_error"]; largest.is_object())
     outcome.largest_energy_error =
         LargestEnergyError{largest["value"].get<double>(), largest["trajectory"].get<std::size_t>()};
   return outcome;
@@ -215,8 +215,8 @@ RunOutcome interrupted_outcome(const LoadedJob& loaded, const RunOptions& option
 
 // output.format "hdf5": the ranks copy the units' /samples into results.h5 together, then rank 0 adds the tables
 // and attributes from the merged CSV files and summary (merge_results_h5.hpp). Collective.
-void finish_results_h5(const LoadedJob& loaded, const RunOptions& options, const Plan& plan, const json& summary,
-                       const Ranks& ranks) {
+void finish_results_h5(const LoadedJob& loaded, const RunOptions& options, const Plan& plan,
+                       const ordered_json& summary, const Ranks& ranks) {
   const SingleRun& run = loaded.job.run();
   if (run.format != OutputFormat::hdf5) return;
 #ifdef NONSEP_HAVE_HDF5

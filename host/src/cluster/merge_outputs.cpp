@@ -173,10 +173,10 @@ void merge_signals(std::span<const UnitFile> parts, const std::filesystem::path&
 
 namespace {
 
-using json = nlohmann::ordered_json;
+using nlohmann::ordered_json;
 
 // What a unit's status says of how its driver ended; its counts say the rest (run_status).
-DriverEnd driver_end(const json& summary) {
+DriverEnd driver_end(const ordered_json& summary) {
   const auto status = trajectory_status_from_string(summary.value("status", "failed"));
   if (status == TrajectoryStatus::interrupted) return DriverEnd::interrupted;
   if (!status || status == TrajectoryStatus::failed) return DriverEnd::failed;
@@ -184,7 +184,7 @@ DriverEnd driver_end(const json& summary) {
 }
 
 // The counts of summary.json's "counts" object.
-StatusCounts status_counts(const json& counts) {
+StatusCounts status_counts(const ordered_json& counts) {
   StatusCounts result;
   for (const TrajectoryStatus status :
        {TrajectoryStatus::completed, TrajectoryStatus::diverged, TrajectoryStatus::failed, TrajectoryStatus::inaccurate,
@@ -193,7 +193,7 @@ StatusCounts status_counts(const json& counts) {
   return result;
 }
 
-void add_counts(json& total, const json& part) {
+void add_counts(ordered_json& total, const ordered_json& part) {
   for (auto& [name, value] : total.items())
     if (part.contains(name) && value.is_number_integer())
       value = value.get<std::uint64_t>() + part[name].get<std::uint64_t>();
@@ -201,13 +201,13 @@ void add_counts(json& total, const json& part) {
 
 }  // namespace
 
-json merge_summaries(std::span<const json> units, std::span<const std::size_t> first_trajectories,
-                     std::size_t trajectories, const std::filesystem::path& directory, double wall_seconds) {
-  json merged = units.front();
+ordered_json merge_summaries(std::span<const ordered_json> units, std::span<const std::size_t> first_trajectories,
+                             std::size_t trajectories, const std::filesystem::path& directory, double wall_seconds) {
+  ordered_json merged = units.front();
   DriverEnd end = driver_end(merged);
   std::string error = merged.value("error", "");
   for (std::size_t u = 1; u < units.size(); ++u) {
-    const json& unit = units[u];
+    const ordered_json& unit = units[u];
     if (const DriverEnd unit_end = driver_end(unit); unit_end != DriverEnd::completed && end != DriverEnd::interrupted)
       end = unit_end;
     if (const std::string e = unit.value("error", ""); !e.empty() && error.find(e) == std::string::npos)
@@ -233,11 +233,11 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
                                  unit["analysis"][entry.key()]["analysed"].get<std::uint64_t>();
   }
   // The largest energy error: strictly larger wins, as one process scans the trajectories in order.
-  json largest = nullptr;
+  ordered_json largest = nullptr;
   for (std::size_t u = 0; u < units.size(); ++u) {
-    const json& energy = units[u]["energy"];
+    const ordered_json& energy = units[u]["energy"];
     if (!energy.contains("largest_relative_error") || energy["largest_relative_error"].is_null()) continue;
-    const json& candidate = energy["largest_relative_error"];
+    const ordered_json& candidate = energy["largest_relative_error"];
     if (largest.is_null() || candidate["value"].get<double>() > largest["value"].get<double>())
       largest = {{"value", candidate["value"]},
                  {"trajectory", candidate["trajectory"].get<std::uint64_t>() + first_trajectories[u]}};
@@ -246,7 +246,7 @@ json merge_summaries(std::span<const json> units, std::span<const std::size_t> f
   merged["status"] = to_string(run_status(end, status_counts(merged["counts"])));
   if (!error.empty()) {
     // "error" follows "status", as run_summary writes it.
-    json ordered;
+    ordered_json ordered;
     for (auto& [name, value] : merged.items()) {
       if (name == "error") continue;
       ordered[name] = value;

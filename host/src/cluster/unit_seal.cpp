@@ -17,7 +17,7 @@ namespace nonsep::host {
 
 namespace {
 
-using json = nlohmann::ordered_json;
+using nlohmann::ordered_json;
 constexpr int seal_format = 1;
 
 struct FileFacts {
@@ -49,8 +49,8 @@ FileFacts facts_of(const std::filesystem::path& path) {
 }
 
 // The unit's files, as RunFolder names a run's files, that are there now (its manifest and seal aside).
-json files_of(const std::filesystem::path& folder) {
-  json files = json::object();
+ordered_json files_of(const std::filesystem::path& folder) {
+  ordered_json files = ordered_json::object();
   for (const std::string& name : RunFolder::output_files()) {
     std::error_code error;
     if (name.front() == '.' || !std::filesystem::exists(std::filesystem::symlink_status(folder / name, error)))
@@ -69,12 +69,12 @@ bool has_seal(const std::filesystem::path& folder) {
 }
 
 void seal_unit(const std::filesystem::path& folder, const UnitIdentity& identity) {
-  const json seal = {{"format", seal_format},
-                     {"unit", identity.unit},
-                     {"first_trajectory", identity.first},
-                     {"trajectories", identity.size},
-                     {"job_fingerprint", identity.fingerprint},
-                     {"files", files_of(folder)}};
+  const ordered_json seal = {{"format", seal_format},
+                             {"unit", identity.unit},
+                             {"first_trajectory", identity.first},
+                             {"trajectories", identity.size},
+                             {"job_fingerprint", identity.fingerprint},
+                             {"files", files_of(folder)}};
   write_file_atomically(folder / unit_seal_name, seal.dump(2) + "\n");
 }
 
@@ -84,11 +84,11 @@ void verify_unit(const std::filesystem::path& folder, const UnitIdentity& identi
                           std::to_string(identity.first + identity.size - 1) + ") " + what +
                           "; it is not merged. Run the job again with --force, or put back the unit's own files");
   };
-  json seal, files, summary;
+  ordered_json seal, files, summary;
   try {
-    seal = json::parse(read_regular_file(folder / unit_seal_name, 1 << 20).value_or(""));
+    seal = ordered_json::parse(read_regular_file(folder / unit_seal_name, 1 << 20).value_or(""));
     files = files_of(folder);
-    summary = json::parse(read_regular_file(folder / "summary.json", 1 << 24).value_or(""));
+    summary = ordered_json::parse(read_regular_file(folder / "summary.json", 1 << 24).value_or(""));
   } catch (const std::exception& error) {
     refuse(std::string("cannot be read: ") + error.what());
   }
@@ -102,7 +102,7 @@ void verify_unit(const std::filesystem::path& folder, const UnitIdentity& identi
       if (!files.contains(name)) refuse("has lost its " + name);
     for (const auto& [name, facts] : files.items()) {
       if (!seal.at("files").contains(name)) refuse("has a " + name + " that was not among its files when it ended");
-      const json& sealed = seal.at("files").at(name);
+      const ordered_json& sealed = seal.at("files").at(name);
       if (sealed != facts)
         refuse("has a " + name + " that is not the one it ended with (" + facts["bytes"].dump() + " bytes, " +
                facts["rows"].dump() + " rows; sealed: " + sealed.at("bytes").dump() + " bytes, " +
@@ -113,7 +113,7 @@ void verify_unit(const std::filesystem::path& folder, const UnitIdentity& identi
       refuse("does not have one row of trajectories.csv per trajectory");
     if (summary.at("trajectories") != identity.size || summary.at("status") == "interrupted")
       refuse("has a summary.json that is not of this unit's finished run");
-  } catch (const nlohmann::json::exception& error) {
+  } catch (const nlohmann::ordered_json::exception& error) {
     refuse(std::string("has a damaged seal (") + unit_seal_name + "): " + error.what());
   }
 }

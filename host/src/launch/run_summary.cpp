@@ -2,19 +2,16 @@
 
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
+#include "nonsep/host/json/finite_or_null.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/output/csv.hpp"
 
 namespace nonsep::host {
 
-using json = nlohmann::ordered_json;
+using nlohmann::ordered_json;
 
 namespace {
-
-json optional_number(std::optional<double> value) {
-  return value && std::isfinite(*value) ? json(*value) : json(nullptr);
-}
 
 std::string hamiltonian_text(const Plugin& plugin, HamiltonianForm form) {
   return plugin.general_hamiltonian()   ? "H(q, p), the model's own"
@@ -22,7 +19,7 @@ std::string hamiltonian_text(const Plugin& plugin, HamiltonianForm form) {
                                         : "H = V_i(q) T_ij(p) V_j(q)";
 }
 
-json energy_facts(const RunFacts& facts) {
+ordered_json energy_facts(const RunFacts& facts) {
   const SingleRun& run = facts.loaded.job.run();
   const std::string hamiltonian = hamiltonian_text(facts.loaded.plugin, run.integrator.form);
   if (!facts.driver.energy_available())
@@ -30,7 +27,7 @@ json energy_facts(const RunFacts& facts) {
             {"hamiltonian", hamiltonian},
             {"reason", "the plugin '" + facts.loaded.plugin.name() +
                            "' provides no Hessians (hessian_T and hessian_V), which " + hamiltonian + " needs"}};
-  json largest = nullptr;
+  ordered_json largest = nullptr;
   if (const auto& l = facts.outcome.largest_energy_error)
     largest = {{"value", l->value}, {"trajectory", l->trajectory}};
   return {{"available", true},
@@ -42,24 +39,24 @@ json energy_facts(const RunFacts& facts) {
                                      : std::string()) +
                "the last step, and the final state of a trajectory that stopped early"},
           {"largest_relative_error", largest},
-          {"max_relative_error_bound", optional_number(run.analysis.max_relative_energy_error)}};
+          {"max_relative_error_bound", finite_or_null(run.analysis.max_relative_energy_error)}};
 }
 
 // Which path stepped the run: the plugin's kernel (and its instruction set) or the evaluation path. Gauss-Legendre
 // (`gauss`, `implicit_midpoint`) has one kernel, gauss_steps, compiled with the plugin's own flags (the baseline).
-json stepping_facts(const RunFacts& facts, const std::string& scheme) {
+ordered_json stepping_facts(const RunFacts& facts, const std::string& scheme) {
   const KernelChoice& kernels = facts.loaded.plugin.kernels();
   const bool kernel = facts.driver.kernel_calls() > 0;
   if (scheme == "gauss" || scheme == "implicit_midpoint")
     return {{"path", kernel ? "kernel" : "evaluation"},
-            {"instruction_set", kernel ? json("x86-64") : json(nullptr)},
+            {"instruction_set", kernel ? ordered_json("x86-64") : ordered_json(nullptr)},
             {"plugin_kernels", kernels.instruction_sets},
             {"note", kernel ? "the plugin's Gauss-Legendre kernel (gauss_steps), compiled with the plugin's own flags: "
                               "the evaluation path's numbers"
                             : "the evaluations (the plugin has no Gauss-Legendre kernel, or "
                               "NONSEP_INSTRUCTION_SET=evaluation)"}};
   return {{"path", kernel ? "kernel" : "evaluation"},
-          {"instruction_set", kernel ? json(kernels.chosen_name()) : json(nullptr)},
+          {"instruction_set", kernel ? ordered_json(kernels.chosen_name()) : ordered_json(nullptr)},
           {"plugin_kernels", kernels.instruction_sets},
           {"note", kernels.chosen && !kernel ? "every step needed the evaluation path (an every-step observer, tangent "
                                                "vectors of a scheme without a tangent kernel, or a scheme without "
@@ -69,12 +66,12 @@ json stepping_facts(const RunFacts& facts, const std::string& scheme) {
 
 }  // namespace
 
-json run_summary(const RunFacts& facts) {
+ordered_json run_summary(const RunFacts& facts) {
   const Job& job = facts.loaded.job;
   const SingleRun& run = job.run();
   const auto description = Integrator::describe(run.integrator);
   const RunOutcome& outcome = facts.outcome;
-  json summary;
+  ordered_json summary;
   summary["status"] = to_string(outcome.status);
   if (!outcome.error.empty()) summary["error"] = outcome.error;
   summary["job"] = job.file.string();
@@ -82,9 +79,9 @@ json run_summary(const RunFacts& facts) {
                       {"version", facts.loaded.plugin.version()},
                       {"path", facts.loaded.plugin.path().string()},
                       {"dimension", job.initial.dimension},
-                      {"parameters", json(facts.loaded.model.parameters())}};
+                      {"parameters", ordered_json(facts.loaded.model.parameters())}};
   if (!job.sweep.empty()) {
-    json swept = json::object();
+    ordered_json swept = ordered_json::object();
     for (const SweptParameter& parameter : job.sweep) {
       summary["model"]["parameters"][parameter.name] = parameter.values;
       swept[parameter.name] = parameter.values.size();
@@ -113,12 +110,13 @@ json run_summary(const RunFacts& facts) {
                      {"steps_completed", outcome.steps_completed}};
   summary["energy"] = energy_facts(facts);
   const bool hdf5 = run.format == OutputFormat::hdf5;
-  summary["output"] = {{"directory", facts.directory.string()},
-                       {"format", hdf5 ? "hdf5" : "csv"},
-                       {"trajectory", facts.samples_written && !hdf5 ? json("trajectory.csv") : json(nullptr)},
-                       {"trajectories", trajectories_file_name},
-                       {"every", run.every},
-                       {"energy_every", run.energy_every}};
+  summary["output"] = {
+      {"directory", facts.directory.string()},
+      {"format", hdf5 ? "hdf5" : "csv"},
+      {"trajectory", facts.samples_written && !hdf5 ? ordered_json("trajectory.csv") : ordered_json(nullptr)},
+      {"trajectories", trajectories_file_name},
+      {"every", run.every},
+      {"energy_every", run.energy_every}};
   if (hdf5) summary["output"]["results"] = results_file_name;
   summary["trajectories"] = job.initial.count;
   summary["counts"] = {{"completed", outcome.counts.completed},
@@ -136,7 +134,7 @@ json run_summary(const RunFacts& facts) {
   summary["stepping"] = stepping_facts(facts, description.scheme);
   // What the scheme reports, under its family's name ("comparator": Tao's omega and largest copy distance).
   if (const std::vector<SchemeFigure> report = facts.driver.scheme_report(); !report.empty()) {
-    json& figures = summary[find_scheme(run.integrator.scheme)->family];
+    ordered_json& figures = summary[find_scheme(run.integrator.scheme)->family];
     for (const SchemeFigure& figure : report) {
       figures[figure.name] = figure.value;
       if (!figure.note.empty()) figures[figure.name + "_note"] = figure.note;
@@ -166,9 +164,9 @@ void write_trajectories_csv(const std::filesystem::path& path, const RunFacts& f
   // A sweep's cells of each parameter set, once.
   std::vector<std::string> set_cells(job.sweep.empty() ? 0 : job.parameter_sets());
   for (std::size_t s = 0; s < set_cells.size(); ++s) {
-    const nlohmann::json parameters = job.parameter_set(s);
+    const nlohmann::ordered_json parameters = job.parameter_set(s);
     for (const SweptParameter& swept : job.sweep) {
-      const nlohmann::json& value = parameters[swept.name];
+      const nlohmann::ordered_json& value = parameters[swept.name];
       set_cells[s] += ',';
       if (value.is_number_float())
         append_number(set_cells[s], value.get<double>());

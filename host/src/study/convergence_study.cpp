@@ -11,6 +11,7 @@
 #include "nonsep/core/base/error.hpp"
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
+#include "nonsep/host/json/finite_or_null.hpp"
 #include "nonsep/host/number_format.hpp"
 #include "nonsep/host/observers/energy_error.hpp"
 #include "nonsep/host/output/atomic_files.hpp"
@@ -20,15 +21,11 @@
 
 namespace nonsep::host {
 
-using json = nlohmann::ordered_json;
+using nlohmann::ordered_json;
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-json optional_number(std::optional<double> value) {
-  return value && std::isfinite(*value) ? json(*value) : json(nullptr);
-}
 
 class StudyExecution {
  public:
@@ -248,8 +245,8 @@ class StudyExecution {
     return TrajectoryStatus::completed;
   }
 
-  json summary(const StudyOutcome& outcome, double wall_seconds) const {
-    json summary;
+  ordered_json summary(const StudyOutcome& outcome, double wall_seconds) const {
+    ordered_json summary;
     summary["status"] = to_string(outcome.status);
     if (!run_error_.empty()) summary["error"] = run_error_;
     summary["job"] = job_.file.string();
@@ -257,18 +254,19 @@ class StudyExecution {
                         {"version", loaded_.plugin.version()},
                         {"path", loaded_.plugin.path().string()},
                         {"dimension", job_.initial.dimension},
-                        {"parameters", json(loaded_.model.parameters())}};
+                        {"parameters", ordered_json(loaded_.model.parameters())}};
     if (job_.formula) summary["model"]["formula"] = formula::formula_record(*job_.formula, job_.formula_cache_key);
     summary["hamiltonian"] = hamiltonian_name(loaded_.plugin, study_.form);
-    json study;
+    ordered_json study;
     study["t_end"] = study_.t_end;
     study["initial"] = {{"q", job_.initial.q}, {"p", job_.initial.p}};
-    study["reference"] = reference_q_.empty() ? json(nullptr) : json{{"q", reference_q_}, {"p", reference_p_}};
+    study["reference"] =
+        reference_q_.empty() ? ordered_json(nullptr) : ordered_json{{"q", reference_q_}, {"p", reference_p_}};
     if (study_.reference_run)
       study["reference_from"] = {{"scheme", study_.reference_run->spec.scheme},
                                  {"options", options_text(study_.reference_run->spec)},
                                  {"steps", study_.reference_run->steps.front()}};
-    study["energy_initial"] = optional_number(energy_initial_);
+    study["energy_initial"] = finite_or_null(energy_initial_);
     study["energy_available"] = energy_available_;
     const StatusCounts& counts = outcome.run_counts;
     study["runs"] = {{"completed", counts.completed},
@@ -276,8 +274,8 @@ class StudyExecution {
                      {"failed", counts.failed},
                      {"interrupted", counts.interrupted}};
     summary["study"] = std::move(study);
-    json fits = json::array();
-    json failures = json::array();
+    ordered_json fits = ordered_json::array();
+    ordered_json failures = ordered_json::array();
     for (std::size_t i = 0; i < outcome.fits.size(); ++i) {
       fits.push_back(to_json(outcome.fits[i]));
       for (const auto& run : outcome.runs[i])

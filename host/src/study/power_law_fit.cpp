@@ -7,7 +7,7 @@
 
 namespace nonsep::host {
 
-using json = nlohmann::ordered_json;
+using nlohmann::ordered_json;
 
 std::optional<PowerLawFit> fit_power_law(std::span<const double> dt, std::span<const double> error) {
   std::vector<double> x, y;
@@ -51,8 +51,8 @@ double constant_at(double exponent, const std::vector<double>& dt, const std::ve
 }
 
 template <class T>
-json or_null(const std::optional<T>& value) {
-  return value ? json(*value) : json(nullptr);
+ordered_json or_null(const std::optional<T>& value) {
+  return value ? ordered_json(*value) : ordered_json(nullptr);
 }
 
 bool usable_error(double e) { return std::isfinite(e) && e != 0.0; }
@@ -71,7 +71,7 @@ std::optional<NonMonotoneStep> first_rise(const std::vector<std::uint64_t>& step
   return std::nullopt;
 }
 
-json to_json(const std::optional<NonMonotoneStep>& rise) {
+ordered_json to_json(const std::optional<NonMonotoneStep>& rise) {
   if (!rise) return nullptr;
   return {{"steps", rise->steps_coarse},
           {"error", rise->error_coarse},
@@ -182,8 +182,8 @@ StudyFit fit_study(const StudyIntegrator& integrator, const IntegratorDescriptio
   return fit;
 }
 
-json to_json(const StudyFit& fit) {
-  json entry;
+ordered_json to_json(const StudyFit& fit) {
+  ordered_json entry;
   entry["integrator"] = fit.integrator;
   entry["scheme"] = fit.description.scheme;
   entry["order"] = fit.description.order.to_string();

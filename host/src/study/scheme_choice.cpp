@@ -14,11 +14,13 @@
 
 namespace nonsep::host {
 
-using json = nlohmann::ordered_json;
+using nlohmann::ordered_json;
 
 namespace {
 
-json number_or_null(double x, bool known) { return known && std::isfinite(x) ? json(x) : json(nullptr); }
+ordered_json number_or_null(double x, bool known) {
+  return known && std::isfinite(x) ? ordered_json(x) : ordered_json(nullptr);
+}
 
 // The choice by `measure`: the pilots at each fraction of t_end in turn until some candidate is usable.
 SchemeChoice choose_by(const LoadedJob& loaded, const RunOptions& options, AutoScheme::Measure measure) {
@@ -154,16 +156,16 @@ void apply_recorded_choice(LoadedJob& loaded, const nlohmann::ordered_json& reco
 
 namespace {
 
-json candidates_json(const std::vector<PilotResult>& pilots) {
-  json candidates = json::array();
+ordered_json candidates_json(const std::vector<PilotResult>& pilots) {
+  ordered_json candidates = ordered_json::array();
   for (const PilotResult& pilot : pilots) {
     const bool usable = pilot.excluded.empty();
     const double order = Integrator::describe(pilot.candidate.spec).order.value();
     candidates.push_back({{"label", pilot.candidate.label},
                           {"scheme", pilot.candidate.spec.scheme},
                           {"order", Integrator::describe(pilot.candidate.spec).order.to_string()},
-                          {"excluded", usable ? json(nullptr) : json(pilot.excluded)},
-                          {"pilot_steps", pilot.pilot_steps ? json(pilot.anchor_steps) : json(nullptr)},
+                          {"excluded", usable ? ordered_json(nullptr) : ordered_json(pilot.excluded)},
+                          {"pilot_steps", pilot.pilot_steps ? ordered_json(pilot.anchor_steps) : ordered_json(nullptr)},
                           {"pilot_dt", number_or_null(pilot.pilot_dt, pilot.pilot_steps > 0)},
                           {"pilot_error", number_or_null(pilot.pilot_error, pilot.pilot_steps > 0)},
                           {"error_ratio_per_halving", number_or_null(pilot.ratio, pilot.pilot_steps > 0)},
@@ -173,7 +175,7 @@ json candidates_json(const std::vector<PilotResult>& pilots) {
                           {"envelope_growth_exponent",
                            number_or_null(pilot.envelope_growth.value_or(0.0), pilot.envelope_growth.has_value())},
                           {"seconds_per_step", number_or_null(pilot.seconds_per_step, pilot.pilot_steps > 0)},
-                          {"steps", usable ? json(pilot.steps) : json(nullptr)},
+                          {"steps", usable ? ordered_json(pilot.steps) : ordered_json(nullptr)},
                           {"predicted_error", number_or_null(pilot.predicted_error, usable)},
                           {"predicted_seconds", number_or_null(pilot.predicted_seconds, usable)}});
   }
@@ -186,44 +188,44 @@ const char* measure_name(AutoScheme::Measure measure) {
 
 }  // namespace
 
-json to_json(const SchemeChoice& choice) {
+ordered_json to_json(const SchemeChoice& choice) {
   const PilotResult& chosen = choice.pilots[choice.chosen];
   const EvaluationCounts& e = choice.pilot_evaluations;
   const bool asked = choice.chosen_by == choice.measure;  // false: chosen by the energy for a phase tolerance
   // The phase error at t_end of an exponentially growing one is not predicted (its pilots' extrapolation stays in
   // "candidates" or "phase_candidates").
   const bool predicted = choice.phase_growth != PhaseGrowth::exponential;
-  return {
-      {"tolerance", choice.tolerance},
-      {"measure", measure_name(choice.measure)},
-      {"phase_error_growth", choice.phase_growth == PhaseGrowth::not_measured  ? json(nullptr)
-                             : choice.phase_growth == PhaseGrowth::exponential ? json("exponential")
-                                                                               : json("polynomial")},
-      {"chosen_by", measure_name(choice.chosen_by)},
-      {"method",
-       "pilots at n, 2n, 4n steps to the pilot horizon; error at t_end predicted as e_p (h / h_p)^order "
-       "(t_end / t_p)^growth_exponent, aimed at tolerance / " +
-           format_number(auto_safety)},
-      {"pilot_horizon", choice.pilot_horizon},
-      {"pilot_states", choice.pilot_states},
-      {"amplified_round_off", number_or_null(choice.amplified_round_off, choice.amplified_round_off > 0.0)},
-      {"candidates", candidates_json(choice.pilots)},
-      {"phase_candidates", asked ? json(nullptr) : candidates_json(choice.phase_pilots)},
-      {"phase_pilot_horizon", asked ? json(nullptr) : json(choice.phase_pilot_horizon)},
-      {"chosen", chosen.candidate.label},
-      {"subdivision", choice.subdivision},
-      {"estimated_error", predicted ? json(chosen.predicted_error) : json(nullptr)},
-      {"estimated_error_meets_tolerance", predicted ? json(chosen.predicted_error <= choice.tolerance) : json(nullptr)},
-      {"estimated_energy_error", asked ? json(nullptr) : json(chosen.predicted_error)},
-      {"pilot_cost",
-       {{"wall_seconds", choice.pilot_seconds},
-        {"state_steps", choice.pilot_state_steps},
-        {"evaluations",
-         {{"grad_T", e.grad_T},
-          {"grad_V", e.grad_V},
-          {"grad_H", e.grad_H},
-          {"grad_K", e.grad_K},
-          {"grad_U", e.grad_U}}}}}};
+  return {{"tolerance", choice.tolerance},
+          {"measure", measure_name(choice.measure)},
+          {"phase_error_growth", choice.phase_growth == PhaseGrowth::not_measured  ? ordered_json(nullptr)
+                                 : choice.phase_growth == PhaseGrowth::exponential ? ordered_json("exponential")
+                                                                                   : ordered_json("polynomial")},
+          {"chosen_by", measure_name(choice.chosen_by)},
+          {"method",
+           "pilots at n, 2n, 4n steps to the pilot horizon; error at t_end predicted as e_p (h / h_p)^order "
+           "(t_end / t_p)^growth_exponent, aimed at tolerance / " +
+               format_number(auto_safety)},
+          {"pilot_horizon", choice.pilot_horizon},
+          {"pilot_states", choice.pilot_states},
+          {"amplified_round_off", number_or_null(choice.amplified_round_off, choice.amplified_round_off > 0.0)},
+          {"candidates", candidates_json(choice.pilots)},
+          {"phase_candidates", asked ? ordered_json(nullptr) : candidates_json(choice.phase_pilots)},
+          {"phase_pilot_horizon", asked ? ordered_json(nullptr) : ordered_json(choice.phase_pilot_horizon)},
+          {"chosen", chosen.candidate.label},
+          {"subdivision", choice.subdivision},
+          {"estimated_error", predicted ? ordered_json(chosen.predicted_error) : ordered_json(nullptr)},
+          {"estimated_error_meets_tolerance",
+           predicted ? ordered_json(chosen.predicted_error <= choice.tolerance) : ordered_json(nullptr)},
+          {"estimated_energy_error", asked ? ordered_json(nullptr) : ordered_json(chosen.predicted_error)},
+          {"pilot_cost",
+           {{"wall_seconds", choice.pilot_seconds},
+            {"state_steps", choice.pilot_state_steps},
+            {"evaluations",
+             {{"grad_T", e.grad_T},
+              {"grad_V", e.grad_V},
+              {"grad_H", e.grad_H},
+              {"grad_K", e.grad_K},
+              {"grad_U", e.grad_U}}}}}};
 }
 
 std::string describe_auto(const LoadedJob& loaded) {
