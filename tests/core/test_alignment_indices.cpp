@@ -14,6 +14,8 @@
 #include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "support/models.hpp"
 
+namespace test_alignment_indices {
+
 using namespace nonsep;
 
 namespace {
@@ -170,3 +172,5 @@ TEST_CASE("the factors and the skipped MEGNO logarithm leave the exponents bit f
   CHECK_THROWS_WITH_AS(lyapunov.after_step(tangents[0], records[0], 0.002, {}, wrong), doctest::Contains("expected 6"),
                        InvalidArgument);
 }
+
+}  // namespace test_alignment_indices

@@ -17,6 +17,8 @@
 #include "support/convergence.hpp"
 #include "support/models.hpp"
 
+namespace test_chaos_against_reference {
+
 using namespace nonsep;
 using nonsep::testing::Paper1D;
 using nonsep::testing::Paper2D;
@@ -155,3 +157,5 @@ TEST_CASE("paper2d, chaotic orbit: the long-time exponent lies within the spread
   CHECK(mean > 0.1);
   CHECK(std::abs(orbit.exponents.back() - mean) < 3.0 * spread);
 }
+
+}  // namespace test_chaos_against_reference

@@ -16,6 +16,8 @@
 #include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "support/models.hpp"
 
+namespace test_chaos_indicators {
+
 using namespace nonsep;
 using nonsep::testing::Paper2D;
 
@@ -216,3 +218,5 @@ TEST_CASE("the full spectrum of a symplectic map sums to zero (det M = 1), and M
     CHECK(r.exponent(0) + r.exponent(1) > 0.1);  // areas grow: the orbit is chaotic
   }
 }
+
+}  // namespace test_chaos_indicators

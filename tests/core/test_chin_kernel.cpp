@@ -17,6 +17,8 @@
 #include "nonsep/core/kernel/chin_kernel.hpp"
 #include "support/models.hpp"
 
+namespace test_chin_kernel {
+
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
@@ -303,3 +305,5 @@ TEST_CASE("kernel path: a kernel that fails leaves no stale first-same-as-last g
     CHECK(x == y);
   }
 }
+
+}  // namespace test_chin_kernel

@@ -21,6 +21,8 @@
 #include "paper1d/paper1d.hpp"
 #include "paper2d/paper2d.hpp"
 
+namespace test_chin_tangent_kernel {
+
 using namespace nonsep;
 
 namespace {
@@ -165,3 +167,5 @@ TEST_CASE("tangent kernel: after_steps of a run gives the records of after_step 
   CHECK(exponents.steps_to_renormalization(runs) == 1);
   CHECK_THROWS_AS(exponents.after_steps(w, runs, dt, 2, {}), InvalidArgument);
 }
+
+}  // namespace test_chin_tangent_kernel

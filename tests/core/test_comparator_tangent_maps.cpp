@@ -23,6 +23,8 @@
 #include "support/phase_space_jacobian.hpp"
 #include "variable_mass2d/variable_mass2d.hpp"
 
+namespace test_comparator_tangent_maps {
+
 using namespace nonsep;
 
 namespace {
@@ -352,3 +354,5 @@ TEST_CASE("tao's tangent map gives Gauss's leading exponent on a chaotic orbit (
   CAPTURE(tao_exponent);
   CHECK(std::abs(tao_exponent - reference) < 1e-4 * reference);  // measured 3e-5 relative
 }
+
+}  // namespace test_comparator_tangent_maps

@@ -20,6 +20,8 @@
 #include "support/finite_difference.hpp"
 #include "support/models.hpp"
 
+namespace test_comparators_convergence {
+
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
@@ -114,3 +116,5 @@ TEST_CASE("the VVT form: both comparators converge to the flow of H_VVT = (q + q
   CHECK(std::abs(measured_order("tao 4 VVT", tao, 0.5, 0.5, t_end, reference[0], reference[1], 64, 3) - 4.0) < 0.1);
   CHECK(std::abs(measured_order("gauss 4 VVT", gauss, 0.5, 0.5, t_end, reference[0], reference[1], 8, 3) - 4.0) < 0.1);
 }
+
+}  // namespace test_comparators_convergence

@@ -22,6 +22,8 @@
 #include "support/nan_aware.hpp"
 #include "support/phase_space_jacobian.hpp"
 
+namespace test_comparators_properties {
+
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
@@ -506,3 +508,5 @@ TEST_CASE("the distance between Tao's copies shrinks with the scheme's order") {
     CHECK(distances[2] > 0.0);
   }
 }
+
+}  // namespace test_comparators_properties

@@ -19,6 +19,8 @@
 #include "support/convergence.hpp"
 #include "support/models.hpp"
 
+namespace test_core_convergence {
+
 using namespace nonsep;
 using nonsep::testing::Paper1D;
 
@@ -185,3 +187,5 @@ TEST_CASE("every scheme of the catalogue, every order of a comparator, has an or
       }
   }
 }
+
+}  // namespace test_core_convergence

@@ -11,6 +11,8 @@
 #include "nonsep/core.hpp"
 #include "support/models.hpp"
 
+namespace test_core_errors {
+
 using namespace nonsep;
 
 namespace {
@@ -320,3 +322,5 @@ TEST_CASE("an option's declared range is what its scheme accepts, at both ends")
     }
   CHECK(ranges == 4);  // tao omega > 0; implicit_midpoint and gauss max_iterations >= 1; gauss stages 1 to 8
 }
+
+}  // namespace test_core_errors

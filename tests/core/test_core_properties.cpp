@@ -19,6 +19,8 @@
 #include "support/nan_aware.hpp"
 #include "support/phase_space_jacobian.hpp"
 
+namespace test_core_properties {
+
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
@@ -506,3 +508,5 @@ TEST_CASE("MPE: the terms batched give the term-by-term numbers and evaluation c
       }
     }
 }
+
+}  // namespace test_core_properties

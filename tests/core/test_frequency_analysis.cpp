@@ -15,6 +15,8 @@
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "support/convergence.hpp"
 
+namespace test_frequency_analysis {
+
 using namespace nonsep;
 using Complex = std::complex<double>;
 
@@ -196,3 +198,5 @@ TEST_CASE("frequency analysis: each bad input gets its own error") {
   CHECK_THROWS_WITH_AS(diffusion_index(std::vector{1.0, 2.0}, std::vector{1.0, std::nan("")}),
                        doctest::Contains("frequency 1 is not finite"), InvalidArgument);
 }
+
+}  // namespace test_frequency_analysis

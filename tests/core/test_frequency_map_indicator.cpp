@@ -11,6 +11,8 @@
 
 #include "nonsep/core/analysis/frequency_map_indicator.hpp"
 
+namespace test_frequency_map_indicator {
+
 using namespace nonsep;
 using Complex = std::complex<double>;
 
@@ -131,3 +133,5 @@ TEST_CASE("frequency map indicator: a signal with a sample that is not finite gi
   CHECK(result.values.empty());
   CHECK(result.spectra.empty());
 }
+
+}  // namespace test_frequency_map_indicator

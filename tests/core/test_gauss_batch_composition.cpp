@@ -13,6 +13,8 @@
 #include "nonsep/core/schemes/gauss_legendre.hpp"
 #include "support/models.hpp"
 
+namespace test_gauss_batch_composition {
+
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
@@ -104,3 +106,5 @@ TEST_CASE("Gauss-Legendre: in two dimensions, many steps of a batch equal the st
     }
   }
 }
+
+}  // namespace test_gauss_batch_composition

@@ -19,6 +19,8 @@
 #include "nonsep/sdk/hamiltonian_adapter.hpp"
 #include "support/models.hpp"
 
+namespace test_gauss_kernel {
+
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
@@ -154,3 +156,5 @@ TEST_CASE("Gauss kernel: a model whose kernel is not at hand is stepped through 
   CHECK(a == b);
   CHECK(off.calls == 0);
 }
+
+}  // namespace test_gauss_kernel

@@ -11,6 +11,8 @@
 #include "nonsep/core/base/error.hpp"
 #include "nonsep/core/tangent/gauss_linear_stages.hpp"
 
+namespace test_gauss_linear_stages {
+
 namespace {
 
 // dz' = dz + dt sum_i b_i J_i (dz + dZ_i), dZ from (I - dt (A (x) I) diag(J_j)) dZ = dt (A (x) I) (J_j dz)_j.
@@ -87,3 +89,5 @@ TEST_CASE("Gauss linear stages: a singular system gives false, sizes beyond the 
   std::vector<double> odd(3 * 3 * 3, 0.0), odd_vector(3, 0.0);
   CHECK_THROWS_AS(nonsep::map_by_linear_stages(three, dt, odd, 3, odd_vector, 1), nonsep::InvalidArgument);
 }
+
+}  // namespace test_gauss_linear_stages

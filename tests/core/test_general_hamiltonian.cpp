@@ -24,6 +24,8 @@
 #include "nonsep/derivative_checker.hpp"
 #include "paper1d/paper1d.hpp"
 
+namespace test_general_hamiltonian {
+
 using namespace nonsep;
 
 namespace {
@@ -326,3 +328,5 @@ TEST_CASE("general H: a Gauss step whose iteration diverges to where grad H over
   // The same state with a step the iteration takes: no failure.
   CHECK(gauss.try_step(model, x, 0.05).empty());
 }
+
+}  // namespace test_general_hamiltonian

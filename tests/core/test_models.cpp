@@ -10,6 +10,8 @@
 #include "nonsep/derivative_checker.hpp"
 #include "support/models.hpp"
 
+namespace test_models {
+
 namespace {
 
 // Largest error (relative to max(1, |difference|)) of every gradient and Hessian entry at 16 random points in
@@ -113,3 +115,5 @@ TEST_CASE("test models with a separable part: T, V, K and U derivatives, and a w
   const double product = g[0] * (h[0] * g[0] + h[1] * g[1]) + g[1] * (h[2] * g[0] + h[3] * g[1]);
   CHECK(plane.hamiltonian(x) == doctest::Approx(product + k + u).epsilon(1e-14));
 }
+
+}  // namespace test_models

@@ -10,6 +10,8 @@
 #include "nonsep/core/analysis/poincare_crossing.hpp"
 #include "support/models.hpp"
 
+namespace test_poincare_crossing {
+
 using namespace nonsep;
 using nonsep::testing::Paper1D;
 using nonsep::testing::Paper2D;
@@ -122,3 +124,5 @@ TEST_CASE("the crossing locator refuses a step without a crossing and a bad plan
                   InvalidArgument);
   CHECK_THROWS_AS(locator.locate(Paper1D{}, q, p, 0.0, 0.0, SectionPlane({1.0, 0.0}, 0.0), crossing), InvalidArgument);
 }
+
+}  // namespace test_poincare_crossing

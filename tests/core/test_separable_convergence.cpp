@@ -22,6 +22,8 @@
 #include "support/finite_difference.hpp"
 #include "support/models.hpp"
 
+namespace test_separable_convergence {
+
 using namespace nonsep;
 
 namespace {
@@ -281,3 +283,5 @@ TEST_CASE(
                  study.nominal) < 0.1);
   }
 }
+
+}  // namespace test_separable_convergence

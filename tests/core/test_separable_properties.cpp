@@ -17,6 +17,8 @@
 #include "support/models.hpp"
 #include "support/phase_space_jacobian.hpp"
 
+namespace test_separable_properties {
+
 using namespace nonsep;
 using nonsep::testing::MathewsLakshmanan;
 using nonsep::testing::VariableMass2D;
@@ -254,3 +256,5 @@ TEST_CASE("a model with K = U = 0 is stepped bit for bit as by the steppers over
     CHECK(tangent.hessian_evaluations().hessian_K == 0);
   }
 }
+
+}  // namespace test_separable_properties

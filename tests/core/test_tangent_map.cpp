@@ -14,6 +14,8 @@
 #include "support/models.hpp"
 #include "support/phase_space_jacobian.hpp"
 
+namespace test_tangent_map {
+
 using namespace nonsep;
 using nonsep::testing::Coupled2D;
 using nonsep::testing::Paper1D;
@@ -220,3 +222,5 @@ TEST_CASE("tangent vectors that do not fit the states are refused with the shape
   }
   CHECK_THROWS_AS(TangentIntegrator(IntegratorSpec{"triplet", ChinOptions{Fraction(1, 3)}}), InvalidArgument);
 }
+
+}  // namespace test_tangent_map

@@ -12,6 +12,8 @@
 #include "address_sanitizer.hpp"
 #include "formula_test_support.hpp"
 
+namespace test_formula_cache_safety {
+
 using namespace nonsep::host_testing;
 using namespace nonsep::formula_testing;
 
@@ -301,3 +303,5 @@ TEST_CASE("formula cache: run checks what validate checks before compiling anyth
   CHECK(count_lines(folder / "calls.log") == 0);
   CHECK(!fs::exists(folder / "cache" / "formula"));
 }
+
+}  // namespace test_formula_cache_safety

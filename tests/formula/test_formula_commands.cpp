@@ -11,17 +11,14 @@
 #include <vector>
 
 #include "formula_test_support.hpp"
+#include "malformed_formulas.hpp"
+
+namespace test_formula_commands {
 
 using nlohmann::json;
 using namespace nonsep::host_testing;
 using namespace nonsep::formula_testing;
 namespace fs = std::filesystem;
-
-struct Malformed {
-  std::string text;
-  std::size_t column;
-};
-extern const std::vector<Malformed> malformed_formulas;  // test_formula_parser.cpp
 
 TEST_CASE("formula commands: each malformed formula exits 2 from validate, quoting it with a caret at its column") {
   TemporaryFolder folder;
@@ -393,3 +390,5 @@ TEST_CASE("formula commands: the cache with a stand-in compiler: one compile for
     CHECK(contains(bad.err, "bad.json#/V"));
   }
 }
+
+}  // namespace test_formula_commands

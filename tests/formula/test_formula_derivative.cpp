@@ -15,6 +15,8 @@
 #include "nonsep/host/formula/derivative.hpp"
 #include "nonsep/host/formula/expression.hpp"
 
+namespace test_formula_derivative {
+
 using namespace nonsep::host::formula;
 namespace sdk = nonsep::sdk;
 
@@ -204,3 +206,5 @@ TEST_CASE("formula derivatives: the SDK's derivative rules are names a formula c
   }
   CHECK_FALSE(is_derivative_rule("log"));
 }
+
+}  // namespace test_formula_derivative

@@ -16,6 +16,8 @@
 #include "formula_test_support.hpp"
 #include "nonsep/reference/paper1d_exact.hpp"
 
+namespace test_formula_frequencies {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 using namespace nonsep::formula_testing;
@@ -142,3 +144,5 @@ TEST_CASE("frequency map: two uncoupled paper1d oscillators, each frequency with
     }
   }
 }
+
+}  // namespace test_formula_frequencies

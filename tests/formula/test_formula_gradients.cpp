@@ -10,6 +10,8 @@
 
 #include "host_test_support.hpp"
 
+namespace test_formula_gradients {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 namespace fs = std::filesystem;
@@ -110,3 +112,5 @@ TEST_CASE("formula gradients: coupled Tao oscillators with c = 1/2 run off with 
   CHECK(!contains(compact.err, "non-compact"));
   ::unsetenv("NONSEP_CACHE_DIR");
 }
+
+}  // namespace test_formula_gradients

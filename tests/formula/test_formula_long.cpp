@@ -11,6 +11,8 @@
 #include "formula_test_support.hpp"
 #include "nonsep/host/formula/expression.hpp"
 
+namespace test_formula_long {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 using namespace nonsep::formula_testing;
@@ -56,3 +58,5 @@ TEST_CASE("formula commands: formulas at the length limit compile in bounded tim
 
   check_final_states_match_paper1d(folder, folder / "formula", 1e-12);
 }
+
+}  // namespace test_formula_long

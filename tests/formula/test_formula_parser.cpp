@@ -8,12 +8,16 @@
 #include <string>
 #include <vector>
 
+#include "malformed_formulas.hpp"
 #include "nonsep/host/formula/cpp_source.hpp"
 #include "nonsep/host/formula/derivative.hpp"
 #include "nonsep/host/formula/expression.hpp"
 #include "nonsep/host/formula/formula_model.hpp"
 
+namespace test_formula_parser {
+
 using namespace nonsep::host::formula;
+using nonsep::formula_testing::malformed_formulas;
 
 namespace {
 
@@ -34,63 +38,6 @@ Node tree_of(const std::string& text, const Symbols& symbols = q_symbols) {
 }
 
 }  // namespace
-
-// A malformed formula and the column its error must point at (1-based).
-struct Malformed {
-  std::string text;
-  std::size_t column;
-};
-
-// The same list drives tests/formula/test_formula_commands.cpp through `nonsep validate` (exit 2).
-extern const std::vector<Malformed> malformed_formulas;
-const std::vector<Malformed> malformed_formulas = {
-    {"", 1},                    // empty
-    {"   ", 4},                 // blanks only
-    {"q0 +", 5},                // ends after an operator
-    {"q0 + * q1", 6},           // two operators
-    {"* q0", 1},                // starts with an operator
-    {"(q0 + 1", 8},             // unclosed parenthesis
-    {"q0 + 1)", 7},             // unopened parenthesis
-    {"()", 2},                  // empty parentheses
-    {"q0 q1", 4},               // two terms without an operator
-    {"2q0", 2},                 // number glued to a name
-    {"1.5e", 5},                // exponent without digits
-    {"1e999", 1},               // overflow
-    {"x + q0", 1},              // unknown name
-    {"q0 + p0", 6},             // p in V
-    {"q01", 1},                 // leading zero in an index
-    {"q64", 1},                 // index beyond the dimension limit
-    {"sin q0", 5},              // function without parentheses
-    {"sin(q0, q1)", 1},         // too many arguments
-    {"atan2(q0)", 1},           // too few arguments
-    {"foo(q0)", 1},             // unknown function
-    {"sin()", 5},               // no argument
-    {"pow(q0,)", 8},            // empty argument
-    {"q0 ^", 5},                // power without exponent
-    {"q0 ^ * 2", 6},            // power then operator
-    {"q0 = 1", 4},              // assignment
-    {"q0 % 2", 4},              // modulo
-    {"q0; system(\"x\")", 3},   // statement separator
-    {"\"q0\"", 1},              // quotes
-    {"q0 + 'a'", 6},            // single quotes
-    {"#include <cstdlib>", 1},  // preprocessor line
-    {"q0\n#define X", 3},       // newline then preprocessor
-    {"{q0}", 1},                // braces
-    {"q0[0]", 3},               // brackets
-    {"q0 \\ 2", 4},             // backslash
-    {"q0 // comment", 5},       // a C++ comment: '/' then '/'
-    {"q0 /* c */", 5},          // a block comment: '/' then '*'
-    {"q0 & 1", 4},              // bitwise and
-    {"q0 < 1", 4},              // comparison
-    {"q0 ? 1 : 2", 4},          // conditional
-    {"lambda(q0)", 1},          // a parameter called as a function
-    {"sin", 4},                 // a function without call
-    {"q0 + \xc3\xa9", 6},       // non-ASCII
-    {"std::exp(q0)", 4},        // C++ scope
-    {"q0.x", 3},                // member access after an index is a number glued to a name
-    {"0x10", 2},                // hexadecimal
-    {"1,2", 2},                 // comma outside a call
-};
 
 TEST_CASE("formula parser: every malformed formula is refused at its column, saying what is allowed") {
   CHECK(malformed_formulas.size() >= 30);
@@ -354,3 +301,5 @@ TEST_CASE("formula models: H alone or T and V, never both, its dimension countin
   CHECK(source.find("dH_dp[2] = S(p[2])") != std::string::npos);
   CHECK(source.find("S T(") == std::string::npos);
 }
+
+}  // namespace test_formula_parser

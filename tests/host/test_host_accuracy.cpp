@@ -17,6 +17,8 @@
 #include "nonsep/sdk/model_adapter.hpp"
 #include "paper1d/paper1d.hpp"
 
+namespace test_host_accuracy {
+
 using json = nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -37,8 +39,8 @@ struct Ran {
   std::string out, err;
   std::filesystem::path folder;
 };
-Ran run_job(const TemporaryFolder& folder, const std::string& name, const json& job,
-            std::vector<std::string> extra = {"--quiet"}) {
+Ran run_accuracy_job(const TemporaryFolder& folder, const std::string& name, const json& job,
+                     std::vector<std::string> extra = {"--quiet"}) {
   const auto file = write_job(folder / (name + ".json"), job);
   std::vector<std::string> args{"run"};
   args.insert(args.end(), extra.begin(), extra.end());
@@ -68,7 +70,7 @@ TEST_CASE("a study reports the largest |dH/H0| over each run, which the core fin
                     {"initial", {{"q", {2.0}}, {"p", {0.0}}}},
                     {"time", {{"t_end", t_end}}},
                     {"study", {{"integrators", {{{"scheme", "triplet"}, {"order", "8/3"}, {"steps", {256, 512}}}}}}}};
-  const auto ran = run_job(folder, "study", job);
+  const auto ran = run_accuracy_job(folder, "study", job);
   REQUIRE(ran.status == 0);
   const auto rows = table(ran.folder / "work_precision.csv");
   REQUIRE(rows.size() == 2);
@@ -131,7 +133,7 @@ TEST_CASE("the error estimate is within a factor 3 of the error against exact so
       json job = run_of({{"plugin", "paper1d"}}, integrator, {{"q", {2.0}}, {"p", {0.0}}}, quarter_period / 64,
                         quarter_period, 0);
       job["analysis"] = {{"error_estimate", true}};
-      const auto ran = run_job(folder, "paper1d", job, {"--quiet", "--force"});
+      const auto ran = run_accuracy_job(folder, "paper1d", job, {"--quiet", "--force"});
       REQUIRE(ran.status == 0);
       const auto row = table(ran.folder / "trajectories.csv").at(0);
       const double actual = distance(number(row, "q0"), number(row, "p0"), 0.0, p_at_quarter);
@@ -154,7 +156,7 @@ TEST_CASE("the error estimate is within a factor 3 of the error against exact so
                       {{"scheme", "triplet"}, {"order", "8/3"}}, {{"q", {amplitude}}, {"p", {0.0}}}, period / 1024,
                       3 * period, 128);
     job["analysis"] = {{"error_estimate", true}};
-    const auto ran = run_job(folder, "ml", job);
+    const auto ran = run_accuracy_job(folder, "ml", job);
     REQUIRE(ran.status == 0);
     const auto rows = table(ran.folder / "error_estimate.csv");
     const auto samples = table(ran.folder / "trajectory.csv");
@@ -180,7 +182,7 @@ TEST_CASE("the error estimate is within a factor 3 of the error against exact so
 TEST_CASE("the error estimate on paper2d: a regular orbit against Gauss 6 at a tiny step, a chaotic one flagged") {
   const TemporaryFolder folder;
   const auto end_of = [&](const std::string& name, const json& job) {
-    const auto ran = run_job(folder, name, job);
+    const auto ran = run_accuracy_job(folder, name, job);
     REQUIRE(ran.status == 0);
     return table(ran.folder / "trajectories.csv").at(0);
   };
@@ -214,7 +216,7 @@ TEST_CASE("the error estimate on paper2d: a regular orbit against Gauss 6 at a t
     json job =
         run_of(model, {{"scheme", "gauss"}, {"stages", 3}}, {{"q", {0.5, 0.0}}, {"p", {0.0, 2.5}}}, 0.01, 40.0, 0);
     job["analysis"] = {{"error_estimate", true}};
-    const auto ran = run_job(folder, "chaotic", job);
+    const auto ran = run_accuracy_job(folder, "chaotic", job);
     REQUIRE(ran.status == 0);
     const auto row = table(ran.folder / "trajectories.csv").at(0);
     CHECK(row.at("error_estimate") == "separated");
@@ -235,7 +237,7 @@ TEST_CASE("scheme auto meets its tolerance against the exact solution and record
   SUBCASE("paper1d, phase, 1e-8") {
     const json job = run_of({{"plugin", "paper1d"}}, {{"scheme", "auto"}, {"tolerance", 1e-8}},
                             {{"q", {2.0}}, {"p", {0.0}}}, quarter_period, quarter_period, 1);
-    const auto ran = run_job(folder, "paper1d", job, {});
+    const auto ran = run_accuracy_job(folder, "paper1d", job, {});
     REQUIRE(ran.status == 0);
     CHECK(ran.out.find("auto: ") != std::string::npos);
     const auto row = table(ran.folder / "trajectories.csv").at(0);
@@ -258,7 +260,7 @@ TEST_CASE("scheme auto meets its tolerance against the exact solution and record
         run_of({{"plugin", "mathews_lakshmanan"}}, {{"scheme", "auto"}, {"tolerance", 1e-7}, {"measure", "energy"}},
                {{"q", {1.5}}, {"p", {0.0}}}, period / 4, period / 4, 0);
     job["output"]["energy_every"] = 1;
-    const auto ran = run_job(folder, "ml", job);
+    const auto ran = run_accuracy_job(folder, "ml", job);
     REQUIRE(ran.status == 0);
     const auto row = table(ran.folder / "trajectories.csv").at(0);
     CHECK(number(row, "max_abs_relative_energy_error") <= 1e-7);
@@ -269,7 +271,7 @@ TEST_CASE("scheme auto meets its tolerance against the exact solution and record
     json job = run_of({{"plugin", "paper2d"}}, {{"scheme", "auto"}, {"tolerance", 1e-4}},
                       {{"q", {0.0, 0.0}}, {"p", {0.5, 2.0}}}, 0.5, 1.0, 0);
     job["analysis"] = {{"megno", true}};
-    const auto ran = run_job(folder, "megno", job);
+    const auto ran = run_accuracy_job(folder, "megno", job);
     REQUIRE(ran.status == 0);
     const json summary = read_json(ran.folder / "summary.json");  // kept: the loop below reads into it
     bool gauss = false;
@@ -287,11 +289,11 @@ TEST_CASE("scheme auto on an ensemble: the largest error of every state meets th
   // started from the round-off bound of the finest pilot chose 143 steps and overshot it by five decades (1.1e-13).
   const json initial = {{"grid", {{"q", {{{"from", 0.2}, {"to", 2.0}, {"count", 64}}}}, {"p", {0.0}}}}};
   const json model = {{"plugin", "paper1d"}};
-  const auto reference =
-      run_job(folder, "reference", run_of(model, {{"scheme", "gauss"}, {"stages", 8}}, initial, 10.0 / 400, 10.0, 0));
+  const auto reference = run_accuracy_job(
+      folder, "reference", run_of(model, {{"scheme", "gauss"}, {"stages", 8}}, initial, 10.0 / 400, 10.0, 0));
   REQUIRE(reference.status == 0);
-  const auto ran =
-      run_job(folder, "auto", run_of(model, {{"scheme", "auto"}, {"tolerance", 1e-8}}, initial, 10.0, 10.0, 0));
+  const auto ran = run_accuracy_job(folder, "auto",
+                                    run_of(model, {{"scheme", "auto"}, {"tolerance", 1e-8}}, initial, 10.0, 10.0, 0));
   REQUIRE(ran.status == 0);
   const auto exact = table(reference.folder / "trajectories.csv"), rows = table(ran.folder / "trajectories.csv");
   REQUIRE(rows.size() == 64);
@@ -311,11 +313,11 @@ TEST_CASE("scheme auto: a phase error at the round-off the orbit amplifies is me
   // ulp away ends as far apart). The fixed bound (1e-13 of the state's length) took that for an error that does not
   // fall with the order, left Gauss 16 out and chose Gauss 8 at 14667 steps.
   const json model = {{"plugin", "paper2d"}}, initial = {{"q", {0.0, 0.0}}, {"p", {0.5, 2.0}}};
-  const auto reference = run_job(folder, "reference",
-                                 run_of(model, {{"scheme", "gauss"}, {"stages", 8}}, initial, 100.0 / 16384, 100.0, 0));
+  const auto reference = run_accuracy_job(
+      folder, "reference", run_of(model, {{"scheme", "gauss"}, {"stages", 8}}, initial, 100.0 / 16384, 100.0, 0));
   REQUIRE(reference.status == 0);
-  const auto ran =
-      run_job(folder, "auto", run_of(model, {{"scheme", "auto"}, {"tolerance", 1e-10}}, initial, 100.0, 100.0, 0));
+  const auto ran = run_accuracy_job(
+      folder, "auto", run_of(model, {{"scheme", "auto"}, {"tolerance", 1e-10}}, initial, 100.0, 100.0, 0));
   REQUIRE(ran.status == 0);
   const json choice = read_json(ran.folder / "summary.json")["scheme_choice"];
   CHECK(choice["chosen"] == "gauss 16");
@@ -331,8 +333,8 @@ TEST_CASE("scheme auto: a phase error at the round-off the orbit amplifies is me
   CAPTURE(std::sqrt(squares));
   CHECK(std::sqrt(squares) <= 1e-10);
   // Below that round-off no step meets a tolerance, and the prediction does not claim it: the run warns.
-  const auto below =
-      run_job(folder, "below", run_of(model, {{"scheme", "auto"}, {"tolerance", 1e-12}}, initial, 100.0, 100.0, 0));
+  const auto below = run_accuracy_job(
+      folder, "below", run_of(model, {{"scheme", "auto"}, {"tolerance", 1e-12}}, initial, 100.0, 100.0, 0));
   REQUIRE(below.status == 0);
   const json below_choice = read_json(below.folder / "summary.json")["scheme_choice"];
   CHECK(below_choice["estimated_error"].get<double>() >= gauss16["round_off"].get<double>());
@@ -352,7 +354,7 @@ TEST_CASE("scheme auto: a phase tolerance on a chaotic orbit is not promised, th
     json job = run_of({{"plugin", "paper2d"}}, {{"scheme", "auto"}, {"tolerance", 1e-6}},
                       {{"q", {q0, 0.3}}, {"p", {-1.5, 0.2}}}, 100.0, 100.0, 0);
     job["output"]["energy_every"] = 1;
-    return run_job(folder, name, job, {});
+    return run_accuracy_job(folder, name, job, {});
   };
   SUBCASE("chaotic: q = (-0.75, 0.3), p = (-1.5, 0.2)") {
     const auto ran = run_orbit("chaotic", -0.75);
@@ -405,7 +407,7 @@ TEST_CASE("scheme auto with a sweep meets its tolerance on every set, whose step
     CAPTURE(alphas[1]);
     const json job = run_of({{"plugin", "mathews_lakshmanan"}, {"parameters", {{"alpha", alphas}}}},
                             {{"scheme", "auto"}, {"tolerance", 1e-8}}, {{"q", {1.5}}, {"p", {0.0}}}, 1.0, 10.0, 0);
-    const auto ran = run_job(folder, "sweep-" + std::to_string(static_cast<int>(alphas[1])), job);
+    const auto ran = run_accuracy_job(folder, "sweep-" + std::to_string(static_cast<int>(alphas[1])), job);
     CHECK(ran.status == 0);
     const auto rows = table(ran.folder / "trajectories.csv");
     REQUIRE(rows.size() == alphas.size());
@@ -447,3 +449,5 @@ TEST_CASE("scheme auto: validate says what would be tried, and bad tolerances an
   CHECK(study.status == 2);
   CHECK(study.err.find("/study/integrators/0/scheme") != std::string::npos);
 }
+
+}  // namespace test_host_accuracy

@@ -14,6 +14,8 @@
 
 #include "host_run_support.hpp"
 
+namespace test_host_alignment_indices {
+
 using namespace nonsep::host_testing;
 
 namespace {
@@ -175,3 +177,5 @@ TEST_CASE("SALI and GALI share the tangent vectors: the Lyapunov exponents and M
   CHECK(summary["analysis"]["tangent_map"]["vectors"] == 3);
   CHECK(summary["analysis"]["tangent_map"]["gali"]["vectors"] == 3);
 }
+
+}  // namespace test_host_alignment_indices

@@ -17,6 +17,8 @@
 #include "nonsep/host/output/atomic_files.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
+namespace test_host_cluster {
+
 using nonsep::host_testing::read_text;
 using nonsep::host_testing::TemporaryFolder;
 namespace host = nonsep::host;
@@ -307,3 +309,5 @@ TEST_CASE("a distributed resume follows no link at units/ or a unit, and no othe
     CHECK(refused_resume(loaded, out).find("work unit " + (out / "units/000001").string()) != std::string::npos);
   }
 }
+
+}  // namespace test_host_cluster

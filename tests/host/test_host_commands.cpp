@@ -7,6 +7,8 @@
 
 #include "host_run_support.hpp"
 
+namespace test_host_commands {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -226,3 +228,5 @@ TEST_CASE("a closed standard output is a write error with exit 1, not death by S
   CHECK(WEXITSTATUS(status) == 1);
   CHECK(read_text(err).find("cannot write to standard output") != std::string::npos);
 }
+
+}  // namespace test_host_commands

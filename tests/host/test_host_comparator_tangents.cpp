@@ -13,6 +13,8 @@
 #include "nonsep/core/runtime/tangent_integrator.hpp"
 #include "paper2d/paper2d.hpp"
 
+namespace test_host_comparator_tangents {
+
 using namespace nonsep::host_testing;
 
 namespace {
@@ -154,3 +156,5 @@ TEST_CASE("a comparator's tangent vectors with a plugin without hvp_H are refuse
     CHECK(run_named(folder, std::string(key) + "_plain", job).status == 0);
   }
 }
+
+}  // namespace test_host_comparator_tangents

@@ -16,6 +16,8 @@
 #include "nonsep/host/checkpoint/checkpoint_file.hpp"
 #include "nonsep/host/job.hpp"
 
+namespace test_host_comparators {
+
 using json = nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -341,3 +343,5 @@ TEST_CASE(
     CHECK(read_text(folder / "out" / "checkpoint.json") == checkpoint);
   }
 }
+
+}  // namespace test_host_comparators

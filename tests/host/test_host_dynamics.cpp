@@ -17,6 +17,8 @@
 #include "host_run_support.hpp"
 #include "paper2d/paper2d.hpp"
 
+namespace test_host_dynamics {
+
 using namespace nonsep::host_testing;
 
 namespace {
@@ -604,3 +606,5 @@ TEST_CASE("MEGNO to the scheme's order: <Y>(20) from gauss 3 stages converges at
   }
   CHECK(mean_errors[1] < 1e-6);  // dt = 0.005
 }
+
+}  // namespace test_host_dynamics

@@ -15,6 +15,8 @@
 #include "nonsep/host/observers/progress_bar.hpp"
 #include "support/nan_aware.hpp"
 
+namespace test_host_energy {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -188,3 +190,5 @@ TEST_CASE("the time left is estimated from the steps this process ran: after a r
   CHECK(remaining_seconds(10.0, 90, 90, 100) == 0.0);  // nothing measured yet
   CHECK(remaining_seconds(3.0, 10, 100, 100) == 0.0);
 }
+
+}  // namespace test_host_energy

@@ -10,6 +10,8 @@
 
 #include "host_test_support.hpp"
 
+namespace test_host_example {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 namespace fs = std::filesystem;
@@ -98,3 +100,5 @@ TEST_CASE("an executable copied without share/nonsep still writes the compiled-i
                   "looked in " +
                   (folder / "share" / "nonsep").string()) != std::string::npos);
 }
+
+}  // namespace test_host_example

@@ -12,6 +12,8 @@
 
 #include "host_run_support.hpp"
 
+namespace test_host_frequencies {
+
 using namespace nonsep::host_testing;
 
 namespace {
@@ -210,3 +212,5 @@ TEST_CASE("frequency map: validate says what will be sampled and how large the s
   CHECK(by_h.out.find("H given by the model") != std::string::npos);
   CHECK(by_h.out.find("H_TTV") == std::string::npos);
 }
+
+}  // namespace test_host_frequencies

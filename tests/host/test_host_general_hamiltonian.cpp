@@ -12,6 +12,8 @@
 
 #include "host_run_support.hpp"
 
+namespace test_host_general_hamiltonian {
+
 using json = nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -203,3 +205,5 @@ TEST_CASE("a model given by H: a convergence study finds each scheme's order aga
     CHECK(std::log2(coarse / fine) == doctest::Approx(expected[scheme]).epsilon(0.05));
   }
 }
+
+}  // namespace test_host_general_hamiltonian

@@ -12,6 +12,8 @@
 #include "address_sanitizer.hpp"
 #include "host_test_support.hpp"
 
+namespace test_host_inspect_check {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -214,3 +216,5 @@ TEST_CASE(
   CHECK(result.status == 1);
   CHECK(result.out.find("likely culprit") == std::string::npos);  // its gradient is right: the Hessian is wrong
 }
+
+}  // namespace test_host_inspect_check

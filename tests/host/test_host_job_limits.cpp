@@ -11,6 +11,8 @@
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/json/strict_json.hpp"
 
+namespace test_host_job_limits {
+
 using nlohmann::json;
 using namespace nonsep::host;
 
@@ -210,3 +212,5 @@ TEST_CASE("the model's size: dimension 0 is refused, and so is a dense Hessian t
   CHECK(ran.status == 0);
   CHECK(std::filesystem::exists(folder / "lattice" / "summary.json"));
 }
+
+}  // namespace test_host_job_limits

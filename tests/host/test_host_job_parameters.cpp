@@ -12,6 +12,8 @@
 #include "nonsep/host/job.hpp"
 #include "nonsep/sdk/parameters.hpp"
 
+namespace test_host_job_parameters {
+
 using nlohmann::json;
 using namespace nonsep::host;
 
@@ -153,3 +155,5 @@ TEST_CASE("a sweep that changes the model's dimension is refused at the swept ke
     CHECK(issues[0].found.find("(set 1 of the sweep), whose model has dimension 3 where set 0") != std::string::npos);
   }
 }
+
+}  // namespace test_host_job_parameters

@@ -14,6 +14,8 @@
 #include "nonsep/host/json/strict_json.hpp"
 #include "nonsep/host/platform/build_features.hpp"
 
+namespace test_host_job_reader {
+
 using nlohmann::json;
 using namespace nonsep;
 using namespace nonsep::host;
@@ -428,3 +430,5 @@ TEST_CASE("/output/format \"hdf5\": accepted by a build with HDF5, refused at /o
     CHECK(parsed.issues[0].found.find("this build of nonsep has no HDF5") != std::string::npos);
   }
 }
+
+}  // namespace test_host_job_reader

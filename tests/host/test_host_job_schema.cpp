@@ -16,6 +16,8 @@
 #include "nonsep/host/job.hpp"
 #include "nonsep/host/job_schema.hpp"
 
+namespace test_host_job_schema {
+
 using nlohmann::json;
 using namespace nonsep;
 using namespace nonsep::host;
@@ -497,3 +499,5 @@ TEST_CASE("scheme auto's tolerance range is its key table's, in the schema and i
     }
   }
 }
+
+}  // namespace test_host_job_schema

@@ -15,6 +15,8 @@
 #include "host_run_support.hpp"
 #include "nonsep/core/kernel/chin_kernel.hpp"
 
+namespace test_host_kernels {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -256,3 +258,5 @@ TEST_CASE("NONSEP_INSTRUCTION_SET naming a set the plugin lacks is refused with 
   CHECK(result.err.find("NONSEP_INSTRUCTION_SET=x86-64-v9 names no kernel of this plugin (it has x86-64") !=
         std::string::npos);
 }
+
+}  // namespace test_host_kernels

@@ -13,6 +13,8 @@
 
 #include "host_run_support.hpp"
 
+namespace test_host_orthogonal_fli {
+
 using namespace nonsep::host_testing;
 
 TEST_CASE(
@@ -100,3 +102,5 @@ TEST_CASE("OFLI needs grad H: refused at /analysis/ofli for a plugin without thi
   CHECK(result.err.find("no third derivatives") != std::string::npos);
   CHECK(result.err.find("/analysis/fli") == std::string::npos);  // FLI needs the tangent map only
 }
+
+}  // namespace test_host_orthogonal_fli

@@ -14,6 +14,8 @@
 
 #include "host_test_support.hpp"
 
+namespace test_host_output_folder {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -275,3 +277,5 @@ TEST_CASE("resume refuses a checkpoint of another plugin file with the same name
   CHECK(refused.status == 2);
   CHECK(contains(refused.err, "belongs to a different job: its plugin differs"));
 }
+
+}  // namespace test_host_output_folder

@@ -16,6 +16,8 @@
 
 #include "host_test_support.hpp"
 
+namespace test_host_output_integrity {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -115,3 +117,5 @@ TEST_CASE("a lock held by another process: the message does not name the pid an 
   CHECK(!contains(refused.err, "another nonsep run"));
   CHECK(contains(refused.err, "of an earlier run, ended"));
 }
+
+}  // namespace test_host_output_integrity

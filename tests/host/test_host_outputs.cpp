@@ -22,6 +22,8 @@
 #include "nonsep/host/output/csv.hpp"
 #include "nonsep/host/output/csv_reader.hpp"
 
+namespace test_host_outputs {
+
 using namespace nonsep::host;
 using nonsep::host_testing::read_csv;
 using nonsep::host_testing::read_text;
@@ -268,3 +270,5 @@ TEST_CASE("CsvReader with Rules: a hand-written file's last line without newline
   CHECK_THROWS_WITH_AS(endless.next(cells), "the file:1: cell 1, longer than 4 bytes", OutputError);
   CHECK(endless.text().size() <= (std::size_t{1} << 20));  // at most a buffer's worth was taken
 }
+
+}  // namespace test_host_outputs

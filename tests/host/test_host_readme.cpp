@@ -16,6 +16,8 @@
 #include "nonsep/core/runtime/scheme_catalogue.hpp"
 #include "nonsep/host/run/trajectory.hpp"
 
+namespace test_host_readme {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -163,3 +165,5 @@ TEST_CASE("User guide: the job-key table and the schemes table name every scheme
     CHECK(readme.find("\n| `" + scheme.name + "` ") != std::string::npos);  // a row of the schemes table
   }
 }
+
+}  // namespace test_host_readme

@@ -16,6 +16,8 @@
 #include "host_test_support.hpp"
 #include "nonsep/host/output/content_hash.hpp"
 
+namespace test_host_reliability {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -492,3 +494,5 @@ TEST_CASE("a plugin that crashes the process: its own exit status (134, 139, 3),
   ::setenv("ASAN_OPTIONS", sanitizer_options.c_str(), 1);
 #endif
 }
+
+}  // namespace test_host_reliability

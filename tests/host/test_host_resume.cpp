@@ -21,6 +21,8 @@
 #include "nonsep/host/output/hdf5_file.hpp"
 #endif
 
+namespace test_host_resume {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -336,3 +338,5 @@ TEST_CASE(
   CHECK(!std::filesystem::exists(out / "checkpoint.json"));
   CHECK(!std::filesystem::exists(out / "summary.json"));
 }
+
+}  // namespace test_host_resume

@@ -13,6 +13,8 @@
 #include "nonsep/reference/paper1d_exact.hpp"
 #include "support/models.hpp"
 
+namespace test_host_run {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -202,3 +204,5 @@ TEST_CASE("backwards in time: a negative dt retraces the quickstart to its start
   CHECK(number(backward["trajectories"][0]["final"]["q"][0]) == doctest::Approx(2.0).epsilon(1e-12));
   CHECK(std::abs(number(backward["trajectories"][0]["final"]["p"][0])) < 1e-11);
 }
+
+}  // namespace test_host_run

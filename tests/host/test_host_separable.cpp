@@ -12,6 +12,8 @@
 #include "host_run_support.hpp"
 #include "nonsep/reference/mathews_lakshmanan_exact.hpp"
 
+namespace test_host_separable {
+
 using json = nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -87,3 +89,5 @@ TEST_CASE("variable_mass2d: Lyapunov exponents through the separable flows' tang
   REQUIRE(column != rows[0].end());
   CHECK(std::isfinite(std::stod(rows[1][static_cast<std::size_t>(column - rows[0].begin())])));
 }
+
+}  // namespace test_host_separable

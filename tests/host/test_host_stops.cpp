@@ -8,6 +8,8 @@
 
 #include "host_run_support.hpp"
 
+namespace test_host_stops {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -105,3 +107,5 @@ TEST_CASE("many trajectories stop: stderr names the first 20 and says how many m
   CHECK(result.err.find("... and 5 more trajectories that stopped early; ") != std::string::npos);
   CHECK(read_json(folder / "many.out/summary.json")["counts"]["diverged"] == 25);
 }
+
+}  // namespace test_host_stops

@@ -16,6 +16,8 @@
 #include "nonsep/sdk/model_adapter.hpp"
 #include "paper1d/paper1d.hpp"
 
+namespace test_host_study {
+
 using json = nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -274,3 +276,5 @@ TEST_CASE("the study's report: exponents to 4 significant digits, and the round-
   CHECK(quiet.out.empty());
   CHECK(quiet.err.find("nonsep: warning: mpe 4: 4 runs at the round-off floor") != std::string::npos);
 }
+
+}  // namespace test_host_study

@@ -13,6 +13,8 @@
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/host/run/ensemble_driver.hpp"
 
+namespace test_host_threads {
+
 using nlohmann::json;
 using namespace nonsep::host_testing;
 
@@ -254,3 +256,5 @@ TEST_CASE("blocks are sized from the ensemble, so that 71 trajectories are block
     CHECK(counter.retired == 71);
   }
 }
+
+}  // namespace test_host_threads

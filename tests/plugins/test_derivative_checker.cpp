@@ -5,6 +5,8 @@
 #include "nonsep/sdk/model_adapter.hpp"
 #include "support/models.hpp"
 
+namespace test_derivative_checker {
+
 namespace {
 
 // A correct model except for one deliberately wrong derivative, chosen by `wrong`.
@@ -107,3 +109,5 @@ TEST_CASE("a model without values has its Hessians checked and the gradient chec
   CHECK(report.skipped[0] == "gradients: the model has no value_T/value_V");
   CHECK(report.skipped[1] == "Hessian-vector products: the model has no hvp_T/hvp_V");
 }
+
+}  // namespace test_derivative_checker

@@ -12,6 +12,8 @@
 #include "nonsep/sdk/model_adapter.hpp"
 #include "support/finite_difference.hpp"
 
+namespace test_dual_numbers {
+
 using nonsep::sdk::Dual;
 
 namespace {
@@ -271,3 +273,5 @@ TEST_CASE("directional third derivatives of a function of three variables are ex
       f_xxz * ux * ux + 2 * f_xyz * ux * uy + f_yyz * uy * uy + 2 * f_yzz * uy * uz + f_zzz * uz * uz};
   for (int k = 0; k < 3; ++k) CHECK(third[k] == doctest::Approx(expected[k]).epsilon(1e-14));
 }
+
+}  // namespace test_dual_numbers

@@ -16,6 +16,8 @@
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/plugin_abi.h"
 
+namespace test_general_hamiltonian {
+
 using nonsep::host::load_plugin;
 using nonsep::host::PluginModel;
 
@@ -136,3 +138,5 @@ TEST_CASE("schwarzschild_charged: gauss keeps H on the mass shell and p_t, p_phi
   CHECK(x.p()[3] == L);
   CHECK(r_min > 2.0);
 }
+
+}  // namespace test_general_hamiltonian

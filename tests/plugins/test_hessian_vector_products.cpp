@@ -21,6 +21,8 @@
 #include "nonsep/reference/hamiltonian_flow.hpp"
 #include "support/random_points.hpp"
 
+namespace test_hessian_vector_products {
+
 using nonsep::host::load_plugin;
 using nonsep::host::PluginModel;
 using nonsep::sdk::Derivatives;
@@ -379,3 +381,5 @@ TEST_CASE("tangent vectors through products follow the dense tangent map, withou
     CHECK(by_products.hessian_evaluations() == nonsep::HessianCounts{});
   }
 }
+
+}  // namespace test_hessian_vector_products

@@ -15,6 +15,8 @@
 #include "nonsep/host/plugin_loader.hpp"
 #include "nonsep/plugin_abi.h"
 
+namespace test_loader_errors {
+
 using namespace nonsep::host;
 namespace fs = std::filesystem;
 
@@ -404,3 +406,5 @@ TEST_CASE("a model given by H: its required entries, and no entry of the product
   CHECK(dp[0] == 0.25);
   CHECK_THROWS_AS(model.grad_T(p, dq, 1), nonsep::ModelError);
 }
+
+}  // namespace test_loader_errors

@@ -8,6 +8,8 @@
 
 #include "nonsep/host/plugin_loader.hpp"
 
+namespace test_plugin_lifetime {
+
 namespace {
 
 const std::filesystem::path plugin_file = std::filesystem::path(NONSEP_TEST_PLUGIN_DIR) / "evaluation_fails.so";
@@ -56,3 +58,5 @@ TEST_CASE("a failed load leaves nothing loaded") {
                   nonsep::host::PluginError);
   CHECK_FALSE(is_loaded());
 }
+
+}  // namespace test_plugin_lifetime

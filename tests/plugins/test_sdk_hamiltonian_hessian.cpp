@@ -17,6 +17,8 @@
 #include "paper2d/paper2d.hpp"
 #include "support/random_points.hpp"
 
+namespace test_sdk_hamiltonian_hessian {
+
 using nonsep::HamiltonianForm;
 using nonsep::sdk::Derivatives;
 using nonsep::sdk::ModelAdapter;
@@ -163,3 +165,5 @@ TEST_CASE("SDK grad H: the inner product taken from the pass of the third deriva
   static_assert(!nonsep::ModelWithThirdAndProduct<ModelAdapter<Paper2D>>);
   static_assert(!nonsep::ModelWithThirdAndProduct<ModelAdapter<Lattice>>);
 }
+
+}  // namespace test_sdk_hamiltonian_hessian

@@ -5,6 +5,8 @@
 
 #include "nonsep/sdk/parameters.hpp"
 
+namespace test_sdk_parameters {
+
 using namespace nonsep::sdk;
 
 namespace {
@@ -66,3 +68,5 @@ TEST_CASE("a model asking for an undeclared parameter is a bug, reported as such
   CHECK_THROWS_AS(values.number("lambda2"), std::logic_error);
   CHECK_THROWS_AS(values.boolean("lambda"), std::logic_error);
 }
+
+}  // namespace test_sdk_parameters

@@ -14,6 +14,8 @@
 #include "support/models.hpp"
 #include "variable_mass2d/variable_mass2d.hpp"
 
+namespace test_sdk_separable {
+
 namespace {
 
 using OscillatorAdapter = nonsep::sdk::ModelAdapter<MathewsLakshmanan>;
@@ -92,3 +94,5 @@ TEST_CASE("SDK separable part: spans too short for the batch are refused with th
   std::vector<double> one(1), none(0);
   CHECK_THROWS_AS(oscillator.grad_K(one, none, 1), nonsep::InvalidArgument);
 }
+
+}  // namespace test_sdk_separable

@@ -24,6 +24,8 @@
 #include "radial/radial.hpp"
 #include "tao_product/tao_product.hpp"
 
+namespace test_shipped_models {
+
 using nonsep::host::load_plugin;
 using nonsep::host::PluginModel;
 using nonsep::sdk::Derivatives;
@@ -397,3 +399,5 @@ TEST_CASE("every shipped plugin has hvp_H, the derivative of grad H along a tang
     }
   }
 }
+
+}  // namespace test_shipped_models

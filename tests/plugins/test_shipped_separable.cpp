@@ -19,6 +19,8 @@
 #include "support/models.hpp"
 #include "variable_mass2d/variable_mass2d.hpp"
 
+namespace test_shipped_separable {
+
 using nonsep::host::load_plugin;
 using nonsep::host::PluginModel;
 
@@ -109,3 +111,5 @@ TEST_CASE("shipped separable models: a plugin steps bit for bit like the same mo
     CHECK(a.evaluations().grad_K > 0);
   }
 }
+
+}  // namespace test_shipped_separable
