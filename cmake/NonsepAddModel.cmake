@@ -2,8 +2,9 @@
 #
 # Builds a nonsep model plugin: a MODULE library named exactly <target>.so (no "lib" prefix) whose metadata name
 # must equal <target>. Only the symbol `nonsep_plugin` that NONSEP_EXPORT_MODEL (plugin_sdk.hpp) or
-# NONSEP_DEFINE_PLUGIN (plugin_abi.h) defines is exported; everything else is hidden. It uses nonsep::sdk, which is
-# header-only: no nonsep library is linked into a plugin (the host steps; a plugin only evaluates, plugin_abi.h).
+# NONSEP_DEFINE_PLUGIN (plugin_abi.h) defines is exported; everything else is hidden. It links nonsep::sdk, the SDK's
+# headers and its small static library of JSON reading and writing (plugins/CMakeLists.txt), and no other nonsep
+# library (the host steps; a plugin evaluates, and carries kernels compiled from the core's headers: plugin_abi.h).
 #
 # Unloading: GCC marks static locals of inline functions (the SDK's metadata string) STB_GNU_UNIQUE, which makes
 # glibc refuse to ever unload the library; -fno-gnu-unique keeps a plugin unloadable (tests/plugins/

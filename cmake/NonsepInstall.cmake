@@ -4,7 +4,8 @@
 # Layout under the prefix:
 #   include/nonsep/...                  core, SDK (plugin_abi.h, plugin_sdk.hpp, derivative_checker.hpp), loader
 #   lib/libnonsep_core.a, lib/libnonsep_loader.a  (for programs that integrate or load plugins; a plugin links
-#                                                  neither: nonsep::sdk is header-only)
+#                                                  neither)
+#   lib/libnonsep_sdk.a                 the SDK's JSON reading and writing, which every plugin links (nonsep::sdk)
 #   lib/nonsep/plugins/<name>.so        shipped models (NONSEP_INSTALL_PLUGINDIR; the host finds it from bin/)
 #   lib/cmake/nonsep/                   nonsepConfig.cmake, targets, NonsepAddModel.cmake
 include(CMakePackageConfigHelpers)

@@ -10,7 +10,7 @@
 
 #include "host_test_support.hpp"
 #include "nonsep/host/job.hpp"
-#include "nonsep/sdk/parameters.hpp"
+#include "nonsep/sdk/parameter_rules.hpp"
 
 namespace test_host_job_parameters {
 

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "nonsep/plugin_abi.h"
-#include "nonsep/sdk/parameters.hpp"
+#include "nonsep/sdk/parameter_rules.hpp"
 #include "plugin_internals.hpp"
 
 namespace nonsep::host {

@@ -3,7 +3,7 @@
 #include <set>
 #include <string>
 
-#include "nonsep/sdk/parameters.hpp"
+#include "nonsep/sdk/parameter_rules.hpp"
 #include "plugin_internals.hpp"
 
 namespace nonsep::host {

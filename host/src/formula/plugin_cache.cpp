@@ -119,6 +119,7 @@ void compile_plugin(const std::string& source, const Toolchain& toolchain, const
   arguments.insert(arguments.end(), toolchain.flags.begin(), toolchain.flags.end());
   for (const auto& include : toolchain.include_directories) arguments.push_back("-I" + include.string());
   arguments.insert(arguments.end(), {"-o", (work / "plugin.so").string(), (work / "model.cpp").string()});
+  for (const auto& library : toolchain.libraries) arguments.push_back(library.string());
   std::vector<fs::path> remove_when_abandoned = abandon;
   remove_when_abandoned.push_back(work);
   CompilerOutcome outcome;
@@ -152,7 +153,7 @@ std::string cache_key(const std::string& source, const Toolchain& toolchain) {
   const auto add = [&](const std::string& part) { hash = content_hash(part + '\0', hash); };
   add(toolchain.identity);
   for (const auto& flag : toolchain.flags) add(flag);
-  add(toolchain.header_hash);
+  add(toolchain.sdk_hash);
   add(NONSEP_VERSION);
   add(std::to_string(NONSEP_PLUGIN_ABI_VERSION) + "/" + std::to_string(chin_kernel_version));
   return content_hash_hex(hash);

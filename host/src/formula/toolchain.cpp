@@ -45,9 +45,10 @@ std::optional<fs::path> locate(const std::string& compiler) {
   return std::nullopt;
 }
 
-// The content hash of every nonsep header a formula plugin includes: nonsep/plugin_sdk.hpp and, transitively, each
-// "nonsep/..." header it names, found in the include folders in order; by name and content, not by folder.
-std::string header_hash(const std::vector<fs::path>& folders) {
+// The content hash of the SDK a formula plugin is built with: every nonsep header it includes (nonsep/plugin_sdk.hpp
+// and, transitively, each "nonsep/..." header it names, found in the include folders in order; by name and content,
+// not by folder) and the content of each library it links.
+std::string sdk_hash(const std::vector<fs::path>& folders, const std::vector<fs::path>& libraries) {
   static const std::regex include_line(R"(^\s*#\s*include\s*[<"](nonsep/[^>"]+)[>"])");
   std::map<std::string, std::string> headers;
   std::vector<std::string> pending{"nonsep/plugin_sdk.hpp"};
@@ -69,6 +70,7 @@ std::string header_hash(const std::vector<fs::path>& folders) {
   }
   std::uint64_t hash = content_hash_start;
   for (const auto& [name, text] : headers) hash = content_hash(text + '\0', content_hash(name + '\0', hash));
+  for (const auto& library : libraries) hash = content_hash(read_file(library) + '\0', hash);
   return content_hash_hex(hash);
 }
 
@@ -84,7 +86,8 @@ Toolchain find_toolchain(PluginUse use) {
                               "): reinstall nonsep");
   const json description = json::parse(read_file(file), nullptr, false);
   if (!description.is_object() || !description.value("compiler", json()).is_string() ||
-      !description.value("flags", json()).is_array() || !description.value("include_directories", json()).is_array())
+      !description.value("flags", json()).is_array() || !description.value("include_directories", json()).is_array() ||
+      !description.value("libraries", json()).is_array())
     throw FormulaCompileError("the toolchain file " + file.string() + " is damaged: reinstall nonsep");
   Toolchain toolchain;
   toolchain.compiler = description["compiler"].get<std::string>();
@@ -99,6 +102,15 @@ Toolchain find_toolchain(PluginUse use) {
   if (!has_sdk)
     throw FormulaCompileError("the plugin SDK's headers (nonsep/plugin_sdk.hpp) are not in the folders of " +
                               file.string() + ": reinstall nonsep with its headers");
+  for (const auto& library : description["libraries"]) {
+    if (!library.is_string())
+      throw FormulaCompileError("the toolchain file " + file.string() + " is damaged: reinstall nonsep");
+    const fs::path path = (file.parent_path() / library.get<std::string>()).lexically_normal();
+    if (!fs::is_regular_file(path, error))
+      throw FormulaCompileError("the plugin SDK's library " + path.string() + ", named in " + file.string() +
+                                ", is missing: reinstall nonsep with its libraries");
+    toolchain.libraries.push_back(path);
+  }
   const auto compiler = locate(toolchain.compiler);
   if (!compiler)
     throw FormulaCompileError(
@@ -113,7 +125,7 @@ Toolchain find_toolchain(PluginUse use) {
                               ": " + version.output + "); " + install_hint);
   const fs::path resolved = fs::canonical(*compiler, error);
   toolchain.identity = (error ? compiler->string() : resolved.string()) + "\n" + version.output;
-  toolchain.header_hash = header_hash(toolchain.include_directories);
+  toolchain.sdk_hash = sdk_hash(toolchain.include_directories, toolchain.libraries);
   for (const auto& flag : kernel_flags(use)) toolchain.flags.push_back(flag);
   return toolchain;
 }

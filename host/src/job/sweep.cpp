@@ -8,7 +8,7 @@
 
 #include "nonsep/core/runtime/integrator.hpp"
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/sdk/parameters.hpp"
+#include "nonsep/sdk/parameter_rules.hpp"
 #include "sections.hpp"
 
 namespace nonsep::host {

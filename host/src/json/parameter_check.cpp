@@ -1,7 +1,7 @@
 #include "nonsep/host/json/parameter_check.hpp"
 
 #include "nonsep/host/number_format.hpp"
-#include "nonsep/sdk/parameters.hpp"
+#include "nonsep/sdk/parameter_rules.hpp"
 
 namespace nonsep::host::job_reader {
 

@@ -2,6 +2,12 @@
 // real model may: create() must fail with a message naming the parameter.
 #include <nonsep/plugin_sdk.hpp>
 
+// A plugin's own units read no JSON: the SDK's library does (nonsep/sdk/parameters.hpp says why). This plugin does
+// not compile if the SDK's headers bring in nlohmann/json.hpp again.
+#ifdef NLOHMANN_JSON_VERSION_MAJOR
+#error "nonsep/plugin_sdk.hpp includes nlohmann/json.hpp: every plugin would compile the JSON library itself"
+#endif
+
 struct CreateFailing {
   static constexpr std::size_t dimension = 1;
   static constexpr nonsep::sdk::Parameter parameters[] = {

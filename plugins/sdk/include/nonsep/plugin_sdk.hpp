@@ -39,14 +39,14 @@
 // "thread_safe": true: distinct instances share nothing mutable, provided the model class keeps no mutable
 // global or static state (a model that does is not for this SDK's export macro; see plugin_abi.h).
 //
-// The SDK is header-only: a plugin needs no nonsep library linked in (it includes a few header-only core
-// headers, nonsep/core/base/error.hpp).
+// The SDK is these headers and one small static library, nonsep::sdk in CMake (plugins/sdk/src): what reads and writes
+// JSON (parse_parameters, metadata_text), compiled once instead of in every plugin (parameters.hpp says why). A
+// plugin links nothing else of nonsep (it includes a few header-only core headers, nonsep/core/base/error.hpp).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <exception>
-#include <nlohmann/json.hpp>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -56,6 +56,7 @@
 #include "nonsep/sdk/dual.hpp"
 #include "nonsep/sdk/hamiltonian_adapter.hpp"
 #include "nonsep/sdk/kernels.hpp"
+#include "nonsep/sdk/metadata.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 #include "nonsep/sdk/parameters.hpp"
 
@@ -65,14 +66,6 @@ struct nonsep_instance {
 };
 
 namespace nonsep::sdk {
-
-// A model's identity, as given to NONSEP_EXPORT_MODEL.
-struct ModelIdentity {
-  const char* name;
-  const char* version;
-  const char* description;
-  const char* hamiltonian;
-};
 
 // What every table of the SDK shares, for an adapter type (ModelAdapter, HamiltonianAdapter) of a model class M: the
 // instance holding the adapter and its last error, the mapping of exceptions to statuses, create, destroy,
@@ -131,23 +124,21 @@ class PluginTableBase {
     }
   }
 
-  // The metadata's identity, dimension, parameters and thread safety (plugin_abi.h).
-  static nlohmann::json common_metadata(const ModelIdentity& id) {
-    nlohmann::json dimension;
-    if constexpr (HasFixedDimension<M>)
-      dimension = {{"fixed", M::dimension}};
-    else
-      dimension = {{"parameter", M::dimension_parameter}, {"max_dimension", M::max_dimension}};
-    return {{"name", id.name},
-            {"version", id.version},
-            {"description", id.description},
-            {"hamiltonian", id.hamiltonian},
-            {"dimension", dimension},
-            {"parameters", parameters_metadata(parameter_table<M>())},
-            {"thread_safe", true}};
+  // The metadata's identity, dimension and parameters (metadata.hpp).
+  static PluginFacts common_facts(const ModelIdentity& id) {
+    PluginFacts facts;
+    facts.identity = id;
+    if constexpr (HasFixedDimension<M>) {
+      facts.fixed_dimension = M::dimension;
+    } else {
+      facts.dimension_parameter = M::dimension_parameter;
+      facts.max_dimension = M::max_dimension;
+    }
+    facts.parameters = parameter_table<M>();
+    return facts;
   }
   template <std::string (*build)()>
-  static const char* metadata_text() noexcept {
+  static const char* cached_metadata() noexcept {
     try {
       static const std::string text = build();
       return text.c_str();
@@ -266,49 +257,46 @@ class PluginTable : PluginTableBase<ModelAdapter<M, policy>> {
 
   static std::string build_metadata() {
     auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
-    nlohmann::json kernel_sets = nlohmann::json::array();
-    for (const auto name : kernel_instruction_sets) kernel_sets.push_back(std::string(name));
-    nlohmann::json metadata = Base::common_metadata(Identity::value);
-    metadata.update({{"capabilities",
-                      {{"value_T", true},
-                       {"value_V", true},
-                       {"hessian_T", true},
-                       {"hessian_V", true},
-                       {"d3T", true},
-                       {"d3V", true},
-                       {"hvp_T", true},
-                       {"hvp_V", true},
-                       {"chin_steps", true},
-                       {"energy_TTV", Adapter::analytic_energy_TTV},
-                       {"energy_VVT", Adapter::analytic_energy_VVT},
-                       {"hvp_H", Adapter::has_hamiltonian_hessian},
-                       {"chin_tangent_steps", NONSEP_SDK_TANGENT_KERNELS != 0},
-                       {"gauss_steps", true}}},
-                     {"derivatives",
-                      {{"grad_T", kind(Adapter::analytic_grad_T)},
-                       {"grad_V", kind(Adapter::analytic_grad_V)},
-                       {"hessian_T", kind(Adapter::analytic_hessian_T)},
-                       {"hessian_V", kind(Adapter::analytic_hessian_V)},
-                       {"d3T", kind(Adapter::analytic_d3T)},
-                       {"d3V", kind(Adapter::analytic_d3V)},
-                       {"hvp_T", kind(Adapter::analytic_hvp_T)},
-                       {"hvp_V", kind(Adapter::analytic_hvp_V)}}},
-                     {"automatic_differentiation", automatic_differentiation_text<Adapter>()},
-                     {"kernels", {{"instruction_sets", kernel_sets}}}});
-    for (const char* function : {"grad_K", "value_K", "hessian_K"}) metadata["capabilities"][function] = HasK<M>;
-    for (const char* function : {"grad_U", "value_U", "hessian_U"}) metadata["capabilities"][function] = HasU<M>;
+    PluginFacts facts = Base::common_facts(Identity::value);
+    facts.capabilities = {{"value_T", true},
+                          {"value_V", true},
+                          {"hessian_T", true},
+                          {"hessian_V", true},
+                          {"d3T", true},
+                          {"d3V", true},
+                          {"hvp_T", true},
+                          {"hvp_V", true},
+                          {"chin_steps", true},
+                          {"energy_TTV", Adapter::analytic_energy_TTV},
+                          {"energy_VVT", Adapter::analytic_energy_VVT},
+                          {"hvp_H", Adapter::has_hamiltonian_hessian},
+                          {"chin_tangent_steps", NONSEP_SDK_TANGENT_KERNELS != 0},
+                          {"gauss_steps", true}};
+    for (const char* function : {"grad_K", "value_K", "hessian_K"}) facts.capabilities.emplace_back(function, HasK<M>);
+    for (const char* function : {"grad_U", "value_U", "hessian_U"}) facts.capabilities.emplace_back(function, HasU<M>);
+    facts.derivatives = {{"grad_T", kind(Adapter::analytic_grad_T)},
+                         {"grad_V", kind(Adapter::analytic_grad_V)},
+                         {"hessian_T", kind(Adapter::analytic_hessian_T)},
+                         {"hessian_V", kind(Adapter::analytic_hessian_V)},
+                         {"d3T", kind(Adapter::analytic_d3T)},
+                         {"d3V", kind(Adapter::analytic_d3V)},
+                         {"hvp_T", kind(Adapter::analytic_hvp_T)},
+                         {"hvp_V", kind(Adapter::analytic_hvp_V)}};
     if constexpr (HasK<M>) {
-      metadata["derivatives"]["grad_K"] = kind(Adapter::analytic_grad_K);
-      metadata["derivatives"]["hessian_K"] = kind(Adapter::analytic_hessian_K);
+      facts.derivatives.emplace_back("grad_K", kind(Adapter::analytic_grad_K));
+      facts.derivatives.emplace_back("hessian_K", kind(Adapter::analytic_hessian_K));
     }
     if constexpr (HasU<M>) {
-      metadata["derivatives"]["grad_U"] = kind(Adapter::analytic_grad_U);
-      metadata["derivatives"]["hessian_U"] = kind(Adapter::analytic_hessian_U);
+      facts.derivatives.emplace_back("grad_U", kind(Adapter::analytic_grad_U));
+      facts.derivatives.emplace_back("hessian_U", kind(Adapter::analytic_hessian_U));
     }
-    return metadata.dump();
+    facts.automatic_differentiation = automatic_differentiation_text<Adapter>();
+    facts.has_kernels = true;
+    facts.instruction_sets = kernel_instruction_sets;
+    return metadata_text(facts);
   }
 
-  static const char* metadata_json() noexcept { return Base::template metadata_text<&build_metadata>(); }
+  static const char* metadata_json() noexcept { return Base::template cached_metadata<&build_metadata>(); }
 
   // The batched functions: spans over the caller's arrays (sizes from the batch layout of plugin_abi.h).
 #define NONSEP_SDK_BATCHED(function, per_state_of)                                                                     \
@@ -530,15 +518,14 @@ class HamiltonianPluginTable : PluginTableBase<HamiltonianAdapter<M, policy>> {
 
   static std::string build_metadata() {
     auto kind = [](bool analytic) { return analytic ? "analytic" : "automatic"; };
-    nlohmann::json metadata = Base::common_metadata(Identity::value);
-    metadata.update(
-        {{"hamiltonian_form", "general"},
-         {"capabilities", {{"value_H", true}, {"grad_H", true}, {"hvp_H", true}, {"gauss_steps", true}}},
-         {"derivatives", {{"grad_H", kind(Adapter::analytic_grad_H)}, {"hvp_H", kind(Adapter::analytic_hvp_H)}}},
-         {"automatic_differentiation", hamiltonian_differentiation_text<Adapter>()}});
-    return metadata.dump();
+    PluginFacts facts = Base::common_facts(Identity::value);
+    facts.general_form = true;
+    facts.capabilities = {{"value_H", true}, {"grad_H", true}, {"hvp_H", true}, {"gauss_steps", true}};
+    facts.derivatives = {{"grad_H", kind(Adapter::analytic_grad_H)}, {"hvp_H", kind(Adapter::analytic_hvp_H)}};
+    facts.automatic_differentiation = hamiltonian_differentiation_text<Adapter>();
+    return metadata_text(facts);
   }
-  static const char* metadata_json() noexcept { return Base::template metadata_text<&build_metadata>(); }
+  static const char* metadata_json() noexcept { return Base::template cached_metadata<&build_metadata>(); }
 
   static nonsep_status value_H(nonsep_instance* instance, const double* q, const double* p, double* out,
                                std::size_t count) noexcept {

@@ -11,7 +11,8 @@
 // formula/<key>/ holding <name>.so, model.cpp (the source) and entry.json (the plugin's size and content hash, the
 // compiler's identity), where key is the content hash of what determines the plugin: the source, the compiler's
 // identity (its resolved path and --version text), the flags, the content of every nonsep header the source
-// includes (not the folders holding them: a build tree's nonsep and the installed one share entries), nonsep's
+// includes and of the SDK's library (not the folders holding them: a build tree's nonsep and the installed one share
+// entries), nonsep's
 // version, the plugin ABI and the kernel version. An entry is used only when its files are regular files (checked
 // through their descriptors: a FIFO, a device or a link is never read), model.cpp equals the source and the
 // plugin's size and hash match entry.json; anything else (a half-written, damaged or planted entry) is removed and
@@ -40,8 +41,9 @@ struct Toolchain {
   std::string compiler;  // a path, or a name looked up in PATH
   std::vector<std::string> flags;
   std::vector<std::filesystem::path> include_directories;
-  std::string identity;     // the compiler's resolved path and --version text, part of the cache key
-  std::string header_hash;  // the content hash of the nonsep headers a formula plugin includes, part of the key
+  std::vector<std::filesystem::path> libraries;  // linked after the source: the SDK's (plugins/CMakeLists.txt)
+  std::string identity;  // the compiler's resolved path and --version text, part of the cache key
+  std::string sdk_hash;  // the content hash of the nonsep headers a formula plugin includes and of the libraries, ditto
 };
 
 // Where a formula plugin will run: `cache`, on this machine only (the formula cache, whose key holds the flags);
