@@ -33,7 +33,7 @@ struct PluginFacts {
   std::vector<std::pair<const char*, bool>> capabilities;
   std::vector<std::pair<const char*, const char*>> derivatives;  // function, "analytic" or "automatic"
   std::string automatic_differentiation;
-  bool has_kernels = false;                     // "kernels": {"instruction_sets": [...]}
+  bool has_kernels = false;  // "kernels": {"instruction_sets": [...]}
   std::span<const std::string_view> instruction_sets;
 };
 
