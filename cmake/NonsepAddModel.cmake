@@ -1,4 +1,5 @@
-# nonsep_add_model(<target> [OUTPUT_DIRECTORY <dir>] [TANGENT_KERNELS] [KERNEL_SETS native|all|baseline] <sources>...)
+# nonsep_add_model(<target> [OUTPUT_DIRECTORY <dir>] [TANGENT_KERNELS]
+#                  [KERNEL_SETS native|native+baseline|all|baseline] <sources>...)
 #
 # Builds a nonsep model plugin: a MODULE library named exactly <target>.so (no "lib" prefix) whose metadata name
 # must equal <target>. Only the symbol `nonsep_plugin` that NONSEP_EXPORT_MODEL (plugin_sdk.hpp) or
@@ -10,15 +11,19 @@
 # glibc refuse to ever unload the library; -fno-gnu-unique keeps a plugin unloadable (tests/plugins/
 # test_plugin_lifetime.cpp). A plugin's symbols are private to it, so uniqueness buys nothing.
 #
-# KERNEL_SETS chooses the stepping kernels compiled besides the baseline x86-64 one (nonsep/sdk/kernels.hpp), each a
-# large part of the compile time: `native` (the default, or NONSEP_KERNEL_SETS when set) the widest set the building
-# machine runs, x86-64-v4 or x86-64-v3 (none on another processor), found once per build folder by running a probe;
-# `all` both wider sets, for plugins that run on other machines than the one that builds them; `baseline` none.
-# The host picks the widest kernel the plugin has and the processor runs (NONSEP_INSTRUCTION_SET overrides).
+# KERNEL_SETS chooses the stepping kernels compiled (nonsep/sdk/kernels.hpp), each set a large part of the compile
+# time: `native` (the default, or NONSEP_KERNEL_SETS when set) the widest set the building machine runs alone,
+# x86-64-v4 or x86-64-v3, found once per build folder by running a probe (the baseline x86-64 where it runs neither,
+# and the baseline with both wider sets where the probe cannot run: another compiler, cross-compiling), since the host
+# never takes the baseline over a wider set the processor runs; `native+baseline` that set and the baseline, which
+# NONSEP_INSTRUCTION_SET=baseline runs (bit for bit the evaluation path: the doctests pin it, tests/test_main.cpp);
+# `all` the baseline and both wider sets, for plugins that run on other machines than the one that builds them;
+# `baseline` the baseline alone. The host picks the widest kernel the plugin has and the processor runs
+# (NONSEP_INSTRUCTION_SET overrides), and steps through the evaluation path where it runs none of them.
 #
 # A one-file plugin that exports its model with NONSEP_EXPORT_MODEL, built with GCC on x86-64, is compiled as
 # translation units that make can run in parallel:
-# the plugin with its baseline kernels, and the x86-64-v3 and x86-64-v4 kernels it has each in a unit of its own
+# the plugin with its baseline kernels (where it has them), and its x86-64-v3 and x86-64-v4 kernels each in a unit of its own
 # (${target}_kernel_unit_1.cpp and _2.cpp in the binary folder, which include the source; nonsep/sdk/kernels.hpp,
 # "Kernel units"). The plugin is the same; on two cores it builds in about two thirds of the wall time
 # (docs/writing-models.md, "How long a plugin takes to build"). Several sources are compiled as they are.
@@ -79,15 +84,19 @@ function(nonsep_add_model target)
       set(arg_KERNEL_SETS ${NONSEP_KERNEL_SETS})
     endif()
   endif()
-  if(arg_KERNEL_SETS STREQUAL "native")
+  set(baseline_kernels 1)
+  if(arg_KERNEL_SETS MATCHES "^native(\\+baseline)?$")
     _nonsep_native_kernel_sets(wide_sets)
+    if(arg_KERNEL_SETS STREQUAL "native" AND (wide_sets EQUAL 1 OR wide_sets EQUAL 2))
+      set(baseline_kernels 0)
+    endif()
   elseif(arg_KERNEL_SETS STREQUAL "all")
     set(wide_sets 3)
   elseif(arg_KERNEL_SETS STREQUAL "baseline")
     set(wide_sets 0)
   else()
     message(FATAL_ERROR "nonsep_add_model(${target}): KERNEL_SETS \"${arg_KERNEL_SETS}\" (NONSEP_KERNEL_SETS?); "
-                        "allowed: native, all or baseline")
+                        "allowed: native, native+baseline, all or baseline")
   endif()
   add_library(${target} MODULE ${arg_UNPARSED_ARGUMENTS})
   list(LENGTH arg_UNPARSED_ARGUMENTS source_count)
@@ -123,7 +132,8 @@ function(nonsep_add_model target)
     set_property(SOURCE "${source}" TARGET_DIRECTORY ${target} APPEND PROPERTY COMPILE_DEFINITIONS
                  NONSEP_SDK_SEPARATE_KERNEL_UNITS=${wide_sets})
   endif()
-  target_compile_definitions(${target} PRIVATE NONSEP_SDK_WIDE_KERNEL_SETS=${wide_sets})
+  target_compile_definitions(${target} PRIVATE NONSEP_SDK_WIDE_KERNEL_SETS=${wide_sets}
+                                               NONSEP_SDK_BASELINE_KERNELS=${baseline_kernels})
   set_target_properties(${target} PROPERTIES
     PREFIX ""
     SUFFIX ".so"

@@ -27,9 +27,12 @@ if(NONSEP_NATIVE)
 endif()
 
 # The stepping kernels of the plugins built here (nonsep_add_model's KERNEL_SETS): native (the widest set this machine
-# runs, besides the baseline), all (x86-64-v3 and x86-64-v4 too, for plugins that run elsewhere) or baseline.
-set(NONSEP_KERNEL_SETS "native" CACHE STRING "Plugin stepping kernels besides the baseline: native, all or baseline")
-set_property(CACHE NONSEP_KERNEL_SETS PROPERTY STRINGS native all baseline)
+# runs, alone), native+baseline (and the baseline), all (the baseline, x86-64-v3 and x86-64-v4, for plugins that run
+# elsewhere) or baseline. Empty, the default: native, or native+baseline in a build with the tests (BUILD_TESTING),
+# whose doctests pin the baseline kernel (tests/test_main.cpp); the top-level CMakeLists.txt decides, after CTest.
+set(NONSEP_KERNEL_SETS "" CACHE STRING
+    "Plugin stepping kernels: native, native+baseline, all or baseline; empty: native (native+baseline with tests)")
+set_property(CACHE NONSEP_KERNEL_SETS PROPERTY STRINGS "" native native+baseline all baseline)
 
 option(NONSEP_WARNINGS_AS_ERRORS "Treat compiler warnings as errors" OFF)
 

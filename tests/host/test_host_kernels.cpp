@@ -259,4 +259,33 @@ TEST_CASE("NONSEP_INSTRUCTION_SET naming a set the plugin lacks is refused with 
         std::string::npos);
 }
 
+TEST_CASE(
+    "a plugin with the default kernels carries this machine's widest set alone, and the baseline pinned is refused") {
+  TemporaryFolder folder;
+  std::string sets;
+  {
+    InstructionSet pin("evaluation");
+    const auto shown = run_nonsep({"inspect", "native_kernels"}, folder.path());
+    REQUIRE(shown.status == 0);
+    const std::string prefix = "kernels:     version " + std::to_string(nonsep::chin_kernel_version) + " for ";
+    const auto at = shown.out.find(prefix);
+    REQUIRE(at != std::string::npos);
+    const auto from = at + prefix.size();
+    sets = shown.out.substr(from, shown.out.find(';', from) - from);
+  }
+  INFO("kernels: " << sets);
+  const auto pinned = run_nonsep({"inspect", "native_kernels"}, folder.path());
+  if (sets == "x86-64") {
+    // This processor runs no wider set: the baseline is the native one, and runs.
+    CHECK(pinned.status == 0);
+  } else {
+    CHECK((sets == "x86-64-v4" || sets == "x86-64-v3"));
+    CHECK(pinned.status == 2);
+    CHECK(pinned.err.find("NONSEP_INSTRUCTION_SET=x86-64 names no kernel of this plugin (it has " + sets +
+                          "); the evaluation path, NONSEP_INSTRUCTION_SET=evaluation, gives the baseline kernel's "
+                          "numbers bit for bit") != std::string::npos);
+    CHECK(pinned.err.find("KERNEL_SETS native+baseline") != std::string::npos);
+  }
+}
+
 }  // namespace test_host_kernels

@@ -94,8 +94,14 @@ KernelChoice choose_kernel(const json& metadata, const nonsep_plugin_api& api, u
   }
   std::string known;
   for (const auto& name : choice.instruction_sets) known += (known.empty() ? "" : ", ") + name;
-  throw PluginError("NONSEP_INSTRUCTION_SET=" + pin + " names no kernel of this plugin (it has " + known +
-                    "; \"baseline\" means x86-64, \"evaluation\" the evaluation path)");
+  const std::string advice =
+      pin == "x86-64"
+          ? "; the evaluation path, NONSEP_INSTRUCTION_SET=evaluation, gives the baseline kernel's numbers bit "
+            "for bit, or rebuild the plugin with its baseline kernels: nonsep_add_model(... KERNEL_SETS "
+            "native+baseline), or all, -DNONSEP_KERNEL_SETS=... for nonsep's own plugins"
+          : "; \"baseline\" means x86-64, \"evaluation\" the evaluation path";
+  throw PluginError("NONSEP_INSTRUCTION_SET=" + pin + " names no kernel of this plugin (it has " + known + ")" +
+                    advice);
 }
 
 }  // namespace nonsep::host

@@ -19,9 +19,11 @@
 // function of another arch, so a wider kernel there would call the model's gradients out of line.
 // NONSEP_SDK_WIDE_KERNEL_SETS (default 3) chooses the wider sets compiled, as bits: 1 for x86-64-v3, 2 for x86-64-v4, 0
 // for none (each costs compile time; formula models compile the one the host uses). NONSEP_SDK_BASELINE_KERNELS 0
-// leaves the baseline kernels out when a wider set is compiled (a formula model's cached plugin, which runs only on
-// the machine that compiled it, where the host takes the wider set: about a sixth of its compile time); the
-// metadata then names the wider set alone, and NONSEP_INSTRUCTION_SET=x86-64 compiles a plugin of its own.
+// leaves the baseline kernels out when a wider set is compiled (nonsep_add_model's default, KERNEL_SETS native, and a
+// formula model's cached plugin: built for the machine that compiles them, where the host takes the wider set; the
+// baseline Chin kernels are about a third of a plugin's compile time); the metadata then names the wider set alone,
+// NONSEP_INSTRUCTION_SET=x86-64 is refused for such a plugin (a formula model compiles a plugin of its own), and a
+// processor that runs none of its sets steps it through the evaluation path.
 //
 // Kernel units: the wider sets' kernels may be compiled in translation units of their own, in parallel with the rest
 // of the plugin (nonsep_add_model does so for a one-file plugin; the plugin is the same, built in about half the wall
