@@ -4,6 +4,7 @@
 // reader all apply, and the "parameters" array of a plugin's metadata. Not for a plugin's own sources: it includes
 // nlohmann/json.hpp, which the SDK compiles once, in its library (plugins/sdk/src).
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,13 @@
 #include "nonsep/sdk/parameters.hpp"
 
 namespace nonsep::sdk {
+
+// Shortest text that reads back as the same double; integral values without a decimal point.
+inline std::string format_number(double x) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x);
+  return std::string(buffer, result.ptr);
+}
 
 // The default of a table row as JSON of the row's type.
 inline nlohmann::json default_as_json(const Parameter& p) {

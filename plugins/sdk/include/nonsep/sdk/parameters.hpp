@@ -21,7 +21,6 @@
 // themselves are nonsep/sdk/parameter_rules.hpp, which the library and the host's job reader and plugin loader
 // include. A plugin's own translation units then never parse or instantiate nlohmann::json (about 7 s of compile
 // time of every plugin: docs/writing-models.md, "How long a plugin takes to build").
-#include <charconv>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -69,13 +68,6 @@ class InvalidParameter : public std::invalid_argument {
   std::string parameter_;
 };
 
-// Shortest text that reads back as the same double; integral values without a decimal point.
-inline std::string format_number(double x) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x);
-  return std::string(buffer, result.ptr);
-}
-
 // The parameters in effect for one model instance: every table entry, given or defaulted, already checked.
 class ParameterValues {
  public:
@@ -94,8 +86,6 @@ class ParameterValues {
   double number(std::string_view name) const { return at(name, "number").value; }
   std::int64_t integer(std::string_view name) const { return static_cast<std::int64_t>(at(name, "integer").value); }
   bool boolean(std::string_view name) const { return at(name, "boolean").value != 0.0; }
-  // Every parameter in effect, in the order of the model's table.
-  const std::vector<Entry>& entries() const { return entries_; }
   bool operator==(const ParameterValues&) const = default;
 
  private:
