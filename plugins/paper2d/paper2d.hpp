@@ -24,7 +24,7 @@
 // Gauss-Legendre's grad H the products and the third derivatives of V at every stage point; automatic
 // differentiation checks them in tests/plugins). With u^T Hess V u = (1 + |q|^2/3)|u|^2 + (2/3)(q.u)^2 +
 // coupling (2 q2^2 u1^2 + 8 q1 q2 u1 u2 + 2 q1^2 u2^2), d3V's entries are its derivatives in q1 and q2; T''' is 1 on
-// the diagonal.
+// the diagonal. The mixed third and the fourth derivatives of hvp_H (Gauss-Legendre's tangent map) are written out too.
 #include <nonsep/plugin_sdk.hpp>
 
 class Paper2D {
@@ -90,6 +90,32 @@ class Paper2D {
     const double x = q[0], y = q[1], a = u[0], b = u[1], u2 = a * a + b * b, qu = x * a + y * b;
     out[0] = 2.0 / 3.0 * x * u2 + 4.0 / 3.0 * qu * a + coupling_ * (8.0 * y * a * b + 4.0 * x * b * b);
     out[1] = 2.0 / 3.0 * y * u2 + 4.0 / 3.0 * qu * b + coupling_ * (4.0 * y * a * a + 8.0 * x * a * b);
+  }
+  // The mixed third derivatives (the gradient in q of a^T Hess V b; T''' is 1 on the diagonal) and the fourth (of
+  // c . d3V(q, a, b): constant, V being quartic) of the Hessian-vector product of H, which Gauss-Legendre's tangent
+  // map takes 2n times per stage point.
+  void d3T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> a, nonsep::sdk::Vector<double> b,
+           std::span<double> out) const {
+    out[0] = a[0] * b[0];
+    out[1] = a[1] * b[1];
+  }
+  void d3V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> a, nonsep::sdk::Vector<double> b,
+           std::span<double> out) const {
+    const double x = q[0], y = q[1], ab = a[0] * b[0] + a[1] * b[1], qa = x * a[0] + y * a[1];
+    const double qb = x * b[0] + y * b[1], cross = a[0] * b[1] + a[1] * b[0];
+    out[0] = 2.0 / 3.0 * (x * ab + a[0] * qb + b[0] * qa) + 4.0 * coupling_ * (y * cross + x * a[1] * b[1]);
+    out[1] = 2.0 / 3.0 * (y * ab + a[1] * qb + b[1] * qa) + 4.0 * coupling_ * (y * a[0] * b[0] + x * cross);
+  }
+  void d4T(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double>,
+           nonsep::sdk::Vector<double>, std::span<double> out) const {
+    out[0] = out[1] = 0.0;
+  }
+  void d4V(nonsep::sdk::Vector<double>, nonsep::sdk::Vector<double> a, nonsep::sdk::Vector<double> b,
+           nonsep::sdk::Vector<double> c, std::span<double> out) const {
+    const double ab = a[0] * b[0] + a[1] * b[1], ac = a[0] * c[0] + a[1] * c[1], bc = b[0] * c[0] + b[1] * c[1];
+    const double cross = a[0] * b[1] + a[1] * b[0];
+    out[0] = 2.0 / 3.0 * (c[0] * ab + ac * b[0] + bc * a[0]) + 4.0 * coupling_ * (c[0] * a[1] * b[1] + c[1] * cross);
+    out[1] = 2.0 / 3.0 * (c[1] * ab + ac * b[1] + bc * a[1]) + 4.0 * coupling_ * (c[0] * cross + c[1] * a[0] * b[0]);
   }
 
  private:

@@ -1,8 +1,9 @@
 // The SDK's derivatives of grad H (model_adapter.hpp): hvp_H forms its sums of third and fourth derivatives in three
 // seeded passes, and grad H takes the inner product from the pass of the third derivatives. Checked for every kind
 // of tangent (only dq, only dp, both, none) and both forms, with derivatives by duals over T and V, over gradient
-// templates, and partly written out: against central differences of grad H, linear in the tangent, and grad H bit
-// for bit what the separate products give.
+// templates, and partly or wholly written out: against central differences of grad H, linear in the tangent, the
+// written-out mixed third and fourth derivatives against the dual numbers' to round-off, and grad H bit for bit what
+// the separate products give.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "lattice_chain/lattice_chain.hpp"
 #include "nonsep/core/base/hamiltonian_gradient.hpp"
 #include "nonsep/plugin_sdk.hpp"
+#include "paper1d/paper1d.hpp"
 #include "paper2d/paper2d.hpp"
 #include "support/random_points.hpp"
 
@@ -139,6 +141,36 @@ struct Paper2DGradients {
   }
 };
 
+// hvp_H of a model that writes out d3T, d3V (mixed), d4T and d4V against the same model differentiated by dual
+// numbers, at random points and tangents of every kind, both forms: the same numbers to round-off.
+template <class M>
+void check_written_out_fourth(const char* parameters, const char* what) {
+  const auto written = ModelAdapter<M>::from_json(parameters);
+  const auto automatic = ModelAdapter<M, Derivatives::automatic>::from_json(parameters);
+  static_assert(ModelAdapter<M>::analytic_mixed_T && ModelAdapter<M>::analytic_mixed_V);
+  static_assert(!decltype(automatic)::analytic_mixed_T && !decltype(automatic)::analytic_mixed_V);
+  const std::size_t n = written.dimension(), count = 24, size = count * n;
+  const auto q = random_points(size, 1.5, 31), p = random_points(size, 1.5, 32);
+  auto dq = random_points(size, 1.0, 33), dp = random_points(size, 1.0, 34);
+  for (std::size_t b = 0; b < count; ++b)  // every third state without dq, every third from the second without dp
+    for (std::size_t i = 0; i < n; ++i) {
+      if (b % 3 == 0) dq[b * n + i] = 0.0;
+      if (b % 3 == 1) dp[b * n + i] = 0.0;
+    }
+  for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT}) {
+    CAPTURE(what);
+    CAPTURE(form == HamiltonianForm::TTV);
+    std::vector<double> a_q(size), a_p(size), b_q(size), b_p(size);
+    written.hvp_H(form, q, p, dq, dp, a_q, a_p, count);
+    automatic.hvp_H(form, q, p, dq, dp, b_q, b_p, count);
+    for (std::size_t k = 0; k < size; ++k) {
+      CAPTURE(k);
+      CHECK(std::abs(a_q[k] - b_q[k]) <= 1e-14 * std::max(1.0, std::abs(b_q[k])) * 8);
+      CHECK(std::abs(a_p[k] - b_p[k]) <= 1e-14 * std::max(1.0, std::abs(b_p[k])) * 8);
+    }
+  }
+}
+
 using Lattice = LatticeChainModel<16>;
 const char* const lattice_parameters = R"({"sites": 5, "kinetic_quartic": 0.7, "coupling": 0.4, "bond_quartic": 1.3})";
 
@@ -150,9 +182,15 @@ TEST_CASE("SDK hvp_H: every kind of tangent, both forms, against differences of 
   check_every_form(ModelAdapter<Paper2DGradients>(), "paper2d, gradient templates");
   check_every_form(ModelAdapter<Lattice, Derivatives::automatic>::from_json(lattice_parameters),
                    "lattice chain, duals over T and V");
-  check_every_form(ModelAdapter<Paper2D>::from_json(R"({"coupling": 0.25})"), "paper2d, written-out products");
+  check_every_form(ModelAdapter<Paper2D>::from_json(R"({"coupling": 0.25})"), "paper2d, every derivative written out");
   check_every_form(ModelAdapter<Paper2D, Derivatives::automatic>::from_json(R"({"coupling": 0.25})"),
                    "paper2d, duals over T and V");
+}
+
+TEST_CASE("SDK hvp_H: written-out mixed third and fourth derivatives give the dual numbers' products to round-off") {
+  check_written_out_fourth<Paper1D>("{}", "paper1d");
+  check_written_out_fourth<Paper2D>(R"({"coupling": 0.25})", "paper2d");
+  check_written_out_fourth<Paper2D>(R"({"coupling": -0.1})", "paper2d, negative coupling");
 }
 
 TEST_CASE("SDK grad H: the inner product taken from the pass of the third derivatives is bit for bit the product's") {

@@ -234,6 +234,19 @@ template <class M>
 concept HasAnalyticD3V = requires(const M& m, Vector<double> x, Vector<double> u, std::span<double> out) {
   m.d3V(x, u, out);
 };
+// The mixed third and the fourth derivatives hvp_H takes (optional, both of T or of V, with that function's hvp):
+// d3T(p, a, b, out) writes out_k = T_kij(p) a_i b_j and d4T(p, a, b, c, out) out_k = T_kijl(p) a_i b_j c_l; the same
+// for V at q.
+template <class M>
+concept HasAnalyticMixedT = requires(const M& m, Vector<double> x, Vector<double> u, std::span<double> out) {
+  m.d3T(x, u, u, out);
+  m.d4T(x, u, u, u, out);
+};
+template <class M>
+concept HasAnalyticMixedV = requires(const M& m, Vector<double> x, Vector<double> u, std::span<double> out) {
+  m.d3V(x, u, u, out);
+  m.d4V(x, u, u, u, out);
+};
 template <class M>
 concept HasAnalyticHvpT = requires(const M& m, Vector<double> x, Vector<double> v, std::span<double> out) {
   m.hvp_T(x, v, out);
@@ -365,7 +378,11 @@ class ModelAdapter {
   // The fourth derivatives of hvp_H: of the gradient templates where they compile for ThirdDirectionalDual, else of
   // T and V on FourthDerivativeDual; a model with neither has no hvp_H.
   static constexpr bool fourth_by_gradients = differentiates_gradients && HasFourthOrderGradientTemplates<M>;
-  static constexpr bool has_hamiltonian_hessian = fourth_by_gradients || HasFourthOrderTV<M>;
+  // hvp_H's passes over T (V) replaced by the model's written-out d3T, d4T and hvp_T (d3V, d4V, hvp_V).
+  static constexpr bool analytic_mixed_T = policy == Derivatives::preferred && HasAnalyticMixedT<M> && analytic_hvp_T;
+  static constexpr bool analytic_mixed_V = policy == Derivatives::preferred && HasAnalyticMixedV<M> && analytic_hvp_V;
+  static constexpr bool has_hamiltonian_hessian =
+      fourth_by_gradients || HasFourthOrderTV<M> || (analytic_mixed_T && analytic_mixed_V);
 
   static constexpr bool analytic_grad_K = policy == Derivatives::preferred && HasAnalyticGradK<M>;
   static constexpr bool analytic_grad_U = policy == Derivatives::preferred && HasAnalyticGradU<M>;
@@ -598,7 +615,8 @@ class ModelAdapter {
   void hamiltonian_products(const double* ys, const double* xs, const double* dys, const double* dxs, double* out_ys,
                             double* out_xs, std::size_t count) const requires has_hamiltonian_hessian {
     const std::size_t n = batch_dimension();
-    auto& scratch = detail::GradientScratch<double>::of_size(3 * n);
+    // Sized once for every use below: g, dg, w here, sum and the written-out passes' terms in scratch.g.
+    auto& scratch = detail::GradientScratch<double>::of_size(4 * n);
     double* g = scratch.x.data();
     double* dg = g + n;
     double* w = dg + n;
@@ -703,7 +721,12 @@ class ModelAdapter {
   template <bool kinetic>
   NONSEP_SDK_DUAL_INLINE void mixed_third_of(const double* x, const double* a, const double* b, double* out,
                                              std::size_t n, const detail::MixedPassExtras& extras) const {
-    if constexpr (differentiates_gradients)
+    if constexpr (kinetic ? analytic_mixed_T : analytic_mixed_V) {
+      written_third<kinetic>(x, a, b, out, n);
+      if (extras.seed != nullptr) add_product<kinetic>(x, extras.seed, out, n);
+      if (extras.along_a != nullptr) product_of<kinetic>(x, a, extras.along_a, n);
+      if (extras.along_b != nullptr) product_of<kinetic>(x, b, extras.along_b, n);
+    } else if constexpr (differentiates_gradients)
       detail::mixed_third_by_gradient(gradient_template_of<kinetic>(), x, a, b, n, out, extras);
     else
       poison_pass(detail::mixed_third_by_dual<capacity>(function_of<kinetic>(), x, a, b, n, out, extras), out, extras,
@@ -713,11 +736,51 @@ class ModelAdapter {
   NONSEP_SDK_DUAL_INLINE void mixed_fourth_of(
       const double* x, const double* a, const double* b, const double* c, double* out, std::size_t n,
       const detail::MixedPassExtras& extras) const requires has_hamiltonian_hessian {
-    if constexpr (fourth_by_gradients)
+    if constexpr (kinetic ? analytic_mixed_T : analytic_mixed_V) {
+      const Vector<double> at(x, n), along_a(a, n), along_b(b, n), along_c(c, n);
+      const std::span<double> result(out, n);
+      if constexpr (kinetic)
+        model_.d4T(at, along_a, along_b, along_c, result);
+      else
+        model_.d4V(at, along_a, along_b, along_c, result);
+      if (extras.seed != nullptr) {
+        add_third<kinetic>(x, a, extras.seed, out, n);
+        add_third<kinetic>(x, b, extras.seed, out, n);
+      }
+      if (extras.along_a != nullptr) product_of<kinetic>(x, a, extras.along_a, n);
+      if (extras.lower != nullptr) {
+        written_third<kinetic>(x, b, c, extras.lower, n);
+        if (extras.seed != nullptr) add_product<kinetic>(x, extras.seed, extras.lower, n);
+      }
+    } else if constexpr (fourth_by_gradients)
       detail::mixed_fourth_by_gradient(gradient_template_of<kinetic>(), x, a, b, c, n, out, extras);
     else
       poison_pass(detail::mixed_fourth_by_dual<capacity>(function_of<kinetic>(), x, a, b, c, n, out, extras), out,
                   extras, n);
+  }
+  // The model's written-out mixed third derivative of T (kinetic) or V into out, or added to it; its Hessian-vector
+  // product added to out (scratch: hamiltonian_products sized it).
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void written_third(const double* x, const double* a, const double* b, double* out,
+                                            std::size_t n) const {
+    const Vector<double> at(x, n), along_a(a, n), along_b(b, n);
+    if constexpr (kinetic)
+      model_.d3T(at, along_a, along_b, std::span<double>(out, n));
+    else
+      model_.d3V(at, along_a, along_b, std::span<double>(out, n));
+  }
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void add_third(const double* x, const double* a, const double* b, double* out,
+                                        std::size_t n) const {
+    double* term = detail::GradientScratch<double>::of_size(4 * n).g.data() + 3 * n;  // past hvp_H's other uses
+    written_third<kinetic>(x, a, b, term, n);
+    for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
+  }
+  template <bool kinetic>
+  NONSEP_SDK_DUAL_INLINE void add_product(const double* x, const double* v, double* out, std::size_t n) const {
+    double* term = detail::GradientScratch<double>::of_size(4 * n).g.data() + 3 * n;
+    product_of<kinetic>(x, v, term, n);
+    for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
   }
   static void poison_pass(double value, double* out, const detail::MixedPassExtras& extras, std::size_t n) {
     detail::poison_if_not_finite(value, out, n);
