@@ -1,11 +1,14 @@
 // The direct solve of Gauss-Legendre's linear stages (core/src/tangent/gauss_linear_stages.cpp) at every size it
 // takes (s = 1 .. 8 stages, d = 2n components, 2ns <= 32), against the same equations solved by Eigen's LU: random
-// Jacobians, 1 and 3 vectors, each vector's result independent of the others; sizes it does not take are refused.
+// Jacobians, 1 and 3 vectors, each vector's result independent of the others, several states solved together each
+// bit for bit as alone (a singular one among them named alone); sizes it does not take are refused.
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "nonsep/core/base/error.hpp"
@@ -74,6 +77,46 @@ TEST_CASE("Gauss linear stages: every size solved directly agrees with Eigen's L
       ++sizes;
     }
   CHECK(sizes == 16 + 8 + 5 + 4 + 3 + 2 + 2 + 2);
+}
+
+TEST_CASE("Gauss linear stages: states solved together give each state's numbers alone, a singular one named") {
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const std::size_t lanes = nonsep::linear_stage_lanes;
+  for (const int s : {1, 3, 4})
+    for (const std::size_t d : {std::size_t{2}, std::size_t{4}, std::size_t{8}}) {
+      if (static_cast<std::size_t>(s) * d > 32) continue;
+      const auto tableau = nonsep::GaussLegendreTableau::for_stages(s);
+      const double dt = 0.3;
+      const std::size_t k = 2, block = static_cast<std::size_t>(s) * d * d;
+      for (std::size_t states = 1; states <= lanes; ++states) {
+        std::vector<double> jacobians(states * block), vectors(states * k * d);
+        for (double& x : jacobians) x = uniform(random);
+        for (double& x : vectors) x = uniform(random);
+        const std::size_t singular = states - 1;  // the last state's Jacobians not finite
+        if (states > 1) jacobians[singular * block + 1] = std::numeric_limits<double>::infinity();
+        std::vector<double> together = vectors;
+        const unsigned failed = nonsep::map_by_linear_stages(tableau, dt, jacobians, d, together, k, states);
+        CAPTURE(s);
+        CAPTURE(d);
+        CAPTURE(states);
+        CHECK(failed == (states > 1 ? 1u << singular : 0u));
+        for (std::size_t b = 0; b < states; ++b) {
+          if (states > 1 && b == singular) continue;
+          std::vector<double> alone(vectors.begin() + static_cast<std::ptrdiff_t>(b * k * d),
+                                    vectors.begin() + static_cast<std::ptrdiff_t>((b + 1) * k * d));
+          const std::span<const double> own(jacobians.data() + b * block, block);
+          REQUIRE(nonsep::map_by_linear_stages(tableau, dt, own, d, alone, k));
+          for (std::size_t c = 0; c < k * d; ++c) CHECK(together[b * k * d + c] == alone[c]);
+        }
+      }
+      std::vector<double> jacobians((lanes + 1) * block, 0.0), vectors((lanes + 1) * k * d, 0.0);
+      CHECK_THROWS_AS(nonsep::map_by_linear_stages(tableau, dt, jacobians, d, vectors, k, lanes + 1),
+                      nonsep::InvalidArgument);
+      CHECK_THROWS_AS(
+          nonsep::map_by_linear_stages(tableau, dt, std::span<const double>(jacobians).first(block), d, vectors, k, 2),
+          nonsep::InvalidArgument);  // the spans of one state, two asked for
+    }
 }
 
 TEST_CASE("Gauss linear stages: a singular system gives false, sizes beyond the direct solve are refused") {

@@ -18,86 +18,137 @@ constexpr std::size_t capacity = 32;
 
 // The solve for S stages of D = 2n components, both known at compile time so that every loop has fixed bounds
 // (bench/tangent_cost.py, paper1d: with only the size 2ns fixed, the loops over the vectors and components and the
-// sums kept in memory made this solve half of a tangent run). The system is factored once (P A = L U, the rows
-// swapped whole, L's multipliers below the diagonal), then each vector is solved alone: its numbers are those of
+// sums kept in memory made this solve half of a tangent run), for L states at once: every number is an array of L
+// lanes, one state each, and each lane takes the operations of a solve of its state alone in the same order, so that
+// the elimination's long chains of dependent operations of one state overlap with the other states' (a paper2d
+// tangent run spent 42% of its time here with one state at a time). The system is factored once (P A = L U, the
+// rows swapped whole, L's multipliers below the diagonal), then each vector is solved alone: its numbers are those of
 // eliminating every right-hand side alongside the system, operation for operation (the multiplier of a row is
 // applied to the same value in the same order; only where the value is kept differs).
+//
+// On x86-64 each solve is compiled for AVX-512 and AVX2 besides the build's instruction set and the widest the
+// processor runs is taken at load time (8 lanes are one AVX-512 register); core/CMakeLists.txt compiles this file with
+// -ffp-contract=off, so no multiply and add are fused and every clone gives the baseline's numbers bit for bit.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define NONSEP_LINEAR_STAGES_CLONES [[gnu::target_clones("avx512f", "avx2", "default")]]
+#else
+#define NONSEP_LINEAR_STAGES_CLONES
+#endif
 template <std::size_t S, std::size_t D>
-bool map_by_linear_stages_of(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
-                             std::span<double> vectors, std::size_t k) {
-  constexpr std::size_t M = S * D;
-  // J_j(r, c) at jacobians[(j*D + c)*D + r]; the system row-major, row i*D + r for stage i, component r.
-  const auto J = [&](std::size_t j, std::size_t r, std::size_t c) { return jacobians[(j * D + c) * D + r]; };
+NONSEP_LINEAR_STAGES_CLONES unsigned map_by_linear_stages_of(const GaussLegendreTableau& tableau, double dt,
+                                                             std::span<const double> jacobians,
+                                                             std::span<double> vectors, std::size_t k,
+                                                             std::size_t states) {
+  constexpr std::size_t M = S * D, L = linear_stage_lanes;
+  using Lanes = std::array<double, L>;
+  // J_j(r, c) of lane l at Js[(j*D + c)*D + r][l], from state l's jacobians[(j*D + c)*D + r] (lanes past `states`
+  // repeat state 0, and are dropped).
+  std::array<Lanes, S * D * D> Js;
+  for (std::size_t e = 0; e < S * D * D; ++e)
+    for (std::size_t l = 0; l < L; ++l) Js[e][l] = jacobians[(l < states ? l : 0) * S * D * D + e];
+  const auto J = [&](std::size_t j, std::size_t r, std::size_t c) -> const Lanes& { return Js[(j * D + c) * D + r]; };
   std::array<double, S * S> weight;  // dt a_ij
   for (std::size_t i = 0; i < S; ++i)
     for (std::size_t j = 0; j < S; ++j) weight[i * S + j] = dt * tableau.a[i * S + j];
-  // system = I - dt (A (x) I) diag(J_j)
-  std::array<double, M * M> system;
+  // system = I - dt (A (x) I) diag(J_j), row-major, row i*D + r for stage i, component r
+  std::array<Lanes, M * M> system;
   for (std::size_t i = 0; i < S; ++i)
     for (std::size_t r = 0; r < D; ++r) {
       const std::size_t row = i * D + r;
       for (std::size_t j = 0; j < S; ++j)
         for (std::size_t c = 0; c < D; ++c)
-          system[row * M + j * D + c] = (row == j * D + c ? 1.0 : 0.0) - weight[i * S + j] * J(j, r, c);
+          for (std::size_t l = 0; l < L; ++l)
+            system[row * M + j * D + c][l] = (row == j * D + c ? 1.0 : 0.0) - weight[i * S + j] * J(j, r, c)[l];
     }
-  // Gaussian elimination with partial pivoting.
-  std::array<std::size_t, M> pivots;
+  // Gaussian elimination with partial pivoting, each lane its own pivots.
+  std::array<std::array<std::size_t, L>, M> pivots;
   for (std::size_t col = 0; col < M; ++col) {
-    std::size_t pivot = col;
+    std::array<std::size_t, L> pivot;
+    Lanes largest;
+    for (std::size_t l = 0; l < L; ++l) {
+      pivot[l] = col;
+      largest[l] = std::abs(system[col * M + col][l]);
+    }
     for (std::size_t row = col + 1; row < M; ++row)
-      if (std::abs(system[row * M + col]) > std::abs(system[pivot * M + col])) pivot = row;
+      for (std::size_t l = 0; l < L; ++l) {
+        const double size = std::abs(system[row * M + col][l]);
+        pivot[l] = size > largest[l] ? row : pivot[l];
+        largest[l] = size > largest[l] ? size : largest[l];
+      }
     pivots[col] = pivot;
-    if (pivot != col)
-      for (std::size_t c = 0; c < M; ++c) std::swap(system[col * M + c], system[pivot * M + c]);
-    const double inverse = 1.0 / system[col * M + col];  // inf for a singular system: the result is then not finite
+    for (std::size_t l = 0; l < L; ++l)
+      if (pivot[l] != col)
+        for (std::size_t c = 0; c < M; ++c) std::swap(system[col * M + c][l], system[pivot[l] * M + c][l]);
+    Lanes inverse;  // inf for a singular system: the result is then not finite
+    for (std::size_t l = 0; l < L; ++l) inverse[l] = 1.0 / system[col * M + col][l];
     for (std::size_t row = col + 1; row < M; ++row) {
-      const double factor = system[row * M + col] * inverse;
-      system[row * M + col] = factor;
-      for (std::size_t c = col + 1; c < M; ++c) system[row * M + c] -= factor * system[col * M + c];
+      Lanes factor;
+      for (std::size_t l = 0; l < L; ++l) {
+        factor[l] = system[row * M + col][l] * inverse[l];
+        system[row * M + col][l] = factor[l];
+      }
+      for (std::size_t c = col + 1; c < M; ++c)
+        for (std::size_t l = 0; l < L; ++l) system[row * M + c][l] -= factor[l] * system[col * M + c][l];
     }
   }
-  bool finite = true;
+  std::array<bool, L> finite;
+  finite.fill(true);
   for (std::size_t v = 0; v < k; ++v) {
-    double* z = vectors.data() + v * D;  // dz on entry, dz' on return
-    std::array<double, M> products, right;
+    std::array<Lanes, D> z;  // dz on entry, dz' at the end
+    for (std::size_t c = 0; c < D; ++c)
+      for (std::size_t l = 0; l < L; ++l) z[c][l] = vectors[((l < states ? l : 0) * k + v) * D + c];
+    std::array<Lanes, M> products, right;
     for (std::size_t j = 0; j < S; ++j)  // products_j = J_j dz
       for (std::size_t r = 0; r < D; ++r) {
-        double sum = 0.0;
-        for (std::size_t c = 0; c < D; ++c) sum += J(j, r, c) * z[c];
+        Lanes sum{};
+        for (std::size_t c = 0; c < D; ++c)
+          for (std::size_t l = 0; l < L; ++l) sum[l] += J(j, r, c)[l] * z[c][l];
         products[j * D + r] = sum;
       }
     for (std::size_t i = 0; i < S; ++i)  // right_i = dt sum_j a_ij products_j
       for (std::size_t r = 0; r < D; ++r) {
-        double sum = 0.0;
-        for (std::size_t j = 0; j < S; ++j) sum += weight[i * S + j] * products[j * D + r];
+        Lanes sum{};
+        for (std::size_t j = 0; j < S; ++j)
+          for (std::size_t l = 0; l < L; ++l) sum[l] += weight[i * S + j] * products[j * D + r][l];
         right[i * D + r] = sum;
       }
     for (std::size_t col = 0; col < M; ++col)  // P right, then L and U: right becomes dZ
-      if (pivots[col] != col) std::swap(right[col], right[pivots[col]]);
+      for (std::size_t l = 0; l < L; ++l)
+        if (pivots[col][l] != col) std::swap(right[col][l], right[pivots[col][l]][l]);
     for (std::size_t col = 0; col < M; ++col)
-      for (std::size_t row = col + 1; row < M; ++row) right[row] -= system[row * M + col] * right[col];
+      for (std::size_t row = col + 1; row < M; ++row)
+        for (std::size_t l = 0; l < L; ++l) right[row][l] -= system[row * M + col][l] * right[col][l];
     for (std::size_t col = M; col-- > 0;) {
-      double sum = right[col];
-      for (std::size_t c = col + 1; c < M; ++c) sum -= system[col * M + c] * right[c];
-      right[col] = sum / system[col * M + col];
+      Lanes sum = right[col];
+      for (std::size_t c = col + 1; c < M; ++c)
+        for (std::size_t l = 0; l < L; ++l) sum[l] -= system[col * M + c][l] * right[c][l];
+      for (std::size_t l = 0; l < L; ++l) right[col][l] = sum[l] / system[col * M + col][l];
     }
-    // dz' = dz + dt sum_i b_i (J_i dz + J_i dZ_i): in place, dz being read no more (products holds J_i dz)
+    // dz' = dz + dt sum_i b_i (J_i dz + J_i dZ_i), products holding J_i dz
     for (std::size_t r = 0; r < D; ++r) {
-      double sum = 0.0;
+      Lanes sum{};
       for (std::size_t i = 0; i < S; ++i) {
-        double stage = products[i * D + r];
-        for (std::size_t c = 0; c < D; ++c) stage += J(i, r, c) * right[i * D + c];
-        sum += dt * tableau.b[i] * stage;
+        Lanes stage = products[i * D + r];
+        for (std::size_t c = 0; c < D; ++c)
+          for (std::size_t l = 0; l < L; ++l) stage[l] += J(i, r, c)[l] * right[i * D + c][l];
+        for (std::size_t l = 0; l < L; ++l) sum[l] += dt * tableau.b[i] * stage[l];
       }
-      z[r] += sum;
-      finite = finite && std::isfinite(z[r]);
+      for (std::size_t l = 0; l < L; ++l) {
+        z[r][l] += sum[l];
+        finite[l] = finite[l] && std::isfinite(z[r][l]);
+      }
     }
+    for (std::size_t l = 0; l < states; ++l)
+      for (std::size_t c = 0; c < D; ++c) vectors[(l * k + v) * D + c] = z[c][l];
   }
-  return finite;
+  unsigned failed = 0;
+  for (std::size_t l = 0; l < states; ++l) failed |= finite[l] ? 0u : 1u << l;
+  return failed;
 }
 
 // The solvers of every S = 1 .. max_stages and even D with S D <= capacity, at [(S - 1) * columns + D / 2 - 1].
-using Solver = bool (*)(const GaussLegendreTableau&, double, std::span<const double>, std::span<double>, std::size_t);
+using Solver = unsigned (*)(const GaussLegendreTableau&, double, std::span<const double>, std::span<double>,
+                            std::size_t, std::size_t);
 constexpr std::size_t columns = capacity / 2;  // D = 2, 4, .., capacity
 
 template <std::size_t S, std::size_t D>
@@ -116,17 +167,29 @@ constexpr auto solver_table =
 
 }  // namespace
 
+unsigned map_by_linear_stages(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
+                              std::size_t d, std::span<double> vectors, std::size_t k, std::size_t states) {
+  const std::size_t s = static_cast<std::size_t>(tableau.stages), m = s * d;
+  if (m == 0 || states == 0) return 0;  // nothing to solve
+  if (m > capacity || k > capacity || d % 2 != 0 || s > static_cast<std::size_t>(GaussLegendreTableau::max_stages) ||
+      states > linear_stage_lanes)
+    throw InvalidArgument(
+        "the direct solve of Gauss-Legendre's linear stages takes d = 2n components, s stages, k vectors and up "
+        "to " +
+        std::to_string(linear_stage_lanes) + " states with sd <= " + std::to_string(capacity) +
+        " and k <= " + std::to_string(capacity) + "; found d = " + std::to_string(d) + ", s = " + std::to_string(s) +
+        ", k = " + std::to_string(k) + ", " + std::to_string(states) + " states");
+  if (jacobians.size() < states * s * d * d || vectors.size() < states * k * d)
+    throw InvalidArgument("the direct solve of Gauss-Legendre's linear stages: found " +
+                          std::to_string(jacobians.size()) + " Jacobian entries and " + std::to_string(vectors.size()) +
+                          " vector components for " + std::to_string(states) + " states; needed " +
+                          std::to_string(states * s * d * d) + " and " + std::to_string(states * k * d));
+  return solver_table[(s - 1) * columns + d / 2 - 1](tableau, dt, jacobians, vectors, k, states);
+}
+
 bool map_by_linear_stages(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
                           std::size_t d, std::span<double> vectors, std::size_t k) {
-  const std::size_t s = static_cast<std::size_t>(tableau.stages), m = s * d;
-  if (m == 0) return true;  // nothing to solve
-  if (m > capacity || k > capacity || d % 2 != 0 || s > static_cast<std::size_t>(GaussLegendreTableau::max_stages))
-    throw InvalidArgument(
-        "the direct solve of Gauss-Legendre's linear stages takes d = 2n components, s stages and k "
-        "vectors with sd <= " +
-        std::to_string(capacity) + " and k <= " + std::to_string(capacity) + "; found d = " + std::to_string(d) +
-        ", s = " + std::to_string(s) + ", k = " + std::to_string(k));
-  return solver_table[(s - 1) * columns + d / 2 - 1](tableau, dt, jacobians, vectors, k);
+  return map_by_linear_stages(tableau, dt, jacobians, d, vectors, k, 1) == 0;
 }
 
 }  // namespace nonsep

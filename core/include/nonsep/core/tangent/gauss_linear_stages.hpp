@@ -1,5 +1,5 @@
 #pragma once
-// The linear stages of Gauss-Legendre's tangent map (tangent_gauss_legendre.hpp) solved directly, for one state.
+// The linear stages of Gauss-Legendre's tangent map (tangent_gauss_legendre.hpp) solved directly, a few states at once.
 // Given J_i = Df(Y_i) at the step's s stage points (d x d, d = 2n, f = (dH/dp, -dH/dq)), the stage equations
 //   dZ_i - dt sum_j a_ij J_j dZ_j = dt sum_j a_ij J_j dz        (i = 1..s)
 // are one linear system of size sd, eliminated once (Gaussian elimination with partial pivoting) for the state's k
@@ -15,10 +15,19 @@
 
 namespace nonsep {
 
-// jacobians: s matrices J_i of d x d, column-major, J_i's column e at jacobians[(i*d + e)*d]. vectors: k vectors
-// of d numbers (dq then dp), dz on entry and dz' on return. Returns false when a number of dz' is not finite (a
-// Jacobian that is not, or a singular system): vectors are then unspecified. Throws InvalidArgument unless d is even,
-// 2ns <= 32 and k <= 32 (the sizes TangentGaussLegendre solves directly); allocates nothing.
+// The states solved together (map_by_linear_stages_of interleaves their operations; each state's numbers are those
+// of solving it alone, bit for bit).
+inline constexpr std::size_t linear_stage_lanes = 8;
+
+// jacobians: s matrices J_i of d x d per state, column-major, J_i's column e of state b at
+// jacobians[((b*s + i)*d + e)*d]. vectors: k vectors of d numbers (dq then dp) per state, vector v of state b at
+// (b*k + v)*d, dz on entry and dz' on return. Returns a mask of the states whose dz' has a number that is not finite
+// (bit b for state b: a Jacobian that is not, or a singular system); their vectors are then unspecified. Throws
+// InvalidArgument unless d is even, 2ns <= 32, k <= 32 and 1 <= states <= linear_stage_lanes (the sizes
+// TangentGaussLegendre solves directly), or when the spans are too short; allocates nothing.
+unsigned map_by_linear_stages(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
+                              std::size_t d, std::span<double> vectors, std::size_t k, std::size_t states);
+// One state: true when its dz' is finite.
 bool map_by_linear_stages(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
                           std::size_t d, std::span<double> vectors, std::size_t k);
 

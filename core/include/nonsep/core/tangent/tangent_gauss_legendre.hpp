@@ -14,8 +14,8 @@
 // Solving the linear stages, one of two ways chosen by n, k and s alone (solves_directly), so that every state of a
 // run takes the same path whatever its batch:
 // - directly (gauss_linear_stages.hpp): J(Y_i) formed from 2n products per stage point (hvp_H along each unit
-//   vector), then one LU of the 2ns x 2ns system per state, solved for its k vectors together. Costs s 2n products
-//   per state whatever k, plus the LU.
+//   vector), then one LU of the 2ns x 2ns system per state, solved for its k vectors together, a few states at once
+//   (their operations interleaved). Costs s 2n products per state whatever k, plus the LU.
 // - by fixed-point iteration dZ^{m+1}_i = dt sum_j a_ij J(Y_j) (dz + dZ^m_j) from dZ^0 = 0, with the stages' own
 //   stopping rule (gauss_legendre.hpp) per tangent vector: relative change
 //   max |dZ^{m+1} - dZ^m| / max(|dz|_inf, |dZ^{m+1}|_inf) at one ulp, or stalled at round-off (<= 64 ulp and not
@@ -108,44 +108,64 @@ class TangentGaussLegendre {
     const std::size_t states = x.count(), size = x.size(), points = s * states * d;
     const std::span<const double> stage_q = base_.stage_points_q(), stage_p = base_.stage_points_p();
     for (auto* v : {&point_q_, &point_p_, &product_q_, &product_p_}) v->resize(points * n);
-    for (auto* v : {&direction_q_, &direction_p_}) v->assign(points * n, 0.0);
+    if (direction_q_.size() != points * n || !directions_are_units_) {  // the unit directions, kept between steps
+      for (auto* v : {&direction_q_, &direction_p_}) v->assign(points * n, 0.0);
+      for (std::size_t point = 0; point < points; ++point) {
+        const std::size_t e = point % d;
+        (e < n ? direction_q_[point * n + e] : direction_p_[point * n + e - n]) = 1.0;
+      }
+      directions_are_units_ = true;
+    }
     for (std::size_t i = 0; i < s; ++i)
-      for (std::size_t b = 0; b < states; ++b)
+      for (std::size_t b = 0; b < states; ++b) {
+        const double* from_q = stage_q.data() + i * size + b * n;
+        const double* from_p = stage_p.data() + i * size + b * n;
         for (std::size_t e = 0; e < d; ++e) {
           const std::size_t to = ((i * states + b) * d + e) * n;
-          std::copy_n(stage_q.begin() + static_cast<std::ptrdiff_t>(i * size + b * n), n, point_q_.begin() + to);
-          std::copy_n(stage_p.begin() + static_cast<std::ptrdiff_t>(i * size + b * n), n, point_p_.begin() + to);
-          (e < n ? direction_q_[to + e] : direction_p_[to + e - n]) = 1.0;
-        }
-    model.hvp_H(base_.form(), point_q_, point_p_, direction_q_, direction_p_, product_q_, product_p_, points);
-    hessians_.hvp_H += points;
-    jacobians_.resize(s * d * d);
-    vectors_.resize(k * d);
-    std::vector<std::size_t> failed;
-    for (std::size_t b = 0; b < states; ++b) {
-      // Column e of J(Y_i) = (d(dH/dp), -d(dH/dq)) along e.
-      for (std::size_t i = 0; i < s; ++i)
-        for (std::size_t e = 0; e < d; ++e) {
-          const std::size_t from = ((i * states + b) * d + e) * n, to = (i * d + e) * d;
           for (std::size_t c = 0; c < n; ++c) {
-            jacobians_[to + c] = product_p_[from + c];
-            jacobians_[to + n + c] = -product_q_[from + c];
+            point_q_[to + c] = from_q[c];
+            point_p_[to + c] = from_p[c];
           }
         }
-      for (std::size_t j = 0; j < k; ++j)
-        for (std::size_t c = 0; c < n; ++c) {
-          vectors_[j * d + c] = tangents.q()[(b * k + j) * n + c];
-          vectors_[j * d + n + c] = tangents.p()[(b * k + j) * n + c];
-        }
-      if (!map_by_linear_stages(tableau, dt, jacobians_, d, vectors_, k)) {
-        for (std::size_t j = 0; j < k; ++j) failed.push_back(b * k + j);
-        continue;
       }
-      for (std::size_t j = 0; j < k; ++j)
-        for (std::size_t c = 0; c < n; ++c) {
-          tangents.q()[(b * k + j) * n + c] = vectors_[j * d + c];
-          tangents.p()[(b * k + j) * n + c] = vectors_[j * d + n + c];
+    model.hvp_H(base_.form(), point_q_, point_p_, direction_q_, direction_p_, product_q_, product_p_, points);
+    hessians_.hvp_H += points;
+    // The states in groups of linear_stage_lanes, solved together (each bit for bit as alone).
+    jacobians_.resize(linear_stage_lanes * s * d * d);
+    vectors_.resize(linear_stage_lanes * k * d);
+    std::vector<std::size_t> failed;
+    for (std::size_t first = 0; first < states; first += linear_stage_lanes) {
+      const std::size_t group = std::min(linear_stage_lanes, states - first);
+      for (std::size_t g = 0; g < group; ++g) {
+        const std::size_t b = first + g;
+        // Column e of J(Y_i) = (d(dH/dp), -d(dH/dq)) along e.
+        for (std::size_t i = 0; i < s; ++i)
+          for (std::size_t e = 0; e < d; ++e) {
+            const std::size_t from = ((i * states + b) * d + e) * n, to = ((g * s + i) * d + e) * d;
+            for (std::size_t c = 0; c < n; ++c) {
+              jacobians_[to + c] = product_p_[from + c];
+              jacobians_[to + n + c] = -product_q_[from + c];
+            }
+          }
+        for (std::size_t j = 0; j < k; ++j)
+          for (std::size_t c = 0; c < n; ++c) {
+            vectors_[(g * k + j) * d + c] = tangents.q()[(b * k + j) * n + c];
+            vectors_[(g * k + j) * d + n + c] = tangents.p()[(b * k + j) * n + c];
+          }
+      }
+      const unsigned not_finite = map_by_linear_stages(tableau, dt, jacobians_, d, vectors_, k, group);
+      for (std::size_t g = 0; g < group; ++g) {
+        const std::size_t b = first + g;
+        if (not_finite & (1u << g)) {
+          for (std::size_t j = 0; j < k; ++j) failed.push_back(b * k + j);
+          continue;
         }
+        for (std::size_t j = 0; j < k; ++j)
+          for (std::size_t c = 0; c < n; ++c) {
+            tangents.q()[(b * k + j) * n + c] = vectors_[(g * k + j) * d + c];
+            tangents.p()[(b * k + j) * n + c] = vectors_[(g * k + j) * d + n + c];
+          }
+      }
     }
     if (!failed.empty())
       throw ModelError(failure_message(failed, k, states, "the linear stages are singular or not finite"));
@@ -170,6 +190,7 @@ class TangentGaussLegendre {
       const std::size_t count = active_.size(), points = s * count;
       for (auto* v : {&point_q_, &point_p_, &direction_q_, &direction_p_, &product_q_, &product_p_})
         v->resize(points * n);
+      directions_are_units_ = false;
       for (std::size_t i = 0; i < s; ++i)
         for (std::size_t a = 0; a < count; ++a) {
           const std::size_t r = active_[a], b = r / k, to = (i * count + a) * n, z = (i * rows + r) * n;
@@ -260,6 +281,7 @@ class TangentGaussLegendre {
   std::vector<double> dZ_q_, dZ_p_, next_q_, next_p_;
   std::vector<double> point_q_, point_p_, direction_q_, direction_p_, product_q_, product_p_;
   std::vector<double> jacobians_, vectors_;
+  bool directions_are_units_ = false;  // direction_q_, direction_p_ hold the direct solve's unit directions
   std::vector<double> last_change_;
   std::vector<std::size_t> active_, still_;
 };
