@@ -615,8 +615,7 @@ class ModelAdapter {
   void hamiltonian_products(const double* ys, const double* xs, const double* dys, const double* dxs, double* out_ys,
                             double* out_xs, std::size_t count) const requires has_hamiltonian_hessian {
     const std::size_t n = batch_dimension();
-    // Sized once for every use below: g, dg, w here, sum and the written-out passes' terms in scratch.g.
-    auto& scratch = detail::GradientScratch<double>::of_size(4 * n);
+    auto& scratch = detail::GradientScratch<double>::of_size(3 * n);
     double* g = scratch.x.data();
     double* dg = g + n;
     double* w = dg + n;
@@ -759,7 +758,7 @@ class ModelAdapter {
                   extras, n);
   }
   // The model's written-out mixed third derivative of T (kinetic) or V into out, or added to it; its Hessian-vector
-  // product added to out (scratch: hamiltonian_products sized it).
+  // product added to out.
   template <bool kinetic>
   NONSEP_SDK_DUAL_INLINE void written_third(const double* x, const double* a, const double* b, double* out,
                                             std::size_t n) const {
@@ -772,15 +771,29 @@ class ModelAdapter {
   template <bool kinetic>
   NONSEP_SDK_DUAL_INLINE void add_third(const double* x, const double* a, const double* b, double* out,
                                         std::size_t n) const {
-    double* term = detail::GradientScratch<double>::of_size(4 * n).g.data() + 3 * n;  // past hvp_H's other uses
-    written_third<kinetic>(x, a, b, term, n);
-    for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
+    with_term(n, [&](double* term) {
+      written_third<kinetic>(x, a, b, term, n);
+      for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
+    });
   }
   template <bool kinetic>
   NONSEP_SDK_DUAL_INLINE void add_product(const double* x, const double* v, double* out, std::size_t n) const {
-    double* term = detail::GradientScratch<double>::of_size(4 * n).g.data() + 3 * n;
-    product_of<kinetic>(x, v, term, n);
-    for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
+    with_term(n, [&](double* term) {
+      product_of<kinetic>(x, v, term, n);
+      for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
+    });
+  }
+  // n numbers for a term: on the stack for a model of at most 64 degrees of freedom, else a per-thread buffer.
+  template <class F>
+  NONSEP_SDK_DUAL_INLINE static void with_term(std::size_t n, const F& use) {
+    if constexpr (capacity > 0 && capacity <= 64) {
+      std::array<double, capacity> term;
+      use(term.data());
+    } else {
+      thread_local std::vector<double> term;
+      if (term.size() < n) term.resize(n);
+      use(term.data());
+    }
   }
   static void poison_pass(double value, double* out, const detail::MixedPassExtras& extras, std::size_t n) {
     detail::poison_if_not_finite(value, out, n);
