@@ -193,6 +193,16 @@ TEST_CASE("inspect shows the metadata, --json the raw metadata, --check the deri
   };
   CHECK(line("energy_TTV (written out)").ends_with("(relative to max(1, |H|)): FAILED, above the tolerance"));
   CHECK(line("energy_VVT (written out)").ends_with("(relative to max(1, |H|))"));
+  // hvp_H of a product-form plugin against differences of grad H: a wrong written-out d4V fails in TTV, which takes
+  // it, and passes in VVT; paper1d's (every derivative written out) passes both.
+  result = run_nonsep({"inspect", "wrong_fourth", "--check"}, folder.path());
+  CHECK(result.status == 1);
+  CHECK(line("hvp_H (TTV) against differences of grad H").ends_with("FAILED, above the tolerance"));
+  CHECK(line("hvp_H (VVT) against differences of grad H").ends_with("(relative to max(1, |d|))"));
+  result = run_nonsep({"inspect", "paper1d", "--check"}, folder.path());
+  CHECK(result.status == 0);
+  CHECK(line("hvp_H (TTV) against differences of grad H").ends_with("(relative to max(1, |d|))"));
+  CHECK(line("hvp_H (VVT) against differences of grad H").ends_with("(relative to max(1, |d|))"));
   result = run_nonsep({"inspect", "lattice_chain", "--check"}, folder.path());
   CHECK(result.status == 0);
   CHECK(result.out.find("  energy:      available (the plugin has both Hessians; writes out H_TTV and H_VVT, one "

@@ -156,6 +156,10 @@ TEST_CASE("each shipped model documents T, V and the Hamiltonian it solves") {
     CHECK(hamiltonian.find("H_TTV = ") != std::string::npos);
     CHECK(plugin.metadata()["derivatives"]["grad_T"] == "analytic");
   }
+  // hvp_H from the written-out mixed third and fourth derivatives where the model has them, else by dual numbers.
+  CHECK(load_plugin("paper1d", "").metadata()["derivatives"]["hvp_H"] == "analytic");
+  CHECK(load_plugin("paper2d", "").metadata()["derivatives"]["hvp_H"] == "analytic");
+  CHECK(load_plugin("radial", "").metadata()["derivatives"]["hvp_H"] == "automatic");
 }
 
 TEST_CASE("the energy of each shipped model is the Hamiltonian it documents") {

@@ -298,8 +298,11 @@ DerivativeCheck check_derivatives(const PluginModel& model, const Plugin& plugin
   result.text += gauss.text;
   const PathCheck energy = check_product_energy(model, plugin, samples.q.at, samples.p.at, states, settings.tolerance);
   result.text += energy.text;
-  result.passed =
-      report.passed() && difference.empty() && threads.empty() && kernels.passed && gauss.passed && energy.passed;
+  const PathCheck products = check_hamiltonian_products(model, plugin, samples.q.at, samples.p.at, states,
+                                                        DerivativeCheckOptions{}.step, settings.tolerance);
+  result.text += products.text;
+  result.passed = report.passed() && difference.empty() && threads.empty() && kernels.passed && gauss.passed &&
+                  energy.passed && products.passed;
   if (!result.passed)
     result.text += "derivative check FAILED\n";
   else if (report.comparisons == 0)

@@ -62,7 +62,7 @@ std::string describe_derivative_costs(const Plugin& plugin, const PluginModel& m
   const std::vector<Function> functions = {
       {"value_H", general, [&] { model.value_H(x, u, out, count); }},
       {"grad_H", general, [&] { model.grad_H(x, u, out, out2, count); }},
-      {"hvp_H", general && plugin.has_hamiltonian_hessian_products(),
+      {"hvp_H", plugin.has_hamiltonian_hessian_products(),
        [&] { model.hvp_H(HamiltonianForm::TTV, x, u, u, x, out, out2, count); }},
       {"grad_T", !general, [&] { model.grad_T(x, out, count); }},
       {"grad_V", !general, [&] { model.grad_V(x, out, count); }},

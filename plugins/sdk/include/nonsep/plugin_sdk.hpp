@@ -282,6 +282,8 @@ class PluginTable : PluginTableBase<ModelAdapter<M, policy>> {
                          {"d3V", kind(Adapter::analytic_d3V)},
                          {"hvp_T", kind(Adapter::analytic_hvp_T)},
                          {"hvp_V", kind(Adapter::analytic_hvp_V)}};
+    if constexpr (Adapter::has_hamiltonian_hessian)  // from written-out mixed third and fourth derivatives, or duals
+      facts.derivatives.emplace_back("hvp_H", kind(Adapter::analytic_mixed_T && Adapter::analytic_mixed_V));
     if constexpr (HasK<M>) {
       facts.derivatives.emplace_back("grad_K", kind(Adapter::analytic_grad_K));
       facts.derivatives.emplace_back("hessian_K", kind(Adapter::analytic_hessian_K));

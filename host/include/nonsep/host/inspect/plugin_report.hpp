@@ -94,6 +94,13 @@ PathCheck check_gauss_kernel(const PluginModel& model, const Plugin& plugin, std
 PathCheck check_product_energy(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
                                std::span<const double> p, std::size_t count, double tolerance);
 
+// A product-form plugin's hvp_H (nothing for a general one, or one without hvp_H or third derivatives) against
+// five-point central differences of grad H along a seeded tangent per state, h = step max(1, |(q, p)|_inf), in both
+// forms at the count states (q, p): the largest difference relative to max(1, |difference|) is reported, and above
+// `tolerance` (or non-finite on one side only) the check fails.
+PathCheck check_hamiltonian_products(const PluginModel& model, const Plugin& plugin, std::span<const double> q,
+                                     std::span<const double> p, std::size_t count, double step, double tolerance);
+
 // The number of bytes the check of a model of dimension n with these settings holds at its largest (an estimate
 // within a small factor, computed without overflow: saturates at the largest double).
 double derivative_check_bytes(std::size_t n, bool third_derivatives, const DerivativeCheckSettings& settings);
