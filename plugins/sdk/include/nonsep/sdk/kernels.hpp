@@ -178,7 +178,7 @@ struct ChinKernels {
   }
 
   static bool run(std::size_t index, const Adapter& adapter, const ChinStepsCall& call) {
-    const bool expansion = !call.weights.empty();
+    [[maybe_unused]] const bool expansion = !call.weights.empty();  // unused when every set is in a unit of its own
     std::size_t set = 0;
 #if NONSEP_SDK_KERNEL_BASELINE
     if (index == set++) {
