@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <span>
 #include <string>
 #include <vector>
@@ -171,6 +172,46 @@ void check_written_out_fourth(const char* parameters, const char* what) {
   }
 }
 
+// A batch whose states share points in runs (as Gauss's tangent map asks: 2n directions per stage point), broken by
+// other points and zero tangents: each state's hvp_H bit for bit what a call for it alone gives.
+template <class Adapter>
+void check_batch_equals_single(const Adapter& model, const char* what) {
+  const std::size_t n = model.dimension();
+  const auto a_q = random_points(n, 0.8, 41), a_p = random_points(n, 0.8, 42), b_q = random_points(n, 0.8, 43),
+             b_p = random_points(n, 0.8, 44);
+  const int at[] = {0, 0, 0, 1, 1, 0, 0, 0, 1};  // point A or B per state
+  const std::size_t count = std::size(at);
+  std::vector<double> q, p;
+  for (const int point : at) {
+    q.insert(q.end(), (point ? b_q : a_q).begin(), (point ? b_q : a_q).end());
+    p.insert(p.end(), (point ? b_p : a_p).begin(), (point ? b_p : a_p).end());
+  }
+  auto dq = random_points(count * n, 1.0, 45), dp = random_points(count * n, 1.0, 46);
+  for (std::size_t i = 0; i < n; ++i) {
+    dq[1 * n + i] = 0.0;                  // dp only
+    dp[2 * n + i] = 0.0;                  // dq only
+    dq[6 * n + i] = dp[6 * n + i] = 0.0;  // none, between two states at A
+    dq[7 * n + i] = 0.0;
+  }
+  for (const auto form : {HamiltonianForm::TTV, HamiltonianForm::VVT}) {
+    CAPTURE(what);
+    CAPTURE(form == HamiltonianForm::TTV);
+    std::vector<double> out_q(count * n), out_p(count * n);
+    model.hvp_H(form, q, p, dq, dp, out_q, out_p, count);
+    for (std::size_t b = 0; b < count; ++b) {
+      CAPTURE(b);
+      const auto part = [&](const std::vector<double>& v) {
+        return std::vector<double>(v.begin() + static_cast<std::ptrdiff_t>(b * n),
+                                   v.begin() + static_cast<std::ptrdiff_t>((b + 1) * n));
+      };
+      std::vector<double> alone_q(n), alone_p(n);
+      model.hvp_H(form, part(q), part(p), part(dq), part(dp), alone_q, alone_p, 1);
+      CHECK(std::memcmp(alone_q.data(), out_q.data() + b * n, n * sizeof(double)) == 0);
+      CHECK(std::memcmp(alone_p.data(), out_p.data() + b * n, n * sizeof(double)) == 0);
+    }
+  }
+}
+
 using Lattice = LatticeChainModel<16>;
 const char* const lattice_parameters = R"({"sites": 5, "kinetic_quartic": 0.7, "coupling": 0.4, "bond_quartic": 1.3})";
 
@@ -191,6 +232,14 @@ TEST_CASE("SDK hvp_H: written-out mixed third and fourth derivatives give the du
   check_written_out_fourth<Paper1D>("{}", "paper1d");
   check_written_out_fourth<Paper2D>(R"({"coupling": 0.25})", "paper2d");
   check_written_out_fourth<Paper2D>(R"({"coupling": -0.1})", "paper2d, negative coupling");
+}
+
+TEST_CASE("SDK hvp_H: states at one point in a row give each state's numbers alone, bit for bit") {
+  check_batch_equals_single(ModelAdapter<Paper2D>::from_json(R"({"coupling": 0.25})"), "paper2d, written out");
+  check_batch_equals_single(ModelAdapter<Paper2D, Derivatives::automatic>::from_json(R"({"coupling": 0.25})"),
+                            "paper2d, duals over T and V");
+  check_batch_equals_single(ModelAdapter<Paper2DGradients>(), "paper2d, gradient templates");
+  check_batch_equals_single(ModelAdapter<Lattice>::from_json(lattice_parameters), "lattice chain");
 }
 
 TEST_CASE("SDK grad H: the inner product taken from the pass of the third derivatives is bit for bit the product's") {

@@ -620,6 +620,9 @@ class ModelAdapter {
     double* dg = g + n;
     double* w = dg + n;
     double* sum = scratch.g.data();
+    // g and w depend on the point alone: states at the point of the last one that formed them (Gauss's tangent map
+    // asks for 2n directions at each stage point in a row) take them again, where they are separate passes.
+    std::size_t formed = count;  // the state whose point g and w are of; count: none
     for (std::size_t b = 0; b < count; ++b) {
       const std::size_t at = b * n;
       const double *x = xs + at, *dx = dxs + at, *y = ys + at, *dy = dys + at;
@@ -635,12 +638,23 @@ class ModelAdapter {
         std::fill(out_y, out_y + n, 0.0);
         continue;
       }
-      gradient_and_product_of<ttv>(x, moves_x ? dx : nullptr, g, dg, n);
+      const bool same_point =
+          formed < count && std::equal(x, x + n, xs + formed * n) && std::equal(y, y + n, ys + formed * n);
+      if (same_point && !combined_gradient_pass<ttv>) {
+        if (moves_x)
+          product_of<ttv>(x, dx, dg, n);
+        else
+          std::fill(dg, dg + n, 0.0);
+      } else {
+        gradient_and_product_of<ttv>(x, moves_x ? dx : nullptr, g, dg, n);
+      }
+      double* const along = same_point ? nullptr : w;  // w kept from the state that formed it
+      formed = same_point ? formed : b;
       if (moves_y) {
         mixed_fourth_of<!ttv>(y, g, g, dy, out_y, n,
-                              {.seed = moves_x ? dg : nullptr, .along_a = w, .along_b = nullptr, .lower = sum});
+                              {.seed = moves_x ? dg : nullptr, .along_a = along, .along_b = nullptr, .lower = sum});
       } else {
-        mixed_third_of<!ttv>(y, g, dg, out_y, n, {.seed = nullptr, .along_a = w, .along_b = sum});
+        mixed_third_of<!ttv>(y, g, dg, out_y, n, {.seed = nullptr, .along_a = along, .along_b = sum});
         for (std::size_t i = 0; i < n; ++i) out_y[i] *= 2.0;
       }
       if (moves_x)
@@ -685,16 +699,20 @@ class ModelAdapter {
     else
       hvp_V(std::span<const double>(x, n), std::span<const double>(v, n), std::span<double>(out, n), 1);
   }
+  // Whether X's gradient and product come from one pass (X differentiated over X itself).
+  template <bool kinetic>
+  static constexpr bool combined_gradient_pass = (kinetic ? !analytic_grad_T && !analytic_hvp_T
+                                                          : !analytic_grad_V && !analytic_hvp_V) &&
+                                                 !differentiates_gradients;
   // g = grad X at x and, with a direction dx, dg = X'' dx (else 0): one Hessian-column pass, which gives the
   // gradient alongside, where X is differentiated over X itself; else the gradient and the product as computed alone.
   template <bool kinetic>
   NONSEP_SDK_DUAL_INLINE void gradient_and_product_of(const double* x, const double* dx, double* g, double* dg,
                                                       std::size_t n) const {
-    constexpr bool automatic = kinetic ? !analytic_grad_T && !analytic_hvp_T : !analytic_grad_V && !analytic_hvp_V;
     if (dx == nullptr) {
       gradient_of<kinetic>(x, g, n);
       std::fill(dg, dg + n, 0.0);
-    } else if constexpr (automatic && !differentiates_gradients) {
+    } else if constexpr (combined_gradient_pass<kinetic>) {
       detail::poison_if_not_finite(detail::hessian_vector_by_dual<capacity>(function_of<kinetic>(), x, dx, n, dg, g),
                                    dg, n);
     } else {
