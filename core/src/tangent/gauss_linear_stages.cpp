@@ -63,22 +63,21 @@ NONSEP_LINEAR_STAGES_CLONES unsigned map_by_linear_stages_of(const GaussLegendre
   // Gaussian elimination with partial pivoting, each lane its own pivots.
   std::array<std::array<std::size_t, L>, M> pivots;
   for (std::size_t col = 0; col < M; ++col) {
-    std::array<std::size_t, L> pivot;
-    Lanes largest;
+    Lanes pivot, largest;  // the pivot's row kept as a double, so that the search is a select of doubles
     for (std::size_t l = 0; l < L; ++l) {
-      pivot[l] = col;
+      pivot[l] = static_cast<double>(col);
       largest[l] = std::abs(system[col * M + col][l]);
     }
     for (std::size_t row = col + 1; row < M; ++row)
       for (std::size_t l = 0; l < L; ++l) {
         const double size = std::abs(system[row * M + col][l]);
-        pivot[l] = size > largest[l] ? row : pivot[l];
+        pivot[l] = size > largest[l] ? static_cast<double>(row) : pivot[l];
         largest[l] = size > largest[l] ? size : largest[l];
       }
-    pivots[col] = pivot;
+    for (std::size_t l = 0; l < L; ++l) pivots[col][l] = static_cast<std::size_t>(pivot[l]);
     for (std::size_t l = 0; l < L; ++l)
-      if (pivot[l] != col)
-        for (std::size_t c = 0; c < M; ++c) std::swap(system[col * M + c][l], system[pivot[l] * M + c][l]);
+      if (pivots[col][l] != col)
+        for (std::size_t c = 0; c < M; ++c) std::swap(system[col * M + c][l], system[pivots[col][l] * M + c][l]);
     Lanes inverse;  // inf for a singular system: the result is then not finite
     for (std::size_t l = 0; l < L; ++l) inverse[l] = 1.0 / system[col * M + col][l];
     for (std::size_t row = col + 1; row < M; ++row) {
@@ -115,9 +114,11 @@ NONSEP_LINEAR_STAGES_CLONES unsigned map_by_linear_stages_of(const GaussLegendre
     for (std::size_t col = 0; col < M; ++col)  // P right, then L and U: right becomes dZ
       for (std::size_t l = 0; l < L; ++l)
         if (pivots[col][l] != col) std::swap(right[col][l], right[pivots[col][l]][l]);
-    for (std::size_t col = 0; col < M; ++col)
+    for (std::size_t col = 0; col < M; ++col) {
+      const Lanes solved = right[col];  // a copy, so that the compiler sees no overlap and takes the lanes together
       for (std::size_t row = col + 1; row < M; ++row)
-        for (std::size_t l = 0; l < L; ++l) right[row][l] -= system[row * M + col][l] * right[col][l];
+        for (std::size_t l = 0; l < L; ++l) right[row][l] -= system[row * M + col][l] * solved[l];
+    }
     for (std::size_t col = M; col-- > 0;) {
       Lanes sum = right[col];
       for (std::size_t c = col + 1; c < M; ++c)
