@@ -40,6 +40,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -98,6 +99,20 @@ class TangentGaussLegendre {
       map_tangents_by_iteration(model, x, tangents, k, dt);
   }
 
+  // body(dimension) with the dimension n as a compile-time constant for 1 to 3 degrees of freedom (the loops over a
+  // state's components then unroll), else as it is.
+  template <class Body>
+  static void with_dimension(std::size_t n, const Body& body) {
+    if (n == 1)
+      body(std::integral_constant<std::size_t, 1>{});
+    else if (n == 2)
+      body(std::integral_constant<std::size_t, 2>{});
+    else if (n == 3)
+      body(std::integral_constant<std::size_t, 3>{});
+    else
+      body(n);
+  }
+
   // Stage point i of state b along unit direction e (e < n: dq_e, else dp_{e-n}) at point ((i*B + b)*2n + e), B the
   // states; the point's components at that index times n. J(Y_i) of state b goes column-major into jacobians_.
   template <class M>
@@ -116,57 +131,63 @@ class TangentGaussLegendre {
       }
       directions_are_units_ = true;
     }
-    for (std::size_t i = 0; i < s; ++i)
-      for (std::size_t b = 0; b < states; ++b) {
-        const double* from_q = stage_q.data() + i * size + b * n;
-        const double* from_p = stage_p.data() + i * size + b * n;
-        for (std::size_t e = 0; e < d; ++e) {
-          const std::size_t to = ((i * states + b) * d + e) * n;
-          for (std::size_t c = 0; c < n; ++c) {
-            point_q_[to + c] = from_q[c];
-            point_p_[to + c] = from_p[c];
+    with_dimension(n, [&](auto dimension) {
+      const std::size_t n = dimension;  // known at compile time for 1 to 3 degrees of freedom
+      for (std::size_t i = 0; i < s; ++i)
+        for (std::size_t b = 0; b < states; ++b) {
+          const double* from_q = stage_q.data() + i * size + b * n;
+          const double* from_p = stage_p.data() + i * size + b * n;
+          for (std::size_t e = 0; e < d; ++e) {
+            const std::size_t to = ((i * states + b) * d + e) * n;
+            for (std::size_t c = 0; c < n; ++c) {
+              point_q_[to + c] = from_q[c];
+              point_p_[to + c] = from_p[c];
+            }
           }
         }
-      }
+    });
     model.hvp_H(base_.form(), point_q_, point_p_, direction_q_, direction_p_, product_q_, product_p_, points);
     hessians_.hvp_H += points;
     // The states in groups of linear_stage_lanes, solved together (each bit for bit as alone).
     jacobians_.resize(linear_stage_lanes * s * d * d);
     vectors_.resize(linear_stage_lanes * k * d);
     std::vector<std::size_t> failed;
-    for (std::size_t first = 0; first < states; first += linear_stage_lanes) {
-      const std::size_t group = std::min(linear_stage_lanes, states - first);
-      for (std::size_t g = 0; g < group; ++g) {
-        const std::size_t b = first + g;
-        // Column e of J(Y_i) = (d(dH/dp), -d(dH/dq)) along e.
-        for (std::size_t i = 0; i < s; ++i)
-          for (std::size_t e = 0; e < d; ++e) {
-            const std::size_t from = ((i * states + b) * d + e) * n, to = ((g * s + i) * d + e) * d;
-            for (std::size_t c = 0; c < n; ++c) {
-              jacobians_[to + c] = product_p_[from + c];
-              jacobians_[to + n + c] = -product_q_[from + c];
+    with_dimension(n, [&](auto dimension) {
+      const std::size_t n = dimension, d = 2 * n;
+      for (std::size_t first = 0; first < states; first += linear_stage_lanes) {
+        const std::size_t group = std::min(linear_stage_lanes, states - first);
+        for (std::size_t g = 0; g < group; ++g) {
+          const std::size_t b = first + g;
+          // Column e of J(Y_i) = (d(dH/dp), -d(dH/dq)) along e.
+          for (std::size_t i = 0; i < s; ++i)
+            for (std::size_t e = 0; e < d; ++e) {
+              const std::size_t from = ((i * states + b) * d + e) * n, to = ((g * s + i) * d + e) * d;
+              for (std::size_t c = 0; c < n; ++c) {
+                jacobians_[to + c] = product_p_[from + c];
+                jacobians_[to + n + c] = -product_q_[from + c];
+              }
             }
-          }
-        for (std::size_t j = 0; j < k; ++j)
-          for (std::size_t c = 0; c < n; ++c) {
-            vectors_[(g * k + j) * d + c] = tangents.q()[(b * k + j) * n + c];
-            vectors_[(g * k + j) * d + n + c] = tangents.p()[(b * k + j) * n + c];
-          }
-      }
-      const unsigned not_finite = map_by_linear_stages(tableau, dt, jacobians_, d, vectors_, k, group);
-      for (std::size_t g = 0; g < group; ++g) {
-        const std::size_t b = first + g;
-        if (not_finite & (1u << g)) {
-          for (std::size_t j = 0; j < k; ++j) failed.push_back(b * k + j);
-          continue;
+          for (std::size_t j = 0; j < k; ++j)
+            for (std::size_t c = 0; c < n; ++c) {
+              vectors_[(g * k + j) * d + c] = tangents.q()[(b * k + j) * n + c];
+              vectors_[(g * k + j) * d + n + c] = tangents.p()[(b * k + j) * n + c];
+            }
         }
-        for (std::size_t j = 0; j < k; ++j)
-          for (std::size_t c = 0; c < n; ++c) {
-            tangents.q()[(b * k + j) * n + c] = vectors_[(g * k + j) * d + c];
-            tangents.p()[(b * k + j) * n + c] = vectors_[(g * k + j) * d + n + c];
+        const unsigned not_finite = map_by_linear_stages(tableau, dt, jacobians_, d, vectors_, k, group);
+        for (std::size_t g = 0; g < group; ++g) {
+          const std::size_t b = first + g;
+          if (not_finite & (1u << g)) {
+            for (std::size_t j = 0; j < k; ++j) failed.push_back(b * k + j);
+            continue;
           }
+          for (std::size_t j = 0; j < k; ++j)
+            for (std::size_t c = 0; c < n; ++c) {
+              tangents.q()[(b * k + j) * n + c] = vectors_[(g * k + j) * d + c];
+              tangents.p()[(b * k + j) * n + c] = vectors_[(g * k + j) * d + n + c];
+            }
+        }
       }
-    }
+    });
     if (!failed.empty())
       throw ModelError(failure_message(failed, k, states, "the linear stages are singular or not finite"));
   }
