@@ -1,5 +1,6 @@
 #include "nonsep/core/tangent/gauss_linear_stages.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -20,26 +21,25 @@ constexpr std::size_t capacity = 32;
 // (bench/tangent_cost.py, paper1d: with only the size 2ns fixed, the loops over the vectors and components and the
 // sums kept in memory made this solve half of a tangent run), for L states at once: every number is an array of L
 // lanes, one state each, and each lane takes the operations of a solve of its state alone in the same order, so that
-// the elimination's long chains of dependent operations of one state overlap with the other states' (a paper2d
-// tangent run spent 42% of its time here with one state at a time). The system is factored once (P A = L U, the
-// rows swapped whole, L's multipliers below the diagonal), then each vector is solved alone: its numbers are those of
-// eliminating every right-hand side alongside the system, operation for operation (the multiplier of a row is
-// applied to the same value in the same order; only where the value is kept differs).
+// the elimination's long chains of dependent operations of one state overlap with the other states'. The system is
+// factored once (P A = L U, the rows swapped whole, L's multipliers below the diagonal), then each vector is solved
+// alone: its numbers are those of eliminating every right-hand side alongside the system, operation for operation
+// (the multiplier of a row is applied to the same value in the same order; only where the value is kept differs).
 //
-// On x86-64 each solve is compiled for AVX-512 and AVX2 besides the build's instruction set and the widest the
-// processor runs is taken at load time (8 lanes are one AVX-512 register); core/CMakeLists.txt compiles this file with
-// -ffp-contract=off, so no multiply and add are fused and every clone gives the baseline's numbers bit for bit.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// Compiled by GCC for x86-64 (ELF), each solve is cloned for AVX-512 and AVX2 besides the build's instruction set and
+// the widest the processor runs is taken at load time (8 lanes are one AVX-512 register); core/CMakeLists.txt
+// compiles this file with -ffp-contract=off, so no multiply and add are fused and every clone gives the baseline's
+// numbers bit for bit. (Clang does not clone function templates: there the build's instruction set alone.)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__ELF__)
 #define NONSEP_LINEAR_STAGES_CLONES [[gnu::target_clones("avx512f", "avx2", "default")]]
 #else
 #define NONSEP_LINEAR_STAGES_CLONES
 #endif
-template <std::size_t S, std::size_t D>
-NONSEP_LINEAR_STAGES_CLONES unsigned map_by_linear_stages_of(const GaussLegendreTableau& tableau, double dt,
-                                                             std::span<const double> jacobians,
-                                                             std::span<double> vectors, std::size_t k,
-                                                             std::size_t states) {
-  constexpr std::size_t M = S * D, L = linear_stage_lanes;
+template <std::size_t S, std::size_t D, std::size_t L>
+NONSEP_LINEAR_STAGES_CLONES unsigned eliminate_lanes(const GaussLegendreTableau& tableau, double dt,
+                                                     std::span<const double> jacobians, std::span<double> vectors,
+                                                     std::size_t k, std::size_t states) {
+  constexpr std::size_t M = S * D;
   using Lanes = std::array<double, L>;
   // J_j(r, c) of lane l at Js[(j*D + c)*D + r][l], from state l's jacobians[(j*D + c)*D + r] (lanes past `states`
   // repeat state 0, and are dropped).
@@ -144,6 +144,24 @@ NONSEP_LINEAR_STAGES_CLONES unsigned map_by_linear_stages_of(const GaussLegendre
   }
   unsigned failed = 0;
   for (std::size_t l = 0; l < states; ++l) failed |= finite[l] ? 0u : 1u << l;
+  return failed;
+}
+
+// The states of a call in chunks of eight lanes, or four where the system and the Jacobians of eight would take more
+// than 80 KB, so that a solve fits the smallest thread stacks in use (128 KB; the largest frame, gauss 8 stages with
+// 2n = 4 on eight lanes, is 88 KB with the AVX-512 clone's other arrays).
+template <std::size_t S, std::size_t D>
+unsigned map_by_linear_stages_of(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
+                                 std::span<double> vectors, std::size_t k, std::size_t states) {
+  constexpr std::size_t eight_lanes_bytes = (S * D * S * D + S * D * D) * linear_stage_lanes * sizeof(double);
+  constexpr std::size_t L = eight_lanes_bytes <= 80 * 1024 ? linear_stage_lanes : linear_stage_lanes / 2;
+  unsigned failed = 0;
+  for (std::size_t first = 0; first < states; first += L) {
+    const std::size_t chunk = std::min(L, states - first);
+    failed |= eliminate_lanes<S, D, L>(tableau, dt, jacobians.subspan(first * S * D * D),
+                                       vectors.subspan(first * k * D), k, chunk)
+              << first;
+  }
   return failed;
 }
 

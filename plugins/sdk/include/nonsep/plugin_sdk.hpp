@@ -17,11 +17,12 @@
 // chin_steps and chin_tangent_steps: the core's chin_kernel_steps and chin_tangent_kernel_blocks with the model
 // inlined, compiled for the instruction sets of
 // kernels.hpp (metadata "kernels": {"instruction_sets"}); no stepping code is written here; and, where the model's
-// T and V (or gradient templates) compile for one more level of dual numbers, the directional derivative of grad H,
-// hvp_H, by automatic differentiation (model_adapter.hpp; capability "hvp_H"). Its
-// metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T and
-// hvp_V, whether it is "analytic" (written by the model) or "automatic" (of the gradient templates where the model
-// has them, else of T and V). A model that writes out energy_TTV or energy_VVT (the product term of H) fills that
+// T and V (or gradient templates) compile for one more level of dual numbers, or where it writes out their mixed third
+// and fourth derivatives, the directional derivative of grad H, hvp_H (model_adapter.hpp; capability "hvp_H"). Its
+// metadata adds a "derivatives" object saying, for grad_T, grad_V, hessian_T, hessian_V, d3T, d3V, hvp_T, hvp_V and
+// hvp_H (where present), whether it is "analytic" (written by the model; for hvp_H, from the written-out mixed third
+// and fourth derivatives of both T and V) or "automatic" (of the gradient templates where the model has them, else of
+// T and V). A model that writes out energy_TTV or energy_VVT (the product term of H) fills that
 // entry; the other stays null.
 // A model class with K(p) or U(q) (model_adapter.hpp) also fills grad_K, value_K, hessian_K (resp. the U ones) of
 // ABI version 4, announces them as capabilities and adds them to "derivatives"; the absent part's entries are null.

@@ -15,15 +15,15 @@
 
 namespace nonsep {
 
-// The states solved together (map_by_linear_stages_of interleaves their operations; each state's numbers are those
+// The states solved together (their operations interleaved, eight or four at a time; each state's numbers are those
 // of solving it alone, bit for bit).
 inline constexpr std::size_t linear_stage_lanes = 8;
 
 // jacobians: s matrices J_i of d x d per state, column-major, J_i's column e of state b at
 // jacobians[((b*s + i)*d + e)*d]. vectors: k vectors of d numbers (dq then dp) per state, vector v of state b at
 // (b*k + v)*d, dz on entry and dz' on return. Returns a mask of the states whose dz' has a number that is not finite
-// (bit b for state b: a Jacobian that is not, or a singular system); their vectors are then unspecified. Throws
-// InvalidArgument unless d is even, 2ns <= 32, k <= 32 and 1 <= states <= linear_stage_lanes (the sizes
+// (bit b for state b: a Jacobian that is not, or a singular system); their vectors are then unspecified. No states:
+// nothing, 0. Throws InvalidArgument unless d is even, 2ns <= 32, k <= 32 and states <= linear_stage_lanes (the sizes
 // TangentGaussLegendre solves directly), or when the spans are too short; allocates nothing.
 unsigned map_by_linear_stages(const GaussLegendreTableau& tableau, double dt, std::span<const double> jacobians,
                               std::size_t d, std::span<double> vectors, std::size_t k, std::size_t states);

@@ -123,13 +123,14 @@ class TangentGaussLegendre {
     const std::size_t states = x.count(), size = x.size(), points = s * states * d;
     const std::span<const double> stage_q = base_.stage_points_q(), stage_p = base_.stage_points_p();
     for (auto* v : {&point_q_, &point_p_, &product_q_, &product_p_}) v->resize(points * n);
-    if (direction_q_.size() != points * n || !directions_are_units_) {  // the unit directions, kept between steps
+    if (units_for_ != std::pair{points, n}) {  // the unit directions, kept between steps of the same sizes
+      units_for_ = {};
       for (auto* v : {&direction_q_, &direction_p_}) v->assign(points * n, 0.0);
       for (std::size_t point = 0; point < points; ++point) {
         const std::size_t e = point % d;
         (e < n ? direction_q_[point * n + e] : direction_p_[point * n + e - n]) = 1.0;
       }
-      directions_are_units_ = true;
+      units_for_ = {points, n};
     }
     with_dimension(n, [&](auto dimension) {
       const std::size_t n = dimension;  // known at compile time for 1 to 3 degrees of freedom
@@ -211,7 +212,7 @@ class TangentGaussLegendre {
       const std::size_t count = active_.size(), points = s * count;
       for (auto* v : {&point_q_, &point_p_, &direction_q_, &direction_p_, &product_q_, &product_p_})
         v->resize(points * n);
-      directions_are_units_ = false;
+      units_for_ = {};
       for (std::size_t i = 0; i < s; ++i)
         for (std::size_t a = 0; a < count; ++a) {
           const std::size_t r = active_[a], b = r / k, to = (i * count + a) * n, z = (i * rows + r) * n;
@@ -302,7 +303,8 @@ class TangentGaussLegendre {
   std::vector<double> dZ_q_, dZ_p_, next_q_, next_p_;
   std::vector<double> point_q_, point_p_, direction_q_, direction_p_, product_q_, product_p_;
   std::vector<double> jacobians_, vectors_;
-  bool directions_are_units_ = false;  // direction_q_, direction_p_ hold the direct solve's unit directions
+  // The points and dimension whose unit directions direction_q_, direction_p_ hold for the direct solve ({0, 0}: none).
+  std::pair<std::size_t, std::size_t> units_for_{};
   std::vector<double> last_change_;
   std::vector<std::size_t> active_, still_;
 };

@@ -24,6 +24,11 @@
 //   void hvp_V(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> v, std::span<double> out) const;
 //                                     Hessian-vector products, out[i] = sum_j T_ij v_j (n entries): what the energy
 //                                     and the tangent map of a large sparse model cost (plugins/lattice_chain).
+//   void d3T(Vector<double> p, Vector<double> a, Vector<double> b, std::span<double> out) const;
+//   void d4T(Vector<double> p, Vector<double> a, Vector<double> b, Vector<double> c, std::span<double> out) const;
+//                                     the mixed third and the fourth derivatives, out[k] = sum_ij T_kij a_i b_j and
+//                                     sum_ijl T_kijl a_i b_j c_l; both, with hvp_T, replace hvp_H's passes over T
+//                                     (and d3V, d4V with hvp_V those over V: plugins/paper2d).
 //   double energy_TTV(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> p) const;
 //   double energy_VVT(nonsep::sdk::Vector<double> q, nonsep::sdk::Vector<double> p) const;
 //                                     the product term of H written out, T'(p).V''(q)T'(p) (resp. V'(q).T''(p)V'(q)),
@@ -43,8 +48,9 @@
 // Hessians in n passes; no capacity-sized dual is used, so max_dimension may be large (a lattice of 10^6 sites),
 // and T and V need only compile for double. Their scratch is a per-thread buffer of 2n numbers that grows once.
 // The directional derivative of grad H (hvp_H, plugin_abi.h), which the comparators' tangent maps need, reaches fourth
-// derivatives: one pass of the gradient templates on Dual<Dual<Dual<double, 1>, 1>, 1> (O(n)), else of T and V on
-// FourthDerivativeDual<K> (automatic_derivatives.hpp); a model whose T and V compile for neither has no hvp_H.
+// derivatives: the written-out d3T, d4T (d3V, d4V) above, else one pass of the gradient templates on
+// Dual<Dual<Dual<double, 1>, 1>, 1> (O(n)), else of T and V on FourthDerivativeDual<K> (automatic_derivatives.hpp); a
+// model with none of these for T or for V has no hvp_H.
 // Model code signals a point where it cannot be evaluated by throwing EvaluationError; the plugin returns
 // NONSEP_EVALUATION_FAILED with that message. Any other exception becomes NONSEP_INTERNAL_ERROR.
 //
@@ -70,6 +76,7 @@
 #include <cmath>
 #include <concepts>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 #include <span>
 #include <stdexcept>
@@ -620,8 +627,10 @@ class ModelAdapter {
     double* dg = g + n;
     double* w = dg + n;
     double* sum = scratch.g.data();
-    // g and w depend on the point alone: states at the point of the last one that formed them (Gauss's tangent map
-    // asks for 2n directions at each stage point in a row) take them again, where they are separate passes.
+    // g and w depend on the point alone: a state at the point (bit for bit) of the last one that formed them (Gauss's
+    // tangent map asks for 2n directions at each stage point in a row) keeps them where the same function would form
+    // them again whatever the tangent: g from X's gradient (not X's combined pass), w from Y's written-out product
+    // (not a by-product of Y's passes, which costs nothing more). A state's numbers never depend on its neighbours.
     std::size_t formed = count;  // the state whose point g and w are of; count: none
     for (std::size_t b = 0; b < count; ++b) {
       const std::size_t at = b * n;
@@ -638,8 +647,8 @@ class ModelAdapter {
         std::fill(out_y, out_y + n, 0.0);
         continue;
       }
-      const bool same_point =
-          formed < count && std::equal(x, x + n, xs + formed * n) && std::equal(y, y + n, ys + formed * n);
+      const bool same_point = formed < count && std::memcmp(x, xs + formed * n, n * sizeof(double)) == 0 &&
+                              std::memcmp(y, ys + formed * n, n * sizeof(double)) == 0;
       if (same_point && !combined_gradient_pass<ttv>) {
         if (moves_x)
           product_of<ttv>(x, dx, dg, n);
@@ -648,7 +657,7 @@ class ModelAdapter {
       } else {
         gradient_and_product_of<ttv>(x, moves_x ? dx : nullptr, g, dg, n);
       }
-      double* const along = same_point ? nullptr : w;  // w kept from the state that formed it
+      double* const along = same_point && (ttv ? analytic_mixed_V : analytic_mixed_T) ? nullptr : w;
       formed = same_point ? formed : b;
       if (moves_y) {
         mixed_fourth_of<!ttv>(y, g, g, dy, out_y, n,
