@@ -382,8 +382,8 @@ class ModelAdapter {
   static constexpr bool differentiates_gradients = policy == Derivatives::preferred && HasGradientTemplates<M>;
   static_assert(differentiates_gradients || HasDualTV<M>,
                 "Derivatives::automatic needs T and V that compile for the dual numbers of automatic_derivatives.hpp");
-  // The fourth derivatives of hvp_H: written out (analytic_mixed_T, _V below), else of the gradient templates where they
-  // compile for ThirdDirectionalDual, else of T and V on FourthDerivativeDual; a model with none has no hvp_H.
+  // The fourth derivatives of hvp_H: written out (analytic_mixed_T, _V below), else of the gradient templates where
+  // they compile for ThirdDirectionalDual, else of T and V on FourthDerivativeDual; a model with none has no hvp_H.
   static constexpr bool fourth_by_gradients = differentiates_gradients && HasFourthOrderGradientTemplates<M>;
   // hvp_H's passes over T (V) replaced by the model's written-out d3T, d4T and hvp_T (d3V, d4V, hvp_V).
   static constexpr bool analytic_mixed_T = policy == Derivatives::preferred && HasAnalyticMixedT<M> && analytic_hvp_T;
