@@ -28,8 +28,18 @@ std::string error_of(F f) {
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 }  // namespace
 
+TEST_CASE("a message shows a number as the shortest text that reads back as it") {
+  CHECK(found_number(2.5) == "2.5");
+  CHECK(found_number(0.1) == "0.1");
+  CHECK(found_number(1e-8) == "1e-08");  // std::to_string: 0.000000
+  CHECK(found_number(-0.0) == "-0");
+  CHECK(found_number(std::numeric_limits<double>::infinity()) == "inf");
+}
+
 TEST_CASE("t2 = 0 and non-finite t2 are rejected") {
   CHECK(contains(error_of([] { ChinBasicStep(HamiltonianForm::TTV, 0.0); }), "t2 must be a finite non-zero number"));
+  CHECK(error_of([] { ChinCoefficients::from_t2(0.0); }).ends_with("(found 0)"));  // not 0.000000
+  CHECK(error_of([] { ChinCoefficients::from_t2(std::nan("")); }).ends_with("(found nan)"));
   CHECK(contains(error_of([] {
                    Integrator(IntegratorSpec{"triplet", ChinOptions{Fraction(4, 3), std::nan("")}});
                  }),
@@ -232,13 +242,13 @@ TEST_CASE("comparator options: each bad value has its own message") {
   IntegratorSpec tao{"tao", TaoOptions{Fraction(4, 3)}};
   CHECK(contains(error_of([&] { Integrator{tao}; }), "orders 2, 4 and 6 (found 4/3)"));
   tao.options = TaoOptions{Fraction(2), 0.0};
-  CHECK(contains(error_of([&] { Integrator{tao}; }), "omega must be finite and positive"));
+  CHECK(contains(error_of([&] { Integrator{tao}; }), "omega must be finite and positive; the default is 20 (found 0)"));
   // An integer option refuses a number that is not whole when it is set by its catalogue name (the job reader).
   IntegratorSpec gauss{"gauss"};
   const ParameterDescription& stages = find_scheme("gauss")->parameters[0];
-  CHECK(contains(error_of([&] { set_option(gauss, stages, 1.5); }), "stages must be a whole number (found 1.500000)"));
+  CHECK(contains(error_of([&] { set_option(gauss, stages, 1.5); }), "stages must be a whole number (found 1.5)"));
   set_option(gauss, stages, 0.0);
-  CHECK(contains(error_of([&] { Integrator{gauss}; }), "1 to 8 stages"));
+  CHECK(contains(error_of([&] { Integrator{gauss}; }), "1 to 8 stages, orders 2 to 16 (found 0)"));
   gauss.options = GaussOptions{2, 0};
   CHECK(contains(error_of([&] { Integrator{gauss}; }), "max_iterations >= 1"));
   CHECK(contains(error_of([&] { Integrator::describe(gauss); }), "max_iterations >= 1"));

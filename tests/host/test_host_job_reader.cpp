@@ -346,6 +346,27 @@ TEST_CASE("every problem of a job is reported at once, each with its JSON path")
   }
 }
 
+TEST_CASE("a scheme option the core refuses: the rule beside the value as the job has it, the value said once") {
+  json document = host_testing::quickstart_job();
+  const auto issue_of = [&](const json& integrator) {
+    document["integrator"] = integrator;
+    const auto parsed = parse(document);
+    REQUIRE(parsed.issues.size() == 1);
+    return parsed.issues[0];
+  };
+  const auto stages = issue_of({{"scheme", "gauss"}, {"stages", 9}});
+  CHECK(stages.path == "/integrator/stages");
+  CHECK(stages.found == "9");
+  CHECK(stages.allowed == "Gauss-Legendre collocation has 1 to 8 stages, orders 2 to 16");
+  const auto whole = issue_of({{"scheme", "gauss"}, {"stages", 2.5}});
+  CHECK(whole.found == "2.5");
+  CHECK(whole.allowed == "stages must be a whole number");
+  const auto t2 = issue_of({{"scheme", "basic"}, {"t2", 0.0}});
+  CHECK(t2.allowed == "t2 must be a finite non-zero number; the default is -6^(1/3) = -1.8171205928321397");
+  const auto omega = issue_of({{"scheme", "tao"}, {"order", 2}, {"omega", -1.0}});
+  CHECK(omega.allowed == "the binding omega must be finite and positive; the default is 20");
+}
+
 TEST_CASE("an unknown scheme still gets its options checked") {
   json document = host_testing::quickstart_job();
   document["integrator"] = {{"scheme", "rk4"}, {"order", "x"}, {"step", 2}};

@@ -261,8 +261,8 @@ std::vector<FrequencyTerm> FrequencyAnalysis::terms(std::span<const std::complex
     throw InvalidArgument(where + std::to_string(samples.size()) + " samples, at least " +
                           std::to_string(minimum_samples) + " needed");
   if (!std::isfinite(tau) || !(tau > 0.0))
-    throw InvalidArgument(where + "the sampling interval tau must be finite and positive, found " +
-                          std::to_string(tau));
+    throw InvalidArgument(where + "the sampling interval tau must be finite and positive (found " + found_number(tau) +
+                          ")");
   if (count == 0) throw InvalidArgument(where + "asked for 0 terms, at least 1 needed");
   for (std::size_t k = 0; k < samples.size(); ++k)
     if (!std::isfinite(samples[k].real()) || !std::isfinite(samples[k].imag()))

@@ -66,6 +66,13 @@ KeyTable integrator_keys(const Scheme* scheme, const KeyTable* extra) {
   return table;
 }
 
+// The rule of a core message (error.hpp): the message without the " (found X)" it ends with, for the issue shows the
+// value as the job file has it.
+std::string rule_of(const std::string& message) {
+  const std::size_t found = message.rfind(" (found ");
+  return found != std::string::npos && message.back() == ')' ? message.substr(0, found) : message;
+}
+
 // The value of one catalogue option as the table checked it: a Fraction for the order, a double otherwise
 // (nonsep::set_option).
 OptionValue option_value(const ParameterDescription& parameter, const json& value) {
@@ -102,7 +109,7 @@ IntegratorReader::IntegratorReader(Checker& check, const json& integrator, const
       Integrator::describe(probe);
       set_option(spec_, parameter, value);
     } catch (const InvalidArgument& error) {
-      check.issue(keys_.path(parameter.name), describe(*given), error.what());
+      check.issue(keys_.path(parameter.name), describe(*given), rule_of(error.what()));
     }
   }
 }

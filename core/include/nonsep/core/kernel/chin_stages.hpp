@@ -52,8 +52,9 @@ struct ChinCoefficients {
   // Throws InvalidArgument when t2 is zero or not finite.
   static ChinCoefficients from_t2(double t2) {
     if (!std::isfinite(t2) || t2 == 0.0)
-      throw InvalidArgument("t2 must be a finite non-zero number (found " + std::to_string(t2) +
-                            "); the default is -6^(1/3) = -1.8171205928321397");
+      throw InvalidArgument(
+          "t2 must be a finite non-zero number; the default is -6^(1/3) = -1.8171205928321397 (found " +
+          found_number(t2) + ")");
     const double v1 = 1.0 / (t2 * t2);
     const double v2 = -v1 / 2.0;
     return ChinCoefficients{-t2, t2, -2.0 * (v1 + v2), v1, v2};

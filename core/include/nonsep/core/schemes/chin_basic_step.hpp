@@ -67,7 +67,7 @@ struct NoStageObserver {
 [[gnu::noinline]] inline double runtime_cube_root(double dt) { return std::cbrt(dt); }
 
 [[noreturn, gnu::cold, gnu::noinline]] inline void throw_bad_step_size(double dt) {
-  throw InvalidArgument("step size dt must be finite and non-zero (found " + std::to_string(dt) + ")");
+  throw InvalidArgument("step size dt must be finite and non-zero (found " + found_number(dt) + ")");
 }
 [[noreturn, gnu::cold, gnu::noinline]] inline void throw_batch_does_not_fit(std::size_t model, std::size_t states) {
   throw InvalidArgument("the model has dimension " + std::to_string(model) + " but the states have dimension " +

@@ -148,7 +148,7 @@ class GaussLegendre {
     const auto failures = try_step(model, x, dt);
     if (failures.empty()) return;
     std::string message = "Gauss-Legendre collocation (order " + std::to_string(order()) +
-                          ", dt = " + std::to_string(dt) + "): the fixed-point iteration failed";
+                          ", dt = " + found_number(dt) + "): the fixed-point iteration failed";
     if (x.count() == 1) {
       message += " (" + failures[0].reason + ")";
     } else {

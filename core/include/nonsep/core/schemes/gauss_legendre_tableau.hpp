@@ -27,8 +27,8 @@ struct GaussLegendreTableau {
   // Throws InvalidArgument unless 1 <= stages <= max_stages.
   static void check_stages(int stages) {
     if (stages < 1 || stages > max_stages)
-      throw InvalidArgument("Gauss-Legendre collocation has 1 to 8 stages (orders 2 to 16); found " +
-                            std::to_string(stages) + " stages");
+      throw InvalidArgument("Gauss-Legendre collocation has 1 to 8 stages, orders 2 to 16 (found " +
+                            std::to_string(stages) + ")");
   }
   // Throws InvalidArgument unless 1 <= stages <= max_stages.
   static GaussLegendreTableau for_stages(int stages) {

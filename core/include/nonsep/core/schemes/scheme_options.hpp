@@ -79,7 +79,7 @@ concept SchemeOptions = std::default_initializable<O> && std::copyable<O> && req
 // `value` as an int option `name`, or InvalidArgument naming it when it is not a whole number.
 inline int whole_number(double value, const std::string& name) {
   if (!std::isfinite(value) || value != std::floor(value) || std::abs(value) > 1e9)
-    throw InvalidArgument(name + " must be a whole number (found " + std::to_string(value) + ")");
+    throw InvalidArgument(name + " must be a whole number (found " + found_number(value) + ")");
   return static_cast<int>(value);
 }
 

@@ -80,8 +80,8 @@ class TaoExtendedPhaseSpace {
       throw InvalidArgument("Tao's extended phase-space integrator has orders 2, 4 and 6 (found " +
                             std::to_string(order) + ")");
     if (!std::isfinite(omega) || omega <= 0.0)
-      throw InvalidArgument("the binding omega must be finite and positive (found " + std::to_string(omega) +
-                            "); the default is 20");
+      throw InvalidArgument("the binding omega must be finite and positive; the default is 20 (found " +
+                            found_number(omega) + ")");
   }
 
   HamiltonianForm form() const { return gradient_.form(); }
