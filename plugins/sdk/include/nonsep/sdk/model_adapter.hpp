@@ -89,6 +89,7 @@
 #include "nonsep/core/base/model.hpp"
 #include "nonsep/sdk/automatic_derivatives.hpp"
 #include "nonsep/sdk/dual.hpp"
+#include "nonsep/sdk/hamiltonian_products.hpp"
 #include "nonsep/sdk/parameters.hpp"
 
 namespace nonsep::sdk {
@@ -572,7 +573,8 @@ class ModelAdapter {
   // or over T and V, each seeded so that it also forms what the formula adds to its result (MixedPassExtras,
   // automatic_derivatives.hpp): the gradient and a Hessian-vector product of the outer function (T in TTV) in one
   // pass where it is differentiated automatically, the inner's mixed fourth derivative (third when dq or dp is
-  // zero) with its lower derivatives, the outer's mixed third derivative; plus K'' dp and U'' dq.
+  // zero) with its lower derivatives, the outer's mixed third derivative (hamiltonian_products.hpp); plus K'' dp and
+  // U'' dq.
   void hvp_H(HamiltonianForm form, std::span<const double> q, std::span<const double> p, std::span<const double> dq,
              std::span<const double> dp, std::span<double> out_q, std::span<double> out_p,
              std::size_t count) const requires has_hamiltonian_hessian {
@@ -582,9 +584,11 @@ class ModelAdapter {
         throw_bad_batch_sizes(count, dimension_, std::min({q.size(), p.size(), dq.size(), dp.size()}),
                               std::min(out_q.size(), out_p.size()));
     if (form == HamiltonianForm::TTV)
-      hamiltonian_products<true>(q.data(), p.data(), dq.data(), dp.data(), out_q.data(), out_p.data(), count);
+      detail::ProductPasses(*this).template hamiltonian_products<true>(q.data(), p.data(), dq.data(), dp.data(),
+                                                                       out_q.data(), out_p.data(), count);
     else
-      hamiltonian_products<false>(p.data(), q.data(), dp.data(), dq.data(), out_p.data(), out_q.data(), count);
+      detail::ProductPasses(*this).template hamiltonian_products<false>(p.data(), q.data(), dp.data(), dq.data(),
+                                                                        out_p.data(), out_q.data(), count);
     const std::size_t n = batch_dimension();
     for (std::size_t b = 0; b < count; ++b) {
       const std::size_t at = b * n;
@@ -616,119 +620,6 @@ class ModelAdapter {
   }
 
  private:
-  // hvp_H's product term, ttv saying which form: Y the inner function (V at y = q in TTV), X the outer (T at x = p),
-  // each with its tangent and output (out_y = d(dH/dy)); spans of count states in the gradient layout.
-  template <bool ttv>
-  void hamiltonian_products(const double* ys, const double* xs, const double* dys, const double* dxs, double* out_ys,
-                            double* out_xs, std::size_t count) const requires has_hamiltonian_hessian {
-    const std::size_t n = batch_dimension();
-    auto& scratch = detail::GradientScratch<double>::of_size(3 * n);
-    double* g = scratch.x.data();
-    double* dg = g + n;
-    double* w = dg + n;
-    double* sum = scratch.g.data();
-    // g and w depend on the point alone: a state at the point (bit for bit) of the last one that formed them (Gauss's
-    // tangent map asks for 2n directions at each stage point in a row) keeps them where the same function would form
-    // them again whatever the tangent: g from X's gradient (not X's combined pass), w from Y's written-out product
-    // (not a by-product of Y's passes, which costs nothing more). A state's numbers never depend on its neighbours.
-    std::size_t formed = count;  // the state whose point g and w are of; count: none
-    for (std::size_t b = 0; b < count; ++b) {
-      const std::size_t at = b * n;
-      const double *x = xs + at, *dx = dxs + at, *y = ys + at, *dy = dys + at;
-      double *out_x = out_xs + at, *out_y = out_ys + at;
-      // out_y = Y''''[g, g, dy] + 2 Y'''[g, dg],  out_x = 2 (X'''[dx, w] + X'' sum),  with g = X', dg = X'' dx,
-      // w = Y'' g and sum = Y'''[g, dy] + Y'' dg. A tangent without an x part (dx = 0: dg = 0) takes X'' sum by a
-      // product; one without a y part, Y's third derivatives instead of its fourth (the unit directions Gauss's
-      // tangent map forms its Jacobians from, tangent_gauss_legendre.hpp, are of these two kinds).
-      const bool moves_x = std::any_of(dx, dx + n, [](double v) { return v != 0.0; });
-      const bool moves_y = std::any_of(dy, dy + n, [](double v) { return v != 0.0; });
-      if (!moves_x && !moves_y) {
-        std::fill(out_x, out_x + n, 0.0);
-        std::fill(out_y, out_y + n, 0.0);
-        continue;
-      }
-      const bool same_point = formed < count && std::memcmp(x, xs + formed * n, n * sizeof(double)) == 0 &&
-                              std::memcmp(y, ys + formed * n, n * sizeof(double)) == 0;
-      if (same_point && !combined_gradient_pass<ttv>) {
-        if (moves_x)
-          product_of<ttv>(x, dx, dg, n);
-        else
-          std::fill(dg, dg + n, 0.0);
-      } else {
-        gradient_and_product_of<ttv>(x, moves_x ? dx : nullptr, g, dg, n);
-      }
-      double* const along = same_point && (ttv ? analytic_mixed_V : analytic_mixed_T) ? nullptr : w;
-      formed = same_point ? formed : b;
-      if (moves_y) {
-        mixed_fourth_of<!ttv>(y, g, g, dy, out_y, n,
-                              {.seed = moves_x ? dg : nullptr, .along_a = along, .along_b = nullptr, .lower = sum});
-      } else {
-        mixed_third_of<!ttv>(y, g, dg, out_y, n, {.seed = nullptr, .along_a = along, .along_b = sum});
-        for (std::size_t i = 0; i < n; ++i) out_y[i] *= 2.0;
-      }
-      if (moves_x)
-        mixed_third_of<ttv>(x, dx, w, out_x, n, {.seed = sum});
-      else
-        product_of<ttv>(x, sum, out_x, n);
-      for (std::size_t i = 0; i < n; ++i) out_x[i] *= 2.0;
-    }
-  }
-  // T (kinetic) or V, for any number type, and its gradient template (where the model has them).
-  template <bool kinetic>
-  auto function_of() const {
-    return [this](auto v) {
-      if constexpr (kinetic)
-        return model_.T(v);
-      else
-        return model_.V(v);
-    };
-  }
-  template <bool kinetic>
-  auto gradient_template_of() const {
-    return [this](auto v, auto g) {
-      if constexpr (kinetic)
-        model_.grad_T(v, g);
-      else
-        model_.grad_V(v, g);
-    };
-  }
-  // One state's derivatives of T (kinetic) or V, for hvp_H: the gradient and the Hessian-vector product as grad_T and
-  // hvp_T compute them, the mixed third and fourth derivatives by automatic differentiation.
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void gradient_of(const double* x, double* out, std::size_t n) const {
-    if constexpr (kinetic)
-      grad_T(std::span<const double>(x, n), std::span<double>(out, n), 1);
-    else
-      grad_V(std::span<const double>(x, n), std::span<double>(out, n), 1);
-  }
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void product_of(const double* x, const double* v, double* out, std::size_t n) const {
-    if constexpr (kinetic)
-      hvp_T(std::span<const double>(x, n), std::span<const double>(v, n), std::span<double>(out, n), 1);
-    else
-      hvp_V(std::span<const double>(x, n), std::span<const double>(v, n), std::span<double>(out, n), 1);
-  }
-  // Whether X's gradient and product come from one pass (X differentiated over X itself).
-  template <bool kinetic>
-  static constexpr bool combined_gradient_pass = (kinetic ? !analytic_grad_T && !analytic_hvp_T
-                                                          : !analytic_grad_V && !analytic_hvp_V) &&
-                                                 !differentiates_gradients;
-  // g = grad X at x and, with a direction dx, dg = X'' dx (else 0): one Hessian-column pass, which gives the
-  // gradient alongside, where X is differentiated over X itself; else the gradient and the product as computed alone.
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void gradient_and_product_of(const double* x, const double* dx, double* g, double* dg,
-                                                      std::size_t n) const {
-    if (dx == nullptr) {
-      gradient_of<kinetic>(x, g, n);
-      std::fill(dg, dg + n, 0.0);
-    } else if constexpr (combined_gradient_pass<kinetic>) {
-      detail::poison_if_not_finite(detail::hessian_vector_by_dual<capacity>(function_of<kinetic>(), x, dx, n, dg, g),
-                                   dg, n);
-    } else {
-      gradient_of<kinetic>(x, g, n);
-      product_of<kinetic>(x, dx, dg, n);
-    }
-  }
   // d3T_with_product (kinetic) or d3V_with_product: the pass of d3T (d3V) with the product taken alongside.
   template <bool kinetic>
   void third_with_product(std::span<const double> x, std::span<const double> u, std::span<double> out,
@@ -736,96 +627,12 @@ class ModelAdapter {
     check_sizes(x, out, count, dimension_);
     check_sizes(u, product, count, dimension_);
     const std::size_t n = batch_dimension();
+    const detail::ProductPasses passes(*this);
     for (std::size_t b = 0; b < count; ++b) {
       const double* v = u.data() + b * n;
-      mixed_third_of<kinetic>(x.data() + b * n, v, v, out.data() + b * n, n,
-                              {.seed = nullptr, .along_a = product.data() + b * n});
+      passes.template mixed_third_of<kinetic>(x.data() + b * n, v, v, out.data() + b * n, n,
+                                              {.seed = nullptr, .along_a = product.data() + b * n});
     }
-  }
-  // The mixed passes of hvp_H (automatic_derivatives.hpp, with its extras), of the gradient templates where they
-  // compile for the pass's numbers, else of T (kinetic) or V; their lower results poisoned with the main one.
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void mixed_third_of(const double* x, const double* a, const double* b, double* out,
-                                             std::size_t n, const detail::MixedPassExtras& extras) const {
-    if constexpr (kinetic ? analytic_mixed_T : analytic_mixed_V) {
-      written_third<kinetic>(x, a, b, out, n);
-      if (extras.seed != nullptr) add_product<kinetic>(x, extras.seed, out, n);
-      if (extras.along_a != nullptr) product_of<kinetic>(x, a, extras.along_a, n);
-      if (extras.along_b != nullptr) product_of<kinetic>(x, b, extras.along_b, n);
-    } else if constexpr (differentiates_gradients)
-      detail::mixed_third_by_gradient(gradient_template_of<kinetic>(), x, a, b, n, out, extras);
-    else
-      poison_pass(detail::mixed_third_by_dual<capacity>(function_of<kinetic>(), x, a, b, n, out, extras), out, extras,
-                  n);
-  }
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void mixed_fourth_of(
-      const double* x, const double* a, const double* b, const double* c, double* out, std::size_t n,
-      const detail::MixedPassExtras& extras) const requires has_hamiltonian_hessian {
-    if constexpr (kinetic ? analytic_mixed_T : analytic_mixed_V) {
-      const Vector<double> at(x, n), along_a(a, n), along_b(b, n), along_c(c, n);
-      const std::span<double> result(out, n);
-      if constexpr (kinetic)
-        model_.d4T(at, along_a, along_b, along_c, result);
-      else
-        model_.d4V(at, along_a, along_b, along_c, result);
-      if (extras.seed != nullptr) {
-        add_third<kinetic>(x, a, extras.seed, out, n);
-        add_third<kinetic>(x, b, extras.seed, out, n);
-      }
-      if (extras.along_a != nullptr) product_of<kinetic>(x, a, extras.along_a, n);
-      if (extras.lower != nullptr) {
-        written_third<kinetic>(x, b, c, extras.lower, n);
-        if (extras.seed != nullptr) add_product<kinetic>(x, extras.seed, extras.lower, n);
-      }
-    } else if constexpr (fourth_by_gradients)
-      detail::mixed_fourth_by_gradient(gradient_template_of<kinetic>(), x, a, b, c, n, out, extras);
-    else
-      poison_pass(detail::mixed_fourth_by_dual<capacity>(function_of<kinetic>(), x, a, b, c, n, out, extras), out,
-                  extras, n);
-  }
-  // The model's written-out mixed third derivative of T (kinetic) or V into out, or added to it; its Hessian-vector
-  // product added to out.
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void written_third(const double* x, const double* a, const double* b, double* out,
-                                            std::size_t n) const {
-    const Vector<double> at(x, n), along_a(a, n), along_b(b, n);
-    if constexpr (kinetic)
-      model_.d3T(at, along_a, along_b, std::span<double>(out, n));
-    else
-      model_.d3V(at, along_a, along_b, std::span<double>(out, n));
-  }
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void add_third(const double* x, const double* a, const double* b, double* out,
-                                        std::size_t n) const {
-    with_term(n, [&](double* term) {
-      written_third<kinetic>(x, a, b, term, n);
-      for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
-    });
-  }
-  template <bool kinetic>
-  NONSEP_SDK_DUAL_INLINE void add_product(const double* x, const double* v, double* out, std::size_t n) const {
-    with_term(n, [&](double* term) {
-      product_of<kinetic>(x, v, term, n);
-      for (std::size_t i = 0; i < n; ++i) out[i] += term[i];
-    });
-  }
-  // n numbers for a term: on the stack for a model of at most 64 degrees of freedom, else a per-thread buffer.
-  template <class F>
-  NONSEP_SDK_DUAL_INLINE static void with_term(std::size_t n, const F& use) {
-    if constexpr (capacity > 0 && capacity <= 64) {
-      std::array<double, capacity> term;
-      use(term.data());
-    } else {
-      thread_local std::vector<double> term;
-      if (term.size() < n) term.resize(n);
-      use(term.data());
-    }
-  }
-  static void poison_pass(double value, double* out, const detail::MixedPassExtras& extras, std::size_t n) {
-    detail::poison_if_not_finite(value, out, n);
-    for (double* lower : {extras.along_a, extras.along_b, extras.lower})
-      if (lower != nullptr) detail::poison_if_not_finite(value, lower, n);
   }
   // out += K''(x) v (kinetic) or U''(x) v: one directional pass over grad_K (grad_U) where it is a template, else
   // one Hessian-column pass over K (U).
