@@ -222,6 +222,22 @@ TEST_CASE("kernel path: Gauss-Legendre through the plugin's gauss_steps gives th
               {"output", {{"every", 25}}}};
   const auto file = write_job(folder / "henon.json", job);
   check_same_files(run_with("baseline", folder, "kernel", file), run_with("evaluation", folder, "evaluation", file));
+  // paper2d and paper1d write out every derivative grad H needs: their kernels are flattened and have wider copies
+  // (x86-64-v3, v4, without fused multiply-adds), which the plugin runs where the processor runs them, whatever
+  // NONSEP_INSTRUCTION_SET pins for the Chin kernels; paper2d's two degrees of freedom interleave in those vectors.
+  json orbits = json::array();
+  for (int i = 0; i < 70; ++i) orbits.push_back({{"q", {0.0, 0.01 * i}}, {"p", {0.5 + 0.002 * i, 2.0}}});
+  for (const int stages : {2, 3, 8}) {
+    CAPTURE(stages);
+    const json paper2d = {{"model", {{"plugin", "paper2d"}}},
+                          {"integrator", {{"scheme", "gauss"}, {"stages", stages}}},
+                          {"initial", orbits},
+                          {"time", {{"dt", 0.02}, {"steps", 50}}},
+                          {"output", {{"every", 25}}}};
+    const auto orbits_file = write_job(folder / "paper2d.json", paper2d);
+    check_same_files(run_with("baseline", folder, "kernel", orbits_file),
+                     run_with("evaluation", folder, "evaluation", orbits_file));
+  }
 }
 
 TEST_CASE("inspect shows a plugin's kernels and --check compares them with the evaluation path") {

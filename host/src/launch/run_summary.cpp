@@ -43,7 +43,8 @@ ordered_json energy_facts(const RunFacts& facts) {
 }
 
 // Which path stepped the run: the plugin's kernel (and its instruction set) or the evaluation path. Gauss-Legendre
-// (`gauss`, `implicit_midpoint`) has one kernel, gauss_steps, compiled with the plugin's own flags (the baseline).
+// (`gauss`, `implicit_midpoint`) has one kernel, gauss_steps, with the numbers of the plugin's own flags (the
+// baseline) whichever copy the plugin runs (nonsep/sdk/kernels.hpp, GaussKernels).
 ordered_json stepping_facts(const RunFacts& facts, const std::string& scheme) {
   const KernelChoice& kernels = facts.loaded.plugin.kernels();
   const bool kernel = facts.driver.kernel_calls() > 0;
@@ -51,8 +52,9 @@ ordered_json stepping_facts(const RunFacts& facts, const std::string& scheme) {
     return {{"path", kernel ? "kernel" : "evaluation"},
             {"instruction_set", kernel ? ordered_json("x86-64") : ordered_json(nullptr)},
             {"plugin_kernels", kernels.instruction_sets},
-            {"note", kernel ? "the plugin's Gauss-Legendre kernel (gauss_steps), compiled with the plugin's own flags: "
-                              "the evaluation path's numbers"
+            {"note", kernel ? "the plugin's Gauss-Legendre kernel (gauss_steps): the evaluation path's numbers, from "
+                              "the copy compiled with the plugin's own flags or a wider one without fused "
+                              "multiply-adds"
                             : "the evaluations (the plugin has no Gauss-Legendre kernel, or "
                               "NONSEP_INSTRUCTION_SET=evaluation)"}};
   return {{"path", kernel ? "kernel" : "evaluation"},

@@ -184,7 +184,7 @@ class PluginTableBase {
   }
 
   // The Gauss-Legendre stepping kernel (plugin_abi.h gauss_steps): the core's gauss_kernel_steps with this model
-  // inlined, compiled with the plugin's own flags; its arguments checked (std::invalid_argument names what is wrong).
+  // inlined (kernels.hpp, GaussKernels); its arguments checked (std::invalid_argument names what is wrong).
   static nonsep_status gauss_steps(nonsep_instance* instance, const nonsep_gauss_steps_args* args) noexcept {
     return guarded(instance, "gauss_steps", [&](const Instance& self) {
       if (args == nullptr) throw std::invalid_argument("gauss_steps: no arguments");
@@ -217,28 +217,8 @@ class PluginTableBase {
                                 out(args->points_p, stages),
                                 std::span<int>(reinterpret_cast<int*>(args->iterations), args->count),
                                 std::span<GaussOutcome>(reinterpret_cast<GaussOutcome*>(args->outcome), args->count)};
-      gauss_kernel(self.adapter, call);
+      GaussKernels<Adapter>::run(self.adapter, call);
     });
-  }
-  // A model that writes out every derivative grad H needs gets the iteration flattened (the derivatives inlined into
-  // it: 1.28x -> 1.2x a hand-written loop on paper1d); one differentiated automatically does not, since the inlined
-  // dual-number code multiplies the plugin's compile time (radial: 15 s -> 70 s).
-  static constexpr bool gradient_written_out = [] {
-    if constexpr (requires { Adapter::analytic_grad_H; })
-      return Adapter::analytic_grad_H;
-    else
-      return Adapter::analytic_grad_T && Adapter::analytic_grad_V && Adapter::analytic_hvp_T &&
-             Adapter::analytic_hvp_V && Adapter::analytic_d3T && Adapter::analytic_d3V;
-  }();
-  static constexpr std::size_t fixed_dimension = HasFixedDimension<M> ? dimension_capacity<M>() : 0;
-  static void gauss_kernel(const Adapter& adapter, const GaussStepsCall& call) {
-    if constexpr (gradient_written_out)
-      flat_gauss_kernel(adapter, call);
-    else
-      gauss_kernel_steps<fixed_dimension>(adapter, call);
-  }
-  [[gnu::flatten]] static void flat_gauss_kernel(const Adapter& adapter, const GaussStepsCall& call) {
-    gauss_kernel_steps<fixed_dimension>(adapter, call);
   }
 };
 

@@ -33,11 +33,20 @@
 //   1, 2         the x86-64-v3 (1) or x86-64-v4 (2) kernels alone: NONSEP_EXPORT_MODEL expands to the definition of
 //                nonsep::sdk::kernel_unit_1 (_2) and nothing else
 // The units see the same source, so the adapter they step is the plugin's (the function takes it as const void*).
+//
+// The Gauss-Legendre kernel (plugin_abi.h gauss_steps, GaussKernels below) has no instruction set to choose: every
+// copy of it gives the evaluation path's numbers. It is compiled with the plugin's own flags and, for a model that
+// writes out every derivative grad H needs (its kernel flattened), also for the widest set this unit compiles the Chin
+// kernels for, that copy without fused multiply-adds (GCC's optimize attribute, fp-contract=off): vectors across a
+// block's states then round every operation as the baseline's scalars do, so the copy the processor runs changes the
+// speed alone (paper2d's 1024 orbits, gauss 3, 2000 steps: 0.72 s against 0.93 s of CPU on AVX-512). The plugin
+// takes the widest copy the processor runs (the baseline where it does not run the wider one).
 #include <cstddef>
 #include <span>
 #include <string_view>
 
 #include "nonsep/core/kernel/chin_kernel.hpp"
+#include "nonsep/core/kernel/gauss_stages.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 
 namespace nonsep::sdk {
@@ -223,6 +232,67 @@ struct ChinKernels {
 #if NONSEP_SDK_TANGENT_KERNELS
   static void run_tangent_unit(const Adapter& adapter, const ChinTangentStepsCall& call) { tangent_v4(adapter, call); }
 #endif
+#endif
+};
+
+// The Gauss-Legendre kernel of one adapter type (above): run(adapter, call) takes call's step. A model that writes out
+// every derivative grad H needs gets the iteration flattened (the derivatives inlined into it: 1.28x -> 1.2x a
+// hand-written loop on paper1d) and the wider copy; one differentiated automatically does not, since the inlined
+// dual-number code multiplies the plugin's compile time (radial: 15 s -> 70 s).
+template <class Adapter>
+struct GaussKernels {
+  static constexpr bool gradient_written_out = [] {
+    if constexpr (requires { Adapter::analytic_grad_H; })
+      return Adapter::analytic_grad_H;
+    else
+      return Adapter::analytic_grad_T && Adapter::analytic_grad_V && Adapter::analytic_hvp_T &&
+             Adapter::analytic_hvp_V && Adapter::analytic_d3T && Adapter::analytic_d3V;
+  }();
+  static constexpr std::size_t fixed_dimension =
+      HasFixedDimension<typename Adapter::Model> ? dimension_capacity<typename Adapter::Model>() : 0;
+
+  static void run(const Adapter& adapter, const GaussStepsCall& call) {
+    if constexpr (!gradient_written_out)
+      gauss_kernel_steps<fixed_dimension>(adapter, call);
+    else if (processor_runs_wide())
+      flat_wide(adapter, call);
+    else
+      flat(adapter, call);
+  }
+
+ private:
+  [[gnu::flatten]] static void flat(const Adapter& adapter, const GaussStepsCall& call) {
+    gauss_kernel_steps<fixed_dimension>(adapter, call);
+  }
+  // One wider copy, of the widest set this unit compiles the Chin kernels for (each copy costs a flattened kernel's
+  // compile time: about 12 s of CPU for paper2d).
+#if NONSEP_SDK_KERNEL_V4
+  static bool processor_runs_wide() {
+    static const bool runs = [] {
+      __builtin_cpu_init();
+      return __builtin_cpu_supports("x86-64-v4");
+    }();
+    return runs;
+  }
+  [[gnu::target("arch=x86-64-v4"), gnu::optimize("fp-contract=off"), gnu::flatten]] static void flat_wide(
+      const Adapter& adapter, const GaussStepsCall& call) {
+    gauss_kernel_steps<fixed_dimension>(adapter, call);
+  }
+#elif NONSEP_SDK_KERNEL_V3
+  static bool processor_runs_wide() {
+    static const bool runs = [] {
+      __builtin_cpu_init();
+      return __builtin_cpu_supports("x86-64-v3");
+    }();
+    return runs;
+  }
+  [[gnu::target("arch=x86-64-v3"), gnu::optimize("fp-contract=off"), gnu::flatten]] static void flat_wide(
+      const Adapter& adapter, const GaussStepsCall& call) {
+    gauss_kernel_steps<fixed_dimension>(adapter, call);
+  }
+#else
+  static bool processor_runs_wide() { return false; }
+  static void flat_wide(const Adapter& adapter, const GaussStepsCall& call) { flat(adapter, call); }
 #endif
 };
 
