@@ -110,6 +110,7 @@ TEST_CASE("orders are exact fractions or integers and must exist for the scheme"
   REQUIRE(issues.size() == 1);
   CHECK(issues[0].path == "/integrator/order");
   CHECK(issues[0].allowed.find("2/3") != std::string::npos);
+  CHECK(issues[0].allowed == "the highest order of basic is 2/3");  // the value said once, by "found"
 }
 
 TEST_CASE("t_end is reached exactly: steps = ceil(t_end/dt) with a relative slack of 1e-9, dt = t_end/steps") {

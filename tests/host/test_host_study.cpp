@@ -60,8 +60,10 @@ Finished run_study_job(const TemporaryFolder& folder, const std::string& name, c
 // one per run that diverged or failed.
 std::string expected_report(const json& summary, const std::filesystem::path& directory) {
   const json& runs = summary["study"]["runs"];
-  std::string text = summary["status"].get<std::string>() + ": study of " + std::to_string(summary["fits"].size()) +
-                     " integrators, " + std::to_string(runs["completed"].get<std::size_t>()) + " runs completed";
+  const std::size_t integrators = summary["fits"].size(), completed = runs["completed"].get<std::size_t>();
+  std::string text = summary["status"].get<std::string>() + ": study of " + std::to_string(integrators) +
+                     (integrators == 1 ? " integrator, " : " integrators, ") + std::to_string(completed) +
+                     (completed == 1 ? " run" : " runs") + " completed";
   for (const char* other : {"diverged", "failed", "interrupted"})
     if (runs[other].get<std::size_t>() > 0) text += ", " + std::to_string(runs[other].get<std::size_t>()) + " " + other;
   text += "; results in " + directory.string() + "\n";
@@ -170,6 +172,10 @@ TEST_CASE("a study's rows are the core's runs bit for bit, and its fit is the sl
   const auto loud = run_study_job(folder, "study_loud", study_job(integrators, {128, 256}), false);
   CHECK(loud.out == expected_report(loud.summary, folder / "study_loud"));
   CHECK(loud.err.empty());
+  // One integrator is one, not "1 integrators".
+  const auto one = run_study_job(folder, "study_one", study_job(json::array({integrators[0]}), {128, 256}), false);
+  CHECK(one.out == expected_report(one.summary, folder / "study_one"));
+  CHECK(one.out.find(": study of 1 integrator, 2 runs completed; results in ") != std::string::npos);
 }
 
 TEST_CASE("a study run that blows up is a diverged row, left out of the fit, and the exit status is 1") {

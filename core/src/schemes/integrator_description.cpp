@@ -19,14 +19,14 @@ int chin_order_index(const Fraction& order, int max_j, const std::string& what) 
   const std::int64_t a = order.numerator();
   const std::int64_t b = order.denominator();
   if (a <= 0 || a % 2 != 0 || (b != 1 && b != 3))
-    throw InvalidArgument("order " + order.to_string() + " does not exist for " + what + "; the orders are " +
-                          chin_orders_text());
+    throw InvalidArgument("the orders of " + what + " are " + chin_orders_text() + " (found " + order.to_string() +
+                          ")");
   const std::int64_t half = a / 2;
   const bool beyond = b == 1 ? half > max_j / 3 : half > max_j;
   const std::int64_t j = beyond ? std::int64_t{max_j} + 1 : (b == 1 ? 3 * half : half);
   if (j > max_j)
-    throw InvalidArgument("order " + order.to_string() + " is beyond the highest order of " + what + ", " +
-                          Fraction(2 * max_j, 3).to_string());
+    throw InvalidArgument("the highest order of " + what + " is " + Fraction(2 * max_j, 3).to_string() + " (found " +
+                          order.to_string() + ")");
   return static_cast<int>(j);
 }
 

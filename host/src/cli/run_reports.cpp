@@ -127,8 +127,8 @@ void report_trajectories(const RunOutcome& outcome, const std::filesystem::path&
 
 int report_study(const StudyOutcome& outcome, const std::filesystem::path& directory, bool quiet) {
   const StatusCounts& runs = outcome.run_counts;
-  std::string line = std::string(to_string(outcome.status)) + ": study of " + std::to_string(outcome.fits.size()) +
-                     " integrators, " + std::to_string(runs.completed) + " runs completed";
+  std::string line = std::string(to_string(outcome.status)) + ": study of " +
+                     counted(outcome.fits.size(), "integrator") + ", " + counted(runs.completed, "run") + " completed";
   const std::pair<const char*, std::size_t> others[] = {
       {"diverged", runs.diverged}, {"failed", runs.failed}, {"interrupted", runs.interrupted}};
   for (const auto& [other, count] : others)
