@@ -237,6 +237,12 @@ TEST_CASE("kernel path: Gauss-Legendre through the plugin's gauss_steps gives th
     const auto orbits_file = write_job(folder / "paper2d.json", paper2d);
     check_same_files(run_with("baseline", folder, "kernel", orbits_file),
                      run_with("evaluation", folder, "evaluation", orbits_file));
+    // The same model with the x86-64-v3 copy as its wider one (tests/host/plugins/gauss_v3.cpp).
+    json v3 = paper2d;
+    v3["model"]["plugin"] = "gauss_v3";
+    const auto v3_file = write_job(folder / "gauss_v3.json", v3);
+    check_same_files(run_with("baseline", folder, "kernel", v3_file),
+                     run_with("evaluation", folder, "evaluation", v3_file));
   }
 }
 

@@ -36,11 +36,13 @@
 //
 // The Gauss-Legendre kernel (plugin_abi.h gauss_steps, GaussKernels below) has no instruction set to choose: every
 // copy of it gives the evaluation path's numbers. It is compiled with the plugin's own flags and, for a model that
-// writes out every derivative grad H needs (its kernel flattened), also for the widest set this unit compiles the Chin
-// kernels for, that copy without fused multiply-adds (GCC's optimize attribute, fp-contract=off): vectors across a
-// block's states then round every operation as the baseline's scalars do, so the copy the processor runs changes the
-// speed alone (paper2d's 1024 orbits, gauss 3, 2000 steps: 0.72 s against 0.93 s of CPU on AVX-512). The plugin
-// takes the widest copy the processor runs (the baseline where it does not run the wider one).
+// writes out every derivative grad H needs (its kernel flattened), also for the widest set of
+// NONSEP_SDK_WIDE_KERNEL_SETS (in that set's kernel unit where it has one), that copy without fused multiply-adds
+// (GCC's optimize attribute, fp-contract=off): with the SDK's flags (no -ffast-math, so no reassociation either)
+// vectors across a block's states round every operation as the baseline's scalars do, and the copy the processor runs
+// changes the speed alone (paper2d's 1024 orbits, gauss 3, 2000 steps: 0.72 s against 0.93 s of CPU on AVX-512). The
+// plugin takes the wider copy where the processor runs it, else the baseline one; NONSEP_INSTRUCTION_SET pins the Chin
+// kernels, not this.
 #include <cstddef>
 #include <span>
 #include <string_view>
@@ -235,10 +237,32 @@ struct ChinKernels {
 #endif
 };
 
+// The Gauss-Legendre kernel's wider copy (GaussKernels below): for the widest set the plugin's Chin kernels are
+// compiled for, x86-64-v4 (unit 2) or x86-64-v3 (unit 1), 0 for none; compiled in that set's kernel unit where it has
+// one of its own (NONSEP_SDK_SEPARATE_KERNEL_UNITS), else here.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX__)
+#define NONSEP_SDK_GAUSS_WIDE_UNIT ((NONSEP_SDK_WIDE_KERNEL_SETS & 2) ? 2 : (NONSEP_SDK_WIDE_KERNEL_SETS & 1) ? 1 : 0)
+#else
+#define NONSEP_SDK_GAUSS_WIDE_UNIT 0
+#endif
+#define NONSEP_SDK_GAUSS_WIDE_HERE                                                                 \
+  (NONSEP_SDK_GAUSS_WIDE_UNIT != 0 &&                                                              \
+   (NONSEP_SDK_KERNEL_UNIT == 0 ? !(NONSEP_SDK_SEPARATE_KERNEL_UNITS & NONSEP_SDK_GAUSS_WIDE_UNIT) \
+                                : NONSEP_SDK_KERNEL_UNIT == NONSEP_SDK_GAUSS_WIDE_UNIT))
+#if NONSEP_SDK_GAUSS_WIDE_UNIT == 2
+#define NONSEP_SDK_GAUSS_WIDE_TARGET "arch=x86-64-v4"
+#elif NONSEP_SDK_GAUSS_WIDE_UNIT == 1
+#define NONSEP_SDK_GAUSS_WIDE_TARGET "arch=x86-64-v3"
+#endif
+void gauss_kernel_unit_1(const void* adapter, const GaussStepsCall& call);
+void gauss_kernel_unit_2(const void* adapter, const GaussStepsCall& call);
+
 // The Gauss-Legendre kernel of one adapter type (above): run(adapter, call) takes call's step. A model that writes out
-// every derivative grad H needs gets the iteration flattened (the derivatives inlined into it: 1.28x -> 1.2x a
-// hand-written loop on paper1d) and the wider copy; one differentiated automatically does not, since the inlined
-// dual-number code multiplies the plugin's compile time (radial: 15 s -> 70 s).
+// every derivative grad H needs gets the iteration flattened (the derivatives inlined into it) and the wider copy;
+// one differentiated automatically does not, since the inlined dual-number code multiplies the plugin's compile time
+// (radial: 15 s -> 70 s). A plugin without the baseline kernels (KERNEL_SETS native, a formula model's cached plugin)
+// keeps the baseline copy for a processor that does not run its wider set, not flattened, so that it compiles one
+// flattened kernel, the wider one.
 template <class Adapter>
 struct GaussKernels {
   static constexpr bool gradient_written_out = [] {
@@ -255,45 +279,69 @@ struct GaussKernels {
     if constexpr (!gradient_written_out)
       gauss_kernel_steps<fixed_dimension>(adapter, call);
     else if (processor_runs_wide())
-      flat_wide(adapter, call);
+      wide(adapter, call);
     else
-      flat(adapter, call);
+      baseline(adapter, call);
+  }
+  // The wider copy, where a kernel unit calls it (gauss_kernel_unit_1, _2): nothing for a model whose kernel is not
+  // flattened, which never calls it.
+  static void run_wide_unit([[maybe_unused]] const Adapter& adapter, [[maybe_unused]] const GaussStepsCall& call) {
+#if NONSEP_SDK_GAUSS_WIDE_HERE
+    if constexpr (gradient_written_out) flat_wide(adapter, call);
+#endif
   }
 
  private:
+  static void baseline(const Adapter& adapter, const GaussStepsCall& call) {
+#if NONSEP_SDK_KERNEL_BASELINE
+    flat(adapter, call);
+#else
+    gauss_kernel_steps<fixed_dimension>(adapter, call);
+#endif
+  }
   [[gnu::flatten]] static void flat(const Adapter& adapter, const GaussStepsCall& call) {
     gauss_kernel_steps<fixed_dimension>(adapter, call);
   }
-  // One wider copy, of the widest set this unit compiles the Chin kernels for (each copy costs a flattened kernel's
-  // compile time: about 12 s of CPU for paper2d).
-#if NONSEP_SDK_KERNEL_V4
-  static bool processor_runs_wide() {
-    static const bool runs = [] {
-      __builtin_cpu_init();
-      return __builtin_cpu_supports("x86-64-v4");
-    }();
-    return runs;
-  }
-  [[gnu::target("arch=x86-64-v4"), gnu::optimize("fp-contract=off"), gnu::flatten]] static void flat_wide(
+#if NONSEP_SDK_GAUSS_WIDE_HERE
+  [[gnu::target(NONSEP_SDK_GAUSS_WIDE_TARGET), gnu::optimize("fp-contract=off"), gnu::flatten]] static void flat_wide(
       const Adapter& adapter, const GaussStepsCall& call) {
     gauss_kernel_steps<fixed_dimension>(adapter, call);
   }
-#elif NONSEP_SDK_KERNEL_V3
-  static bool processor_runs_wide() {
-    static const bool runs = [] {
-      __builtin_cpu_init();
-      return __builtin_cpu_supports("x86-64-v3");
-    }();
-    return runs;
-  }
-  [[gnu::target("arch=x86-64-v3"), gnu::optimize("fp-contract=off"), gnu::flatten]] static void flat_wide(
-      const Adapter& adapter, const GaussStepsCall& call) {
-    gauss_kernel_steps<fixed_dimension>(adapter, call);
-  }
-#else
-  static bool processor_runs_wide() { return false; }
-  static void flat_wide(const Adapter& adapter, const GaussStepsCall& call) { flat(adapter, call); }
 #endif
+  static void wide(const Adapter& adapter, const GaussStepsCall& call) {
+#if NONSEP_SDK_GAUSS_WIDE_UNIT == 0
+    baseline(adapter, call);  // not reached: the processor runs no wider copy
+#elif NONSEP_SDK_GAUSS_WIDE_HERE
+    flat_wide(adapter, call);
+#elif NONSEP_SDK_GAUSS_WIDE_UNIT == 1
+    gauss_kernel_unit_1(&adapter, call);
+#else
+    gauss_kernel_unit_2(&adapter, call);
+#endif
+  }
+  // Whether this processor runs the wider copy, found once.
+  static bool processor_runs_wide() {
+#if NONSEP_SDK_GAUSS_WIDE_UNIT == 0
+    return false;
+#else
+    static const bool runs = [] {
+      __builtin_cpu_init();
+#if __GNUC__ >= 12
+      return NONSEP_SDK_GAUSS_WIDE_UNIT == 2 ? __builtin_cpu_supports("x86-64-v4")
+                                             : __builtin_cpu_supports("x86-64-v3");
+#else  // the levels' vector and bit-manipulation features (GCC 11 knows features, not levels)
+      const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+                      __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+      return NONSEP_SDK_GAUSS_WIDE_UNIT == 1
+                 ? v3
+                 : v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+                       __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
+                       __builtin_cpu_supports("avx512vl");
+#endif
+    }();
+    return runs;
+#endif
+  }
 };
 
 }  // namespace nonsep::sdk
@@ -307,7 +355,17 @@ struct GaussKernels {
                                                                  const ::nonsep::ChinStepsCall& call) { \
     ::nonsep::sdk::ChinKernels<__VA_ARGS__>::run_unit(*static_cast<const __VA_ARGS__*>(adapter), call); \
   }                                                                                                     \
-  NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(__VA_ARGS__)
+  NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(__VA_ARGS__)                                                    \
+  NONSEP_SDK_DEFINE_GAUSS_KERNEL_UNIT(__VA_ARGS__)
+#if NONSEP_SDK_KERNEL_UNIT == NONSEP_SDK_GAUSS_WIDE_UNIT
+#define NONSEP_SDK_DEFINE_GAUSS_KERNEL_UNIT(...)                                                               \
+  void NONSEP_SDK_KERNEL_UNIT_FUNCTION(gauss_, NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                    \
+                                                                       const ::nonsep::GaussStepsCall& call) { \
+    ::nonsep::sdk::GaussKernels<__VA_ARGS__>::run_wide_unit(*static_cast<const __VA_ARGS__*>(adapter), call);  \
+  }
+#else
+#define NONSEP_SDK_DEFINE_GAUSS_KERNEL_UNIT(...)
+#endif
 #if NONSEP_SDK_TANGENT_KERNELS
 #define NONSEP_SDK_DEFINE_TANGENT_KERNEL_UNIT(...)                                                                     \
   void NONSEP_SDK_KERNEL_UNIT_FUNCTION(tangent_, NONSEP_SDK_KERNEL_UNIT)(const void* adapter,                          \
