@@ -5,6 +5,7 @@
 #include <string>
 
 #include "nonsep/core/kernel/chin_kernel.hpp"
+#include "nonsep/core/kernel/processor_levels.hpp"
 #include "plugin_internals.hpp"
 
 namespace nonsep::host {
@@ -14,25 +15,7 @@ using nlohmann::json;
 namespace {
 
 // Whether this processor runs code compiled for `name` (an x86-64 micro-architecture level).
-bool processor_runs(const std::string& name) {
-  if (name == "x86-64") return true;
-#if defined(__x86_64__) && defined(__clang__)
-  // Clang knows features, not micro-architecture levels: the levels' vector and bit-manipulation features.
-  __builtin_cpu_init();
-  const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-                  __builtin_cpu_supports("bmi2");
-  if (name == "x86-64-v3") return v3;
-  if (name == "x86-64-v4")
-    return v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-           __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
-           __builtin_cpu_supports("avx512vl");
-#elif defined(__x86_64__) && defined(__GNUC__)
-  __builtin_cpu_init();
-  if (name == "x86-64-v3") return __builtin_cpu_supports("x86-64-v3");
-  if (name == "x86-64-v4") return __builtin_cpu_supports("x86-64-v4");
-#endif
-  return false;
-}
+bool processor_runs(const std::string& name) { return processor_runs_level(processor_level(name)); }
 
 }  // namespace
 

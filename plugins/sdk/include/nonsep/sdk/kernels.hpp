@@ -49,6 +49,7 @@
 
 #include "nonsep/core/kernel/chin_kernel.hpp"
 #include "nonsep/core/kernel/gauss_stages.hpp"
+#include "nonsep/core/kernel/processor_levels.hpp"
 #include "nonsep/sdk/model_adapter.hpp"
 
 namespace nonsep::sdk {
@@ -324,21 +325,7 @@ struct GaussKernels {
 #if NONSEP_SDK_GAUSS_WIDE_UNIT == 0
     return false;
 #else
-    static const bool runs = [] {
-      __builtin_cpu_init();
-#if __GNUC__ >= 12
-      return NONSEP_SDK_GAUSS_WIDE_UNIT == 2 ? __builtin_cpu_supports("x86-64-v4")
-                                             : __builtin_cpu_supports("x86-64-v3");
-#else  // the levels' vector and bit-manipulation features (GCC 11 knows features, not levels)
-      const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-                      __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
-      return NONSEP_SDK_GAUSS_WIDE_UNIT == 1
-                 ? v3
-                 : v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-                       __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
-                       __builtin_cpu_supports("avx512vl");
-#endif
-    }();
+    static const bool runs = processor_runs_level(NONSEP_SDK_GAUSS_WIDE_UNIT == 2 ? 4 : 3);
     return runs;
 #endif
   }
